@@ -1,0 +1,58 @@
+/// @file controller.hpp
+/// @brief One control job: estimator update, control law, actuator quantisation.
+///
+/// The estimator decides the task model: HalfKalman / CompleteKalman predict to the
+/// actuation instant (one-shot), StandardKalman / DeadbeatObserver assume zero delay.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+
+#include "oneshot/control_law.hpp"
+#include "oneshot/status.hpp"
+
+namespace oneshot {
+
+/// Control job around an estimator (HalfKalman, CompleteKalman, StandardKalman, DeadbeatObserver).
+template <typename Fmt, typename Structure, typename Estimator>
+class Controller {
+ public:
+  static constexpr std::size_t kN = Structure::kStates;
+  static constexpr std::size_t kM = Structure::kInputs;
+  static constexpr std::size_t kP = Structure::kOutputs;
+  using Design = ControllerDesign<Fmt, kN, kM, kP>;
+  using OutputVec = Vector<typename Fmt::State, kP>;
+  using InputVec = Vector<typename Fmt::Input, kM>;
+
+  /// Controller over `design` and an estimator built on the same design.
+  constexpr Controller(const Design& design, const Estimator& estimator)
+      : design_(&design), estimator_(estimator) {}
+
+  /// Job: sample y taken tau_us before the actuation instant it prepares, set-point r.
+  /// Writes the actuator codes to `codes` and returns the estimator's status.
+  constexpr Status job(std::int32_t tau_us, const OutputVec& y, const OutputVec& setpoint,
+                       std::int32_t (&codes)[kM]) {
+    const Status status = estimator_.update(tau_us, y);
+    const InputVec u = control_law<Fmt, Structure>(*design_, estimator_.prediction(), setpoint);
+    for (std::size_t j = 0; j < kM; ++j) {
+      codes[j] = quantize_input(design_->actuator, j, u[j]);
+      applied_[j] = input_of_code(design_->actuator, j, codes[j]);
+    }
+    estimator_.set_applied_input(applied_);
+    return status;
+  }
+
+  /// The estimator (for its prediction, covariance and gain).
+  constexpr const Estimator& estimator() const { return estimator_; }
+  /// Mutable estimator access (reset).
+  constexpr Estimator& estimator() { return estimator_; }
+  /// The input realised by the last job's codes.
+  constexpr const InputVec& applied_input() const { return applied_; }
+
+ private:
+  const Design* design_;
+  Estimator estimator_;
+  InputVec applied_{};
+};
+
+}  // namespace oneshot

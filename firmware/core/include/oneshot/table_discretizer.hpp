@@ -1,0 +1,189 @@
+/// @file table_discretizer.hpp
+/// @brief Φ(τ), Γ(τ), Q_d(τ) from a look-up table (see table_view.hpp for the layout).
+///
+/// Out-of-range policy (documented in the README and tested):
+///  * τ < 0 (sample after the actuation instant: a scheduling fault): clamped to 0,
+///    status kClamped.
+///  * range < τ ≤ (kMaxExtensions+1)·range with OutOfRange::kExtend: exact, by composing
+///    the triple of `range` with itself and the in-range remainder; status kExtended.
+///    The complete filter's argument up to 2h needs no bigger table.
+///  * beyond that, or any τ > range with OutOfRange::kClamp: clamped to the largest
+///    supported τ, status kClamped.
+/// No index is ever formed outside the stored entries.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+
+#include "oneshot/assert_handler.hpp"
+#include "oneshot/discretization.hpp"
+#include "oneshot/status.hpp"
+#include "oneshot/table_view.hpp"
+
+namespace oneshot {
+
+/// What to do with τ beyond the table range.
+enum class OutOfRange : std::uint8_t {
+  kExtend,  ///< Exact composition up to kMaxExtensions extra ranges, then clamp.
+  kClamp,   ///< Clamp to the range.
+};
+
+/// Table-driven discretizer for a plant with structure `Structure`.
+template <typename Fmt, typename Structure, typename Storage, OutOfRange kPolicy = OutOfRange::kExtend>
+class TableDiscretizer {
+ public:
+  static constexpr std::size_t kN = Structure::kStates;
+  static constexpr std::size_t kM = Structure::kInputs;
+  /// Compositions of the full range allowed beyond the table (kExtend).
+  static constexpr std::int32_t kMaxExtensions = 3;
+  using Triple = Discretization<Fmt, kN, kM>;  ///< What discretize() produces.
+
+  /// Uses `view` (its arrays must outlive the discretizer). Every structural entry the
+  /// patterns claim must be one in the table's slot maps (checked).
+  constexpr explicit TableDiscretizer(const TableView<Storage>& view) : view_(view) {
+    ONESHOT_ASSERT(view.levels >= 1 && view.granularity_us > 0 && view.range_us > 0);
+    ONESHOT_ASSERT(view.range_us % view.granularity_us == 0);
+    ONESHOT_ASSERT(maps_match_structure(view));
+  }
+
+  /// True when the slot maps of `view` agree with Structure (usable in static_assert).
+  static constexpr bool maps_match_structure(const TableView<Storage>& view) {
+    using PhiP = typename Structure::PhiPattern;
+    using GammaP = typename Structure::GammaPattern;
+    using QdP = typename Structure::QdPattern;
+    for (std::size_t i = 0; i < kN; ++i) {
+      for (std::size_t j = 0; j < kN; ++j) {
+        if (!slot_matches<PhiP>(view.phi_slot[i * kN + j], i, j, view.slots)) return false;
+        if (!slot_matches<QdP>(view.qd_slot[i * kN + j], i, j, view.slots)) return false;
+      }
+      for (std::size_t j = 0; j < kM; ++j)
+        if (!slot_matches<GammaP>(view.gamma_slot[i * kM + j], i, j, view.slots)) return false;
+    }
+    return true;
+  }
+
+  /// Φ, Γ (and Q_d when asked) over τ_us, with the out-of-range policy above.
+  constexpr Status discretize(std::int32_t tau_us, Triple& out, WithQd with_qd) const {
+    Status status = Status::kOk;
+    if (tau_us < 0) {
+      tau_us = 0;
+      status = Status::kClamped;
+    }
+    const std::int32_t range = view_.range_us;
+    if (tau_us <= range) {
+      out = in_range(tau_us, with_qd);
+      return status;
+    }
+    if constexpr (kPolicy == OutOfRange::kClamp) {
+      out = in_range(range, with_qd);
+      return Status::kClamped;
+    } else {
+      std::int32_t repeats = tau_us / range;
+      std::int32_t remainder = tau_us - repeats * range;
+      status = Status::kExtended;
+      if (repeats > kMaxExtensions + 1 || (repeats == kMaxExtensions + 1 && remainder > 0)) {
+        repeats = kMaxExtensions + 1;
+        remainder = 0;
+        status = Status::kClamped;
+      }
+      const Triple full = in_range(range, with_qd);
+      Triple d = remainder > 0 ? in_range(remainder, with_qd) : full;
+      for (std::int32_t k = remainder > 0 ? 0 : 1; k < repeats; ++k)
+        d = compose<Fmt, Structure>(d, full, with_qd);
+      out = d;
+      return status;
+    }
+  }
+
+  /// The table in use.
+  constexpr const TableView<Storage>& view() const { return view_; }
+
+ private:
+  template <typename P>
+  static constexpr bool slot_matches(std::int8_t slot, std::size_t i, std::size_t j,
+                                     std::uint8_t slots) {
+    if (P::is_zero(i, j)) return slot == kSlotZero;
+    if (P::is_one(i, j)) return slot == kSlotOne;
+    // A free pattern entry claims nothing: the table may still know it is 0 or 1.
+    return slot == kSlotZero || slot == kSlotOne || (slot >= 0 && slot < static_cast<std::int8_t>(slots));
+  }
+
+  /// The triple for 0 ≤ τ ≤ range.
+  constexpr Triple in_range(std::int32_t tau_us, WithQd with_qd) const {
+    const std::int32_t g = view_.granularity_us;
+    std::int32_t index = tau_us / g;
+    const std::int32_t residual_us = tau_us - index * g;
+    Triple d;
+    bool have = false;
+    if (residual_us > 0) {
+      d = residual(residual_us, with_qd);
+      have = true;
+    }
+    for (std::uint8_t level = 0; level < view_.levels && index > 0; ++level) {
+      const std::int32_t radix = view_.radix[level];
+      const std::int32_t digit = index % radix;
+      index /= radix;
+      if (digit == 0) continue;
+      const std::size_t entry = static_cast<std::size_t>(view_.level_offset[level]) +
+                                static_cast<std::size_t>(digit - 1);
+      ONESHOT_ASSERT(entry < view_.entries);
+      const Triple e = expand(view_.values + entry * view_.slots, with_qd);
+      d = have ? compose<Fmt, Structure>(d, e, with_qd) : e;
+      have = true;
+    }
+    ONESHOT_ASSERT(index == 0);  // range/g fits the radix levels (checked by the generator)
+    return have ? d : Triple::identity();
+  }
+
+  /// The triple over δ = residual_us < g from the slot polynomials in r = δ/g.
+  constexpr Triple residual(std::int32_t residual_us, WithQd with_qd) const {
+    using F = typename Fmt::Fraction;
+    const F r = ScalarTraits<F>::from_int(residual_us) *
+                ScalarTraits<F>::from_ratio(1, view_.granularity_us);
+    Storage slot_values[kMaxSlots]{};
+    ONESHOT_ASSERT(view_.slots <= kMaxSlots);
+    const std::uint8_t used = with_qd == WithQd::kYes ? view_.slots : view_.transition_slots;
+    for (std::uint8_t s = 0; s < used; ++s) {
+      const Storage* c = view_.residual_coefficients + view_.residual_offset[s];  // c[k] ↔ r^(low+k)
+      const std::uint8_t low = view_.residual_low[s];
+      const std::uint8_t high = view_.residual_high[s];
+      // p(r) = r^low · (c_low + r·(c_low+1 + … + r·c_high)), Horner.
+      Storage v = c[high - low];
+      for (std::uint8_t k = high; k > low; --k) v = v * r + c[k - 1 - low];
+      for (std::uint8_t k = 0; k < low; ++k) v = v * r;
+      slot_values[s] = v;
+    }
+    return expand(slot_values, with_qd);
+  }
+
+  /// Matrices from one entry's free values.
+  constexpr Triple expand(const Storage* slot_values, WithQd with_qd) const {
+    Triple d;
+    for (std::size_t i = 0; i < kN; ++i) {
+      for (std::size_t j = 0; j < kN; ++j)
+        d.phi(i, j) = pick<typename Fmt::Transition>(view_.phi_slot[i * kN + j], slot_values);
+      for (std::size_t j = 0; j < kM; ++j)
+        d.gamma(i, j) = pick<typename Fmt::InputGain>(view_.gamma_slot[i * kM + j], slot_values);
+    }
+    if (with_qd == WithQd::kYes) {
+      for (std::size_t i = 0; i < kN; ++i)
+        for (std::size_t j = 0; j < kN; ++j)
+          d.qd(i, j) = pick<typename Fmt::Covariance>(view_.qd_slot[i * kN + j], slot_values);
+    }
+    return d;
+  }
+
+  template <typename To>
+  static constexpr To pick(std::int8_t slot, const Storage* slot_values) {
+    if (slot == kSlotZero) return ScalarTraits<To>::zero();
+    if (slot == kSlotOne) return ScalarTraits<To>::one();
+    return convert<To>(slot_values[slot]);
+  }
+
+  /// Free values per entry supported (n² + nm + n(n+1)/2 for n ≤ 4, m ≤ 2 is 34).
+  static constexpr std::size_t kMaxSlots = kN * kN + kN * kM + kN * (kN + 1) / 2;
+
+  TableView<Storage> view_;
+};
+
+}  // namespace oneshot

@@ -1,0 +1,59 @@
+/// @file table_view.hpp
+/// @brief Layout of a Φ/Γ/Q_d look-up table (generated at build time or built on the host).
+///
+/// Grid: t_i = i·g for i = 0 … range/g. The index i is split in mixed radix
+/// (i = d₀ + r₀·d₁ + r₀r₁·d₂ …, finest level first); level l stores the triples for
+/// digits 1 … r_l − 1 at spacing r₀…r_{l−1}·g, and a grid point is the composition of
+/// its non-zero digits (exact: Φ(a+b) = Φ(b)Φ(a), see discretization.hpp). One level is
+/// the plain table; more levels trade look-up time for memory.
+/// Only free values are stored: an entry's structural 0/1 entries and entries that
+/// repeat another one (same function of t, e.g. Γ₂ ≡ Φ₁₂ for the double integrator)
+/// map to a shared slot. Between grid points the residual δ = τ − t_i < g is covered
+/// by a per-slot polynomial in r = δ/g (the Taylor series of each entry, truncated
+/// below the format's precision by the generator).
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+
+namespace oneshot {
+
+/// Slot code of an entry that is structurally zero.
+inline constexpr std::int8_t kSlotZero = -1;
+/// Slot code of an entry that is structurally one.
+inline constexpr std::int8_t kSlotOne = -2;
+
+/// Read-only description of a table whose values are stored as `Storage`.
+template <typename Storage>
+struct TableView {
+  std::int32_t granularity_us;          ///< Grid step g (µs).
+  std::int32_t range_us;                ///< Covered range [0, range] (µs), a multiple of g.
+  std::uint8_t levels;                  ///< Number of radix levels (≥ 1).
+  const std::uint16_t* radix;           ///< Radix of each level, finest first.
+  const std::uint16_t* level_offset;    ///< Index of each level's first entry.
+  std::uint16_t entries;                ///< Number of stored entries.
+  std::uint8_t slots;                   ///< Free values per entry.
+  std::uint8_t transition_slots;        ///< Slots [0, this) feed Φ or Γ; the rest only Q_d.
+  const std::int8_t* phi_slot;          ///< n×n slot map of Φ (kSlotZero/kSlotOne/slot).
+  const std::int8_t* gamma_slot;        ///< n×m slot map of Γ.
+  const std::int8_t* qd_slot;           ///< n×n slot map of Q_d (symmetric).
+  const Storage* values;                ///< entries × slots values, entry-major.
+  const std::uint8_t* residual_low;     ///< Lowest degree of each slot polynomial.
+  const std::uint8_t* residual_high;    ///< Highest degree of each slot polynomial.
+  const std::uint8_t* residual_offset;  ///< First coefficient of each slot polynomial.
+  std::uint8_t residual_count;          ///< Number of stored residual coefficients.
+  const Storage* residual_coefficients; ///< Per slot, degrees low … high, ascending.
+};
+
+/// Every byte of plant-specific data the look-up reads: values, residual coefficients,
+/// slot maps, level arrays and residual indices.
+template <typename Storage>
+constexpr std::size_t table_bytes(const TableView<Storage>& v, std::size_t n, std::size_t m) {
+  const std::size_t values = sizeof(Storage) * (static_cast<std::size_t>(v.entries) * v.slots + v.residual_count);
+  const std::size_t maps = n * n + n * m + n * n;                  // int8 slot maps
+  const std::size_t levels = 2 * sizeof(std::uint16_t) * v.levels;  // radix + offset
+  const std::size_t residual_index = 3U * v.slots;                 // low, high, offset
+  return values + maps + levels + residual_index;
+}
+
+}  // namespace oneshot

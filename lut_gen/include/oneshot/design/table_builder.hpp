@@ -1,0 +1,89 @@
+/// @file table_builder.hpp
+/// @brief Builds the Φ/Γ/Q_d look-up table of a plant in a storage format (host).
+///
+/// Steps: evaluate the triple on the whole grid with the generic routine in double;
+/// assign a slot to each free entry (structural 0/1 entries get none, entries that are
+/// the same function of t share one); derive each slot's sub-grid Taylor polynomial,
+/// truncated below the storage precision; choose the radix layout with the fewest
+/// levels that fits table.max_bytes (then the fewest bytes); round into the storage
+/// format. See oneshot/table_view.hpp for how the firmware reads it.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "oneshot/design/controller_synthesis.hpp"
+#include "oneshot/design/plant_description.hpp"
+#include "oneshot/design/structure_analysis.hpp"
+#include "oneshot/table_view.hpp"
+
+namespace oneshot::design {
+
+/// Owning table data; view() gives the firmware's TableView.
+template <typename S>
+struct TableData {
+  std::int32_t granularity_us = 0;          ///< Grid step g.
+  std::int32_t range_us = 0;                ///< Covered range.
+  std::vector<std::uint16_t> radix;         ///< Per level, finest first.
+  std::vector<std::uint16_t> level_offset;  ///< First entry of each level.
+  std::vector<std::int32_t> entry_time_us;  ///< Time of each stored entry.
+  std::uint8_t slots = 0;                   ///< Free values per entry.
+  std::uint8_t transition_slots = 0;        ///< Slots used by Φ or Γ (first).
+  std::vector<std::int8_t> phi_slot;        ///< n×n map.
+  std::vector<std::int8_t> gamma_slot;      ///< n×m map.
+  std::vector<std::int8_t> qd_slot;         ///< n×n map.
+  std::vector<S> values;                    ///< entries × slots.
+  std::vector<std::uint8_t> residual_low;   ///< Per slot.
+  std::vector<std::uint8_t> residual_high;  ///< Per slot.
+  std::vector<std::uint8_t> residual_offset;  ///< Per slot.
+  std::vector<S> residual_coefficients;     ///< Packed.
+  std::size_t n = 0;                        ///< States.
+  std::size_t m = 0;                        ///< Inputs.
+
+  /// The firmware's view (valid while this object lives and is not modified).
+  TableView<S> view() const {
+    return TableView<S>{granularity_us,
+                        range_us,
+                        static_cast<std::uint8_t>(radix.size()),
+                        radix.data(),
+                        level_offset.data(),
+                        static_cast<std::uint16_t>(entry_time_us.size()),
+                        slots,
+                        transition_slots,
+                        phi_slot.data(),
+                        gamma_slot.data(),
+                        qd_slot.data(),
+                        values.data(),
+                        residual_low.data(),
+                        residual_high.data(),
+                        residual_offset.data(),
+                        static_cast<std::uint8_t>(residual_coefficients.size()),
+                        residual_coefficients.data()};
+  }
+  /// Every byte the look-up reads (see table_bytes()).
+  std::size_t bytes() const { return table_bytes(view(), n, m); }
+};
+
+/// Builds the table of `plant` in storage format S (float or double) within
+/// plant.table_max_bytes; DesignError when no layout fits.
+template <typename S>
+TableData<S> build_table(const PlantDescription& plant, const DesignResult& design, const PlantPatterns& patterns);
+
+/// Largest errors of a table against the double generic routine.
+struct TableAccuracy {
+  double max_abs_error = 0;   ///< Max over Φ, Γ, Q_d entries.
+  double phi_abs = 0;         ///< Max |ΔΦ|.
+  double gamma_abs = 0;       ///< Max |ΔΓ|.
+  double qd_abs = 0;          ///< Max |ΔQ_d|.
+  double phi_rel = 0;         ///< Max |ΔΦ| / max|Φ| at the same τ.
+  double gamma_rel = 0;       ///< Max |ΔΓ| / max|Γ|.
+  double qd_rel = 0;          ///< Max |ΔQ_d| / max|Q_d|.
+  std::size_t points = 0;     ///< Number of τ compared.
+};
+
+/// Compares the table with the double generic routine at every grid point, every
+/// midpoint and a sweep of off-grid points up to twice the range (extension).
+template <typename S>
+TableAccuracy measure_accuracy(const TableData<S>& table, const PlantDescription& plant, const DesignResult& design);
+
+}  // namespace oneshot::design

@@ -1,0 +1,86 @@
+/// @file lut_gen_main.cpp
+/// @brief lut_gen: build-time generator of the table header and lut_report.json.
+#include <CLI/CLI.hpp>
+#include <fstream>
+#include <iostream>
+#include <nlohmann/json.hpp>
+
+#include "oneshot/design/controller_synthesis.hpp"
+#include "oneshot/design/design_report.hpp"
+#include "oneshot/design/header_emitter.hpp"
+#include "oneshot/design/plant_description.hpp"
+#include "oneshot/design/structure_analysis.hpp"
+#include "oneshot/design/table_builder.hpp"
+
+namespace {
+
+template <typename S>
+nlohmann::json table_json(const oneshot::design::TableData<S>& t, const oneshot::design::TableAccuracy& a) {
+  nlohmann::json j;
+  j["bytes"] = t.bytes();
+  j["value_bytes"] = sizeof(S) * t.values.size();
+  j["residual_bytes"] = sizeof(S) * t.residual_coefficients.size();
+  j["index_bytes"] = t.bytes() - sizeof(S) * (t.values.size() + t.residual_coefficients.size());
+  j["entries"] = t.entry_time_us.size();
+  j["slots"] = t.slots;
+  j["levels"] = t.radix.size();
+  j["radix"] = t.radix;
+  j["entry_time_us"] = t.entry_time_us;
+  j["granularity_us"] = t.granularity_us;
+  j["range_us"] = t.range_us;
+  j["max_abs_error"] = a.max_abs_error;
+  j["phi_max_abs_error"] = a.phi_abs;
+  j["gamma_max_abs_error"] = a.gamma_abs;
+  j["qd_max_abs_error"] = a.qd_abs;
+  j["phi_max_rel_error"] = a.phi_rel;
+  j["gamma_max_rel_error"] = a.gamma_rel;
+  j["qd_max_rel_error"] = a.qd_rel;
+  j["points_compared"] = a.points;
+  return j;
+}
+
+void write_file(const std::string& path, const std::string& text) {
+  std::ofstream out(path, std::ios::binary);
+  out << text;
+  if (!out) throw std::runtime_error(path + ": cannot write");
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  namespace d = oneshot::design;
+  CLI::App app{"lut_gen: design step and Phi/Gamma/Qd table generator (run by the build)"};
+  std::string plant_path;
+  std::string header_path;
+  std::string report_path;
+  app.add_option("--plant", plant_path, "plant description JSON (default: the built-in reference board)");
+  app.add_option("--header", header_path, "generated C++ header to write")->required();
+  app.add_option("--report", report_path, "lut_report.json to write")->required();
+  CLI11_PARSE(app, argc, argv);
+  try {
+    const d::PlantDescription plant = plant_path.empty() ? d::reference_plant() : d::load_plant_file(plant_path);
+    const d::DesignResult design = d::synthesize(plant);
+    const d::PlantPatterns patterns = d::analyse_structure(plant, design);
+    const auto table_f = d::build_table<float>(plant, design, patterns);
+    const auto table_d = d::build_table<double>(plant, design, patterns);
+    const auto acc_f = d::measure_accuracy(table_f, plant, design);
+    const auto acc_d = d::measure_accuracy(table_d, plant, design);
+    write_file(header_path, d::emit_header(plant, design, patterns, table_f, table_d, "lut_gen"));
+    nlohmann::json report = table_json(table_f, acc_f);  // top level: the float table the MCU uses
+    report["generated_by"] = "lut_gen";
+    report["plant"] = plant.name;
+    report["source"] = plant.source;
+    report["max_bytes"] = plant.table_max_bytes;
+    report["formats"]["float"] = table_json(table_f, acc_f);
+    report["formats"]["double"] = table_json(table_d, acc_d);
+    report["design"] = d::design_json(plant, design);
+    write_file(report_path, report.dump(2) + "\n");
+    std::cout << "lut_gen: " << plant.name << ": float table " << table_f.bytes() << " bytes (" << table_f.radix.size()
+              << " levels, " << table_f.entry_time_us.size() << " entries x " << static_cast<int>(table_f.slots)
+              << " slots), max abs error " << acc_f.max_abs_error << "\n";
+  } catch (const std::exception& e) {
+    std::cerr << "lut_gen: error: " << e.what() << "\n";
+    return 1;
+  }
+  return 0;
+}

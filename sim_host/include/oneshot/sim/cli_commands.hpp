@@ -1,0 +1,12 @@
+/// @file cli_commands.hpp
+/// @brief Subcommands of oneshot-sim; each registers itself on the CLI11 application.
+#pragma once
+
+#include <CLI/CLI.hpp>
+
+namespace oneshot::sim {
+
+/// `design [--plant FILE] [--json PATH|-]`: the design in text and JSON.
+void register_design_command(CLI::App& app);
+
+}  // namespace oneshot::sim

@@ -1,0 +1,112 @@
+/// @file test_plants.cpp
+/// @brief Test plants.
+#include "support/test_plants.hpp"
+
+#include <nlohmann/json.hpp>
+#include <unistd.h>
+
+namespace oneshot::test {
+
+std::string plant_json(const std::string& a, const std::string& b, const std::string& c, const std::string& extra) {
+  nlohmann::json j = nlohmann::json::parse(design::reference_plant_json());
+  j["A"] = nlohmann::json::parse(a);
+  j["B"] = nlohmann::json::parse(b);
+  j["C"] = nlohmann::json::parse(c);
+  const std::size_t n = j["A"].size();
+  const std::size_t m = j["B"][0].size();
+  const std::size_t p = j["C"].size();
+  nlohmann::json eye_n = nlohmann::json::array();
+  nlohmann::json qn = nlohmann::json::array();
+  for (std::size_t i = 0; i < n; ++i) {
+    nlohmann::json row = nlohmann::json::array();
+    nlohmann::json qrow = nlohmann::json::array();
+    for (std::size_t k = 0; k < n; ++k) {
+      row.push_back(i == k ? 1.0 : 0.0);
+      qrow.push_back(i == k ? 2e-7 : 0.0);
+    }
+    eye_n.push_back(row);
+    qn.push_back(qrow);
+  }
+  j.erase("states");
+  j.erase("inputs");
+  j.erase("outputs");
+  j["cost"]["Q1c"] = eye_n;
+  j["noise"]["process_covariance"] = qn;
+  nlohmann::json r = nlohmann::json::array();
+  nlohmann::json umin = nlohmann::json::array();
+  nlohmann::json umax = nlohmann::json::array();
+  nlohmann::json q2 = nlohmann::json::array();
+  for (std::size_t i = 0; i < p; ++i) {
+    nlohmann::json row = nlohmann::json::array();
+    for (std::size_t k = 0; k < p; ++k) row.push_back(i == k ? 8e-5 : 0.0);
+    r.push_back(row);
+    umin.push_back(-1.65);
+    umax.push_back(1.65);
+  }
+  j["noise"]["measurement_covariance"] = r;
+  j["board"]["adc_min_volts"] = umin;
+  j["board"]["adc_max_volts"] = umax;
+  nlohmann::json low = nlohmann::json::array();
+  nlohmann::json high = nlohmann::json::array();
+  for (std::size_t i = 0; i < m; ++i) {
+    nlohmann::json row = nlohmann::json::array();
+    for (std::size_t k = 0; k < m; ++k) row.push_back(i == k ? 1.0 : 0.0);
+    q2.push_back(row);
+    low.push_back(-1.65);
+    high.push_back(1.65);
+  }
+  j["cost"]["Q2c"] = q2;
+  j["board"]["pwm_low_volts"] = low;
+  j["board"]["pwm_high_volts"] = high;
+  j["table"]["max_bytes"] = 2048;  // room for 3-state and double tables
+  j.merge_patch(nlohmann::json::parse(extra));
+  return j.dump();
+}
+
+design::PlantDescription damped_oscillator() {
+  // ẍ = −ω² x − 2ζω ẋ + ω² u, ω = 30, ζ = 0.2.
+  return design::parse_plant(plant_json("[[0, 1], [-900, -12]]", "[[0], [900]]", "[[1, 0]]",
+                                        R"({"name": "damped-oscillator"})"),
+                             "damped oscillator");
+}
+
+design::PlantDescription unstable_plant() {
+  return design::parse_plant(plant_json("[[8, 1], [0, -15]]", "[[0], [15]]", "[[1, 0]]", R"({"name": "unstable"})"),
+                             "unstable plant");
+}
+
+design::PlantDescription three_state_plant() {
+  return design::parse_plant(plant_json("[[-2, 5, 0], [0, -1, 10], [1, 0, -20]]", "[[0], [0], [20]]",
+                                        "[[1, 0, 0]]", R"({"name": "three-state"})"),
+                             "three-state plant");
+}
+
+std::string reference_with(const std::string& pointer, const std::string& value_json) {
+  nlohmann::json j = nlohmann::json::parse(design::reference_plant_json());
+  const nlohmann::json::json_pointer ptr(pointer);
+  if (value_json.empty()) {
+    j[ptr.parent_pointer()].erase(ptr.back());
+  } else {
+    j[ptr] = nlohmann::json::parse(value_json);
+  }
+  return j.dump();
+}
+
+}  // namespace oneshot::test
+
+#include <filesystem>
+#include <fstream>
+
+#include "support/run_command.hpp"
+
+namespace oneshot::test {
+
+std::string write_temp_file(const std::string& name, const std::string& text) {
+  const auto dir = std::filesystem::temp_directory_path() / ("oneshot_test_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  const auto path = dir / name;
+  std::ofstream(path, std::ios::binary) << text;
+  return path.string();
+}
+
+}  // namespace oneshot::test
