@@ -2,7 +2,7 @@
 function(oneshot_warnings target)
   target_compile_options(${target} PRIVATE
     -Wall -Wextra -Wpedantic -Wconversion -Wsign-conversion -Wshadow -Wdouble-promotion
-    -Wcast-align -Wnull-dereference -Wold-style-cast -Wuseless-cast)
+    -Wcast-align -Wold-style-cast -Wuseless-cast)
   if(ONESHOT_WERROR)
     target_compile_options(${target} PRIVATE -Werror)
   endif()

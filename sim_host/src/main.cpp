@@ -3,6 +3,7 @@
 #include <CLI/CLI.hpp>
 #include <exception>
 #include <iostream>
+#include <string>
 
 #include "oneshot/sim/cli_commands.hpp"
 
@@ -10,6 +11,17 @@ int main(int argc, char** argv) {
   CLI::App app{"oneshot-sim: host simulator of the one-shot task model with an embedded Kalman filter"};
   app.require_subcommand(1);
   oneshot::sim::register_design_command(app);
+  oneshot::sim::register_experiment_commands(app);
+  const auto known = [&](const std::string& name) {
+    for (const CLI::App* sub : app.get_subcommands({})) {
+      if (sub->get_name() == name) return true;
+    }
+    return false;
+  };
+  if (argc > 1 && argv[1][0] != '-' && !known(argv[1])) {
+    std::cerr << "oneshot-sim: unknown command '" << argv[1] << "' (see oneshot-sim --help)\n";
+    return 2;
+  }
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

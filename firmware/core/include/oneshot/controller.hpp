@@ -23,6 +23,9 @@ class Controller {
   using Design = ControllerDesign<Fmt, kN, kM, kP>;
   using OutputVec = Vector<typename Fmt::State, kP>;
   using InputVec = Vector<typename Fmt::Input, kM>;
+  using StateVec = Vector<typename Fmt::State, kN>;
+  using CovScalar = typename Fmt::Covariance;
+  using EstimatorType = Estimator;
 
   /// Controller over `design` and an estimator built on the same design.
   constexpr Controller(const Design& design, const Estimator& estimator)
@@ -46,6 +49,8 @@ class Controller {
   constexpr const Estimator& estimator() const { return estimator_; }
   /// Mutable estimator access (reset).
   constexpr Estimator& estimator() { return estimator_; }
+  /// The design constants.
+  constexpr const Design& design() const { return *design_; }
   /// The input realised by the last job's codes.
   constexpr const InputVec& applied_input() const { return applied_; }
 

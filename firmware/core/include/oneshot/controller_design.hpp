@@ -35,6 +35,10 @@ struct SensorModel {
 /// Design results for an n-state, m-input, p-output plant (convention u = −L x).
 template <typename Fmt, std::size_t N, std::size_t M, std::size_t P>
 struct ControllerDesign {
+  using Format = Fmt;                          ///< Number formats.
+  static constexpr std::size_t kStates = N;    ///< n.
+  static constexpr std::size_t kInputs = M;    ///< m.
+  static constexpr std::size_t kOutputs = P;   ///< p.
   std::int32_t period_us;                                ///< Control period h (µs).
   Matrix<typename Fmt::Transition, P, N> c;              ///< Output matrix C.
   Matrix<typename Fmt::FeedbackGain, M, N> l;            ///< LQR gain L.

@@ -9,4 +9,7 @@ namespace oneshot::sim {
 /// `design [--plant FILE] [--json PATH|-]`: the design in text and JSON.
 void register_design_command(CLI::App& app);
 
+/// noise, jitter, gain, table1, exectime, run, benchmark, report.
+void register_experiment_commands(CLI::App& app);
+
 }  // namespace oneshot::sim

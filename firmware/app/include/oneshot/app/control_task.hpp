@@ -1,0 +1,104 @@
+/// @file control_task.hpp
+/// @brief The control task of the firmware: the same code on the MCU and in the host harness.
+///
+/// One-shot model: the actuation timer interrupt applies, at each actuation instant
+/// t_k, the codes the job prepared; the job samples whenever it runs, computes
+/// τ = t_k − t_sample from the timer's compare value, and prepares the next codes.
+/// Standard model: the job samples and writes the PWM as soon as it has computed.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+
+#include "oneshot/control_law.hpp"
+#include "oneshot/controller.hpp"
+#include "oneshot/hal/board_contract.hpp"
+#include "oneshot/status.hpp"
+
+namespace oneshot::app {
+
+/// Which task model the job follows.
+enum class TaskModel : std::uint8_t {
+  kOneShot,   ///< Strictly periodic actuation from the timer interrupt.
+  kStandard,  ///< Actuation when the job finishes.
+};
+
+/// Counters a host or a debugger can read.
+struct TaskStatistics {
+  std::uint32_t jobs = 0;            ///< Jobs run.
+  std::uint32_t overruns = 0;        ///< Actuation instants with no prepared value.
+  std::uint32_t faults = 0;          ///< Jobs whose maths returned a non-exact status.
+  std::int32_t last_tau_us = 0;      ///< τ of the last job.
+  Status last_status = Status::kOk;  ///< Status of the last job.
+};
+
+/// Control task over board `Board` running controller `Ctrl`.
+template <typename Board, typename Ctrl, TaskModel kModel>
+class ControlTask {
+  static_assert(hal::kHasClock<Board>, "Board::Clock must provide static std::uint32_t now_us()");
+  static_assert(hal::kHasTimer<Board>, "Board::Timer must provide static std::uint32_t next_actuation_us()");
+  static_assert(hal::kHasPwm<Board>, "Board::Pwm must provide static void write_duty(std::size_t, std::int32_t)");
+  static_assert(hal::kHasAdc<Board>, "Board::Adc must provide static std::int32_t sample(std::size_t)");
+  static_assert(hal::kHasSetpoint<Board>,
+                "Board::Setpoint must provide static std::int32_t setpoint_code(std::size_t, std::uint32_t)");
+
+ public:
+  static constexpr std::size_t kM = Ctrl::kM;
+  static constexpr std::size_t kP = Ctrl::kP;
+
+  /// Task around `controller` (which must outlive it).
+  explicit ControlTask(Ctrl& controller) : controller_(&controller) {}
+
+  /// Actuation timer interrupt (one-shot): applies the prepared codes.
+  void on_actuation_interrupt() {
+    if constexpr (kModel == TaskModel::kOneShot) {
+      if (!ready_) {
+        ++stats_.overruns;  // keep the previous duty: the job did not finish in time
+        return;
+      }
+      for (std::size_t j = 0; j < kM; ++j) Board::Pwm::write_duty(j, prepared_[j]);
+      ready_ = false;
+    }
+  }
+
+  /// The control job: sample, τ, estimator, control law, actuation codes.
+  Status run_job() {
+    const std::uint32_t t_sample = Board::Clock::now_us();
+    // One-shot: the output is applied at the next actuation instant t_k; standard: now.
+    const std::uint32_t t_apply = kModel == TaskModel::kOneShot ? Board::Timer::next_actuation_us() : t_sample;
+    typename Ctrl::OutputVec y;
+    typename Ctrl::OutputVec r;
+    for (std::size_t o = 0; o < kP; ++o) {
+      y[o] = output_of_code(controller_->design().sensor, o, Board::Adc::sample(o));
+      r[o] = output_of_code(controller_->design().sensor, o, Board::Setpoint::setpoint_code(o, t_apply));
+    }
+    // τ = t_k − t_sample in wrapping 32-bit µs arithmetic (standard model: assumed 0).
+    const std::int32_t tau_us = static_cast<std::int32_t>(t_apply - t_sample);
+    std::int32_t codes[kM] = {};
+    const Status status = controller_->job(tau_us, y, r, codes);
+    ++stats_.jobs;
+    stats_.last_tau_us = tau_us;
+    stats_.last_status = status;
+    if (!is_exact(status)) ++stats_.faults;
+    if constexpr (kModel == TaskModel::kOneShot) {
+      for (std::size_t j = 0; j < kM; ++j) prepared_[j] = codes[j];
+      ready_ = true;
+    } else {
+      for (std::size_t j = 0; j < kM; ++j) Board::Pwm::write_duty(j, codes[j]);
+    }
+    return status;
+  }
+
+  /// Counters.
+  const TaskStatistics& statistics() const { return stats_; }
+  /// The controller.
+  const Ctrl& controller() const { return *controller_; }
+
+ private:
+  Ctrl* controller_;
+  volatile std::int32_t prepared_[kM] = {};  // shared with the interrupt: volatile keeps the order
+  volatile bool ready_ = false;
+  TaskStatistics stats_{};
+};
+
+}  // namespace oneshot::app

@@ -1,0 +1,59 @@
+/// @file experiments.hpp
+/// @brief The experiments of the brief (§7) and the user's own runs; each writes CSV files
+///        and PNG plots into an output folder and returns a JSON summary.
+#pragma once
+
+#include <cstdint>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+#include "oneshot/sim/scenario.hpp"
+#include "oneshot/sim/simulation.hpp"
+
+namespace oneshot::sim {
+
+/// Options shared by every experiment.
+struct CommonOptions {
+  std::string out_dir = "out";                            ///< Output folder.
+  NumberFormat format = NumberFormat::kFloat;              ///< Job number format.
+  DiscretizerKind discretizer = DiscretizerKind::kTable;   ///< One-shot Φ/Γ/Q_d source.
+  NoiseModel noise = NoiseModel::kExact;                   ///< Constant Q or exact Q_d.
+  BoardOptions board;                                      ///< Emulator options.
+  unsigned threads = 0;                                    ///< Worker threads (0: every core).
+  bool plots = true;                                       ///< Draw PNG plots with gnuplot.
+  std::uint64_t seed = 1;                                  ///< Seed (first seed for sweeps).
+};
+
+/// Experiment 1: noisy measured v1 beside the estimated states (half Kalman, one-shot).
+nlohmann::json run_noise_experiment(const SimContext& ctx, const CommonOptions& opt, double duration_s);
+
+/// Experiment 2: one-shot + half Kalman against standard controllers under jitter.
+nlohmann::json run_jitter_experiment(const SimContext& ctx, const CommonOptions& opt, double duration_s,
+                                     std::int32_t jitter_us);
+
+/// Experiment 3: first Kalman gain element over time (half, complete, standard without jitter).
+nlohmann::json run_gain_experiment(const SimContext& ctx, const CommonOptions& opt, double duration_s,
+                                   double p0_scale);
+
+/// Experiment 4: approaches A–E on the scenarios, `seeds` seeds each, 95 % intervals.
+nlohmann::json run_table1(const SimContext& ctx, const CommonOptions& opt, const std::vector<Scenario>& scenarios,
+                          std::size_t seeds);
+
+/// Experiment 5: execution time of the control job, half/complete × table/generic, over
+/// the jobs of 4 s of operation: steady-clock time on this host, and instruction counts
+/// under valgrind (callgrind) when available.
+nlohmann::json run_exectime(const SimContext& ctx, const CommonOptions& opt, const std::string& self_path);
+
+/// The hidden half of run_exectime: replays one variant once inside the function that
+/// callgrind counts. Prints the number of jobs replayed.
+int run_exectime_probe(const SimContext& ctx, const CommonOptions& opt, const std::string& variant);
+
+/// One configurable run with full traces (jobs and a dense state trace).
+nlohmann::json run_single(const SimContext& ctx, const CommonOptions& opt, const Scenario& scenario, Approach approach,
+                          std::int32_t trace_step_us);
+
+/// Simulated seconds per wall second of the board emulation on one core.
+nlohmann::json run_benchmark(const SimContext& ctx, const CommonOptions& opt, double simulated_s);
+
+}  // namespace oneshot::sim

@@ -1,0 +1,51 @@
+/// @file scenario.hpp
+/// @brief Experiment scenarios: duration, set-point profile and jitter.
+///
+/// The circuit starts at rest with reference 0 V; set-points then change every
+/// `change_period_s` to a value drawn uniformly in [−amplitude, +amplitude] and rounded
+/// to an ADC code, so that the controller and the
+/// cost see the same reference. The reference is a known trajectory: a job asks for the
+/// value valid when its output will be applied.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "oneshot/design/plant_description.hpp"
+#include "oneshot/sim/jitter_model.hpp"
+
+namespace oneshot::sim {
+
+/// One scenario.
+struct Scenario {
+  std::string name;                   ///< Identifier.
+  double duration_s = 20;             ///< Simulated time per run.
+  double amplitude_volts = 0.2;       ///< Set-points within ±amplitude.
+  double change_period_s = 1.0;       ///< Time between set-point changes.
+  JitterModel jitter;                 ///< Job timing.
+};
+
+/// The ten scenarios of Table I (documented in the README).
+std::vector<Scenario> default_scenarios();
+
+/// Reads {"scenarios": [{"name", "duration_s", "setpoint": {"amplitude_volts",
+/// "change_period_s"}, "jitter": {...}}, ...]} (ScenarioError naming the field).
+std::vector<Scenario> load_scenarios(const std::string& path);
+
+/// Checks a scenario against a plant: the job must finish within the period
+/// (release + exec < h), set-points within the ADC range (ScenarioError).
+void validate_scenario(const Scenario& s, const design::PlantDescription& plant);
+
+/// Set-point code schedule: (time, ADC code) pairs, first at t = 0.
+struct SetpointSchedule {
+  std::vector<std::int64_t> at_ns;   ///< Change instants.
+  std::vector<std::int32_t> code;    ///< ADC code from that instant.
+  /// Code valid at time t (ns).
+  std::int32_t code_at(std::int64_t t_ns) const;
+};
+
+/// Draws the schedule of scenario `s` for `seed` on output channel 0 of `plant`.
+SetpointSchedule make_schedule(const Scenario& s, const design::PlantDescription& plant, std::uint64_t seed);
+
+}  // namespace oneshot::sim

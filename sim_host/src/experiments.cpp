@@ -1,0 +1,596 @@
+/// @file experiments.cpp
+/// @brief Experiments 1–5 of the brief, single runs and the benchmark.
+#include "oneshot/sim/experiments.hpp"
+
+#include <algorithm>
+#include <array>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <map>
+#include <sstream>
+#include <sys/wait.h>
+
+#include "oneshot/sim/output_files.hpp"
+#include "oneshot/sim/parallel.hpp"
+#include "oneshot/sim/progress_bar.hpp"
+#include "oneshot/sim/statistics.hpp"
+
+/// The function callgrind counts (see run_exectime): one replay of the recorded jobs.
+extern "C" __attribute__((noinline)) void oneshot_exectime_replay(const std::function<void()>* replay) {
+  (*replay)();
+}
+
+namespace oneshot::sim {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+Scenario demo_scenario(const std::string& name, std::int32_t jitter_us, double amplitude, double change_period,
+                       double duration) {
+  Scenario s;
+  s.name = name;
+  s.duration_s = duration;
+  s.amplitude_volts = amplitude;
+  s.change_period_s = change_period;
+  s.jitter.kind = JitterModel::Kind::kUniform;
+  s.jitter.release_max_us = jitter_us;
+  s.jitter.exec_min_us = 200;
+  s.jitter.exec_max_us = 600;
+  return s;
+}
+
+RunOptions base_options(const CommonOptions& opt, Approach a) {
+  RunOptions r;
+  r.approach = a;
+  r.format = opt.format;
+  r.discretizer = opt.discretizer;
+  r.noise = opt.noise;
+  r.board = opt.board;
+  return r;
+}
+
+std::string path_in(const CommonOptions& opt, const std::string& name) {
+  return (std::filesystem::path(opt.out_dir) / name).string();
+}
+
+nlohmann::json common_json(const SimContext& ctx, const CommonOptions& opt) {
+  nlohmann::json j;
+  j["plant"] = ctx.plant().name;
+  j["number_format"] = to_string(opt.format);
+  j["discretizer"] = to_string(opt.discretizer);
+  j["noise_model"] = opt.noise == NoiseModel::kExact ? "exact" : "constant";
+  j["seed"] = opt.seed;
+  return j;
+}
+
+std::string state_label(const SimContext& ctx, std::size_t i) { return ctx.plant().states.at(i); }
+
+/// Value of the dense trace at time t (trace step divides the period: exact grid point).
+const TracePoint& trace_at(const RunResult& r, double t_s, std::int32_t step_us) {
+  const auto index = static_cast<std::size_t>(std::llround(t_s * 1e6 / step_us));
+  return r.trace.at(std::min(index, r.trace.size() - 1));
+}
+
+const char* png_terminal() { return "set terminal pngcairo size 1100,700 font 'Sans,11' noenhanced\n"; }
+
+}  // namespace
+
+nlohmann::json run_noise_experiment(const SimContext& ctx, const CommonOptions& opt, double duration_s) {
+  make_directory(opt.out_dir);
+  const Scenario sc = demo_scenario("noise-demo", 20'000, 0.2, 1.0, duration_s);
+  RunOptions ro = base_options(opt, Approach::kB);
+  ro.record_jobs = true;
+  ro.trace_step_us = 1000;
+  const RunResult r = simulate(ctx, sc, opt.seed, ro);
+  const std::size_t n = ctx.plant().n();
+  std::vector<std::vector<double>> rows;
+  double se_meas = 0;
+  double se_est = 0;
+  for (const JobRecord& j : r.job_records) {
+    const TracePoint& truth = trace_at(r, j.t_apply_s, ro.trace_step_us);
+    std::vector<double> row = {j.t_sample_s, j.y_volts, j.t_apply_s};
+    for (std::size_t i = 0; i < n; ++i) row.push_back(j.estimate[i]);
+    for (std::size_t i = 0; i < n; ++i) row.push_back(truth.x[i]);
+    row.push_back(j.setpoint_volts);
+    rows.push_back(row);
+    se_meas += (j.y_volts - j.x_true[0]) * (j.y_volts - j.x_true[0]);
+    se_est += (j.estimate[0] - truth.x[0]) * (j.estimate[0] - truth.x[0]);
+  }
+  std::vector<std::string> header = {"t_sample_s", "y_volts", "t_apply_s"};
+  for (std::size_t i = 0; i < n; ++i) header.push_back(state_label(ctx, i) + "_estimate");
+  for (std::size_t i = 0; i < n; ++i) header.push_back(state_label(ctx, i) + "_true");
+  header.push_back("setpoint_volts");
+  write_csv(path_in(opt, "noise_jobs.csv"), header, rows);
+  std::vector<std::vector<double>> trace;
+  for (const TracePoint& p : r.trace) {
+    std::vector<double> row = {p.t_s};
+    row.insert(row.end(), p.x.begin(), p.x.end());
+    row.push_back(p.setpoint_volts);
+    trace.push_back(row);
+  }
+  std::vector<std::string> theader = {"t_s"};
+  for (std::size_t i = 0; i < n; ++i) theader.push_back(state_label(ctx, i));
+  theader.push_back("setpoint_volts");
+  write_csv(path_in(opt, "noise_trace.csv"), theader, trace);
+
+  const double rms_meas = std::sqrt(se_meas / static_cast<double>(r.job_records.size()));
+  const double rms_est = std::sqrt(se_est / static_cast<double>(r.job_records.size()));
+  if (opt.plots) {
+    std::ostringstream g;
+    g << png_terminal() << "set output 'noise.png'\nset datafile separator ','\nset key outside right top\n"
+      << "set multiplot layout " << std::min<std::size_t>(n, 2) << ",1 title 'Noise removal: one-shot controller with half Kalman filter (jitter 0-20 ms)'\n"
+      << "set grid\nset ylabel '" << state_label(ctx, 0) << " (V)'\n"
+      << "plot 'noise_jobs.csv' using 1:2 skip 1 with points pt 7 ps 0.5 lc rgb '#999999' title 'measured (ADC)', "
+      << "'noise_trace.csv' using 1:" << n + 2 << " skip 1 with lines dt 2 lw 1.5 lc rgb 'black' title 'set-point', "
+      << "'noise_trace.csv' using 1:2 skip 1 with lines lw 2 lc rgb '#1f77b4' title 'true', "
+      << "'noise_jobs.csv' using 3:4 skip 1 with steps lw 2 lc rgb '#d62728' title 'estimate'\n";
+    if (n >= 2) {
+      g << "set xlabel 'time (s)'\nset ylabel '" << state_label(ctx, 1) << " (V)'\n"
+        << "plot 'noise_trace.csv' using 1:3 skip 1 with lines lw 2 lc rgb '#1f77b4' title 'true', "
+        << "'noise_jobs.csv' using 3:5 skip 1 with steps lw 2 lc rgb '#d62728' title 'estimate'\n";
+    }
+    g << "unset multiplot\n";
+    run_gnuplot(opt.out_dir, "noise.gp", g.str());
+  }
+  nlohmann::json j = common_json(ctx, opt);
+  j["experiment"] = "noise";
+  j["approach"] = "B";
+  j["duration_s"] = r.duration_s;
+  j["rms_measurement_error_volts"] = rms_meas;
+  j["rms_estimate_error_volts"] = rms_est;
+  j["noise_reduction_factor"] = rms_meas / rms_est;
+  j["files"] = {"noise_jobs.csv", "noise_trace.csv", "noise.png"};
+  return j;
+}
+
+nlohmann::json run_jitter_experiment(const SimContext& ctx, const CommonOptions& opt, double duration_s,
+                                     std::int32_t jitter_us) {
+  make_directory(opt.out_dir);
+  const Scenario sc = demo_scenario("jitter-demo", jitter_us, 0.2, 1.0, duration_s);
+  const std::array<Approach, 4> approaches = {Approach::kA, Approach::kB, Approach::kD, Approach::kE};
+  std::vector<RunResult> results(approaches.size());
+  parallel_for(approaches.size(), worker_count(opt.threads), nullptr, [&](std::size_t i) {
+    RunOptions ro = base_options(opt, approaches[i]);
+    ro.trace_step_us = 1000;
+    results[i] = simulate(ctx, sc, opt.seed, ro);
+  });
+  std::vector<std::vector<double>> rows;
+  for (std::size_t k = 0; k < results[0].trace.size(); ++k) {
+    std::vector<double> row = {results[0].trace[k].t_s, results[0].trace[k].setpoint_volts};
+    for (const RunResult& r : results) row.push_back(r.trace[k].x[0]);
+    rows.push_back(row);
+  }
+  const std::string v = state_label(ctx, 0);
+  write_csv(path_in(opt, "jitter.csv"), {"t_s", "setpoint_volts", v + "_A", v + "_B", v + "_D", v + "_E"}, rows);
+  if (opt.plots) {
+    std::ostringstream g;
+    g << png_terminal() << "set output 'jitter.png'\nset datafile separator ','\nset key top left box opaque\nset grid\n"
+      << "set title 'Response under jitter (release 0-" << jitter_us / 1000.0 << " ms): one-shot + half Kalman vs standard controllers'\n"
+      << "set xlabel 'time (s)'\nset ylabel '" << v << " (V)'\n"
+      << "plot 'jitter.csv' using 1:2 skip 1 with lines dt 2 lw 1.5 lc rgb 'black' title 'set-point', "
+      << "'' using 1:3 skip 1 with lines lw 3 lc rgb '#bbbbbb' title 'A: standard + Kalman, no jitter', "
+      << "'' using 1:4 skip 1 with lines lw 1.5 lc rgb '#d62728' title 'B: one-shot + half Kalman', "
+      << "'' using 1:5 skip 1 with lines lw 1.5 lc rgb '#1f77b4' title 'D: standard + Kalman', "
+      << "'' using 1:6 skip 1 with lines lw 1.5 lc rgb '#2ca02c' title 'E: standard, no Kalman'\n";
+    run_gnuplot(opt.out_dir, "jitter.gp", g.str());
+  }
+  nlohmann::json j = common_json(ctx, opt);
+  j["experiment"] = "jitter";
+  j["jitter_release_max_us"] = jitter_us;
+  for (std::size_t i = 0; i < approaches.size(); ++i) j["cost"][std::string(1, info(approaches[i]).letter)] = results[i].cost.total();
+  j["files"] = {"jitter.csv", "jitter.png"};
+  return j;
+}
+
+nlohmann::json run_gain_experiment(const SimContext& ctx, const CommonOptions& opt, double duration_s, double p0_scale) {
+  make_directory(opt.out_dir);
+  const Scenario sc = demo_scenario("gain-demo", 20'000, 0.2, 1.0, duration_s);
+  const std::array<Approach, 3> approaches = {Approach::kB, Approach::kC, Approach::kA};
+  std::vector<RunResult> results(approaches.size());
+  for (std::size_t i = 0; i < approaches.size(); ++i) {
+    RunOptions ro = base_options(opt, approaches[i]);
+    ro.record_jobs = true;
+    ro.p0_scale = p0_scale;
+    results[i] = simulate(ctx, sc, opt.seed, ro);
+  }
+  std::vector<std::vector<double>> rows;
+  double spread[3] = {0, 0, 0};
+  for (std::size_t k = 0; k < results[0].job_records.size(); ++k) {
+    std::vector<double> row = {static_cast<double>(k)};
+    for (std::size_t i = 0; i < 3; ++i) {
+      row.push_back(results[i].job_records[k].t_sample_s);
+      row.push_back(results[i].job_records[k].gain0);
+    }
+    rows.push_back(row);
+  }
+  // Spread of K₁ over the second half (after convergence): jitter moves the half/complete gains.
+  for (std::size_t i = 0; i < 3; ++i) {
+    double lo = 1e300;
+    double hi = -1e300;
+    const auto& jr = results[i].job_records;
+    for (std::size_t k = jr.size() / 2; k < jr.size(); ++k) {
+      lo = std::min(lo, jr[k].gain0);
+      hi = std::max(hi, jr[k].gain0);
+    }
+    spread[i] = hi - lo;
+  }
+  write_csv(path_in(opt, "gain.csv"), {"job", "t_half_s", "K1_half", "t_complete_s", "K1_complete", "t_standard_s", "K1_standard"},
+            rows);
+  if (opt.plots) {
+    std::ostringstream g;
+    g << png_terminal() << "set output 'gain.png'\nset datafile separator ','\nset key top right box opaque\nset grid\n"
+      << "set title 'First Kalman gain element over time (P0 = " << p0_scale << " x steady state)'\n"
+      << "set xlabel 'time (s)'\nset ylabel 'K(1)'\n"
+      << "plot 'gain.csv' using 2:3 skip 1 with linespoints pt 7 ps 0.6 lw 1.5 lc rgb '#d62728' title 'half Kalman (one-shot, jitter)', "
+      << "'' using 4:5 skip 1 with linespoints pt 6 ps 0.9 lw 1 dt 2 lc rgb '#9467bd' title 'complete Kalman (one-shot, jitter)', "
+      << "'' using 6:7 skip 1 with linespoints pt 5 ps 0.5 lw 1.5 lc rgb '#1f77b4' title 'standard controller + Kalman, no jitter'\n";
+    run_gnuplot(opt.out_dir, "gain.gp", g.str());
+  }
+  nlohmann::json j = common_json(ctx, opt);
+  j["experiment"] = "gain";
+  j["p0_scale"] = p0_scale;
+  j["steady_state_K1"] = ctx.design().kalman_gain(0, 0);
+  j["final_K1"] = {{"half", results[0].job_records.back().gain0},
+                   {"complete", results[1].job_records.back().gain0},
+                   {"standard", results[2].job_records.back().gain0}};
+  j["K1_spread_second_half"] = {{"half", spread[0]}, {"complete", spread[1]}, {"standard", spread[2]}};
+  j["files"] = {"gain.csv", "gain.png"};
+  return j;
+}
+
+nlohmann::json run_table1(const SimContext& ctx, const CommonOptions& opt, const std::vector<Scenario>& scenarios,
+                          std::size_t seeds) {
+  make_directory(opt.out_dir);
+  if (seeds < 2) throw std::invalid_argument("table1 needs at least 2 seeds for confidence intervals");
+  for (const Scenario& s : scenarios) validate_scenario(s, ctx.plant());
+  const std::size_t na = kAllApproaches.size();
+  const std::size_t ns = scenarios.size();
+  // cost[a][s][seed]
+  std::vector<std::vector<std::vector<double>>> cost(na, std::vector<std::vector<double>>(ns, std::vector<double>(seeds)));
+  const auto start = Clock::now();
+  {
+    ProgressBar bar("table1", ns * seeds);
+    parallel_for(ns * seeds, worker_count(opt.threads), &bar, [&](std::size_t task) {
+      const std::size_t s = task / seeds;
+      const std::size_t k = task % seeds;
+      for (std::size_t a = 0; a < na; ++a) {
+        cost[a][s][k] = simulate(ctx, scenarios[s], opt.seed + k, base_options(opt, kAllApproaches[a])).cost.total();
+      }
+    });
+  }
+  const double wall = std::chrono::duration<double>(Clock::now() - start).count();
+  // Per seed: mean over scenarios; then mean and CI over seeds; ratios paired per seed.
+  std::vector<std::vector<double>> per_seed(na, std::vector<double>(seeds, 0));
+  for (std::size_t a = 0; a < na; ++a)
+    for (std::size_t k = 0; k < seeds; ++k) {
+      for (std::size_t s = 0; s < ns; ++s) per_seed[a][k] += cost[a][s][k] / static_cast<double>(ns);
+    }
+  nlohmann::json j = common_json(ctx, opt);
+  j["experiment"] = "table1";
+  j["scenarios"] = ns;
+  j["seeds"] = seeds;
+  double simulated = 0;
+  for (const Scenario& s : scenarios) simulated += s.duration_s;
+  j["runs"] = na * ns * seeds;
+  j["simulated_seconds"] = simulated * static_cast<double>(na * seeds);
+  j["wall_time_s"] = wall;
+  j["threads"] = worker_count(opt.threads);
+  std::ostringstream md;
+  md << "| approach | description | mean cost J | 95 % CI | ratio to A | ratio 95 % CI |\n|---|---|---|---|---|---|\n";
+  std::vector<std::vector<double>> csv_rows;
+  for (std::size_t a = 0; a < na; ++a) {
+    const Summary c = summarize(per_seed[a]);
+    std::vector<double> ratios(seeds);
+    for (std::size_t k = 0; k < seeds; ++k) ratios[k] = per_seed[a][k] / per_seed[0][k];
+    const Summary r = summarize(ratios);
+    const std::string letter(1, info(kAllApproaches[a]).letter);
+    j["approaches"][letter] = {{"description", info(kAllApproaches[a]).description},
+                               {"cost_mean", c.mean},
+                               {"cost_ci95", c.ci95},
+                               {"ratio_to_A", c.mean / summarize(per_seed[0]).mean},
+                               {"ratio_mean", r.mean},
+                               {"ratio_ci95", r.ci95}};
+    char line[256];
+    std::snprintf(line, sizeof line, "| %s | %s | %.5f | ± %.5f | %.4f | ± %.4f |\n", letter.c_str(),
+                  info(kAllApproaches[a]).description, c.mean, c.ci95, c.mean / summarize(per_seed[0]).mean, r.ci95);
+    md << line;
+    csv_rows.push_back({static_cast<double>(a), c.mean, c.ci95, r.mean, r.ci95});
+  }
+  // Per-scenario table: mean cost and ratio to A.
+  std::ostringstream per;
+  per << "| scenario | jitter | amplitude (V) | change period (s) | A | B/A | C/A | D/A | E/A |\n|---|---|---|---|---|---|---|---|---|\n";
+  nlohmann::json js = nlohmann::json::array();
+  for (std::size_t s = 0; s < ns; ++s) {
+    std::vector<double> mean(na);
+    for (std::size_t a = 0; a < na; ++a) mean[a] = summarize(cost[a][s]).mean;
+    char line[320];
+    std::snprintf(line, sizeof line, "| %s | %s | %.2f | %.2f | %.5f | %.4f | %.4f | %.4f | %.4f |\n",
+                  scenarios[s].name.c_str(), scenarios[s].jitter.describe().c_str(), scenarios[s].amplitude_volts,
+                  scenarios[s].change_period_s, mean[0], mean[1] / mean[0], mean[2] / mean[0], mean[3] / mean[0],
+                  mean[4] / mean[0]);
+    per << line;
+    nlohmann::json e = {{"name", scenarios[s].name}, {"jitter", scenarios[s].jitter.describe()},
+                        {"amplitude_volts", scenarios[s].amplitude_volts}, {"change_period_s", scenarios[s].change_period_s},
+                        {"duration_s", scenarios[s].duration_s}};
+    for (std::size_t a = 0; a < na; ++a) e["cost_mean"][std::string(1, info(kAllApproaches[a]).letter)] = mean[a];
+    js.push_back(e);
+  }
+  j["per_scenario"] = js;
+  j["markdown"] = md.str();
+  j["markdown_per_scenario"] = per.str();
+  {
+    std::ofstream out(path_in(opt, "table1.md"));
+    out << "Table I: mean cost over " << ns << " scenarios, " << seeds << " seeds each (" << to_string(opt.format)
+        << ", " << to_string(opt.discretizer) << ")\n\n" << md.str() << "\nPer scenario (mean over seeds):\n\n" << per.str();
+  }
+  std::vector<std::vector<double>> raw;
+  for (std::size_t a = 0; a < na; ++a)
+    for (std::size_t s = 0; s < ns; ++s)
+      for (std::size_t k = 0; k < seeds; ++k)
+        raw.push_back({static_cast<double>(a), static_cast<double>(s), static_cast<double>(opt.seed + k), cost[a][s][k]});
+  write_csv(path_in(opt, "table1_runs.csv"), {"approach_index", "scenario_index", "seed", "cost"}, raw);
+  write_csv(path_in(opt, "table1.csv"), {"approach_index", "cost_mean", "cost_ci95", "ratio_mean", "ratio_ci95"}, csv_rows);
+  if (opt.plots) {
+    std::ostringstream g;
+    g << png_terminal() << "set output 'table1.png'\nset datafile separator ','\nset grid ytics\nset style fill solid 0.6\n"
+      << "set boxwidth 0.6\nset xtics ('A' 0, 'B' 1, 'C' 2, 'D' 3, 'E' 4)\nset xrange [-0.6:4.6]\nset yrange [0:*]\n"
+      << "set title 'Table I: mean control cost over " << ns << " scenarios x " << seeds << " seeds (95 % CI)'\n"
+      << "set ylabel 'cost J'\nset key off\n"
+      << "plot 'table1.csv' using 1:2 skip 1 with boxes lc rgb '#4c72b0', '' using 1:2:3 skip 1 with yerrorbars pt 0 lw 2 lc rgb 'black'\n";
+    run_gnuplot(opt.out_dir, "table1.gp", g.str());
+  }
+  j["files"] = {"table1.md", "table1.csv", "table1_runs.csv", "table1.png"};
+  return j;
+}
+
+namespace {
+
+struct Variant {
+  const char* name;
+  Approach approach;
+  DiscretizerKind discretizer;
+};
+constexpr std::array<Variant, 4> kVariants = {{{"half_table", Approach::kB, DiscretizerKind::kTable},
+                                               {"half_generic", Approach::kB, DiscretizerKind::kGeneric},
+                                               {"complete_table", Approach::kC, DiscretizerKind::kTable},
+                                               {"complete_generic", Approach::kC, DiscretizerKind::kGeneric}}};
+
+/// The jobs of 4 s of operation of the reference jitter scenario (approach B).
+std::vector<JobRecord> exectime_jobs(const SimContext& ctx, const CommonOptions& opt) {
+  const Scenario sc = demo_scenario("exectime", 20'000, 0.2, 1.0, 4.0);
+  RunOptions ro = base_options(opt, Approach::kB);
+  ro.record_jobs = true;
+  return simulate(ctx, sc, opt.seed, ro).job_records;
+}
+
+const Variant& find_variant(const std::string& name) {
+  for (const Variant& v : kVariants)
+    if (name == v.name) return v;
+  throw std::invalid_argument("unknown variant '" + name + "'");
+}
+
+std::string run_capture(const std::string& command, int& exit_code) {
+  FILE* pipe = ::popen((command + " 2>&1").c_str(), "r");
+  if (pipe == nullptr) {
+    exit_code = -1;
+    return {};
+  }
+  std::string out;
+  std::array<char, 4096> buf{};
+  std::size_t n = 0;
+  while ((n = std::fread(buf.data(), 1, buf.size(), pipe)) > 0) out.append(buf.data(), n);
+  const int status = ::pclose(pipe);
+  exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  return out;
+}
+
+/// Instructions of one replay under callgrind, or −1 when valgrind is unavailable.
+double callgrind_instructions(const std::string& self, const CommonOptions& opt, const std::string& extra_args,
+                              const std::string& variant) {
+#if defined(__SANITIZE_ADDRESS__)
+  return -1;  // valgrind cannot run an AddressSanitizer binary
+#endif
+  int code = 0;
+  run_capture("valgrind --version", code);
+  if (code != 0) return -1;
+  const std::string out_file = path_in(opt, "callgrind." + variant + ".out");
+  const std::string cmd = "valgrind --tool=callgrind --collect-atstart=no --toggle-collect=oneshot_exectime_replay "
+                          "--callgrind-out-file='" + out_file + "' '" + self + "' exectime-probe --variant " + variant +
+                          " " + extra_args;
+  const std::string output = run_capture(cmd, code);
+  if (code != 0) throw std::runtime_error("callgrind run failed:\n" + output);
+  std::ifstream in(out_file);
+  std::string line;
+  double total = -1;
+  while (std::getline(in, line)) {
+    if (line.rfind("summary:", 0) == 0 || line.rfind("totals:", 0) == 0) total = std::stod(line.substr(line.find(':') + 1));
+  }
+  if (total < 0) throw std::runtime_error(out_file + ": no instruction total");
+  return total;
+}
+
+}  // namespace
+
+int run_exectime_probe(const SimContext& ctx, const CommonOptions& opt, const std::string& variant) {
+  const Variant& v = find_variant(variant);
+  const std::vector<JobRecord> jobs = exectime_jobs(ctx, opt);
+  RunOptions ro = base_options(opt, v.approach);
+  ro.discretizer = v.discretizer;
+  with_job_replay(ctx, ro, jobs, [&](const std::function<void()>& replay) { oneshot_exectime_replay(&replay); });
+  std::cout << jobs.size() << "\n";
+  return 0;
+}
+
+nlohmann::json run_exectime(const SimContext& ctx, const CommonOptions& opt, const std::string& self_path) {
+  make_directory(opt.out_dir);
+  const std::vector<JobRecord> jobs = exectime_jobs(ctx, opt);
+  const double jobs_per_4s = static_cast<double>(jobs.size());
+  nlohmann::json j = common_json(ctx, opt);
+  j["experiment"] = "exectime";
+  j["target"] = "host";
+  j["jobs_per_4s"] = jobs.size();
+  const auto measure = [&](NoiseModel noise) {
+    CommonOptions o = opt;
+    o.noise = noise;
+    std::string extra = std::string("--number-format ") + to_string(o.format) + " --noise-model " +
+                        (noise == NoiseModel::kExact ? "exact" : "constant") + " --seed " + std::to_string(o.seed);
+    if (!ctx.generated()) extra += " --plant '" + ctx.plant().source + "'";
+    nlohmann::json variants;
+    for (const Variant& v : kVariants) {
+      RunOptions ro = base_options(o, v.approach);
+      ro.discretizer = v.discretizer;
+      double best_ns = 1e300;
+      with_job_replay(ctx, ro, jobs, [&](const std::function<void()>& replay) {
+        // Batches of replays lasting ≥ 50 ms each; the fastest batch is the least disturbed.
+        for (int batch = 0; batch < 7; ++batch) {
+          std::size_t reps = 0;
+          const auto t0 = Clock::now();
+          auto t1 = t0;
+          do {
+            replay();
+            ++reps;
+            t1 = Clock::now();
+          } while (t1 - t0 < std::chrono::milliseconds(50));
+          const double ns = std::chrono::duration<double, std::nano>(t1 - t0).count() /
+                            (static_cast<double>(reps) * jobs_per_4s);
+          best_ns = std::min(best_ns, ns);
+        }
+      });
+      const double instructions = self_path.empty() ? -1 : callgrind_instructions(self_path, o, extra, v.name);
+      nlohmann::json e = {{"host_ns_per_job", best_ns}, {"host_us_per_4s", best_ns * jobs_per_4s * 1e-3}};
+      if (instructions >= 0) {
+        e["host_instructions_per_job"] = instructions / jobs_per_4s;
+        e["host_instructions_per_4s"] = instructions;
+      } else {
+        e["host_instructions_per_job"] = nullptr;
+        e["note"] = "valgrind not available (not installed, or a sanitizer build): instruction counts skipped";
+      }
+      variants[v.name] = e;
+    }
+    return variants;
+  };
+  const NoiseModel other = opt.noise == NoiseModel::kExact ? NoiseModel::kConstant : NoiseModel::kExact;
+  const char* primary_name = opt.noise == NoiseModel::kExact ? "exact" : "constant";
+  const char* other_name = opt.noise == NoiseModel::kExact ? "constant" : "exact";
+  j["variants"] = measure(opt.noise);
+  j["variants_by_noise_model"][primary_name] = j["variants"];
+  j["variants_by_noise_model"][other_name] = measure(other);
+  std::vector<std::vector<double>> rows;
+  for (const Variant& v : kVariants) {
+    const auto& p = j["variants_by_noise_model"][primary_name][v.name];
+    const auto& q = j["variants_by_noise_model"][other_name][v.name];
+    const auto ins = [](const nlohmann::json& e) {
+      return e["host_instructions_per_job"].is_null() ? 0.0 : e["host_instructions_per_job"].get<double>();
+    };
+    rows.push_back({static_cast<double>(rows.size()), p["host_us_per_4s"].get<double>(), ins(p),
+                    q["host_us_per_4s"].get<double>(), ins(q)});
+  }
+  write_csv(path_in(opt, "exectime.csv"),
+            {"variant_index", std::string("us_per_4s_") + primary_name, std::string("instructions_per_job_") + primary_name,
+             std::string("us_per_4s_") + other_name, std::string("instructions_per_job_") + other_name},
+            rows);
+  if (opt.plots) {
+    std::ostringstream g;
+    g << png_terminal() << "set output 'exectime.png'\nset datafile separator ','\nset grid ytics\nset style fill solid 0.7\n"
+      << "set boxwidth 0.35\nset xtics (\"half\\ntable\" 0, \"half\\ngeneric\" 1, \"complete\\ntable\" 2, \"complete\\ngeneric\" 3)\n"
+      << "set xrange [-0.6:3.6]\nset yrange [0:*]\nset offsets 0,0,graph 0.08,0\nset bmargin 4\nset key top left\n"
+      << "set multiplot layout 1,2 title 'Control job over 4 s of operation (" << jobs.size() << " jobs, "
+      << to_string(opt.format) << ", host)'\n"
+      << "set ylabel 'accumulated execution time (us)'\n"
+      << "plot 'exectime.csv' using ($1-0.18):2 skip 1 with boxes lc rgb '#4c72b0' title '" << primary_name << " Q', "
+      << "'' using ($1+0.18):4 skip 1 with boxes lc rgb '#dd8452' title '" << other_name << " Q'\n"
+      << "set ylabel 'instructions per job (callgrind)'\n"
+      << "plot 'exectime.csv' using ($1-0.18):3 skip 1 with boxes lc rgb '#4c72b0' title '" << primary_name << " Q', "
+      << "'' using ($1+0.18):5 skip 1 with boxes lc rgb '#dd8452' title '" << other_name << " Q'\n"
+      << "unset multiplot\n";
+    run_gnuplot(opt.out_dir, "exectime.gp", g.str());
+  }
+  j["files"] = {"exectime.csv", "exectime.png"};
+  return j;
+}
+
+nlohmann::json run_single(const SimContext& ctx, const CommonOptions& opt, const Scenario& scenario, Approach approach,
+                          std::int32_t trace_step_us) {
+  make_directory(opt.out_dir);
+  RunOptions ro = base_options(opt, approach);
+  ro.record_jobs = true;
+  ro.trace_step_us = trace_step_us;
+  const RunResult r = simulate(ctx, scenario, opt.seed, ro);
+  const std::size_t n = ctx.plant().n();
+  std::vector<std::vector<double>> rows;
+  for (const JobRecord& jr : r.job_records) {
+    std::vector<double> row = {jr.t_sample_s, jr.t_apply_s, static_cast<double>(jr.tau_us), jr.y_volts};
+    row.insert(row.end(), jr.x_true.begin(), jr.x_true.end());
+    row.insert(row.end(), jr.estimate.begin(), jr.estimate.end());
+    row.push_back(jr.gain0);
+    row.push_back(jr.setpoint_volts);
+    row.push_back(jr.u_volts);
+    rows.push_back(row);
+  }
+  std::vector<std::string> header = {"t_sample_s", "t_apply_s", "tau_us", "y_volts"};
+  for (std::size_t i = 0; i < n; ++i) header.push_back(state_label(ctx, i) + "_true_at_sample");
+  for (std::size_t i = 0; i < n; ++i) header.push_back(state_label(ctx, i) + "_estimate");
+  header.insert(header.end(), {"K1", "setpoint_volts", "u_volts"});
+  write_csv(path_in(opt, "run_jobs.csv"), header, rows);
+  if (trace_step_us > 0) {
+    std::vector<std::vector<double>> trace;
+    for (const TracePoint& p : r.trace) {
+      std::vector<double> row = {p.t_s};
+      row.insert(row.end(), p.x.begin(), p.x.end());
+      row.push_back(p.setpoint_volts);
+      row.push_back(p.u_volts);
+      trace.push_back(row);
+    }
+    std::vector<std::string> th = {"t_s"};
+    for (std::size_t i = 0; i < n; ++i) th.push_back(state_label(ctx, i));
+    th.insert(th.end(), {"setpoint_volts", "u_volts"});
+    write_csv(path_in(opt, "run_trace.csv"), th, trace);
+    if (opt.plots) {
+      std::ostringstream g;
+      g << png_terminal() << "set output 'run.png'\nset datafile separator ','\nset key outside right top\nset grid\n"
+        << "set multiplot layout 2,1 title 'Run: approach " << info(approach).letter << " (" << info(approach).description
+        << "), scenario " << scenario.name << ", seed " << opt.seed << "'\n"
+        << "set ylabel '" << state_label(ctx, 0) << " (V)'\nplot 'run_trace.csv' using 1:" << n + 2
+        << " skip 1 with lines dt 2 lc rgb 'black' title 'set-point', '' using 1:2 skip 1 with lines lw 2 lc rgb '#1f77b4' title 'true', "
+        << "'run_jobs.csv' using 2:" << 5 + n << " skip 1 with steps lc rgb '#d62728' title 'estimate'\n"
+        << "set xlabel 'time (s)'\nset ylabel 'u (V)'\nplot 'run_trace.csv' using 1:" << n + 3
+        << " skip 1 with steps lw 1.5 lc rgb '#2ca02c' title 'commanded input'\nunset multiplot\n";
+      run_gnuplot(opt.out_dir, "run.gp", g.str());
+    }
+  }
+  nlohmann::json j = common_json(ctx, opt);
+  j["experiment"] = "run";
+  j["approach"] = std::string(1, info(approach).letter);
+  j["scenario"] = scenario.name;
+  j["jitter"] = scenario.jitter.describe();
+  j["duration_s"] = r.duration_s;
+  j["cost"] = {{"total", r.cost.total()}, {"state", r.cost.state}, {"input", r.cost.input}, {"noise", r.cost.noise}};
+  j["jobs"] = r.jobs;
+  j["overruns"] = r.overruns;
+  j["faults"] = r.faults;
+  return j;
+}
+
+nlohmann::json run_benchmark(const SimContext& ctx, const CommonOptions& opt, double simulated_s) {
+  const Scenario sc = demo_scenario("benchmark", 20'000, 0.2, 1.0, simulated_s);
+  nlohmann::json j = common_json(ctx, opt);
+  j["experiment"] = "benchmark";
+  j["simulated_seconds_per_run"] = simulated_s;
+  for (Approach a : {Approach::kA, Approach::kB, Approach::kE}) {
+    double best = 0;
+    for (int rep = 0; rep < 3; ++rep) {
+      const auto t0 = Clock::now();
+      const RunResult r = simulate(ctx, sc, opt.seed + static_cast<std::uint64_t>(rep), base_options(opt, a));
+      const double wall = std::chrono::duration<double>(Clock::now() - t0).count();
+      best = std::max(best, r.duration_s / wall);
+    }
+    j["real_time_factor_one_core"][std::string(1, info(a).letter)] = best;
+  }
+  return j;
+}
+
+}  // namespace oneshot::sim

@@ -1,0 +1,137 @@
+/// @file scenario.cpp
+/// @brief Scenarios.
+#include "oneshot/sim/scenario.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+namespace oneshot::sim {
+namespace {
+
+Scenario make(const char* name, std::int32_t jitter_us, double amplitude, double change_period) {
+  Scenario s;
+  s.name = name;
+  s.duration_s = 20.0;
+  s.amplitude_volts = amplitude;
+  s.change_period_s = change_period;
+  s.jitter.kind = JitterModel::Kind::kUniform;
+  s.jitter.release_min_us = 0;
+  s.jitter.release_max_us = jitter_us;
+  s.jitter.exec_min_us = 200;  // a Kalman job on a 40-MIPS dsPIC
+  s.jitter.exec_max_us = 600;
+  return s;
+}
+
+double number(const nlohmann::json& j, const char* key, const std::string& field, double fallback, double lo,
+              double hi) {
+  const auto it = j.find(key);
+  if (it == j.end()) return fallback;
+  if (!it->is_number() || !(it->get<double>() >= lo && it->get<double>() <= hi)) {
+    std::ostringstream o;
+    o << "field '" << field << "." << key << "': must be a number in [" << lo << ", " << hi << "]";
+    throw ScenarioError(o.str());
+  }
+  return it->get<double>();
+}
+
+}  // namespace
+
+std::vector<Scenario> default_scenarios() {
+  // The brief's protocol: sampling jitter within 0–20 ms, set-point amplitudes and change
+  // frequencies around the ±0.2 V demonstration (README, "Table I scenarios").
+  return {
+      make("j5-a0.2-p1", 5'000, 0.2, 1.0),    make("j10-a0.2-p1", 10'000, 0.2, 1.0),
+      make("j15-a0.2-p1", 15'000, 0.2, 1.0),  make("j20-a0.2-p1", 20'000, 0.2, 1.0),
+      make("j20-a0.5-p1", 20'000, 0.5, 1.0),  make("j20-a1.0-p1", 20'000, 1.0, 1.0),
+      make("j20-a0.2-p0.5", 20'000, 0.2, 0.5), make("j20-a0.2-p2", 20'000, 0.2, 2.0),
+      make("j10-a0.5-p0.5", 10'000, 0.5, 0.5), make("j15-a1.0-p2", 15'000, 1.0, 2.0),
+  };
+}
+
+std::vector<Scenario> load_scenarios(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw ScenarioError(path + ": cannot read the scenario file");
+  nlohmann::json root;
+  try {
+    in >> root;
+  } catch (const nlohmann::json::exception& e) {
+    throw ScenarioError(path + ": not valid JSON: " + e.what());
+  }
+  const std::string base = std::filesystem::path(path).parent_path().string();
+  try {
+    if (!root.is_object() || !root.contains("scenarios") || !root["scenarios"].is_array() || root["scenarios"].empty()) {
+      throw ScenarioError("field 'scenarios': must be a non-empty array");
+    }
+    std::vector<Scenario> out;
+    for (std::size_t i = 0; i < root["scenarios"].size(); ++i) {
+      const nlohmann::json& j = root["scenarios"][i];
+      const std::string field = "scenarios[" + std::to_string(i) + "]";
+      if (!j.is_object()) throw ScenarioError("field '" + field + "': must be an object");
+      for (const auto& item : j.items()) {
+        if (item.key() != "name" && item.key() != "duration_s" && item.key() != "setpoint" && item.key() != "jitter") {
+          throw ScenarioError("field '" + field + "." + item.key() + "': unknown field");
+        }
+      }
+      Scenario s;
+      const auto name = j.find("name");
+      if (name == j.end() || !name->is_string() || name->get<std::string>().empty()) {
+        throw ScenarioError("field '" + field + ".name': must be a non-empty string");
+      }
+      s.name = name->get<std::string>();
+      s.duration_s = number(j, "duration_s", field, 20.0, 0.05, 1e5);
+      if (j.contains("setpoint")) {
+        const nlohmann::json& sp = j["setpoint"];
+        if (!sp.is_object()) throw ScenarioError("field '" + field + ".setpoint': must be an object");
+        s.amplitude_volts = number(sp, "amplitude_volts", field + ".setpoint", 0.2, 0.0, 1e3);
+        s.change_period_s = number(sp, "change_period_s", field + ".setpoint", 1.0, 1e-3, 1e5);
+      }
+      if (j.contains("jitter")) s.jitter = parse_jitter(j["jitter"], field + ".jitter", base);
+      out.push_back(s);
+    }
+    return out;
+  } catch (const ScenarioError& e) {
+    throw ScenarioError(path + ": " + e.what());
+  }
+}
+
+void validate_scenario(const Scenario& s, const design::PlantDescription& plant) {
+  const std::int32_t busy = s.jitter.max_busy_us();
+  if (busy >= plant.period_us) {
+    throw ScenarioError("scenario '" + s.name + "': release + execution can reach " + std::to_string(busy) +
+                        " us, not below the period of " + std::to_string(plant.period_us) +
+                        " us (the job would overrun its actuation instant)");
+  }
+  for (std::size_t o = 0; o < plant.p(); ++o) {
+    if (s.amplitude_volts >= plant.board.adc_max_volts[o] || -s.amplitude_volts <= plant.board.adc_min_volts[o]) {
+      throw ScenarioError("scenario '" + s.name + "': set-point amplitude is outside the ADC range");
+    }
+  }
+  if (s.duration_s * 1e6 < plant.period_us) throw ScenarioError("scenario '" + s.name + "': shorter than one period");
+}
+
+std::int32_t SetpointSchedule::code_at(std::int64_t t_ns) const {
+  const auto it = std::upper_bound(at_ns.begin(), at_ns.end(), t_ns);
+  return it == at_ns.begin() ? code.front() : code[static_cast<std::size_t>(it - at_ns.begin()) - 1];
+}
+
+SetpointSchedule make_schedule(const Scenario& s, const design::PlantDescription& plant, std::uint64_t seed) {
+  RandomStream rng(seed, "setpoint");
+  SetpointSchedule sch;
+  const double lsb = (plant.board.adc_max_volts[0] - plant.board.adc_min_volts[0]) / std::ldexp(1.0, plant.board.adc_bits);
+  const std::int64_t step = std::llround(s.change_period_s * 1e9);
+  const std::int64_t end = std::llround(s.duration_s * 1e9);
+  for (std::int64_t t = 0; t <= end; t += step) {
+    // The circuit starts at rest: reference 0 V until the first change.
+    const double v = t == 0 ? 0.0 : rng.uniform(-s.amplitude_volts, s.amplitude_volts);
+    // Nearest code whose bin centre (the sensor model's value) is v.
+    const double code = std::floor((v - plant.board.adc_min_volts[0]) / lsb);
+    sch.at_ns.push_back(t);
+    sch.code.push_back(static_cast<std::int32_t>(code));
+  }
+  return sch;
+}
+
+}  // namespace oneshot::sim

@@ -1,0 +1,174 @@
+/// @file simulation_test.cpp
+/// @brief The closed loop: task-model timing, reproducibility, scenario validation.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "oneshot/sim/scenario.hpp"
+#include "oneshot/sim/simulation.hpp"
+#include "oneshot/sim/statistics.hpp"
+#include "support/run_command.hpp"
+
+namespace oneshot::sim {
+namespace {
+
+Scenario short_scenario(std::int32_t jitter_us) {
+  Scenario s = default_scenarios()[3];  // j20-a0.2-p1
+  s.duration_s = 3;
+  s.jitter.release_max_us = jitter_us;
+  return s;
+}
+
+TEST(Simulation, OneShotTauIsTheTimeFromSampleToActuation) {
+  const auto ctx = SimContext::reference();
+  RunOptions o;
+  o.approach = Approach::kB;
+  o.record_jobs = true;
+  const RunResult r = simulate(*ctx, short_scenario(20'000), 3, o);
+  ASSERT_EQ(r.job_records.size(), 60U);
+  for (const JobRecord& j : r.job_records) {
+    EXPECT_NEAR(j.tau_us * 1e-6, j.t_apply_s - j.t_sample_s, 1e-9);
+    EXPECT_GE(j.tau_us, 30'000);  // release ≤ 20 ms after the previous actuation
+    EXPECT_LE(j.tau_us, 50'000);
+    // The actuation instants are exactly periodic.
+    EXPECT_NEAR(std::fmod(j.t_apply_s + 1e-12, 0.05), 0.0, 1e-9);
+  }
+  EXPECT_EQ(r.overruns, 0U);
+  EXPECT_EQ(r.faults, 0U);
+}
+
+TEST(Simulation, StandardTaskAssumesZeroDelayAndSamplesOnTheJitteredInstant) {
+  const auto ctx = SimContext::reference();
+  RunOptions o;
+  o.approach = Approach::kD;
+  o.record_jobs = true;
+  const RunResult r = simulate(*ctx, short_scenario(20'000), 3, o);
+  bool some_late = false;
+  for (std::size_t k = 0; k < r.job_records.size(); ++k) {
+    const JobRecord& j = r.job_records[k];
+    EXPECT_EQ(j.tau_us, 0);
+    const double release = j.t_sample_s - 0.05 * static_cast<double>(k);
+    EXPECT_GE(release, -1e-12);
+    EXPECT_LE(release, 0.020 + 1e-12);
+    some_late = some_late || release > 0.001;
+    EXPECT_GT(j.t_apply_s, j.t_sample_s);  // acts when the job finishes
+  }
+  EXPECT_TRUE(some_late);
+}
+
+TEST(Simulation, ApproachAIgnoresTheScenarioJitter) {
+  const auto ctx = SimContext::reference();
+  RunOptions o;
+  o.approach = Approach::kA;
+  o.record_jobs = true;
+  const RunResult r = simulate(*ctx, short_scenario(20'000), 3, o);
+  for (std::size_t k = 0; k < r.job_records.size(); ++k)
+    EXPECT_NEAR(r.job_records[k].t_sample_s, 0.05 * static_cast<double>(k), 1e-12);
+}
+
+TEST(Simulation, HalfAndCompleteCostTheSame) {
+  const auto ctx = SimContext::reference();
+  for (std::uint64_t seed : {1U, 2U}) {
+    RunOptions o;
+    o.approach = Approach::kB;
+    const double b = simulate(*ctx, short_scenario(20'000), seed, o).cost.total();
+    o.approach = Approach::kC;
+    const double c = simulate(*ctx, short_scenario(20'000), seed, o).cost.total();
+    EXPECT_NEAR(b, c, 1e-6 * b);
+  }
+}
+
+TEST(Simulation, GenericAndTableGiveTheSameLoop) {
+  const auto ctx = SimContext::reference();
+  RunOptions o;
+  o.approach = Approach::kB;
+  const double table = simulate(*ctx, short_scenario(20'000), 4, o).cost.total();
+  o.discretizer = DiscretizerKind::kGeneric;
+  const double generic = simulate(*ctx, short_scenario(20'000), 4, o).cost.total();
+  EXPECT_NEAR(table, generic, 1e-5 * table);
+}
+
+TEST(Simulation, SameSeedSameResultDifferentSeedDifferent) {
+  const auto ctx = SimContext::reference();
+  RunOptions o;
+  o.approach = Approach::kE;
+  const double a = simulate(*ctx, short_scenario(20'000), 9, o).cost.total();
+  const double b = simulate(*ctx, short_scenario(20'000), 9, o).cost.total();
+  const double c = simulate(*ctx, short_scenario(20'000), 10, o).cost.total();
+  EXPECT_EQ(a, b);
+  EXPECT_NE(a, c);
+}
+
+TEST(Simulation, RuntimePlantMatchesTheGeneratedConstants) {
+  // The reference loaded as a plant file (dense structure, run-time table) runs the same loop.
+  const auto generated = SimContext::reference();
+  const auto runtime = SimContext::from_plant(design::reference_plant());
+  RunOptions o;
+  o.approach = Approach::kB;
+  o.format = NumberFormat::kDouble;
+  const double g = simulate(*generated, short_scenario(20'000), 5, o).cost.total();
+  const double r = simulate(*runtime, short_scenario(20'000), 5, o).cost.total();
+  EXPECT_NEAR(g, r, 1e-9 * g);
+}
+
+TEST(Scenario, JobLongerThanThePeriodIsRefused) {
+  Scenario s = short_scenario(49'500);
+  try {
+    validate_scenario(s, design::reference_plant());
+    FAIL();
+  } catch (const ScenarioError& e) {
+    EXPECT_NE(std::string(e.what()).find("overrun"), std::string::npos) << e.what();
+  }
+}
+
+TEST(Scenario, ScheduleStartsAtRestAndUsesAdcCodes) {
+  const auto plant = design::reference_plant();
+  const SetpointSchedule s = make_schedule(short_scenario(0), plant, 1);
+  EXPECT_EQ(s.at_ns[0], 0);
+  EXPECT_EQ(s.code[0], 2048);  // the ADC bin holding 0 V (its centre is +0.4 mV)
+  EXPECT_EQ(s.at_ns[1], 1'000'000'000);
+  EXPECT_EQ(s.code_at(999'999'999), s.code[0]);
+  EXPECT_EQ(s.code_at(1'000'000'000), s.code[1]);
+}
+
+TEST(Scenario, FileErrorsNameTheField) {
+  const std::string bad = test::write_temp_file(
+      "bad_scenarios.json", R"({"scenarios": [{"name": "x", "jitter": {"model": "uniform", "release_max_us": -3}}]})");
+  try {
+    load_scenarios(bad);
+    FAIL();
+  } catch (const ScenarioError& e) {
+    EXPECT_NE(std::string(e.what()).find("scenarios[0].jitter.release_max_us"), std::string::npos) << e.what();
+  }
+  const std::string unknown = test::write_temp_file("unknown_scenarios.json", R"({"scenarios": [{"name": "x", "jiter": {}}]})");
+  EXPECT_THROW(load_scenarios(unknown), ScenarioError);
+}
+
+TEST(Scenario, TraceJitterIsReadAndChecked) {
+  const std::string good = test::write_temp_file("trace.csv", "release_us,exec_us\n1000,300\n# comment\n15000,450\n");
+  const auto t = load_jitter_trace(good);
+  ASSERT_EQ(t.size(), 2U);
+  EXPECT_EQ(t[1].release_us, 15000);
+  const std::string header = test::write_temp_file("trace_bad.csv", "a,b\n1,2\n");
+  EXPECT_THROW(load_jitter_trace(header), ScenarioError);
+  const std::string row = test::write_temp_file("trace_row.csv", "release_us,exec_us\n10,x\n");
+  try {
+    load_jitter_trace(row);
+    FAIL();
+  } catch (const ScenarioError& e) {
+    EXPECT_NE(std::string(e.what()).find("line 2"), std::string::npos) << e.what();
+  }
+}
+
+TEST(Statistics, StudentIntervalsMatchTables) {
+  EXPECT_NEAR(student_t975(1), 12.7062, 1e-4);
+  EXPECT_NEAR(student_t975(19), 2.0930, 1e-4);
+  EXPECT_NEAR(student_t975(60), 2.0003, 2e-4);
+  EXPECT_NEAR(student_t975(120), 1.9799, 2e-4);
+  const Summary s = summarize({1, 2, 3, 4});
+  EXPECT_DOUBLE_EQ(s.mean, 2.5);
+  EXPECT_NEAR(s.ci95, 3.1824 * std::sqrt(5.0 / 3.0) / 2, 1e-4);
+}
+
+}  // namespace
+}  // namespace oneshot::sim
