@@ -87,7 +87,7 @@ void emit_constants(std::ostringstream& o, const char* scalar, const PlantDescri
     << ", " << t.radix.size() << ", kRadix, kLevelOffset, " << t.entry_time_us.size() << ", "
     << static_cast<int>(t.slots) << ", " << static_cast<int>(t.transition_slots)
     << ", kPhiSlot, kGammaSlot, kQdSlot, kValues, kResidualLow, kResidualHigh, kResidualOffset, "
-    << t.residual_coefficients.size() << ", kResidualCoefficients};\n"
+    << t.residual_coefficients.size() << ", kResidualCoefficients, nullptr, nullptr};\n"
     << "  /// Continuous model per microsecond, for the generic routine.\n"
     << "  static constexpr ::oneshot::ContinuousModelPerUs<" << scalar << ", " << n << ", " << m << "> kModel{\n"
     << "      " << matrix<S>(scalar, a_us) << ",\n      " << matrix<S>(scalar, b_us) << ",\n      "

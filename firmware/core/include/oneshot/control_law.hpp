@@ -69,18 +69,19 @@ constexpr std::int32_t quantize_input(const ActuatorModel<Fmt, M>& actuator, std
   using In = typename Fmt::Input;
   const In offset = u - actuator.u_min[j];
   if (!(ScalarTraits<In>::zero() < offset)) return 0;
-  const auto steps = mul<typename Fmt::InverseInput>(offset, actuator.steps_per_volt[j]);
-  if (!(steps < ScalarTraits<typename Fmt::InverseInput>::from_int(actuator.steps))) return actuator.steps;
-  const std::int32_t code = ScalarTraits<typename Fmt::InverseInput>::round_to_int(steps);
+  using Steps = typename Fmt::ActuatorSteps;
+  const Steps steps = mul<Steps>(offset, actuator.steps_per_volt[j]);
+  if (!(steps < ScalarTraits<Steps>::from_int(actuator.steps))) return actuator.steps;
+  const std::int32_t code = ScalarTraits<Steps>::round_to_int(steps);
   return code > actuator.steps ? actuator.steps : code;
 }
 
 /// offset + code·step: the value of an integer converter code.
-template <typename S>
-constexpr S value_of_code(S offset, S step, std::int32_t code) {
+template <typename S, typename Step>
+constexpr S value_of_code(S offset, Step step, std::int32_t code) {
   Accumulator<S> acc;
   acc.add(offset);
-  acc.add_product(ScalarTraits<S>::from_int(code), step);
+  acc.add_product(count_of<S>(code), step);
   return acc.value();
 }
 

@@ -19,7 +19,7 @@ enum class NoiseModel : std::uint8_t {
 template <typename Fmt, std::size_t M>
 struct ActuatorModel {
   Vector<typename Fmt::Input, M> u_min;            ///< Input at code 0 (V).
-  Vector<typename Fmt::Input, M> volts_per_step;   ///< (u_max − u_min)/steps (V).
+  Vector<typename Fmt::CodeStep, M> volts_per_step;   ///< (u_max − u_min)/steps (V).
   Vector<typename Fmt::InverseInput, M> steps_per_volt;  ///< steps/(u_max − u_min) (1/V).
   std::int32_t steps;                              ///< Resolution steps (e.g. PWM period ticks).
 };
@@ -29,7 +29,7 @@ struct ActuatorModel {
 template <typename Fmt, std::size_t P>
 struct SensorModel {
   Vector<typename Fmt::State, P> y_offset;         ///< Value of code 0 (V).
-  Vector<typename Fmt::State, P> volts_per_code;   ///< One LSB (V).
+  Vector<typename Fmt::CodeStep, P> volts_per_code;   ///< One LSB (V).
 };
 
 /// Design results for an n-state, m-input, p-output plant (convention u = −L x).

@@ -18,10 +18,17 @@ struct UniformFormat {
   using State = S;         ///< x, y, set-points (V).
   using Input = S;         ///< u (V).
   using InverseInput = S;  ///< Actuator steps per volt (1/V).
+  using ActuatorSteps = S; ///< A (fractional) number of actuator steps.
+  using CodeStep = S;      ///< Volts per converter code (ADC LSB, PWM step).
   using KalmanGain = S;    ///< K (state unit per output unit).
   using FeedbackGain = S;  ///< L and the set-point feed-forward gains.
   using Fraction = S;      ///< Sub-grid residual r ∈ [0, 1) of the table.
   using Compute = S;       ///< Scalar of the generic matrix-exponential routine.
+  using ModelA = S;        ///< Entries of A per µs.
+  using ModelB = S;        ///< Entries of B per µs.
+  using ModelQc = S;       ///< Entries of Q_c·2^kQdScaleShift per µs.
+  /// Van Loan runs on Q_c·2^kQdScaleShift (fixed point keeps Q_d's tiny entries in range).
+  static constexpr int kQdScaleShift = 0;
 };
 
 }  // namespace oneshot

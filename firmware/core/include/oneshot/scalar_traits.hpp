@@ -57,12 +57,29 @@ struct ScalarTraits<F, std::enable_if_t<std::is_floating_point_v<F>>> {
   static constexpr double to_double(F v) { return static_cast<double>(v); }
   /// |v|.
   static constexpr F abs(F v) { return v < F(0) ? -v : v; }
+  /// num/den for run-time integers (table residual r = δ/g): num·(1/den), as in every build.
+  static constexpr F fraction(std::int32_t num, std::int32_t den) { return from_int(num) * from_ratio(1, den); }
   /// Nearest integer, halves away from zero; the caller keeps |v| < 2^31.
   static constexpr std::int32_t round_to_int(F v) {
     const F half = from_ratio(1, 2);
     return v < F(0) ? -static_cast<std::int32_t>(-v + half) : static_cast<std::int32_t>(v + half);
   }
 };
+
+/// Scalar holding an integer count (converter codes, τ in µs) next to format S:
+/// S itself when floating, Fixed<int32_t, 0> for fixed point (fixed_point.hpp).
+template <typename S, typename Enable = void>
+struct CountScalar {
+  using type = S;  ///< The count type.
+  /// v as a count.
+  static constexpr type make(std::int32_t v) { return static_cast<type>(v); }
+};
+
+/// v as the count type of format S.
+template <typename S>
+constexpr typename CountScalar<S>::type count_of(std::int32_t v) {
+  return CountScalar<S>::make(v);
+}
 
 /// True for the built-in floating types, false for fixed point.
 template <typename S>

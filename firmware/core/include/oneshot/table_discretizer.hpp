@@ -18,6 +18,7 @@
 #include "oneshot/assert_handler.hpp"
 #include "oneshot/discretization.hpp"
 #include "oneshot/status.hpp"
+#include "oneshot/table_storage.hpp"
 #include "oneshot/table_view.hpp"
 
 namespace oneshot {
@@ -127,7 +128,7 @@ class TableDiscretizer {
       const std::size_t entry = static_cast<std::size_t>(view_.level_offset[level]) +
                                 static_cast<std::size_t>(digit - 1);
       ONESHOT_ASSERT(entry < view_.entries);
-      const Triple e = expand(view_.values + entry * view_.slots, with_qd);
+      const Triple e = this->entry(entry, with_qd);
       d = have ? compose<Fmt, Structure>(d, e, with_qd) : e;
       have = true;
     }
@@ -135,29 +136,30 @@ class TableDiscretizer {
     return have ? d : Triple::identity();
   }
 
+  using Reader = TableStorage<Storage>;
+  using Slot = typename Reader::Slot;
+
   /// The triple over δ = residual_us < g from the slot polynomials in r = δ/g.
   constexpr Triple residual(std::int32_t residual_us, WithQd with_qd) const {
     using F = typename Fmt::Fraction;
-    const F r = ScalarTraits<F>::from_int(residual_us) *
-                ScalarTraits<F>::from_ratio(1, view_.granularity_us);
-    Storage slot_values[kMaxSlots]{};
+    const F r = ScalarTraits<F>::fraction(residual_us, view_.granularity_us);
+    Slot slot_values[kMaxSlots]{};
     ONESHOT_ASSERT(view_.slots <= kMaxSlots);
     const std::uint8_t used = with_qd == WithQd::kYes ? view_.slots : view_.transition_slots;
-    for (std::uint8_t s = 0; s < used; ++s) {
-      const Storage* c = view_.residual_coefficients + view_.residual_offset[s];  // c[k] ↔ r^(low+k)
-      const std::uint8_t low = view_.residual_low[s];
-      const std::uint8_t high = view_.residual_high[s];
-      // p(r) = r^low · (c_low + r·(c_low+1 + … + r·c_high)), Horner.
-      Storage v = c[high - low];
-      for (std::uint8_t k = high; k > low; --k) v = v * r + c[k - 1 - low];
-      for (std::uint8_t k = 0; k < low; ++k) v = v * r;
-      slot_values[s] = v;
-    }
+    for (std::uint8_t s = 0; s < used; ++s) slot_values[s] = Reader::residual(view_, s, r);
+    return expand(slot_values, with_qd);
+  }
+
+  /// The triple of stored entry `entry`.
+  constexpr Triple entry(std::size_t entry, WithQd with_qd) const {
+    Slot slot_values[kMaxSlots]{};
+    const std::uint8_t used = with_qd == WithQd::kYes ? view_.slots : view_.transition_slots;
+    for (std::uint8_t s = 0; s < used; ++s) slot_values[s] = Reader::entry(view_, entry, s);
     return expand(slot_values, with_qd);
   }
 
   /// Matrices from one entry's free values.
-  constexpr Triple expand(const Storage* slot_values, WithQd with_qd) const {
+  constexpr Triple expand(const Slot* slot_values, WithQd with_qd) const {
     Triple d;
     for (std::size_t i = 0; i < kN; ++i) {
       for (std::size_t j = 0; j < kN; ++j)
@@ -174,10 +176,10 @@ class TableDiscretizer {
   }
 
   template <typename To>
-  static constexpr To pick(std::int8_t slot, const Storage* slot_values) {
+  static constexpr To pick(std::int8_t slot, const Slot* slot_values) {
     if (slot == kSlotZero) return ScalarTraits<To>::zero();
     if (slot == kSlotOne) return ScalarTraits<To>::one();
-    return convert<To>(slot_values[slot]);
+    return Reader::template to<To>(slot_values[slot]);
   }
 
   /// Free values per entry supported (n² + nm + n(n+1)/2 for n ≤ 4, m ≤ 2 is 34).

@@ -23,9 +23,37 @@ inline constexpr std::int8_t kSlotZero = -1;
 /// Slot code of an entry that is structurally one.
 inline constexpr std::int8_t kSlotOne = -2;
 
+/// Table storage in block floating point: 16-bit mantissas of entry values and 32-bit
+/// mantissas of residual coefficients, each slot with its own scale 2^−frac.
+struct BlockFixedStorage {};
+
+/// A 16-bit table mantissa (its scale is the slot's value_frac).
+struct Mantissa16 {
+  std::int16_t raw;  ///< Mantissa.
+};
+/// A 32-bit residual-coefficient mantissa (its scale is the slot's residual_frac).
+struct Mantissa32 {
+  std::int32_t raw;  ///< Mantissa.
+};
+
+/// Element types of a table: floating tables store the scalar itself.
+template <typename Storage>
+struct TableElements {
+  using Value = Storage;        ///< Entry values.
+  using Coefficient = Storage;  ///< Residual coefficients.
+};
+/// Block floating point tables.
+template <>
+struct TableElements<BlockFixedStorage> {
+  using Value = Mantissa16;        ///< Entry values.
+  using Coefficient = Mantissa32;  ///< Residual coefficients.
+};
+
 /// Read-only description of a table whose values are stored as `Storage`.
 template <typename Storage>
 struct TableView {
+  using Value = typename TableElements<Storage>::Value;              ///< Entry value type.
+  using Coefficient = typename TableElements<Storage>::Coefficient;  ///< Residual coefficient type.
   std::int32_t granularity_us;          ///< Grid step g (µs).
   std::int32_t range_us;                ///< Covered range [0, range] (µs), a multiple of g.
   std::uint8_t levels;                  ///< Number of radix levels (≥ 1).
@@ -37,23 +65,28 @@ struct TableView {
   const std::int8_t* phi_slot;          ///< n×n slot map of Φ (kSlotZero/kSlotOne/slot).
   const std::int8_t* gamma_slot;        ///< n×m slot map of Γ.
   const std::int8_t* qd_slot;           ///< n×n slot map of Q_d (symmetric).
-  const Storage* values;                ///< entries × slots values, entry-major.
+  const Value* values;                  ///< entries × slots values, entry-major.
   const std::uint8_t* residual_low;     ///< Lowest degree of each slot polynomial.
   const std::uint8_t* residual_high;    ///< Highest degree of each slot polynomial.
   const std::uint8_t* residual_offset;  ///< First coefficient of each slot polynomial.
   std::uint8_t residual_count;          ///< Number of stored residual coefficients.
-  const Storage* residual_coefficients; ///< Per slot, degrees low … high, ascending.
+  const Coefficient* residual_coefficients;  ///< Per slot, degrees low … high, ascending.
+  const std::int8_t* value_frac;        ///< Block fixed: scale 2^−frac of each slot's values.
+  const std::int8_t* residual_frac;     ///< Block fixed: scale of each slot's coefficients.
 };
 
 /// Every byte of plant-specific data the look-up reads: values, residual coefficients,
 /// slot maps, level arrays and residual indices.
 template <typename Storage>
 constexpr std::size_t table_bytes(const TableView<Storage>& v, std::size_t n, std::size_t m) {
-  const std::size_t values = sizeof(Storage) * (static_cast<std::size_t>(v.entries) * v.slots + v.residual_count);
+  using V = typename TableView<Storage>::Value;
+  using C = typename TableView<Storage>::Coefficient;
+  const std::size_t values = sizeof(V) * static_cast<std::size_t>(v.entries) * v.slots + sizeof(C) * v.residual_count;
   const std::size_t maps = n * n + n * m + n * n;                  // int8 slot maps
   const std::size_t levels = 2 * sizeof(std::uint16_t) * v.levels;  // radix + offset
   const std::size_t residual_index = 3U * v.slots;                 // low, high, offset
-  return values + maps + levels + residual_index;
+  const std::size_t scales = v.value_frac != nullptr ? 2U * v.slots : 0U;  // block fixed scales
+  return values + maps + levels + residual_index + scales;
 }
 
 }  // namespace oneshot

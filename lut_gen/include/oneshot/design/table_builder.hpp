@@ -58,7 +58,9 @@ struct TableData {
                         residual_high.data(),
                         residual_offset.data(),
                         static_cast<std::uint8_t>(residual_coefficients.size()),
-                        residual_coefficients.data()};
+                        residual_coefficients.data(),
+                        nullptr,
+                        nullptr};
   }
   /// Every byte the look-up reads (see table_bytes()).
   std::size_t bytes() const { return table_bytes(view(), n, m); }

@@ -1,0 +1,270 @@
+/// @file fixed_point.hpp
+/// @brief Q-format fixed-point scalars: distinct types, saturating, rounding.
+///
+/// Fixed<Storage, F> holds value = raw · 2^−F in a 16- or 32-bit signed integer (F may
+/// exceed the storage width for small quantities, or be negative for large ones). Every
+/// operation rounds to nearest (ties away from zero) and saturates; a saturation sets
+/// the sticky flag saturation_flag() that the firmware can read and clear. Products of
+/// two 16-bit formats are one 16×16→32 multiply; 32×16 products use two such multiplies
+/// (exact, no 64-bit multiply routine); sums go through Accumulator's 64-bit register.
+#pragma once
+
+#include <cstdint>
+#include <limits>
+#include <type_traits>
+
+#include "oneshot/accumulator.hpp"
+#include "oneshot/scalar_traits.hpp"
+
+#if defined(__STDC_HOSTED__) && __STDC_HOSTED__ && !defined(ONESHOT_NO_THREAD_LOCAL)
+#define ONESHOT_STICKY_STORAGE thread_local
+#else
+#define ONESHOT_STICKY_STORAGE  // bare metal: one thread of control plus interrupts
+#endif
+
+namespace oneshot {
+
+namespace detail {
+/// The sticky saturation flag (one per thread on hosted builds).
+inline ONESHOT_STICKY_STORAGE bool g_saturated = false;
+
+/// 2^e as a double, e in [−126, 126] (constexpr, exact).
+constexpr double pow2(int e) {
+  double r = 1.0;
+  for (int i = 0; i < e; ++i) r *= 2.0;
+  for (int i = 0; i > e; --i) r *= 0.5;
+  return r;
+}
+
+/// v · 2^−shift rounded to nearest (ties away from zero); shift may be ≤ 0.
+constexpr std::int64_t round_shift(std::int64_t v, int shift) {
+  if (shift <= 0) return v * (std::int64_t{1} << -shift);  // callers keep this in range
+  const std::int64_t half = std::int64_t{1} << (shift - 1);
+  return v >= 0 ? (v + half) >> shift : -((-v + half) >> shift);
+}
+
+/// Clamps v into Storage, raising the sticky flag when it does not fit.
+template <typename Storage>
+constexpr Storage saturate(std::int64_t v) {
+  constexpr std::int64_t lo = std::numeric_limits<Storage>::min();
+  constexpr std::int64_t hi = std::numeric_limits<Storage>::max();
+  if (v > hi) {
+    g_saturated = true;
+    return static_cast<Storage>(hi);
+  }
+  if (v < lo) {
+    g_saturated = true;
+    return static_cast<Storage>(lo);
+  }
+  return static_cast<Storage>(v);
+}
+
+/// Exact product of two 16-bit or 32-bit integers; 32×16 uses two 16×16 products.
+template <typename A, typename B>
+constexpr std::int64_t wide_product(A a, B b) {
+  if constexpr (sizeof(A) <= 2 && sizeof(B) <= 2) {
+    return static_cast<std::int32_t>(a) * static_cast<std::int32_t>(b);
+  } else if constexpr (sizeof(A) == 4 && sizeof(B) <= 2) {
+    const std::int32_t hi = (a >> 16) * static_cast<std::int32_t>(b);
+    const std::int32_t lo = static_cast<std::int32_t>(static_cast<std::uint32_t>(a) & 0xFFFFU) * static_cast<std::int32_t>(b);
+    return static_cast<std::int64_t>(hi) * 65536 + lo;
+  } else if constexpr (sizeof(A) <= 2 && sizeof(B) == 4) {
+    return wide_product(b, a);
+  } else {
+    return static_cast<std::int64_t>(a) * static_cast<std::int64_t>(b);
+  }
+}
+}  // namespace detail
+
+/// True when a fixed-point operation has saturated since the last clear.
+inline bool saturation_flag() { return detail::g_saturated; }
+/// Clears the sticky saturation flag.
+inline void clear_saturation_flag() { detail::g_saturated = false; }
+
+/// value = raw · 2^−kFrac, stored in Storage (int16_t or int32_t).
+template <typename Storage, int kFracBits>
+class Fixed {
+  static_assert(std::is_same_v<Storage, std::int16_t> || std::is_same_v<Storage, std::int32_t>,
+                "fixed-point storage is int16_t or int32_t");
+  static_assert(kFracBits > -32 && kFracBits < 63, "fractional bits out of the supported range");
+
+ public:
+  using StorageType = Storage;                  ///< The integer holding the value.
+  static constexpr int kFrac = kFracBits;       ///< Fractional bits.
+  static constexpr int kBits = sizeof(Storage) * 8;  ///< Storage width.
+
+  /// Zero.
+  constexpr Fixed() = default;
+  /// From a raw mantissa (the only way to read an integer as this format).
+  static constexpr Fixed from_raw(Storage raw) {
+    Fixed f;
+    f.raw_ = raw;
+    return f;
+  }
+  /// The raw mantissa.
+  constexpr Storage raw() const { return raw_; }
+
+  /// Largest representable value.
+  static constexpr double max_value() { return static_cast<double>(std::numeric_limits<Storage>::max()) * detail::pow2(-kFrac); }
+  /// One unit in the last place.
+  static constexpr double resolution() { return detail::pow2(-kFrac); }
+
+  /// Saturating sum.
+  friend constexpr Fixed operator+(Fixed a, Fixed b) {
+    return from_raw(detail::saturate<Storage>(static_cast<std::int64_t>(a.raw_) + b.raw_));
+  }
+  /// Saturating difference.
+  friend constexpr Fixed operator-(Fixed a, Fixed b) {
+    return from_raw(detail::saturate<Storage>(static_cast<std::int64_t>(a.raw_) - b.raw_));
+  }
+  /// Saturating negation.
+  friend constexpr Fixed operator-(Fixed a) { return from_raw(detail::saturate<Storage>(-static_cast<std::int64_t>(a.raw_))); }
+  /// Rounded, saturating product in the same format.
+  friend constexpr Fixed operator*(Fixed a, Fixed b) {
+    return from_raw(detail::saturate<Storage>(detail::round_shift(detail::wide_product(a.raw_, b.raw_), kFrac)));
+  }
+  /// Ordering.
+  friend constexpr bool operator<(Fixed a, Fixed b) { return a.raw_ < b.raw_; }
+  /// Equality.
+  friend constexpr bool operator==(Fixed a, Fixed b) { return a.raw_ == b.raw_; }
+
+ private:
+  Storage raw_ = 0;
+};
+
+/// Q0.15 in 16 bits.
+using Q15 = Fixed<std::int16_t, 15>;
+/// Q0.31 in 32 bits.
+using Q31 = Fixed<std::int32_t, 31>;
+
+template <typename T>
+struct IsFixed : std::false_type {};
+template <typename S, int F>
+struct IsFixed<Fixed<S, F>> : std::true_type {};
+/// True for Fixed<…> types.
+template <typename T>
+inline constexpr bool kIsFixed = IsFixed<T>::value;
+
+/// Description of a fixed-point format.
+template <typename S, int F>
+struct ScalarTraits<Fixed<S, F>> {
+  using T = Fixed<S, F>;
+  static constexpr bool kIsFloating = false;
+  /// One unit in the last place relative to the format's unit range.
+  static constexpr double kEpsilon = detail::pow2(-(T::kBits - 1));
+  /// Taylor degree of the scaled exponential for this precision.
+  static constexpr int kTaylorDegree = detail::taylor_degree_for(kEpsilon);
+  /// Additive identity.
+  static constexpr T zero() { return T{}; }
+  /// 1 (saturates when the format cannot hold it).
+  static constexpr T one() { return from_double(1.0); }
+  /// v rounded into the format, saturated (constant data and host-side conversions).
+  static constexpr T from_double(double v) {
+    const double scaled = v * detail::pow2(F);
+    const double r = scaled >= 0 ? scaled + 0.5 : scaled - 0.5;
+    if (r >= static_cast<double>(std::numeric_limits<S>::max())) {
+      detail::g_saturated = detail::g_saturated || r >= static_cast<double>(std::numeric_limits<S>::max()) + 1.0;
+      return T::from_raw(std::numeric_limits<S>::max());
+    }
+    if (r <= static_cast<double>(std::numeric_limits<S>::min())) {
+      detail::g_saturated = detail::g_saturated || r <= static_cast<double>(std::numeric_limits<S>::min()) - 1.0;
+      return T::from_raw(std::numeric_limits<S>::min());
+    }
+    return T::from_raw(static_cast<S>(static_cast<std::int64_t>(r)));
+  }
+  /// num/den rounded.
+  static constexpr T from_ratio(std::int64_t num, std::int64_t den) {
+    return from_double(static_cast<double>(num) / static_cast<double>(den));
+  }
+  /// An integer, saturated.
+  static constexpr T from_int(std::int32_t v) {
+    return T::from_raw(detail::saturate<S>(F >= 0 ? static_cast<std::int64_t>(v) * (std::int64_t{1} << F)
+                                                   : detail::round_shift(v, -F)));
+  }
+  /// The value as a double (host checks and reports).
+  static constexpr double to_double(T v) { return static_cast<double>(v.raw()) * detail::pow2(-F); }
+  /// |v| (saturating).
+  static constexpr T abs(T v) { return v.raw() < 0 ? -v : v; }
+  /// Nearest integer, halves away from zero.
+  static constexpr std::int32_t round_to_int(T v) {
+    return static_cast<std::int32_t>(detail::round_shift(v.raw(), F));
+  }
+  /// num/den rounded (one integer division; 0 ≤ num, 0 < den).
+  static constexpr T fraction(std::int32_t num, std::int32_t den) {
+    const std::int64_t scaled = F >= 0 ? static_cast<std::int64_t>(num) << F : static_cast<std::int64_t>(num);
+    return T::from_raw(detail::saturate<S>((scaled + den / 2) / den));
+  }
+};
+
+/// Counts next to a fixed format are plain integers in Q31.0.
+template <typename S, int F>
+struct CountScalar<Fixed<S, F>> {
+  using type = Fixed<std::int32_t, 0>;  ///< The count type.
+  /// v as a count.
+  static constexpr type make(std::int32_t v) { return type::from_raw(v); }
+};
+
+/// Format conversion between fixed formats (rounded, saturated).
+template <typename To, typename From>
+constexpr std::enable_if_t<kIsFixed<To> && kIsFixed<From>, To> convert(From v) {
+  return To::from_raw(detail::saturate<typename To::StorageType>(detail::round_shift(v.raw(), From::kFrac - To::kFrac)));
+}
+
+/// a·b in format To (exact product, one rounding, saturated).
+template <typename To, typename A, typename B>
+constexpr std::enable_if_t<kIsFixed<To> && kIsFixed<A> && kIsFixed<B>, To> mul(A a, B b) {
+  return To::from_raw(detail::saturate<typename To::StorageType>(
+      detail::round_shift(detail::wide_product(a.raw(), b.raw()), A::kFrac + B::kFrac - To::kFrac)));
+}
+
+/// 1/v in format To (one 64-bit division; saturates for v ≤ 0 or too small).
+template <typename To, typename From>
+constexpr std::enable_if_t<kIsFixed<To> && kIsFixed<From>, To> reciprocal(From v) {
+  constexpr int kShift = To::kFrac + From::kFrac;
+  static_assert(kShift >= 0 && kShift <= 62, "reciprocal formats need 0 ≤ F_to + F_from ≤ 62");
+  if (v.raw() <= 0) {
+    detail::g_saturated = true;
+    return To::from_raw(std::numeric_limits<typename To::StorageType>::max());
+  }
+  const std::int64_t num = std::int64_t{1} << kShift;
+  const std::int64_t q = (num + v.raw() / 2) / v.raw();
+  return To::from_raw(detail::saturate<typename To::StorageType>(q));
+}
+
+/// Fixed accumulator: 64-bit register with kGuard extra fractional bits over Out.
+template <typename Out>
+class Accumulator<Out, std::enable_if_t<kIsFixed<Out>>> {
+ public:
+  static constexpr int kGuard = 16;                 ///< Extra fractional bits kept.
+  static constexpr int kAccFrac = Out::kFrac + kGuard;  ///< Fractional bits of the register.
+
+  /// value += a·b.
+  template <typename A, typename B>
+  constexpr void add_product(A a, B b) {
+    acc_ += detail::round_shift(detail::wide_product(a.raw(), b.raw()), A::kFrac + B::kFrac - kAccFrac);
+  }
+  /// value −= a·b.
+  template <typename A, typename B>
+  constexpr void sub_product(A a, B b) {
+    acc_ -= detail::round_shift(detail::wide_product(a.raw(), b.raw()), A::kFrac + B::kFrac - kAccFrac);
+  }
+  /// value += x.
+  template <typename X>
+  constexpr void add(X x) {
+    acc_ += detail::round_shift(x.raw(), X::kFrac - kAccFrac);
+  }
+  /// value −= x.
+  template <typename X>
+  constexpr void sub(X x) {
+    acc_ -= detail::round_shift(x.raw(), X::kFrac - kAccFrac);
+  }
+  /// The sum rounded into Out (saturated).
+  constexpr Out value() const {
+    return Out::from_raw(detail::saturate<typename Out::StorageType>(detail::round_shift(acc_, kGuard)));
+  }
+
+ private:
+  std::int64_t acc_ = 0;
+};
+
+}  // namespace oneshot

@@ -1,0 +1,81 @@
+/// @file table_storage.hpp
+/// @brief How a table discretizer reads values: floating scalars, or block fixed point.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <type_traits>
+
+#include "oneshot/fixed_point.hpp"
+#include "oneshot/scalar_traits.hpp"
+#include "oneshot/table_view.hpp"
+
+namespace oneshot {
+
+/// A slot value with its own scale (block fixed point): value = raw · 2^−frac.
+struct ScaledValue {
+  std::int32_t raw = 0;  ///< Mantissa.
+  std::int8_t frac = 0;  ///< Scale.
+};
+
+/// Reading of a table with storage `Storage` (floating specialisation).
+template <typename Storage, typename Enable = void>
+struct TableStorage {
+  using Slot = Storage;  ///< A decoded slot value.
+
+  /// Value of slot s in stored entry `entry`.
+  static constexpr Slot entry(const TableView<Storage>& v, std::size_t entry, std::size_t s) {
+    return v.values[entry * v.slots + s];
+  }
+  /// Slot polynomial at r: r^low · (c_low + r·(c_low+1 + … + r·c_high)), Horner.
+  template <typename F>
+  static constexpr Slot residual(const TableView<Storage>& v, std::size_t s, F r) {
+    const Storage* c = v.residual_coefficients + v.residual_offset[s];  // c[k] ↔ r^(low+k)
+    const std::uint8_t low = v.residual_low[s];
+    const std::uint8_t high = v.residual_high[s];
+    Storage acc = c[high - low];
+    for (std::uint8_t k = high; k > low; --k) acc = acc * r + c[k - 1 - low];
+    for (std::uint8_t k = 0; k < low; ++k) acc = acc * r;
+    return acc;
+  }
+  /// A slot value in format To.
+  template <typename To>
+  static constexpr To to(Slot x) {
+    return convert<To>(x);
+  }
+};
+
+/// Block fixed-point tables.
+template <>
+struct TableStorage<BlockFixedStorage> {
+  using Slot = ScaledValue;  ///< A decoded slot value.
+
+  /// Value of slot s in stored entry `entry`.
+  static constexpr Slot entry(const TableView<BlockFixedStorage>& v, std::size_t entry, std::size_t s) {
+    return Slot{v.values[entry * v.slots + s].raw, v.value_frac[s]};
+  }
+  /// Slot polynomial at r (Horner on 32-bit mantissas at the slot's residual scale).
+  template <typename F>
+  static constexpr Slot residual(const TableView<BlockFixedStorage>& v, std::size_t s, F r) {
+    static_assert(kIsFixed<F>, "block fixed tables need a fixed-point fraction r");
+    const Mantissa32* c = v.residual_coefficients + v.residual_offset[s];
+    const std::uint8_t low = v.residual_low[s];
+    const std::uint8_t high = v.residual_high[s];
+    std::int32_t acc = c[high - low].raw;
+    for (std::uint8_t k = high; k > low; --k) {
+      acc = detail::saturate<std::int32_t>(detail::round_shift(detail::wide_product(acc, r.raw()), F::kFrac) +
+                                           c[k - 1 - low].raw);
+    }
+    for (std::uint8_t k = 0; k < low; ++k) {
+      acc = detail::saturate<std::int32_t>(detail::round_shift(detail::wide_product(acc, r.raw()), F::kFrac));
+    }
+    return Slot{acc, v.residual_frac[s]};
+  }
+  /// A slot value in format To.
+  template <typename To>
+  static constexpr To to(Slot x) {
+    return To::from_raw(detail::saturate<typename To::StorageType>(detail::round_shift(x.raw, x.frac - To::kFrac)));
+  }
+};
+
+}  // namespace oneshot
