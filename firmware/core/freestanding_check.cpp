@@ -18,17 +18,25 @@ namespace {
 using oneshot::generated::PlantConstants;
 using oneshot::generated::PlantStructure;
 
+template <typename View>
+struct StorageOf;
+template <typename Storage>
+struct StorageOf<oneshot::TableView<Storage>> {
+  using type = Storage;
+};
+
 template <typename S>
 int run_all(std::int32_t tau_us, std::int32_t adc_code) {
   using K = PlantConstants<S>;
   using Fmt = typename K::Format;
-  using Table = oneshot::TableDiscretizer<Fmt, PlantStructure, S>;
+  using Storage = std::remove_cv_t<std::remove_reference_t<decltype(K::kTable)>>;
+  using Table = oneshot::TableDiscretizer<Fmt, PlantStructure, typename StorageOf<Storage>::type>;
   using Generic = oneshot::GenericDiscretizer<Fmt, PlantStructure::kStates, PlantStructure::kInputs>;
   const Table table(K::kTable);
   const Generic generic(K::kModel);
-  oneshot::Vector<S, 1> y;
+  oneshot::Vector<typename Fmt::State, 1> y;
   y[0] = oneshot::output_of_code(K::kDesign.sensor, 0, adc_code);
-  const oneshot::Vector<S, 1> r{};
+  const oneshot::Vector<typename Fmt::State, 1> r{};
   std::int32_t codes[1] = {0};
   int sum = 0;
   {
@@ -58,5 +66,9 @@ int run_all(std::int32_t tau_us, std::int32_t adc_code) {
 
 /// Entry point kept so the instantiations are not discarded.
 int oneshot_freestanding_check(std::int32_t tau_us, std::int32_t adc_code) {
-  return run_all<float>(tau_us, adc_code) + run_all<double>(tau_us, adc_code);
+  return run_all<float>(tau_us, adc_code) + run_all<double>(tau_us, adc_code)
+#if ONESHOT_GENERATED_FIXED_POINT
+         + run_all<oneshot::generated::FixedTag>(tau_us, adc_code)
+#endif
+      ;
 }

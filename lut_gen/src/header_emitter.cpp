@@ -3,6 +3,7 @@
 #include "oneshot/design/header_emitter.hpp"
 
 #include <cctype>
+#include <cmath>
 #include <cstdio>
 #include <sstream>
 #include <vector>
@@ -115,6 +116,128 @@ void emit_constants(std::ostringstream& o, const char* scalar, const PlantDescri
     << "              \"table slot maps disagree with the structure\");\n\n";
 }
 
+/// Fixed constants: matrices of raw mantissas of a named format.
+struct FixedEmitter {
+  const FixedFormats& f;
+
+  std::string matrix(const std::string& type, const QFormat& q, const DenseMatrix& m, const std::string& what) const {
+    std::ostringstream o;
+    o << "::oneshot::Matrix<FixedFormat::" << type << ", " << m.rows << ", " << m.cols << ">{{";
+    for (std::size_t k = 0; k < m.values.size(); ++k) {
+      std::ostringstream name;
+      name << what << "[" << k / m.cols << "][" << k % m.cols << "]";
+      o << (k ? ", " : "") << "::oneshot::fixed_raw<FixedFormat::" << type << ">(" << q.raw_of(m.values[k], name.str())
+        << ")";
+    }
+    o << "}}";
+    return o.str();
+  }
+  std::string vec(const std::string& type, const QFormat& q, const std::vector<double>& v, const std::string& what) const {
+    return matrix(type, q, DenseMatrix{v.size(), 1, v}, what);
+  }
+};
+
+void emit_fixed(std::ostringstream& o, const PlantDescription& plant, const DesignResult& d, const FixedFormats& f,
+                const TableData<BlockFixedStorage>& t) {
+  const std::size_t n = plant.n();
+  const std::size_t m = plant.m();
+  const std::size_t p = plant.p();
+  const auto type_of = [](const std::string& name) {
+    std::string out;
+    bool up = true;
+    for (char c : name) {
+      if (c == '_') {
+        up = true;
+        continue;
+      }
+      out += up ? static_cast<char>(std::toupper(static_cast<unsigned char>(c))) : c;
+      up = false;
+    }
+    return out;
+  };
+  o << "/// Fixed-point formats chosen by the design step from the plant's numbers.\n"
+    << "struct FixedFormat {\n";
+  for (const QuantityFormat& q : f.table) {
+    o << "  using " << type_of(q.name) << " = " << q.format.cpp_type() << ";  ///< |value| <= " << q.range << ": "
+      << q.rationale << "\n";
+  }
+  o << "  /// Van Loan runs on Q_c * 2^kQdScaleShift.\n"
+    << "  static constexpr int kQdScaleShift = " << f.qd_scale_shift << ";\n"
+    << "};\n";
+  for (const QuantityFormat& q : f.table) {
+    o << "static_assert(FixedFormat::" << type_of(q.name) << "::max_value() >= " << literal(q.range)
+      << ", \"" << q.name << " format narrower than its range\");\n";
+  }
+  o << "\n/// Tag selecting the fixed-point constants.\nstruct FixedTag {};\n\n";
+  const FixedEmitter e{f};
+  DenseMatrix a_us = plant.a;
+  for (double& x : a_us.values) x *= 1e-6;
+  DenseMatrix b_us = plant.b;
+  for (double& x : b_us.values) x *= 1e-6;
+  DenseMatrix qc_us = d.qc;
+  for (double& x : qc_us.values) x = std::ldexp(x * 1e-6, f.qd_scale_shift);
+  std::vector<std::string> values;
+  for (const Mantissa16& v : t.values) values.push_back("{" + std::to_string(v.raw) + "}");
+  std::vector<std::string> coeffs;
+  for (const Mantissa32& c : t.residual_coefficients) coeffs.push_back("{" + std::to_string(c.raw) + "}");
+  const auto join = [](const std::vector<std::string>& v, std::size_t per_line) {
+    std::ostringstream s;
+    for (std::size_t i = 0; i < v.size(); ++i) s << (i ? (per_line && i % per_line == 0 ? ",\n      " : ", ") : "") << v[i];
+    return s.str();
+  };
+  o << "/// Constants in the fixed-point formats.\n"
+    << "template <>\nstruct PlantConstants<FixedTag> {\n"
+    << "  /// Number formats of every quantity.\n"
+    << "  using Format = FixedFormat;\n"
+    << "  static constexpr std::uint16_t kRadix[] = {" << int_list(t.radix) << "};\n"
+    << "  static constexpr std::uint16_t kLevelOffset[] = {" << int_list(t.level_offset) << "};\n"
+    << "  static constexpr std::int8_t kPhiSlot[] = {" << int_list(t.phi_slot) << "};\n"
+    << "  static constexpr std::int8_t kGammaSlot[] = {" << int_list(t.gamma_slot) << "};\n"
+    << "  static constexpr std::int8_t kQdSlot[] = {" << int_list(t.qd_slot) << "};\n"
+    << "  /// Entry times (us): " << int_list(t.entry_time_us) << ".\n"
+    << "  static constexpr ::oneshot::Mantissa16 kValues[] = {\n      " << join(values, t.slots) << "};\n"
+    << "  static constexpr std::int8_t kValueFrac[] = {" << int_list(t.value_frac) << "};\n"
+    << "  static constexpr std::uint8_t kResidualLow[] = {" << int_list(t.residual_low) << "};\n"
+    << "  static constexpr std::uint8_t kResidualHigh[] = {" << int_list(t.residual_high) << "};\n"
+    << "  static constexpr std::uint8_t kResidualOffset[] = {" << int_list(t.residual_offset) << "};\n"
+    << "  static constexpr ::oneshot::Mantissa32 kResidualCoefficients[] = {" << join(coeffs, 0) << "};\n"
+    << "  static constexpr std::int8_t kResidualFrac[] = {" << int_list(t.residual_frac) << "};\n"
+    << "  /// The look-up table (" << t.bytes() << " bytes, 16-bit mantissas with a scale per slot).\n"
+    << "  static constexpr ::oneshot::TableView<::oneshot::BlockFixedStorage> kTable{" << t.granularity_us << ", "
+    << t.range_us << ", " << t.radix.size() << ", kRadix, kLevelOffset, " << t.entry_time_us.size() << ", "
+    << static_cast<int>(t.slots) << ", " << static_cast<int>(t.transition_slots)
+    << ", kPhiSlot, kGammaSlot, kQdSlot, kValues, kResidualLow, kResidualHigh, kResidualOffset, "
+    << t.residual_coefficients.size() << ", kResidualCoefficients, kValueFrac, kResidualFrac};\n"
+    << "  /// Continuous model per microsecond (Q_c scaled by 2^kQdScaleShift), for the generic routine.\n"
+    << "  static constexpr ::oneshot::ContinuousModelPerUs<FixedFormat::Compute, " << n << ", " << m
+    << ", FixedFormat::ModelA, FixedFormat::ModelB, FixedFormat::ModelQc> kModel{\n"
+    << "      " << e.matrix("ModelA", f.model_a, a_us, "A per us") << ",\n      "
+    << e.matrix("ModelB", f.model_b, b_us, "B per us") << ",\n      "
+    << e.matrix("ModelQc", f.model_qc, qc_us, "Qc per us") << "};\n"
+    << "  /// Design results (u = -L x).\n"
+    << "  static constexpr ::oneshot::ControllerDesign<Format, " << n << ", " << m << ", " << p << "> kDesign{\n"
+    << "      " << plant.period_us << ",  // period_us\n"
+    << "      " << e.matrix("Transition", f.transition, plant.c, "C") << ",\n"
+    << "      " << e.matrix("FeedbackGain", f.feedback_gain, d.l, "L") << ",\n"
+    << "      " << e.matrix("FeedbackGain", f.feedback_gain, d.nx, "Nx") << ",\n"
+    << "      " << e.matrix("FeedbackGain", f.feedback_gain, d.nu, "Nu") << ",\n"
+    << "      " << e.matrix("Covariance", f.covariance, d.q_constant, "Q") << ",\n"
+    << "      " << e.matrix("Covariance", f.covariance, d.r, "R") << ",\n"
+    << "      " << e.matrix("Covariance", f.covariance, d.p0, "P0") << ",\n"
+    << "      " << e.matrix("Transition", f.transition, d.phi_h, "Phi(h)") << ",\n"
+    << "      " << e.matrix("InputGain", f.input_gain, d.gamma_h, "Gamma(h)") << ",\n"
+    << "      " << e.matrix("Covariance", f.covariance, d.qd_h, "Qd(h)") << ",\n"
+    << "      " << e.matrix("KalmanGain", f.kalman_gain, d.deadbeat_gain, "K deadbeat") << ",\n"
+    << "      {" << e.vec("Input", f.input, d.u_min, "u_min") << ", " << e.vec("CodeStep", f.code_step, d.volts_per_step, "volts per PWM step")
+    << ", " << e.vec("InverseInput", f.inverse_input, d.steps_per_volt, "PWM steps per volt") << ", " << d.actuator_steps << "},\n"
+    << "      {" << e.vec("State", f.state, d.y_offset, "ADC offset") << ", " << e.vec("CodeStep", f.code_step, d.volts_per_code, "ADC LSB")
+    << "}};\n"
+    << "};\n"
+    << "static_assert(::oneshot::TableDiscretizer<FixedFormat, PlantStructure, ::oneshot::BlockFixedStorage>::maps_match_structure(\n"
+    << "                  PlantConstants<FixedTag>::kTable),\n"
+    << "              \"table slot maps disagree with the structure\");\n\n";
+}
+
 void emit_names(std::ostringstream& o, const char* type, const char* what, const std::vector<std::string>& names) {
   o << "/// Named " << what << " layout.\nstruct " << type << " {\n";
   for (std::size_t i = 0; i < names.size(); ++i)
@@ -140,13 +263,17 @@ std::string constant_name(const std::string& identifier) {
 
 std::string emit_header(const PlantDescription& plant, const DesignResult& design, const PlantPatterns& pat,
                         const TableData<float>& table_float, const TableData<double>& table_double,
-                        const std::string& generator) {
+                        const FixedFormats* formats, const TableData<BlockFixedStorage>* table_fixed,
+                        const std::string& fixed_unavailable_reason, const std::string& generator) {
   std::ostringstream o;
   o << "// Generated by " << generator << " from " << plant.source << ". Do not edit.\n"
     << "// Plant '" << plant.name << "': table of Phi/Gamma/Qd, design constants and structure.\n"
     << "#pragma once\n\n"
+    << "/// 1 when the design step found fixed-point formats for this plant (PlantConstants<FixedTag>).\n"
+    << "#define ONESHOT_GENERATED_FIXED_POINT " << (formats != nullptr ? 1 : 0) << "\n\n"
     << "#include <cstddef>\n#include <cstdint>\n\n"
     << "#include \"oneshot/controller_design.hpp\"\n"
+    << "#include \"oneshot/fixed_point.hpp\"\n"
     << "#include \"oneshot/generic_discretizer.hpp\"\n"
     << "#include \"oneshot/number_format.hpp\"\n"
     << "#include \"oneshot/pattern.hpp\"\n"
@@ -176,6 +303,14 @@ std::string emit_header(const PlantDescription& plant, const DesignResult& desig
     << "template <typename S>\nstruct PlantConstants;\n\n";
   emit_constants(o, "float", plant, design, table_float);
   emit_constants(o, "double", plant, design, table_double);
+  if (formats != nullptr && table_fixed != nullptr) {
+    emit_fixed(o, plant, design, *formats, *table_fixed);
+  } else {
+    std::string reason;
+    for (char c : fixed_unavailable_reason) reason += c == '"' || c == '\\' ? '\'' : c;
+    o << "/// Why this plant has no fixed-point constants.\n"
+      << "inline constexpr char kFixedPointUnavailable[] = \"" << reason << "\";\n\n";
+  }
   o << "}  // namespace oneshot::generated\n";
   return o.str();
 }

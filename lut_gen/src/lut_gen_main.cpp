@@ -3,10 +3,12 @@
 #include <CLI/CLI.hpp>
 #include <fstream>
 #include <iostream>
+#include <memory>
 #include <nlohmann/json.hpp>
 
 #include "oneshot/design/controller_synthesis.hpp"
 #include "oneshot/design/design_report.hpp"
+#include "oneshot/design/fixed_formats.hpp"
 #include "oneshot/design/header_emitter.hpp"
 #include "oneshot/design/plant_description.hpp"
 #include "oneshot/design/structure_analysis.hpp"
@@ -65,7 +67,22 @@ int main(int argc, char** argv) {
     const auto table_d = d::build_table<double>(plant, design, patterns);
     const auto acc_f = d::measure_accuracy(table_f, plant, design);
     const auto acc_d = d::measure_accuracy(table_d, plant, design);
-    write_file(header_path, d::emit_header(plant, design, patterns, table_f, table_d, "lut_gen"));
+    // Fixed point is optional: a plant whose numbers do not fit gets float/double only.
+    std::unique_ptr<d::FixedFormats> formats;
+    std::unique_ptr<d::TableData<oneshot::BlockFixedStorage>> table_q;
+    std::string fixed_reason;
+    try {
+      formats = std::make_unique<d::FixedFormats>(d::choose_fixed_formats(plant, design));
+      table_q = std::make_unique<d::TableData<oneshot::BlockFixedStorage>>(
+          d::build_table<oneshot::BlockFixedStorage>(plant, design, patterns));
+    } catch (const d::DesignError& e) {
+      fixed_reason = e.what();
+      formats.reset();
+      table_q.reset();
+      std::cerr << "lut_gen: warning: no fixed-point build for this plant: " << fixed_reason << "\n";
+    }
+    write_file(header_path, d::emit_header(plant, design, patterns, table_f, table_d, formats.get(), table_q.get(),
+                                           fixed_reason, "lut_gen"));
     nlohmann::json report = table_json(table_f, acc_f);  // top level: the float table the MCU uses
     report["generated_by"] = "lut_gen";
     report["plant"] = plant.name;
@@ -73,11 +90,38 @@ int main(int argc, char** argv) {
     report["max_bytes"] = plant.table_max_bytes;
     report["formats"]["float"] = table_json(table_f, acc_f);
     report["formats"]["double"] = table_json(table_d, acc_d);
+    nlohmann::json fixed;
+    fixed["available"] = formats != nullptr;
+    if (!formats) fixed["reason"] = fixed_reason;
+    if (formats) {
+    fixed["bytes"] = table_q->bytes();
+    fixed["entries"] = table_q->entry_time_us.size();
+    fixed["slots"] = table_q->slots;
+    fixed["levels"] = table_q->radix.size();
+    fixed["radix"] = table_q->radix;
+    fixed["granularity_us"] = table_q->granularity_us;
+    fixed["range_us"] = table_q->range_us;
+    fixed["max_quantization_error"] = table_q->quantization_abs;
+    fixed["max_quantization_error_relative"] = table_q->quantization_rel;
+    fixed["value_frac"] = table_q->value_frac;
+    fixed["residual_frac"] = table_q->residual_frac;
+    for (const d::QuantityFormat& q : formats->table) {
+      fixed["quantity_formats"][q.name] = {{"bits", q.format.bits}, {"frac", q.format.frac}, {"range", q.range},
+                                           {"max_value", q.format.max_value()}, {"resolution", q.format.resolution()},
+                                           {"rationale", q.rationale}};
+    }
+    fixed["qd_scale_shift"] = formats->qd_scale_shift;
+    }
+    report["formats"]["fixed"] = fixed;
     report["design"] = d::design_json(plant, design);
     write_file(report_path, report.dump(2) + "\n");
     std::cout << "lut_gen: " << plant.name << ": float table " << table_f.bytes() << " bytes (" << table_f.radix.size()
               << " levels, " << table_f.entry_time_us.size() << " entries x " << static_cast<int>(table_f.slots)
-              << " slots), max abs error " << acc_f.max_abs_error << "\n";
+              << " slots), max abs error " << acc_f.max_abs_error;
+    if (table_q) {
+      std::cout << "; fixed table " << table_q->bytes() << " bytes, max quantization error " << table_q->quantization_abs;
+    }
+    std::cout << "\n";
   } catch (const std::exception& e) {
     std::cerr << "lut_gen: error: " << e.what() << "\n";
     return 1;

@@ -5,6 +5,8 @@
 #include <algorithm>
 #include <cmath>
 #include <functional>
+#include <type_traits>
+#include <utility>
 #include <limits>
 #include <string>
 
@@ -27,35 +29,98 @@ struct Candidate {
   std::vector<double> coeffs;  // Taylor coefficient of r^k, k = 0 …
 };
 
-/// Rounded, trimmed polynomial of a candidate in storage format S.
+/// Trailing-coefficient cut: terms below eps/16 of the largest do not change the result.
+std::pair<std::size_t, std::size_t> trim(const std::vector<double>& c, double eps) {
+  double biggest = 0;
+  for (double v : c) biggest = std::max(biggest, std::fabs(v));
+  if (biggest == 0) return {0, 0};
+  std::size_t high = c.size() - 1;
+  while (high > 0 && std::fabs(c[high]) < eps / 16 * biggest) --high;
+  std::size_t low = 0;
+  while (low < high && c[low] == 0) ++low;
+  return {low, high};
+}
+
+/// One slot rounded into storage S: values, residual polynomial, scales, errors.
 template <typename S>
-struct Polynomial {
+struct RoundedSlot {
+  using Value = typename TableElements<S>::Value;
+  using Coefficient = typename TableElements<S>::Coefficient;
+  std::vector<Value> grid;
   std::uint8_t low = 0, high = 0;
-  std::vector<S> coeffs;  // low … high
-  bool operator==(const Polynomial& o) const { return low == o.low && high == o.high && coeffs == o.coeffs; }
+  std::vector<Coefficient> coeffs;  // low … high
+  std::int8_t value_frac = 0, residual_frac = 0;
+  double error_abs = 0, error_rel = 0;
 };
 
-template <typename S>
-Polynomial<S> trimmed(const std::vector<double>& c) {
-  std::vector<S> rounded;
-  for (double v : c) rounded.push_back(static_cast<S>(v));
-  double biggest = 0;
-  for (S v : rounded) biggest = std::max(biggest, std::fabs(static_cast<double>(v)));
-  Polynomial<S> p;
-  if (biggest == 0) {
-    p.coeffs = {S(0)};
-    return p;
+template <typename T>
+bool same_raw(const std::vector<T>& a, const std::vector<T>& b) {
+  if (a.size() != b.size()) return false;
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    if constexpr (std::is_floating_point_v<T>) {
+      if (!(a[i] == b[i])) return false;
+    } else {
+      if (a[i].raw != b[i].raw) return false;
+    }
   }
-  const double eps = ScalarTraits<S>::kEpsilon;
-  std::size_t high = rounded.size() - 1;
-  while (high > 0 && std::fabs(static_cast<double>(rounded[high])) < eps / 16 * biggest) --high;
-  std::size_t low = 0;
-  while (low < high && rounded[low] == S(0)) ++low;
-  p.low = static_cast<std::uint8_t>(low);
-  p.high = static_cast<std::uint8_t>(high);
-  p.coeffs.assign(rounded.begin() + static_cast<std::ptrdiff_t>(low),
-                  rounded.begin() + static_cast<std::ptrdiff_t>(high) + 1);
-  return p;
+  return true;
+}
+
+template <typename S>
+bool same(const RoundedSlot<S>& a, const RoundedSlot<S>& b) {
+  return a.low == b.low && a.high == b.high && a.value_frac == b.value_frac && a.residual_frac == b.residual_frac &&
+         same_raw(a.grid, b.grid) && same_raw(a.coeffs, b.coeffs);
+}
+
+template <typename S>
+RoundedSlot<S> round_slot(const std::vector<double>& grid, const std::vector<double>& coeffs) {
+  RoundedSlot<S> r;
+  double scale = 0;
+  for (double v : grid) scale = std::max(scale, std::fabs(v));
+  const auto note = [&](double exact, double stored) {
+    r.error_abs = std::max(r.error_abs, std::fabs(exact - stored));
+    if (scale > 0) r.error_rel = std::max(r.error_rel, std::fabs(exact - stored) / scale);
+  };
+  if constexpr (std::is_floating_point_v<S>) {
+    for (double v : grid) {
+      r.grid.push_back(static_cast<S>(v));
+      note(v, static_cast<double>(r.grid.back()));
+    }
+    std::vector<double> rounded;
+    for (double v : coeffs) rounded.push_back(static_cast<double>(static_cast<S>(v)));
+    const auto [low, high] = trim(rounded, ScalarTraits<S>::kEpsilon);
+    r.low = static_cast<std::uint8_t>(low);
+    r.high = static_cast<std::uint8_t>(high);
+    for (std::size_t k = low; k <= high; ++k) r.coeffs.push_back(static_cast<S>(rounded[k]));
+  } else {
+    // 16-bit values at the largest scale that holds the slot; 32-bit coefficients at the
+    // largest scale holding Σ|c| (a bound on every Horner partial sum, r < 1).
+    const auto frac_for = [](double range, int bits) {
+      int e = 0;
+      std::frexp(range > 0 ? range : 1.0, &e);
+      int frac = bits - 1 - e;
+      while (std::ldexp(range, frac) > std::ldexp(1.0, bits - 1) - 1) --frac;
+      return frac;
+    };
+    r.value_frac = static_cast<std::int8_t>(std::clamp(frac_for(scale, 16), -31, 62));
+    for (double v : grid) {
+      const double raw = std::round(std::ldexp(v, r.value_frac));
+      r.grid.push_back(Mantissa16{static_cast<std::int16_t>(raw)});
+      note(v, std::ldexp(raw, -r.value_frac));
+    }
+    const auto [low, high] = trim(coeffs, std::ldexp(1.0, -31));
+    double sum = 0;
+    for (std::size_t k = low; k <= high; ++k) sum += std::fabs(coeffs[k]);
+    r.residual_frac = static_cast<std::int8_t>(std::clamp(frac_for(1.01 * sum, 32), -31, 62));
+    r.low = static_cast<std::uint8_t>(low);
+    r.high = static_cast<std::uint8_t>(high);
+    for (std::size_t k = low; k <= high; ++k) {
+      const double raw = std::round(std::ldexp(coeffs[k], r.residual_frac));
+      r.coeffs.push_back(Mantissa32{static_cast<std::int32_t>(raw)});
+      note(coeffs[k], std::ldexp(raw, -r.residual_frac));
+    }
+  }
+  return r;
 }
 
 struct Layout {
@@ -96,6 +161,8 @@ TableData<S> build_fixed(const PlantDescription& plant, const DesignResult& desi
   }
 
   // Taylor degree K: (2‖A‖₁g)^(K+1)/(K+1)! ≤ ε/4 bounds the relative truncation error.
+  constexpr double kStorageEpsilon = std::is_floating_point_v<S> ? ScalarTraits<std::conditional_t<std::is_floating_point_v<S>, S, double>>::kEpsilon
+                                                                 : 0x1.0p-31;
   const double g_s = static_cast<double>(g) * 1e-6;
   const auto a = to_fixed<double, N, N>(plant.a);
   const auto b = to_fixed<double, N, M>(plant.b);
@@ -109,7 +176,7 @@ TableData<S> build_fixed(const PlantDescription& plant, const DesignResult& desi
   const double x = 2 * norm_a * g_s;
   int degree = 1;
   double term = x * x / 2;  // x^(K+1)/(K+1)! for K = degree
-  while (term > ScalarTraits<S>::kEpsilon / 4 && degree < 30) {
+  while (term > kStorageEpsilon / 4 && degree < 30) {
     ++degree;
     term *= x / (degree + 1);
   }
@@ -167,23 +234,17 @@ TableData<S> build_fixed(const PlantDescription& plant, const DesignResult& desi
       if (patterns.phi.is_one(i, j)) t.phi_slot[i * N + j] = kSlotOne;
 
   // Slots: identical rounded grid values and polynomial share one.
-  struct Slot {
-    std::vector<S> grid;
-    Polynomial<S> poly;
-  };
-  std::vector<Slot> slots;
+  std::vector<RoundedSlot<S>> slots;
   bool in_transition = true;
   for (const Candidate& c : cands) {
     if (c.kind == Candidate::Kind::kQd && in_transition) {
       t.transition_slots = static_cast<std::uint8_t>(slots.size());
       in_transition = false;
     }
-    Slot s;
-    for (double v : c.grid) s.grid.push_back(static_cast<S>(v));
-    s.poly = trimmed<S>(c.coeffs);
+    const RoundedSlot<S> rs = round_slot<S>(c.grid, c.coeffs);
     std::size_t index = 0;
-    while (index < slots.size() && !(slots[index].grid == s.grid && slots[index].poly == s.poly)) ++index;
-    if (index == slots.size()) slots.push_back(s);
+    while (index < slots.size() && !same(slots[index], rs)) ++index;
+    if (index == slots.size()) slots.push_back(rs);
     if (slots.size() > 127) throw DesignError("table: more than 127 free entries");
     const auto code = static_cast<std::int8_t>(index);
     if (c.kind == Candidate::Kind::kPhi) t.phi_slot[c.i * N + c.j] = code;
@@ -192,21 +253,31 @@ TableData<S> build_fixed(const PlantDescription& plant, const DesignResult& desi
   }
   if (in_transition) t.transition_slots = static_cast<std::uint8_t>(slots.size());
   t.slots = static_cast<std::uint8_t>(slots.size());
-  for (const Slot& s : slots) {
-    t.residual_low.push_back(s.poly.low);
-    t.residual_high.push_back(s.poly.high);
+  constexpr bool kBlock = std::is_same_v<S, BlockFixedStorage>;
+  for (const RoundedSlot<S>& rs : slots) {
+    t.residual_low.push_back(rs.low);
+    t.residual_high.push_back(rs.high);
     t.residual_offset.push_back(static_cast<std::uint8_t>(t.residual_coefficients.size()));
-    t.residual_coefficients.insert(t.residual_coefficients.end(), s.poly.coeffs.begin(), s.poly.coeffs.end());
+    t.residual_coefficients.insert(t.residual_coefficients.end(), rs.coeffs.begin(), rs.coeffs.end());
+    if constexpr (kBlock) {
+      t.value_frac.push_back(rs.value_frac);
+      t.residual_frac.push_back(rs.residual_frac);
+    }
+    t.quantization_abs = std::max(t.quantization_abs, rs.error_abs);
+    t.quantization_rel = std::max(t.quantization_rel, rs.error_rel);
   }
   if (t.residual_coefficients.size() > 255) throw DesignError("table: more than 255 residual coefficients");
+  using Value = typename TableData<S>::Value;
+  using Coefficient = typename TableData<S>::Coefficient;
 
   // Layout: fewest levels that fit table.max_bytes, then fewest bytes.
-  const std::size_t fixed_bytes = sizeof(S) * t.residual_coefficients.size() + 2 * N * N + N * M + 3U * t.slots;
+  const std::size_t fixed_bytes = sizeof(Coefficient) * t.residual_coefficients.size() + 2 * N * N + N * M +
+                                  3U * t.slots + (kBlock ? 2U * t.slots : 0U);
   const auto cost = [&](std::size_t entries, std::size_t levels) {
-    return fixed_bytes + sizeof(S) * entries * t.slots + 4 * levels;
+    return fixed_bytes + sizeof(Value) * entries * t.slots + 4 * levels;
   };
-  // table.max_bytes budgets 4-byte storage (the float firmware table); wider formats scale.
-  const std::size_t budget = static_cast<std::size_t>(plant.table_max_bytes) * std::max<std::size_t>(1, sizeof(S) / 4);
+  // table.max_bytes budgets 4-byte values (the float firmware table); doubles get twice.
+  const std::size_t budget = static_cast<std::size_t>(plant.table_max_bytes) * std::max<std::size_t>(1, sizeof(Value) / 4);
   Layout best;
   std::size_t smallest = std::numeric_limits<std::size_t>::max();
   const auto consider = [&](const std::vector<std::size_t>& below) {
@@ -234,7 +305,7 @@ TableData<S> build_fixed(const PlantDescription& plant, const DesignResult& desi
   };
   for (std::size_t levels = 1; levels <= 4 && best.radix.empty(); ++levels) enumerate(levels - 1, 1);
   if (best.radix.empty()) {
-    throw DesignError("table.max_bytes: " + std::to_string(budget) + " bytes of " + std::to_string(sizeof(S)) +
+    throw DesignError("table.max_bytes: " + std::to_string(budget) + " bytes of " + std::to_string(sizeof(Value)) +
                       "-byte values is too small; the smallest layout of up to 4 levels needs " +
                       std::to_string(smallest) + " bytes");
   }
@@ -246,7 +317,7 @@ TableData<S> build_fixed(const PlantDescription& plant, const DesignResult& desi
     for (std::size_t d = 1; d <= digits; ++d) {
       const std::size_t index = d * spacing;
       t.entry_time_us.push_back(static_cast<std::int32_t>(index) * g);
-      std::vector<S> entry(t.slots);
+      std::vector<Value> entry(t.slots);
       for (std::size_t s = 0; s < t.slots; ++s) entry[s] = slots[s].grid[index - 1];
       t.values.insert(t.values.end(), entry.begin(), entry.end());
     }
@@ -311,6 +382,8 @@ TableAccuracy measure_accuracy(const TableData<S>& table, const PlantDescription
 }
 
 template TableData<float> build_table<float>(const PlantDescription&, const DesignResult&, const PlantPatterns&);
+template TableData<BlockFixedStorage> build_table<BlockFixedStorage>(const PlantDescription&, const DesignResult&,
+                                                                     const PlantPatterns&);
 template TableData<double> build_table<double>(const PlantDescription&, const DesignResult&, const PlantPatterns&);
 template TableAccuracy measure_accuracy<float>(const TableData<float>&, const PlantDescription&, const DesignResult&);
 template TableAccuracy measure_accuracy<double>(const TableData<double>&, const PlantDescription&, const DesignResult&);

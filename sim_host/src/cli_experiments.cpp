@@ -28,7 +28,7 @@ struct CliCommon {
 
   CommonOptions resolve() const {
     CommonOptions o = opt;
-    o.format = format == "double" ? NumberFormat::kDouble : NumberFormat::kFloat;
+    o.format = format == "double" ? NumberFormat::kDouble : format == "fixed" ? NumberFormat::kFixed : NumberFormat::kFloat;
     o.discretizer = discretizer == "generic" ? DiscretizerKind::kGeneric : DiscretizerKind::kTable;
     o.noise = noise == "constant" ? NoiseModel::kConstant : NoiseModel::kExact;
     o.board.update = pwm == "period" ? PwmUpdate::kNextPeriod : PwmUpdate::kImmediate;
@@ -46,7 +46,7 @@ void add_common(CLI::App* cmd, CliCommon& c, const std::string& default_out) {
   cmd->add_option("--json", c.json, "write the summary as JSON to PATH ('-' for standard output)");
   cmd->add_option("--seed", c.opt.seed, "random seed (first seed of a sweep)")->capture_default_str();
   cmd->add_option("--number-format", c.format, "number format of the control job")
-      ->check(CLI::IsMember({"float", "double"}))
+      ->check(CLI::IsMember({"float", "double", "fixed"}))
       ->capture_default_str();
   cmd->add_option("--discretizer", c.discretizer, "Phi/Gamma/Qd of the one-shot filters: table or generic routine")
       ->check(CLI::IsMember({"table", "generic"}))

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <array>
+#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -251,6 +252,7 @@ nlohmann::json run_table1(const SimContext& ctx, const CommonOptions& opt, const
   const std::size_t ns = scenarios.size();
   // cost[a][s][seed]
   std::vector<std::vector<std::vector<double>>> cost(na, std::vector<std::vector<double>>(ns, std::vector<double>(seeds)));
+  std::atomic<std::size_t> saturated_runs{0};
   const auto start = Clock::now();
   {
     ProgressBar bar("table1", ns * seeds);
@@ -258,7 +260,9 @@ nlohmann::json run_table1(const SimContext& ctx, const CommonOptions& opt, const
       const std::size_t s = task / seeds;
       const std::size_t k = task % seeds;
       for (std::size_t a = 0; a < na; ++a) {
-        cost[a][s][k] = simulate(ctx, scenarios[s], opt.seed + k, base_options(opt, kAllApproaches[a])).cost.total();
+        const RunResult r = simulate(ctx, scenarios[s], opt.seed + k, base_options(opt, kAllApproaches[a]));
+        cost[a][s][k] = r.cost.total();
+        if (r.saturated) ++saturated_runs;
       }
     });
   }
@@ -279,6 +283,7 @@ nlohmann::json run_table1(const SimContext& ctx, const CommonOptions& opt, const
   j["simulated_seconds"] = simulated * static_cast<double>(na * seeds);
   j["wall_time_s"] = wall;
   j["threads"] = worker_count(opt.threads);
+  j["saturated_runs"] = saturated_runs.load();
   std::ostringstream md;
   md << "| approach | description | mean cost J | 95 % CI | ratio to A | ratio 95 % CI |\n|---|---|---|---|---|---|\n";
   std::vector<std::vector<double>> csv_rows;

@@ -11,6 +11,7 @@
 #include "oneshot/complete_kalman.hpp"
 #include "oneshot/controller.hpp"
 #include "oneshot/deadbeat_observer.hpp"
+#include "oneshot/fixed_point.hpp"
 #include "oneshot/design/dimension_dispatch.hpp"
 #include "oneshot/design/fixed_size.hpp"
 #include "oneshot/design/structure_analysis.hpp"
@@ -28,6 +29,7 @@ const char* to_string(NumberFormat f) {
   switch (f) {
     case NumberFormat::kFloat: return "float";
     case NumberFormat::kDouble: return "double";
+    case NumberFormat::kFixed: return "fixed";
   }
   return "?";
 }
@@ -108,8 +110,14 @@ RunResult run_loop(const SimContext& ctx, const Scenario& sc, std::uint64_t seed
   emu.set_setpoint(setpoint_at(0));
   typename Ctrl::InputVec u0;
   for (std::size_t j = 0; j < M; ++j) u0[j] = input_of_code(ctrl.design().actuator, j, emu.duty(j));
-  ctrl.estimator().reset(typename Ctrl::StateVec{},
-                         ctrl.design().p0 * ScalarTraits<typename Ctrl::CovScalar>::from_double(opt.p0_scale), u0);
+  // P0 scaled entry by entry in double (a fixed covariance format cannot hold the factor).
+  auto p0 = ctrl.design().p0;
+  using CovScalar = typename Ctrl::CovScalar;
+  for (std::size_t k = 0; k < p0.kSize; ++k) {
+    p0[k] = ScalarTraits<CovScalar>::from_double(ScalarTraits<CovScalar>::to_double(p0[k]) * opt.p0_scale);
+  }
+  clear_saturation_flag();
+  ctrl.estimator().reset(typename Ctrl::StateVec{}, p0, u0);
 
   host::HostBoardState board;
   board.adc_codes.assign(P, 0);
@@ -211,6 +219,7 @@ RunResult run_loop(const SimContext& ctx, const Scenario& sc, std::uint64_t seed
   result.jobs = task.statistics().jobs;
   result.overruns = task.statistics().overruns;
   result.faults = task.statistics().faults;
+  result.saturated = saturation_flag();
   return result;
 }
 
@@ -265,8 +274,21 @@ decltype(auto) with_controller_parts(const SimContext& ctx, const RunOptions& op
       using K = generated::PlantConstants<float>;
       return with_estimator<generated::PlantStructure>(opt, K::kDesign, K::kTable, K::kModel, f);
     }
+    if (opt.format == NumberFormat::kFixed) {
+#if ONESHOT_GENERATED_FIXED_POINT
+      using K = generated::PlantConstants<generated::FixedTag>;
+      return with_estimator<generated::PlantStructure>(opt, K::kDesign, K::kTable, K::kModel, f);
+#else
+      throw std::invalid_argument(std::string("no fixed-point build for this plant: ") + generated::kFixedPointUnavailable);
+#endif
+    }
     using K = generated::PlantConstants<double>;
     return with_estimator<generated::PlantStructure>(opt, K::kDesign, K::kTable, K::kModel, f);
+  }
+  if (opt.format == NumberFormat::kFixed) {
+    throw std::invalid_argument(
+        "--number-format fixed needs the plant's Q formats at build time: configure with -DONESHOT_PLANT=" +
+        ctx.plant().source + " and run without --plant");
   }
   const auto& plant = ctx.plant();
   return design::with_dimensions(plant.n(), plant.m(), plant.p(), [&](auto n, auto m, auto p) {

@@ -111,6 +111,46 @@ TEST(Simulation, RuntimePlantMatchesTheGeneratedConstants) {
   EXPECT_NEAR(g, r, 1e-9 * g);
 }
 
+TEST(Simulation, FixedPointMillionJobsOnTheReferenceScenariosWithoutSaturation) {
+  // GIVEN the ten Table I scenarios, each run for 100 000 jobs (5000 s) with the fixed-point job
+  const auto ctx = SimContext::reference();
+  std::size_t jobs = 0;
+  for (Scenario s : default_scenarios()) {
+    s.duration_s = 5000;
+    for (Approach a : {Approach::kB, Approach::kD}) {
+      RunOptions o;
+      o.approach = a;
+      o.format = NumberFormat::kFixed;
+      const RunResult r = simulate(*ctx, s, 17, o);
+      // THEN the saturation flag is never raised and no job reports a fault
+      EXPECT_FALSE(r.saturated) << s.name << " " << info(a).letter;
+      EXPECT_EQ(r.faults, 0U) << s.name;
+      if (a == Approach::kB) jobs += r.jobs;
+    }
+  }
+  EXPECT_GE(jobs, 1'000'000U);
+}
+
+TEST(Simulation, FixedPointCostMatchesDouble) {
+  const auto ctx = SimContext::reference();
+  for (Approach a : kAllApproaches) {
+    RunOptions o;
+    o.approach = a;
+    o.format = NumberFormat::kDouble;
+    const double d = simulate(*ctx, short_scenario(20'000), 6, o).cost.total();
+    o.format = NumberFormat::kFixed;
+    const double q = simulate(*ctx, short_scenario(20'000), 6, o).cost.total();
+    EXPECT_NEAR(q, d, 0.01 * d) << info(a).letter;
+  }
+}
+
+TEST(Simulation, FixedPointNeedsTheCompiledPlant) {
+  const auto runtime = SimContext::from_plant(design::reference_plant());
+  RunOptions o;
+  o.format = NumberFormat::kFixed;
+  EXPECT_THROW(simulate(*runtime, short_scenario(0), 1, o), std::invalid_argument);
+}
+
 TEST(Scenario, JobLongerThanThePeriodIsRefused) {
   Scenario s = short_scenario(49'500);
   try {

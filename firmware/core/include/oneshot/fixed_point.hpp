@@ -132,6 +132,13 @@ class Fixed {
   Storage raw_ = 0;
 };
 
+/// T from a raw mantissa given as a wide integer (generated constants): saturates, so a
+/// constant that does not fit fails constant evaluation instead of wrapping.
+template <typename T>
+constexpr T fixed_raw(std::int64_t raw) {
+  return T::from_raw(detail::saturate<typename T::StorageType>(raw));
+}
+
 /// Q0.15 in 16 bits.
 using Q15 = Fixed<std::int16_t, 15>;
 /// Q0.31 in 32 bits.

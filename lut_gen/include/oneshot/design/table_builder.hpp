@@ -19,9 +19,12 @@
 
 namespace oneshot::design {
 
-/// Owning table data; view() gives the firmware's TableView.
+/// Owning table data; view() gives the firmware's TableView. S is float, double, or
+/// BlockFixedStorage (16-bit mantissas with a scale per slot).
 template <typename S>
 struct TableData {
+  using Value = typename TableElements<S>::Value;              ///< Stored entry value.
+  using Coefficient = typename TableElements<S>::Coefficient;  ///< Stored residual coefficient.
   std::int32_t granularity_us = 0;          ///< Grid step g.
   std::int32_t range_us = 0;                ///< Covered range.
   std::vector<std::uint16_t> radix;         ///< Per level, finest first.
@@ -32,11 +35,15 @@ struct TableData {
   std::vector<std::int8_t> phi_slot;        ///< n×n map.
   std::vector<std::int8_t> gamma_slot;      ///< n×m map.
   std::vector<std::int8_t> qd_slot;         ///< n×n map.
-  std::vector<S> values;                    ///< entries × slots.
+  std::vector<Value> values;                ///< entries × slots.
   std::vector<std::uint8_t> residual_low;   ///< Per slot.
   std::vector<std::uint8_t> residual_high;  ///< Per slot.
   std::vector<std::uint8_t> residual_offset;  ///< Per slot.
-  std::vector<S> residual_coefficients;     ///< Packed.
+  std::vector<Coefficient> residual_coefficients;  ///< Packed.
+  std::vector<std::int8_t> value_frac;      ///< Block fixed: scale of each slot's values.
+  std::vector<std::int8_t> residual_frac;   ///< Block fixed: scale of each slot's coefficients.
+  double quantization_abs = 0;              ///< Worst |stored − exact| over values and coefficients.
+  double quantization_rel = 0;              ///< Same, relative to the slot's largest value.
   std::size_t n = 0;                        ///< States.
   std::size_t m = 0;                        ///< Inputs.
 
@@ -59,15 +66,15 @@ struct TableData {
                         residual_offset.data(),
                         static_cast<std::uint8_t>(residual_coefficients.size()),
                         residual_coefficients.data(),
-                        nullptr,
-                        nullptr};
+                        value_frac.empty() ? nullptr : value_frac.data(),
+                        residual_frac.empty() ? nullptr : residual_frac.data()};
   }
   /// Every byte the look-up reads (see table_bytes()).
   std::size_t bytes() const { return table_bytes(view(), n, m); }
 };
 
-/// Builds the table of `plant` in storage format S (float or double) within
-/// plant.table_max_bytes; DesignError when no layout fits.
+/// Builds the table of `plant` in storage format S (float, double or BlockFixedStorage)
+/// within plant.table_max_bytes; DesignError when no layout fits.
 template <typename S>
 TableData<S> build_table(const PlantDescription& plant, const DesignResult& design, const PlantPatterns& patterns);
 

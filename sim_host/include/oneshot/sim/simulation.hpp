@@ -30,9 +30,13 @@ namespace oneshot::sim {
 enum class DiscretizerKind : std::uint8_t { kTable, kGeneric };
 
 /// Number format of the control job.
-enum class NumberFormat : std::uint8_t { kFloat, kDouble };
+enum class NumberFormat : std::uint8_t {
+  kFloat,   ///< IEEE single, as on an MCU without double support.
+  kDouble,  ///< IEEE double (the oracle).
+  kFixed,   ///< The design step's Q formats (built-in plant, or one compiled in with ONESHOT_PLANT).
+};
 
-/// Name of a number format ("float", "double").
+/// Name of a number format ("float", "double", "fixed").
 const char* to_string(NumberFormat f);
 /// Name of a discretizer ("table", "generic").
 const char* to_string(DiscretizerKind d);
@@ -79,6 +83,7 @@ struct RunResult {
   std::uint32_t jobs = 0;          ///< Jobs run.
   std::uint32_t overruns = 0;      ///< Actuation instants without a prepared value.
   std::uint32_t faults = 0;        ///< Jobs whose maths was not exact (clamped τ, …).
+  bool saturated = false;          ///< The fixed-point saturation flag was raised.
   std::vector<JobRecord> job_records;  ///< When requested.
   std::vector<TracePoint> trace;       ///< When requested.
 };
