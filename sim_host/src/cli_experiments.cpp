@@ -1,6 +1,8 @@
 /// @file cli_experiments.cpp
 /// @brief Subcommands noise, jitter, gain, table1, exectime, run, benchmark and report.
+#include <algorithm>
 #include <chrono>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
@@ -11,6 +13,7 @@
 #include "oneshot/sim/cli_commands.hpp"
 #include "oneshot/sim/experiments.hpp"
 #include "oneshot/sim/output_files.hpp"
+#include "oneshot/sim/pil_link.hpp"
 
 namespace oneshot::sim {
 namespace {
@@ -133,14 +136,82 @@ void register_experiment_commands(CLI::App& app) {
   }
   {
     auto c = std::make_shared<CliCommon>();
+    auto target = std::make_shared<std::string>("cortex-m0");
+    auto scenario = std::make_shared<std::string>("j20-a0.2-p1");
+    auto approach = std::make_shared<std::string>("B");
+    auto duration = std::make_shared<double>(4.0);
+    auto table1 = std::make_shared<bool>(false);
+    auto seeds = std::make_shared<std::size_t>(2);
+    auto fw_dir = std::make_shared<std::string>();
+    CLI::App* cmd = app.add_subcommand(
+        "pil", "Processor in the loop: the control job runs in the firmware under QEMU, the harness plays the board; "
+               "compared with the host run on the same seeds");
+    add_common(cmd, *c, "out/pil");
+    cmd->add_option("--target", *target, "MCU: cortex-m0 (QEMU microbit) or cortex-m4f (QEMU mps2-an386)")
+        ->check(CLI::IsMember({"cortex-m0", "cortex-m4f"}))
+        ->capture_default_str();
+    cmd->add_option("--approach", *approach, "approach A-E")->check(CLI::IsMember({"A", "B", "C", "D", "E", "a", "b", "c", "d", "e"}))->capture_default_str();
+    cmd->add_option("--scenario", *scenario, "built-in scenario")->capture_default_str();
+    cmd->add_option("--duration", *duration, "simulated seconds")->check(CLI::Range(0.05, 3600.0))->capture_default_str();
+    cmd->add_flag("--table1", *table1, "run Table I (every approach and scenario) through the MCU");
+    cmd->add_option("--seeds", *seeds, "seeds per scenario with --table1")->check(CLI::Range(2, 1000))->capture_default_str();
+    cmd->add_option("--firmware-dir", *fw_dir, "build tree holding firmware-<target>/ (default: this build's)");
+    cmd->callback([=]() {
+      const auto ctx = SimContext::load(c->plant);
+      PilOptions p;
+      p.target = *target;
+      p.firmware_dir = *fw_dir;
+      const CommonOptions o = c->resolve();
+      nlohmann::json j;
+      if (*table1) {
+        std::vector<Scenario> scenarios = default_scenarios();
+        for (Scenario& s : scenarios) s.duration_s = *duration;
+        j = run_pil_table1(*ctx, o, p, scenarios, *seeds);
+        if (c->json != "-") std::cout << j["markdown"].get<std::string>();
+      } else {
+        const std::vector<Scenario> all = default_scenarios();
+        auto it = std::find_if(all.begin(), all.end(), [&](const Scenario& s) { return s.name == *scenario; });
+        if (it == all.end()) throw ScenarioError("unknown scenario '" + *scenario + "'");
+        Scenario sc = *it;
+        sc.duration_s = *duration;
+        j = run_pil_compare(*ctx, o, p, sc, parse_approach(*approach));
+        if (c->json != "-") std::cout << j.dump(2) << "\n";
+      }
+      if (!c->json.empty()) write_json(c->json, j);
+    });
+  }
+  {
+    auto c = std::make_shared<CliCommon>();
+    auto target = std::make_shared<std::string>("host");
+    auto fw_dir = std::make_shared<std::string>();
     CLI::App* cmd = app.add_subcommand("exectime",
                                        "Experiment 5: execution time of the control job over 4 s (host clock and callgrind); "
                                        "both noise models are measured, the original constant Q first");
     c->noise = "constant";  // the brief's protocol measures the original design
     add_common(cmd, *c, "out/exectime");
-    cmd->callback([c]() {
+    cmd->add_option("--target", *target,
+                    "host (steady clock and callgrind), or an MCU under QEMU: cortex-m0, cortex-m4f (instructions per job)")
+        ->check(CLI::IsMember({"host", "cortex-m0", "cortex-m4f"}))
+        ->capture_default_str();
+    cmd->add_option("--firmware-dir", *fw_dir, "build tree holding firmware-<target>/ (default: this build's)");
+    cmd->callback([c, target, fw_dir]() {
       const auto ctx = SimContext::load(c->plant);
-      emit(*c, run_exectime(*ctx, c->resolve(), self_path()));
+      if (*target == "host") {
+        emit(*c, run_exectime(*ctx, c->resolve(), self_path()));
+        return;
+      }
+      PilOptions p;
+      p.target = *target;
+      p.firmware_dir = *fw_dir;
+      const nlohmann::json j = run_exectime_target(*ctx, c->resolve(), p);
+      if (c->json != "-") {
+        for (const auto& [name, v] : j["variants"].items()) {
+          std::printf("%-24s %8.0f instructions/job  %8.0f per 4 s  flash %6zu B  RAM %5zu B\n", name.c_str(),
+                      v["instructions_per_job"].get<double>(), v["instructions_per_4s"].get<double>(),
+                      v["flash_bytes"].get<std::size_t>(), v["ram_bytes"].get<std::size_t>());
+        }
+      }
+      if (!c->json.empty()) write_json(c->json, j);
     });
   }
   {

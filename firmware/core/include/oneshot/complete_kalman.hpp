@@ -63,8 +63,8 @@ class CompleteKalman {
     using GammaP = typename Structure::GammaPattern;
     using CovT = typename Fmt::Covariance;
     const std::int32_t b_us = design_->period_us - tau_us;
-    typename Disc::Triple sum;
-    typename Disc::Triple b;
+    typename Disc::Triple sum{NoInit{}};
+    typename Disc::Triple b{NoInit{}};
     Status status = disc_->discretize(b_us + tau_prev_us_, sum, qd_needed(noise_));
     status = first_failure(status, disc_->discretize(b_us, b, WithQd::kNo));
     // x̂⁻ = Φ(a+b) x̂_s + Φ(b)(Γ(a) u_{k−1}) + Γ(b) u_k.
@@ -93,7 +93,7 @@ class CompleteKalman {
     }
     status = first_failure(status, correct<Fmt, Structure, kForm>(x_, p_, y, design_->c, design_->r, k_));
     xs_ = x_;
-    typename Disc::Triple c;
+    typename Disc::Triple c{NoInit{}};
     status = first_failure(status, disc_->discretize(tau_us, c, WithQd::kNo));
     x_ = predict_state<Fmt, Structure>(c, xs_, u_);
     gamma_a_ = c.gamma;

@@ -43,6 +43,13 @@ constexpr std::int64_t round_shift(std::int64_t v, int shift) {
   return v >= 0 ? (v + half) >> shift : -((-v + half) >> shift);
 }
 
+/// v · 2^−shift for 32-bit v and 0 ≤ shift ≤ 31, rounded to nearest (ties upward),
+/// without 64-bit arithmetic.
+constexpr std::int32_t round_shift32(std::int32_t v, int shift) {
+  if (shift == 0) return v;
+  return ((v >> (shift - 1)) + 1) >> 1;
+}
+
 /// Clamps v into Storage, raising the sticky flag when it does not fit.
 template <typename Storage>
 constexpr Storage saturate(std::int64_t v) {
@@ -196,10 +203,18 @@ struct ScalarTraits<Fixed<S, F>> {
   static constexpr std::int32_t round_to_int(T v) {
     return static_cast<std::int32_t>(detail::round_shift(v.raw(), F));
   }
-  /// num/den rounded (one integer division; 0 ≤ num, 0 < den).
-  static constexpr T fraction(std::int32_t num, std::int32_t den) {
-    const std::int64_t scaled = F >= 0 ? static_cast<std::int64_t>(num) << F : static_cast<std::int64_t>(num);
-    return T::from_raw(detail::saturate<S>((scaled + den / 2) / den));
+  /// Precomputed 2^(F+16)/den for fraction() (one division, at construction).
+  using FractionScale = std::uint32_t;
+  /// The scale of fraction(·, den); 0 < den, F + 16 ≤ 31.
+  static constexpr FractionScale fraction_scale(std::int32_t den) {
+    static_assert(F >= 0 && F + 16 <= 31, "fraction() is for formats with at most 15 fractional bits");
+    return static_cast<std::uint32_t>(((std::uint64_t{1} << (F + 16)) + static_cast<std::uint64_t>(den) / 2) /
+                                      static_cast<std::uint64_t>(den));
+  }
+  /// num/den for 0 ≤ num < den: one 32-bit multiply and shift (error below one LSB).
+  static constexpr T fraction(std::int32_t num, FractionScale scale) {
+    const std::uint32_t raw = (static_cast<std::uint32_t>(num) * scale + 0x8000U) >> 16;
+    return T::from_raw(detail::saturate<S>(static_cast<std::int64_t>(raw)));
   }
 };
 
@@ -224,7 +239,9 @@ constexpr std::enable_if_t<kIsFixed<To> && kIsFixed<A> && kIsFixed<B>, To> mul(A
       detail::round_shift(detail::wide_product(a.raw(), b.raw()), A::kFrac + B::kFrac - To::kFrac)));
 }
 
-/// 1/v in format To (one 64-bit division; saturates for v ≤ 0 or too small).
+/// 1/v in format To, to a relative precision of 2⁻¹⁶: v is normalised to a 16-bit
+/// mantissa m·2^e and 2³¹/m is one 32-bit division (no 64-bit division routine on a
+/// Cortex-M0). Saturates, raising the flag, for v ≤ 0 or a result out of range.
 template <typename To, typename From>
 constexpr std::enable_if_t<kIsFixed<To> && kIsFixed<From>, To> reciprocal(From v) {
   constexpr int kShift = To::kFrac + From::kFrac;
@@ -233,9 +250,24 @@ constexpr std::enable_if_t<kIsFixed<To> && kIsFixed<From>, To> reciprocal(From v
     detail::g_saturated = true;
     return To::from_raw(std::numeric_limits<typename To::StorageType>::max());
   }
-  const std::int64_t num = std::int64_t{1} << kShift;
-  const std::int64_t q = (num + v.raw() / 2) / v.raw();
-  return To::from_raw(detail::saturate<typename To::StorageType>(q));
+  // v.raw() = m · 2^e with m in [2^15, 2^16).
+  std::uint32_t m = static_cast<std::uint32_t>(v.raw());
+  int e = 0;
+  while (m >= (1U << 16)) {
+    m = (m + 1U) >> 1;
+    ++e;
+  }
+  while (m < (1U << 15)) {
+    m <<= 1;
+    --e;
+  }
+  if (m >= (1U << 16)) {  // rounding carried over
+    m >>= 1;
+    ++e;
+  }
+  const std::uint32_t q = ((1U << 31) + m / 2) / m;  // 2^31/m in (2^15, 2^16]
+  // 1/v · 2^kShift = q · 2^(kShift − 31 − e).
+  return To::from_raw(detail::saturate<typename To::StorageType>(detail::round_shift(q, 31 + e - kShift)));
 }
 
 /// Fixed accumulator: 64-bit register with kGuard extra fractional bits over Out.

@@ -50,7 +50,7 @@ class HalfKalman {
   /// Job with sample y taken tau_us before the next actuation instant.
   constexpr Status update(std::int32_t tau_us, const OutputVec& y) {
     const WithQd with_qd = qd_needed(noise_);
-    typename Disc::Triple d;
+    typename Disc::Triple d{NoInit{}};
     Status status = disc_->discretize(design_->period_us - tau_us, d, with_qd);
     x_ = predict_state<Fmt, Structure>(d, x_, u_);
     p_ = predict_covariance<Fmt, Structure>(d, p_, noise_, design_->q_constant);

@@ -12,6 +12,9 @@
 
 namespace oneshot {
 
+/// Tag: construct without initialising the entries (the caller writes every one).
+struct NoInit {};
+
 /// R×C matrix of scalars S, row-major, inline storage.
 template <typename S, std::size_t R, std::size_t C>
 class Matrix {
@@ -25,6 +28,9 @@ class Matrix {
 
   /// All entries zero (value-initialised).
   constexpr Matrix() : data_{} {}
+
+  /// Entries left unset: for kernels that write every entry (saves a zero fill).
+  explicit Matrix(NoInit) {}  // NOLINT(cppcoreguidelines-pro-type-member-init)
 
   /// Entries from a row-major array.
   constexpr explicit Matrix(const S (&row_major)[R * C]) : data_{} {

@@ -57,8 +57,12 @@ struct ScalarTraits<F, std::enable_if_t<std::is_floating_point_v<F>>> {
   static constexpr double to_double(F v) { return static_cast<double>(v); }
   /// |v|.
   static constexpr F abs(F v) { return v < F(0) ? -v : v; }
-  /// num/den for run-time integers (table residual r = δ/g): num·(1/den), as in every build.
-  static constexpr F fraction(std::int32_t num, std::int32_t den) { return from_int(num) * from_ratio(1, den); }
+  /// Precomputed 1/den for fraction() (one division, at construction).
+  using FractionScale = F;
+  /// The scale of fraction(·, den).
+  static constexpr FractionScale fraction_scale(std::int32_t den) { return from_ratio(1, den); }
+  /// num/den for a run-time integer num (table residual r = δ/g): num·(1/den).
+  static constexpr F fraction(std::int32_t num, FractionScale scale) { return from_int(num) * scale; }
   /// Nearest integer, halves away from zero; the caller keeps |v| < 2^31.
   static constexpr std::int32_t round_to_int(F v) {
     const F half = from_ratio(1, 2);

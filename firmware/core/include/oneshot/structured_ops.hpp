@@ -46,7 +46,7 @@ template <typename Out, typename PA, typename PB, typename SA, typename SB, std:
 constexpr Matrix<Out, R, C> product(const Matrix<SA, R, K>& a, const Matrix<SB, K, C>& b) {
   detail::check_pattern_shape<PA, R, K>();
   detail::check_pattern_shape<PB, K, C>();
-  Matrix<Out, R, C> out;
+  Matrix<Out, R, C> out{NoInit{}};
   for (std::size_t i = 0; i < R; ++i)
     for (std::size_t j = 0; j < C; ++j) {
       Accumulator<Out> acc;
@@ -65,7 +65,7 @@ constexpr Matrix<Out, N, C> affine(const Matrix<SA, N, N>& a, const Matrix<SX, N
                                    const Matrix<SB, N, M>& b, const Matrix<SU, M, C>& u) {
   detail::check_pattern_shape<PA, N, N>();
   detail::check_pattern_shape<PB, N, M>();
-  Matrix<Out, N, C> out;
+  Matrix<Out, N, C> out{NoInit{}};
   for (std::size_t i = 0; i < N; ++i)
     for (std::size_t j = 0; j < C; ++j) {
       Accumulator<Out> acc;
@@ -89,7 +89,7 @@ constexpr Matrix<Out, N, N> congruence_impl(const Matrix<SA, N, N>& a, const Mat
   detail::check_pattern_shape<PA, N, N>();
   detail::check_pattern_shape<PQ, N, N>();
   // T = A·P (full rows of T needed), then out_ij = Σ_k T_ik A_jk for j ≥ i.
-  Matrix<Out, N, N> t;
+  Matrix<Out, N, N> t{NoInit{}};
   for (std::size_t i = 0; i < N; ++i)
     for (std::size_t j = 0; j < N; ++j) {
       Accumulator<Out> acc;
@@ -101,7 +101,7 @@ constexpr Matrix<Out, N, N> congruence_impl(const Matrix<SA, N, N>& a, const Mat
       }
       t(i, j) = acc.value();
     }
-  Matrix<Out, N, N> out;
+  Matrix<Out, N, N> out{NoInit{}};  // upper triangle written, lower mirrored
   for (std::size_t i = 0; i < N; ++i)
     for (std::size_t j = i; j < N; ++j) {
       Accumulator<Out> acc;
@@ -139,7 +139,7 @@ constexpr Matrix<Out, N, N> congruence(const Matrix<SA, N, N>& a, const Matrix<S
 template <typename Out, typename PQ, typename SP, typename SQ, std::size_t N>
 constexpr Matrix<Out, N, N> symmetric_add(const Matrix<SP, N, N>& p, const Matrix<SQ, N, N>& q) {
   detail::check_pattern_shape<PQ, N, N>();
-  Matrix<Out, N, N> out;
+  Matrix<Out, N, N> out{NoInit{}};  // upper triangle written, lower mirrored
   for (std::size_t i = 0; i < N; ++i)
     for (std::size_t j = i; j < N; ++j) {
       Accumulator<Out> acc;

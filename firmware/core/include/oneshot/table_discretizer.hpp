@@ -41,7 +41,8 @@ class TableDiscretizer {
 
   /// Uses `view` (its arrays must outlive the discretizer). Every structural entry the
   /// patterns claim must be one in the table's slot maps (checked).
-  constexpr explicit TableDiscretizer(const TableView<Storage>& view) : view_(view) {
+  constexpr explicit TableDiscretizer(const TableView<Storage>& view)
+      : view_(view), fraction_scale_(ScalarTraits<typename Fmt::Fraction>::fraction_scale(view.granularity_us)) {
     ONESHOT_ASSERT(view.levels >= 1 && view.granularity_us > 0 && view.range_us > 0);
     ONESHOT_ASSERT(view.range_us % view.granularity_us == 0);
     ONESHOT_ASSERT(maps_match_structure(view));
@@ -72,11 +73,11 @@ class TableDiscretizer {
     }
     const std::int32_t range = view_.range_us;
     if (tau_us <= range) {
-      out = in_range(tau_us, with_qd);
+      in_range(tau_us, with_qd, out);
       return status;
     }
     if constexpr (kPolicy == OutOfRange::kClamp) {
-      out = in_range(range, with_qd);
+      in_range(range, with_qd, out);
       return Status::kClamped;
     } else {
       std::int32_t repeats = tau_us / range;
@@ -87,11 +88,14 @@ class TableDiscretizer {
         remainder = 0;
         status = Status::kClamped;
       }
-      const Triple full = in_range(range, with_qd);
-      Triple d = remainder > 0 ? in_range(remainder, with_qd) : full;
-      for (std::int32_t k = remainder > 0 ? 0 : 1; k < repeats; ++k)
-        d = compose<Fmt, Structure>(d, full, with_qd);
-      out = d;
+      Triple full{NoInit{}};
+      in_range(range, with_qd, full);
+      if (remainder > 0) {
+        in_range(remainder, with_qd, out);
+      } else {
+        out = full;
+      }
+      for (std::int32_t k = remainder > 0 ? 0 : 1; k < repeats; ++k) compose_into<Fmt, Structure>(out, full, with_qd);
       return status;
     }
   }
@@ -109,17 +113,17 @@ class TableDiscretizer {
     return slot == kSlotZero || slot == kSlotOne || (slot >= 0 && slot < static_cast<std::int8_t>(slots));
   }
 
-  /// The triple for 0 ≤ τ ≤ range.
-  constexpr Triple in_range(std::int32_t tau_us, WithQd with_qd) const {
+  /// d = the triple for 0 ≤ τ ≤ range.
+  constexpr void in_range(std::int32_t tau_us, WithQd with_qd, Triple& d) const {
     const std::int32_t g = view_.granularity_us;
     std::int32_t index = tau_us / g;
     const std::int32_t residual_us = tau_us - index * g;
-    Triple d;
     bool have = false;
     if (residual_us > 0) {
-      d = residual(residual_us, with_qd);
+      residual(residual_us, with_qd, d);
       have = true;
     }
+    Triple e{NoInit{}};
     for (std::uint8_t level = 0; level < view_.levels && index > 0; ++level) {
       const std::int32_t radix = view_.radix[level];
       const std::int32_t digit = index % radix;
@@ -128,39 +132,42 @@ class TableDiscretizer {
       const std::size_t entry = static_cast<std::size_t>(view_.level_offset[level]) +
                                 static_cast<std::size_t>(digit - 1);
       ONESHOT_ASSERT(entry < view_.entries);
-      const Triple e = this->entry(entry, with_qd);
-      d = have ? compose<Fmt, Structure>(d, e, with_qd) : e;
-      have = true;
+      if (have) {
+        load_entry(entry, with_qd, e);
+        compose_into<Fmt, Structure>(d, e, with_qd);
+      } else {
+        load_entry(entry, with_qd, d);
+        have = true;
+      }
     }
     ONESHOT_ASSERT(index == 0);  // range/g fits the radix levels (checked by the generator)
-    return have ? d : Triple::identity();
+    if (!have) d = Triple::identity();
   }
 
   using Reader = TableStorage<Storage>;
   using Slot = typename Reader::Slot;
 
-  /// The triple over δ = residual_us < g from the slot polynomials in r = δ/g.
-  constexpr Triple residual(std::int32_t residual_us, WithQd with_qd) const {
+  /// d = the triple over δ = residual_us < g from the slot polynomials in r = δ/g.
+  constexpr void residual(std::int32_t residual_us, WithQd with_qd, Triple& d) const {
     using F = typename Fmt::Fraction;
-    const F r = ScalarTraits<F>::fraction(residual_us, view_.granularity_us);
-    Slot slot_values[kMaxSlots]{};
+    const F r = ScalarTraits<F>::fraction(residual_us, fraction_scale_);
+    Slot slot_values[kMaxSlots];  // slots [0, used) written; expand() reads no other
     ONESHOT_ASSERT(view_.slots <= kMaxSlots);
     const std::uint8_t used = with_qd == WithQd::kYes ? view_.slots : view_.transition_slots;
     for (std::uint8_t s = 0; s < used; ++s) slot_values[s] = Reader::residual(view_, s, r);
-    return expand(slot_values, with_qd);
+    expand(slot_values, with_qd, d);
   }
 
-  /// The triple of stored entry `entry`.
-  constexpr Triple entry(std::size_t entry, WithQd with_qd) const {
-    Slot slot_values[kMaxSlots]{};
+  /// d = the triple of stored entry `entry`.
+  constexpr void load_entry(std::size_t entry, WithQd with_qd, Triple& d) const {
+    Slot slot_values[kMaxSlots];  // slots [0, used) written; expand() reads no other
     const std::uint8_t used = with_qd == WithQd::kYes ? view_.slots : view_.transition_slots;
     for (std::uint8_t s = 0; s < used; ++s) slot_values[s] = Reader::entry(view_, entry, s);
-    return expand(slot_values, with_qd);
+    expand(slot_values, with_qd, d);
   }
 
-  /// Matrices from one entry's free values.
-  constexpr Triple expand(const Slot* slot_values, WithQd with_qd) const {
-    Triple d;
+  /// d's matrices from one entry's free values (Q_d only when asked).
+  constexpr void expand(const Slot* slot_values, WithQd with_qd, Triple& d) const {
     for (std::size_t i = 0; i < kN; ++i) {
       for (std::size_t j = 0; j < kN; ++j)
         d.phi(i, j) = pick<typename Fmt::Transition>(view_.phi_slot[i * kN + j], slot_values);
@@ -172,7 +179,6 @@ class TableDiscretizer {
         for (std::size_t j = 0; j < kN; ++j)
           d.qd(i, j) = pick<typename Fmt::Covariance>(view_.qd_slot[i * kN + j], slot_values);
     }
-    return d;
   }
 
   template <typename To>
@@ -186,6 +192,7 @@ class TableDiscretizer {
   static constexpr std::size_t kMaxSlots = kN * kN + kN * kM + kN * (kN + 1) / 2;
 
   TableView<Storage> view_;
+  typename ScalarTraits<typename Fmt::Fraction>::FractionScale fraction_scale_;
 };
 
 }  // namespace oneshot

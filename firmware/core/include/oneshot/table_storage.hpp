@@ -71,10 +71,14 @@ struct TableStorage<BlockFixedStorage> {
     }
     return Slot{acc, v.residual_frac[s]};
   }
-  /// A slot value in format To.
+  /// A slot value in format To (32-bit arithmetic when narrowing, the usual case).
   template <typename To>
   static constexpr To to(Slot x) {
-    return To::from_raw(detail::saturate<typename To::StorageType>(detail::round_shift(x.raw, x.frac - To::kFrac)));
+    const int shift = x.frac - To::kFrac;
+    if (shift >= 0 && shift < 32) {
+      return To::from_raw(detail::saturate<typename To::StorageType>(detail::round_shift32(x.raw, shift)));
+    }
+    return To::from_raw(detail::saturate<typename To::StorageType>(detail::round_shift(x.raw, shift)));
   }
 };
 

@@ -57,3 +57,22 @@ nlohmann::json run_single(const SimContext& ctx, const CommonOptions& opt, const
 nlohmann::json run_benchmark(const SimContext& ctx, const CommonOptions& opt, double simulated_s);
 
 }  // namespace oneshot::sim
+
+namespace oneshot::sim {
+
+struct PilOptions;
+
+/// One scenario with the job in the emulated MCU and the same run on the host: costs,
+/// and whether every actuator code and estimate is bit-identical.
+nlohmann::json run_pil_compare(const SimContext& ctx, const CommonOptions& opt, const PilOptions& pil,
+                               const Scenario& scenario, Approach approach);
+
+/// Table I with the job in the emulated MCU (one QEMU for every run), beside the host.
+nlohmann::json run_pil_table1(const SimContext& ctx, const CommonOptions& opt, const PilOptions& pil,
+                              const std::vector<Scenario>& scenarios, std::size_t seeds);
+
+/// Experiment 5 on an MCU: instructions per job (QEMU plugin) of half/complete ×
+/// table/generic × float/fixed over the jobs of 4 s, and flash/RAM of each image.
+nlohmann::json run_exectime_target(const SimContext& ctx, const CommonOptions& opt, const PilOptions& base);
+
+}  // namespace oneshot::sim

@@ -50,6 +50,7 @@ struct RunOptions {
   BoardOptions board;                               ///< Emulator options.
   double p0_scale = 1.0;                            ///< Initial covariance = p0_scale · P0.
   bool record_jobs = false;                         ///< Keep one record per job.
+  class PilLink* pil = nullptr;                     ///< Run the job in the emulated MCU (pil_link.hpp).
   std::int32_t trace_step_us = 0;                   ///< Dense state trace step (0: none).
 };
 

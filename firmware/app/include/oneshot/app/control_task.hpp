@@ -49,6 +49,12 @@ class ControlTask {
   /// Task around `controller` (which must outlive it).
   explicit ControlTask(Ctrl& controller) : controller_(&controller) {}
 
+  /// Forgets any prepared output and clears the counters.
+  void reset() {
+    ready_ = false;
+    stats_ = TaskStatistics{};
+  }
+
   /// Actuation timer interrupt (one-shot): applies the prepared codes.
   void on_actuation_interrupt() {
     if constexpr (kModel == TaskModel::kOneShot) {

@@ -1,0 +1,103 @@
+# Cross build of the firmware images (included when CMAKE_CROSSCOMPILING, see toolchain/).
+# Images: oneshot-<target>-<float|fixed>-<table|generic>.elf, each with every approach.
+if(NOT ONESHOT_FIRMWARE_TARGET)
+  message(FATAL_ERROR "use a toolchain file from toolchain/ (it sets ONESHOT_FIRMWARE_TARGET)")
+endif()
+
+# lut_gen is a host tool: take the host build's, or build it natively here.
+set(ONESHOT_LUT_GEN "" CACHE FILEPATH "host lut_gen executable (built natively when empty)")
+if(ONESHOT_LUT_GEN)
+  set(lut_gen_exe ${ONESHOT_LUT_GEN})
+  set(lut_gen_dep ${ONESHOT_LUT_GEN})
+else()
+  include(ExternalProject)
+  set(host_dir ${CMAKE_BINARY_DIR}/host_tools)
+  ExternalProject_Add(host_tools
+    SOURCE_DIR ${PROJECT_SOURCE_DIR}
+    BINARY_DIR ${host_dir}
+    CMAKE_ARGS -DCMAKE_BUILD_TYPE=Release -DONESHOT_BUILD_TESTS=OFF -DONESHOT_BUILD_FIRMWARE=OFF
+               -DONESHOT_PLANT=${ONESHOT_PLANT}
+    BUILD_COMMAND ${CMAKE_COMMAND} --build ${host_dir} --target lut_gen
+    INSTALL_COMMAND ""
+    BUILD_ALWAYS ON
+    BUILD_BYPRODUCTS ${host_dir}/lut_gen/lut_gen)
+  set(lut_gen_exe ${host_dir}/lut_gen/lut_gen)
+  set(lut_gen_dep host_tools)
+endif()
+
+set(reference_plant ${PROJECT_SOURCE_DIR}/lut_gen/plants/reference_board.json)
+set(generated_dir ${CMAKE_BINARY_DIR}/generated)
+set(generated_header ${generated_dir}/oneshot/generated/plant_tables.hpp)
+if(ONESHOT_PLANT)
+  set(plant_args --plant ${ONESHOT_PLANT})
+  set(plant_dep ${ONESHOT_PLANT})
+else()
+  set(plant_args)
+  set(plant_dep ${reference_plant})
+endif()
+add_custom_command(
+  OUTPUT ${generated_header}
+  COMMAND ${CMAKE_COMMAND} -E make_directory ${generated_dir}/oneshot/generated
+  COMMAND ${lut_gen_exe} ${plant_args} --header ${generated_header} --report ${CMAKE_BINARY_DIR}/lut_report.json
+  DEPENDS ${lut_gen_dep} ${plant_dep}
+  COMMENT "lut_gen: design and tables for the firmware")
+add_custom_target(oneshot_generated DEPENDS ${generated_header})
+
+if(ONESHOT_FIRMWARE_TARGET STREQUAL "cortex-m0")
+  set(soc_define ONESHOT_MCU_NRF51)
+  set(irq_count 32)
+  set(uart_irq 2)
+  set(extra_defines)
+  set(linker_script ${PROJECT_SOURCE_DIR}/firmware/app/mcu/nrf51_microbit.ld)
+elseif(ONESHOT_FIRMWARE_TARGET STREQUAL "cortex-m4f")
+  set(soc_define ONESHOT_MCU_MPS2)
+  set(irq_count 48)
+  set(uart_irq 0)
+  set(extra_defines ONESHOT_MCU_IDLE_IRQ=9)
+  set(linker_script ${PROJECT_SOURCE_DIR}/firmware/app/mcu/mps2_an386.ld)
+else()
+  message(FATAL_ERROR "unknown firmware target ${ONESHOT_FIRMWARE_TARGET}")
+endif()
+
+set(fw_common_options
+  -ffreestanding -fno-exceptions -fno-rtti -fno-threadsafe-statics -fno-use-cxa-atexit
+  -ffunction-sections -fdata-sections -g -O3
+  -Wall -Wextra -Wconversion -Wsign-conversion -Wshadow -Wdouble-promotion)
+if(ONESHOT_WERROR)
+  list(APPEND fw_common_options -Werror)
+endif()
+
+function(oneshot_firmware_link target)
+  target_link_options(${target} PRIVATE -nostdlib -T ${linker_script} -L ${PROJECT_SOURCE_DIR}/firmware/app/mcu
+                      -Wl,--gc-sections -Wl,-Map=$<TARGET_FILE:${target}>.map)
+  target_link_libraries(${target} PRIVATE gcc)
+endfunction()
+
+foreach(format float fixed)
+  foreach(disc table generic)
+    set(image oneshot-${ONESHOT_FIRMWARE_TARGET}-${format}-${disc})
+    add_executable(${image} firmware/app/mcu/main.cpp firmware/app/mcu/startup.cpp)
+    # startup.cpp implements memcpy/memset: keep the compiler from turning their loops into calls to themselves.
+    set_source_files_properties(firmware/app/mcu/startup.cpp PROPERTIES COMPILE_OPTIONS "-fno-builtin;-fno-tree-loop-distribute-patterns")
+    set_target_properties(${image} PROPERTIES SUFFIX ".elf")
+    add_dependencies(${image} oneshot_generated)
+    target_include_directories(${image} PRIVATE
+      firmware/core/include firmware/app/include hal/include hal/mcu/include ${generated_dir})
+    target_compile_options(${image} PRIVATE ${fw_common_options})
+    target_compile_definitions(${image} PRIVATE ${soc_define}
+      ONESHOT_MCU_IRQ_COUNT=${irq_count} ONESHOT_MCU_ACTUATION_IRQ=8 ONESHOT_MCU_UART_IRQ=${uart_irq} ${extra_defines}
+      ONESHOT_FW_FIXED=$<STREQUAL:${format},fixed> ONESHOT_FW_GENERIC=$<STREQUAL:${disc},generic>)
+    oneshot_firmware_link(${image})
+    add_custom_command(TARGET ${image} POST_BUILD
+      COMMAND arm-none-eabi-size $<TARGET_FILE:${image}>
+      COMMENT "size of ${image}")
+  endforeach()
+endforeach()
+
+# A heap use must fail the link: this probe allocates and is never part of ALL.
+add_executable(oneshot-heap-probe-${ONESHOT_FIRMWARE_TARGET} EXCLUDE_FROM_ALL
+  firmware/app/mcu/heap_probe.cpp firmware/app/mcu/startup.cpp)
+target_compile_options(oneshot-heap-probe-${ONESHOT_FIRMWARE_TARGET} PRIVATE -ffreestanding -fno-exceptions -fno-rtti)
+target_compile_definitions(oneshot-heap-probe-${ONESHOT_FIRMWARE_TARGET} PRIVATE
+  ONESHOT_MCU_IRQ_COUNT=${irq_count} ONESHOT_MCU_ACTUATION_IRQ=8 ONESHOT_MCU_UART_IRQ=${uart_irq})
+oneshot_firmware_link(oneshot-heap-probe-${ONESHOT_FIRMWARE_TARGET})

@@ -1,0 +1,24 @@
+# From the host build: cross-build the firmware images of both targets as external
+# projects that use this build's lut_gen. Sets ONESHOT_FIRMWARE_DIRS (target → build dir).
+find_program(ONESHOT_ARM_GXX arm-none-eabi-g++)
+set(ONESHOT_FIRMWARE_AVAILABLE OFF)
+if(ONESHOT_BUILD_FIRMWARE AND ONESHOT_ARM_GXX)
+  include(ExternalProject)
+  set(ONESHOT_FIRMWARE_AVAILABLE ON)
+  foreach(target cortex-m0 cortex-m4f)
+    set(dir ${PROJECT_BINARY_DIR}/firmware-${target})
+    ExternalProject_Add(firmware-${target}
+      SOURCE_DIR ${PROJECT_SOURCE_DIR}
+      BINARY_DIR ${dir}
+      CMAKE_ARGS -DCMAKE_TOOLCHAIN_FILE=${PROJECT_SOURCE_DIR}/toolchain/arm-none-eabi-${target}.cmake
+                 -DCMAKE_BUILD_TYPE=Release -DONESHOT_LUT_GEN=$<TARGET_FILE:lut_gen>
+                 -DONESHOT_PLANT=${ONESHOT_PLANT} -DONESHOT_WERROR=${ONESHOT_WERROR}
+      INSTALL_COMMAND ""
+      BUILD_ALWAYS ON
+      DEPENDS lut_gen)
+  endforeach()
+  set(ONESHOT_FIRMWARE_DIR ${PROJECT_BINARY_DIR} CACHE INTERNAL "")
+elseif(ONESHOT_BUILD_FIRMWARE)
+  message(WARNING "arm-none-eabi-g++ not found: firmware images and processor-in-the-loop tests are skipped "
+                  "(apt-get install gcc-arm-none-eabi libstdc++-arm-none-eabi-newlib qemu-system-arm)")
+endif()

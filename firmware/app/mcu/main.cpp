@@ -1,0 +1,346 @@
+/// @file main.cpp
+/// @brief The oneshot firmware: the control task of every approach behind the PIL link.
+///
+/// Built once per (target, number format, discretizer). The harness selects the approach
+/// with kConfig, sends each sampling instant as kSample (the job runs between the two
+/// instruction-count markers) and each actuation instant as kTick, which raises the SoC's
+/// timer interrupt: its handler is the task's actuation interrupt.
+#include <cstddef>
+#include <cstdint>
+
+#include "oneshot/app/control_task.hpp"
+#include "oneshot/app/pil_protocol.hpp"
+#include "oneshot/assert_handler.hpp"
+#include "oneshot/complete_kalman.hpp"
+#include "oneshot/controller.hpp"
+#include "oneshot/deadbeat_observer.hpp"
+#include "oneshot/fixed_point.hpp"
+#include "oneshot/generated/plant_tables.hpp"
+#include "oneshot/generic_discretizer.hpp"
+#include "oneshot/half_kalman.hpp"
+#include "oneshot/mcu/pil_board.hpp"
+#include "oneshot/mcu/rx_ring.hpp"
+#include "oneshot/standard_kalman.hpp"
+#include "oneshot/table_discretizer.hpp"
+
+#if defined(ONESHOT_MCU_NRF51)
+#include "oneshot/mcu/nrf51.hpp"
+namespace soc = oneshot::mcu::nrf51;
+#elif defined(ONESHOT_MCU_MPS2)
+#include "oneshot/mcu/mps2_an386.hpp"
+namespace soc = oneshot::mcu::mps2;
+#else
+#error "define ONESHOT_MCU_NRF51 or ONESHOT_MCU_MPS2"
+#endif
+
+namespace oneshot::mcu {
+PilRegisters g_pil;
+}  // namespace oneshot::mcu
+
+/// Instruction-count markers: the QEMU plugin counts from the first instruction of
+/// begin to the first of end.
+extern "C" __attribute__((noinline, used)) void oneshot_job_begin() { __asm__ volatile("" ::: "memory"); }
+/// See oneshot_job_begin().
+extern "C" __attribute__((noinline, used)) void oneshot_job_end() { __asm__ volatile("" ::: "memory"); }
+
+namespace {
+
+using namespace oneshot;
+namespace pil = app::pil;
+using app::TaskModel;
+using mcu::PilBoard;
+using mcu::g_pil;
+
+#if ONESHOT_FW_FIXED
+#if !ONESHOT_GENERATED_FIXED_POINT
+#error "this plant has no fixed-point build (see kFixedPointUnavailable in the generated header)"
+#endif
+using Tag = generated::FixedTag;
+constexpr std::uint8_t kFormatId = 1;
+#else
+using Tag = float;
+constexpr std::uint8_t kFormatId = 0;
+#endif
+using K = generated::PlantConstants<Tag>;
+using Fmt = K::Format;
+using Structure = generated::PlantStructure;
+constexpr std::size_t kN = Structure::kStates;
+constexpr std::size_t kM = Structure::kInputs;
+constexpr std::size_t kP = Structure::kOutputs;
+static_assert(kP <= mcu::kMaxChannels && kM <= mcu::kMaxChannels, "too many channels for the PIL link");
+
+template <typename View>
+struct StorageOf;
+template <typename S>
+struct StorageOf<TableView<S>> {
+  using type = S;
+};
+
+#if ONESHOT_FW_GENERIC
+using Disc = GenericDiscretizer<Fmt, kN, kM>;
+const Disc g_disc(K::kModel);
+constexpr std::uint8_t kDiscId = 1;
+#else
+using Disc = TableDiscretizer<Fmt, Structure, StorageOf<std::remove_cv_t<decltype(K::kTable)>>::type>;
+const Disc g_disc(K::kTable);
+constexpr std::uint8_t kDiscId = 0;
+#endif
+
+#if defined(ONESHOT_MCU_NRF51)
+constexpr std::uint8_t kTargetId = 0;  // cortex-m0
+#else
+constexpr std::uint8_t kTargetId = 1;  // cortex-m4f
+#endif
+
+/// Raw 32-bit image of a scalar: IEEE bits, or the sign-extended fixed mantissa.
+template <typename T>
+std::uint32_t raw32(T v) {
+  if constexpr (kIsFloating<T>) {
+    static_assert(sizeof(T) == 4, "the firmware reports single precision");
+    std::uint32_t u = 0;
+    __builtin_memcpy(&u, &v, 4);
+    return u;
+  } else {
+    return static_cast<std::uint32_t>(static_cast<std::int32_t>(v.raw()));
+  }
+}
+
+template <typename T, typename = void>
+struct HasGain : std::false_type {};
+template <typename T>
+struct HasGain<T, std::void_t<decltype(std::declval<const T&>().gain())>> : std::true_type {};
+
+/// One approach: its controller and task.
+template <typename Est, TaskModel kModel>
+struct Loop {
+  using Ctrl = Controller<Fmt, Structure, Est>;
+  Ctrl ctrl;
+  app::ControlTask<PilBoard, Ctrl, kModel> task{ctrl};
+
+  explicit Loop(const Est& e) : ctrl(K::kDesign, e) {}
+
+  void configure(const Est& e, const std::int32_t (&codes)[kM]) {
+    ctrl = Ctrl(K::kDesign, e);
+    typename Ctrl::InputVec u0;
+    for (std::size_t j = 0; j < kM; ++j) u0[j] = input_of_code(K::kDesign.actuator, j, codes[j]);
+    ctrl.estimator().reset(typename Ctrl::StateVec{}, K::kDesign.p0, u0);
+    task.reset();
+  }
+  void results(pil::Writer& w) const {
+    for (std::size_t j = 0; j < kM; ++j) w.u(raw32(ctrl.applied_input()[j]), 4);
+    for (std::size_t i = 0; i < kN; ++i) w.u(raw32(ctrl.estimator().prediction()[i]), 4);
+    if constexpr (HasGain<Est>::value) {
+      w.u(raw32(ctrl.estimator().gain()[0]), 4);
+    } else {
+      w.u(0, 4);
+    }
+  }
+};
+
+using HalfEst = HalfKalman<Fmt, Structure, Disc>;
+using CompleteEst = CompleteKalman<Fmt, Structure, Disc>;
+using StandardEst = StandardKalman<Fmt, Structure>;
+using DeadbeatEst = DeadbeatObserver<Fmt, Structure>;
+
+Loop<StandardEst, TaskModel::kStandard> g_standard{StandardEst(K::kDesign, NoiseModel::kExact)};
+Loop<HalfEst, TaskModel::kOneShot> g_half{HalfEst(K::kDesign, g_disc, NoiseModel::kExact)};
+Loop<CompleteEst, TaskModel::kOneShot> g_complete{CompleteEst(K::kDesign, g_disc, NoiseModel::kExact)};
+Loop<DeadbeatEst, TaskModel::kStandard> g_deadbeat{DeadbeatEst(K::kDesign)};
+
+/// Outcome of one job for the reply.
+struct JobOutcome {
+  Status status;
+  std::int32_t tau_us;
+};
+
+/// Approach letters A–E as 0–4: A, D standard Kalman; B half; C complete; E deadbeat.
+std::uint8_t g_approach = 1;
+volatile bool g_tick_done = false;
+mcu::RxRing g_rx;
+
+/// Next received byte; sleeps until the receive interrupt when there is none.
+std::uint8_t next_byte() {
+  for (;;) {
+    std::uint8_t b = 0;
+    mcu::interrupts_off();
+    if (g_rx.pop(b)) {
+      soc::IdleWakeup::disarm();
+      mcu::interrupts_on();
+      return b;
+    }
+    soc::IdleWakeup::arm();
+    mcu::wait_for_interrupt();  // a pending interrupt ends it even with PRIMASK set
+    soc::Uart::drain([](std::uint8_t c) { g_rx.push(c); });  // whatever woke us
+    mcu::interrupts_on();
+  }
+}
+
+template <typename F>
+decltype(auto) with_loop(F&& f) {
+  switch (g_approach) {
+    case 1: return f(g_half);
+    case 2: return f(g_complete);
+    case 4: return f(g_deadbeat);
+    default: return f(g_standard);
+  }
+}
+
+void send(const pil::Frame& f) {
+  std::uint8_t out[2 * (pil::kMaxPayload + 5) + 2];
+  const std::size_t n = pil::encode(f, out);
+  for (std::size_t i = 0; i < n; ++i) soc::Uart::put(out[i]);
+}
+
+void write_pwm(pil::Writer& w) {
+  w.u(static_cast<std::uint32_t>(g_pil.writes), 1);
+  for (std::size_t i = 0; i < g_pil.writes; ++i) {
+    w.u(g_pil.write_channel[i], 1);
+    w.u(static_cast<std::uint32_t>(g_pil.write_code[i]), 2);
+  }
+}
+
+void hello(pil::Frame& r) {
+  r.type = static_cast<pil::Type>(static_cast<std::uint8_t>(pil::Type::kHello) | 0x80U);
+  pil::Writer w(r);
+  w.u(pil::kProtocolVersion, 1);
+  w.u(kTargetId, 1);
+  w.u(kFormatId, 1);
+  w.u(kDiscId, 1);
+  w.u(kN, 1);
+  w.u(kM, 1);
+  w.u(kP, 1);
+}
+
+void handle(const pil::Frame& q, pil::Frame& r) {
+  r.seq = q.seq;
+  r.type = static_cast<pil::Type>(static_cast<std::uint8_t>(q.type) | 0x80U);
+  r.length = 0;
+  pil::Reader in(q);
+  pil::Writer w(r);
+  switch (q.type) {
+    case pil::Type::kHello:
+      hello(r);
+      return;
+    case pil::Type::kConfig: {
+      const std::uint8_t approach = static_cast<std::uint8_t>(in.u(1));
+      const NoiseModel noise = in.u(1) != 0U ? NoiseModel::kExact : NoiseModel::kConstant;
+      std::int32_t codes[kM] = {};
+      for (std::size_t j = 0; j < kM; ++j) codes[j] = static_cast<std::int32_t>(in.u(2));
+      g_approach = approach <= 4 ? approach : 1;
+      g_half.configure(HalfEst(K::kDesign, g_disc, noise), codes);
+      g_complete.configure(CompleteEst(K::kDesign, g_disc, noise), codes);
+      g_standard.configure(StandardEst(K::kDesign, noise), codes);
+      g_deadbeat.configure(DeadbeatEst(K::kDesign), codes);
+      clear_saturation_flag();
+      w.u(g_approach, 1);
+      return;
+    }
+    case pil::Type::kSample: {
+      g_pil.now_us = in.u(4);
+      g_pil.next_actuation_us = in.u(4);
+      for (std::size_t o = 0; o < kP; ++o) g_pil.adc[o] = in.s(2);
+      for (std::size_t o = 0; o < kP; ++o) g_pil.setpoint[o] = in.s(2);
+      g_pil.writes = 0;
+      const JobOutcome job = with_loop([](auto& loop) {
+        oneshot_job_begin();
+        const Status s = loop.task.run_job();
+        oneshot_job_end();
+        return JobOutcome{s, loop.task.statistics().last_tau_us};
+      });
+      w.u(static_cast<std::uint8_t>(job.status), 1);
+      w.s(job.tau_us, 4);
+      w.u(saturation_flag() ? 1U : 0U, 1);
+      write_pwm(w);
+      with_loop([&](auto& loop) { loop.results(w); });
+      return;
+    }
+    case pil::Type::kTick: {
+      g_pil.now_us = in.u(4);
+      g_pil.writes = 0;
+      g_tick_done = false;
+      soc::ActuationTimer::arm_once();
+      while (!g_tick_done) mcu::wait_for_interrupt();
+      write_pwm(w);
+      return;
+    }
+    case pil::Type::kCalibrate:
+      oneshot_job_begin();
+      oneshot_job_end();
+      return;
+    case pil::Type::kEcho:
+      for (std::size_t i = 0; i < q.length; ++i) r.payload[i] = q.payload[i];
+      r.length = q.length;
+      return;
+    default:
+      r.type = pil::Type::kFault;
+      w.u(0xFFFFFFFEU, 4);  // unknown request
+      return;
+  }
+}
+
+}  // namespace
+
+/// The idle wake-up timer (see IdleWakeup).
+extern "C" void oneshot_idle_wakeup_handler() { soc::IdleWakeup::acknowledge(); }
+
+/// The UART receive interrupt.
+extern "C" void oneshot_uart_rx_handler() {
+  soc::Uart::drain([](std::uint8_t b) { g_rx.push(b); });
+}
+
+/// The actuation timer interrupt: the task's one-shot actuation.
+extern "C" void oneshot_actuation_timer_handler() {
+  soc::ActuationTimer::acknowledge();
+  with_loop([](auto& loop) { loop.task.on_actuation_interrupt(); });
+  g_tick_done = true;
+}
+
+/// Faults and failed invariants: report once over the link, then stop.
+extern "C" [[noreturn]] void oneshot_fault_handler() {
+  pil::Frame f;
+  f.type = pil::Type::kFault;
+  pil::Writer w(f);
+  w.u(0xFFFFFFFFU, 4);  // hard fault
+  send(f);
+  for (;;) {
+  }
+}
+
+namespace oneshot {
+[[noreturn]] void assert_failed(const char* file, int line, const char* /*expression*/) {
+  pil::Frame f;
+  f.type = pil::Type::kFault;
+  pil::Writer w(f);
+  w.u(static_cast<std::uint32_t>(line), 4);
+  for (std::size_t i = 0; file[i] != '\0' && f.length < pil::kMaxPayload; ++i) w.u(static_cast<std::uint8_t>(file[i]), 1);
+  send(f);
+  for (;;) {
+  }
+}
+}  // namespace oneshot
+
+int main() {
+  soc::Uart::init();
+  soc::ActuationTimer::init();
+  soc::IdleWakeup::init();
+  mcu::interrupts_on();
+  pil::Frame r;
+  hello(r);
+  send(r);
+  pil::Decoder decoder;
+  pil::Frame last_reply;
+  bool have_last = false;
+  for (;;) {
+    if (!decoder.feed(next_byte())) continue;
+    const pil::Frame& q = decoder.frame();
+    // A repeated sequence number is a retransmission: the reply was lost, not the job.
+    if (have_last && q.seq == last_reply.seq &&
+        static_cast<std::uint8_t>(last_reply.type) == (static_cast<std::uint8_t>(q.type) | 0x80U)) {
+      send(last_reply);
+      continue;
+    }
+    handle(q, last_reply);
+    have_last = true;
+    send(last_reply);
+  }
+}

@@ -1,0 +1,94 @@
+/// @file pil_link.hpp
+/// @brief The host end of the processor-in-the-loop link: QEMU running a firmware image,
+///        framed requests over its UART, instruction counts from the insn_window plugin.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "oneshot/app/pil_protocol.hpp"
+
+namespace oneshot::sim {
+
+/// The link or the firmware failed (no QEMU, no image, timeout, firmware fault).
+class PilError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+/// Where to find things.
+struct PilOptions {
+  std::string target = "cortex-m0";  ///< cortex-m0 (QEMU microbit) or cortex-m4f (mps2-an386).
+  std::string format = "float";      ///< float or fixed.
+  std::string discretizer = "table"; ///< table or generic.
+  std::string firmware_dir;          ///< Build tree holding firmware-<target>/ (default: this build's).
+  bool count_instructions = false;   ///< Load the insn_window plugin.
+  std::string plugin_path;           ///< The plugin (default: this build's).
+  int timeout_ms = 2000;             ///< Per reply.
+  int retries = 5;                   ///< Resends of one request.
+};
+
+/// What the firmware reports in kHello.
+struct FirmwareInfo {
+  int protocol = 0;        ///< Protocol version.
+  std::string target;      ///< cortex-m0 / cortex-m4f.
+  std::string format;      ///< float / fixed.
+  std::string discretizer; ///< table / generic.
+  int n = 0, m = 0, p = 0; ///< Dimensions.
+};
+
+/// Path of the image for `options` (firmware_dir/firmware-<target>/oneshot-<target>-<format>-<disc>.elf).
+std::string firmware_image_path(const PilOptions& options);
+
+/// Address of symbol `name` in a 32-bit little-endian ELF file (PilError when absent).
+std::uint32_t elf_symbol_address(const std::string& elf_path, const std::string& name);
+
+/// Link faults for tests: corrupt one byte, or drop one byte, of the next request.
+enum class LinkFault { kNone, kCorruptByte, kDropByte };
+
+/// A running firmware image behind its UART.
+class PilLink {
+ public:
+  /// Starts QEMU with the image of `options` and waits for its kHello.
+  explicit PilLink(const PilOptions& options);
+  ~PilLink();
+  PilLink(const PilLink&) = delete;
+  PilLink& operator=(const PilLink&) = delete;
+
+  /// The image's self-description.
+  const FirmwareInfo& info() const { return info_; }
+  /// Sends a request and returns the reply, resending on timeout (PilError when exhausted).
+  app::pil::Frame request(app::pil::Type type, const app::pil::Frame& payload);
+  /// Requests resent so far (timeouts and corrupted frames).
+  std::uint32_t resends() const { return resends_; }
+  /// Damages the next request once (tests of resynchronisation).
+  void inject(LinkFault fault) { fault_ = fault; }
+  /// Instructions counted between the markers so far, in execution order.
+  std::vector<std::uint64_t> instruction_counts() const;
+  /// The image in use.
+  const std::string& image() const { return image_; }
+
+ private:
+  bool read_frame(app::pil::Frame& out, int timeout_ms);
+  void write_bytes(const std::uint8_t* data, std::size_t n);
+  [[noreturn]] void fail(const std::string& what);
+
+  PilOptions options_;
+  std::string image_;
+  std::string workdir_;
+  std::string counts_path_;
+  int pid_ = -1;
+  int to_qemu_ = -1;
+  int from_qemu_ = -1;
+  app::pil::Decoder decoder_;
+  std::vector<app::pil::Frame> pending_;  // frames decoded after the one returned
+  std::uint16_t seq_ = 1;
+  std::uint32_t resends_ = 0;
+  LinkFault fault_ = LinkFault::kNone;
+  FirmwareInfo info_;
+};
+
+}  // namespace oneshot::sim

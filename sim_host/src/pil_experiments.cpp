@@ -1,0 +1,267 @@
+/// @file pil_experiments.cpp
+/// @brief Processor-in-the-loop runs and MCU instruction counts.
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <fstream>
+#include <iostream>
+#include <sstream>
+
+#include "oneshot/sim/experiments.hpp"
+#include "oneshot/sim/output_files.hpp"
+#include "oneshot/sim/pil_link.hpp"
+#include "oneshot/sim/progress_bar.hpp"
+#include "oneshot/sim/statistics.hpp"
+
+namespace oneshot::sim {
+namespace {
+
+RunOptions options_for(const CommonOptions& opt, Approach a) {
+  RunOptions r;
+  r.approach = a;
+  r.format = opt.format;
+  r.discretizer = opt.discretizer;
+  r.noise = opt.noise;
+  r.board = opt.board;
+  r.record_jobs = true;
+  return r;
+}
+
+PilOptions matching(const PilOptions& base, const CommonOptions& opt) {
+  PilOptions p = base;
+  p.format = to_string(opt.format);
+  p.discretizer = to_string(opt.discretizer);
+  if (opt.format == NumberFormat::kDouble) {
+    throw std::invalid_argument("the firmware runs float or fixed (--number-format float|fixed), not double");
+  }
+  return p;
+}
+
+struct Comparison {
+  std::size_t jobs = 0;
+  std::size_t identical_codes = 0;     // applied input identical
+  std::size_t identical_estimates = 0; // every estimate entry identical
+  double max_estimate_diff = 0;
+};
+
+Comparison compare(const RunResult& host, const RunResult& mcu) {
+  Comparison c;
+  c.jobs = std::min(host.job_records.size(), mcu.job_records.size());
+  for (std::size_t k = 0; k < c.jobs; ++k) {
+    const JobRecord& a = host.job_records[k];
+    const JobRecord& b = mcu.job_records[k];
+    if (a.u_volts == b.u_volts) ++c.identical_codes;
+    bool same = true;
+    for (std::size_t i = 0; i < a.estimate.size(); ++i) {
+      same = same && a.estimate[i] == b.estimate[i];
+      c.max_estimate_diff = std::max(c.max_estimate_diff, std::fabs(a.estimate[i] - b.estimate[i]));
+    }
+    if (same) ++c.identical_estimates;
+  }
+  return c;
+}
+
+/// Flash (text + rodata + initialised data) and RAM (data + bss) of an ELF image.
+std::pair<std::size_t, std::size_t> image_memory(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  const std::string d((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const auto u16 = [&](std::size_t o) {
+    return static_cast<std::uint32_t>(static_cast<unsigned char>(d.at(o)) | static_cast<unsigned char>(d.at(o + 1)) << 8);
+  };
+  const auto u32 = [&](std::size_t o) { return u16(o) | u16(o + 2) << 16; };
+  std::size_t flash = 0;
+  std::size_t ram = 0;
+  const std::uint32_t shoff = u32(32);
+  const std::uint32_t entsize = u16(46);
+  const std::uint32_t num = u16(48);
+  for (std::uint32_t i = 0; i < num; ++i) {
+    const std::size_t sh = shoff + i * entsize;
+    const std::uint32_t type = u32(sh + 4);
+    const std::uint32_t flags = u32(sh + 8);
+    const std::uint32_t size = u32(sh + 20);
+    if ((flags & 0x2U) == 0) continue;  // SHF_ALLOC
+    const bool write = (flags & 0x1U) != 0;
+    const bool nobits = type == 8;
+    if (!write) flash += size;
+    if (write && !nobits) {
+      flash += size;
+      ram += size;
+    }
+    if (write && nobits) ram += size;
+  }
+  return {flash, ram};
+}
+
+}  // namespace
+
+nlohmann::json run_pil_compare(const SimContext& ctx, const CommonOptions& opt, const PilOptions& base,
+                               const Scenario& scenario, Approach approach) {
+  const PilOptions p = matching(base, opt);
+  PilLink link(p);
+  RunOptions host_opt = options_for(opt, approach);
+  RunOptions mcu_opt = host_opt;
+  mcu_opt.pil = &link;
+  const auto t0 = std::chrono::steady_clock::now();
+  const RunResult mcu = simulate(ctx, scenario, opt.seed, mcu_opt);
+  const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  const RunResult host = simulate(ctx, scenario, opt.seed, host_opt);
+  const Comparison c = compare(host, mcu);
+  nlohmann::json j;
+  j["experiment"] = "pil";
+  j["target"] = link.info().target;
+  j["image"] = link.image();
+  j["number_format"] = link.info().format;
+  j["discretizer"] = link.info().discretizer;
+  j["approach"] = std::string(1, info(approach).letter);
+  j["scenario"] = scenario.name;
+  j["seed"] = opt.seed;
+  j["jobs"] = c.jobs;
+  j["host_cost"] = host.cost.total();
+  j["pil_cost"] = mcu.cost.total();
+  j["cost_relative_difference"] = std::fabs(mcu.cost.total() - host.cost.total()) / host.cost.total();
+  j["identical_inputs"] = c.identical_codes;
+  j["identical_estimates"] = c.identical_estimates;
+  j["max_estimate_difference"] = c.max_estimate_diff;
+  j["bit_identical"] = c.identical_codes == c.jobs && c.identical_estimates == c.jobs;
+  j["resends"] = link.resends();
+  j["pil_wall_time_s"] = wall;
+  j["overruns"] = mcu.overruns;
+  return j;
+}
+
+nlohmann::json run_pil_table1(const SimContext& ctx, const CommonOptions& opt, const PilOptions& base,
+                              const std::vector<Scenario>& scenarios, std::size_t seeds) {
+  const PilOptions p = matching(base, opt);
+  PilLink link(p);
+  const std::size_t na = kAllApproaches.size();
+  std::vector<std::vector<double>> per_seed_host(na, std::vector<double>(seeds, 0));
+  std::vector<std::vector<double>> per_seed_mcu(na, std::vector<double>(seeds, 0));
+  std::size_t jobs = 0;
+  std::size_t identical = 0;
+  const auto t0 = std::chrono::steady_clock::now();
+  {
+    ProgressBar bar("pil table1", scenarios.size() * seeds * na);
+    for (std::size_t s = 0; s < scenarios.size(); ++s)
+      for (std::size_t k = 0; k < seeds; ++k)
+        for (std::size_t a = 0; a < na; ++a) {
+          RunOptions host_opt = options_for(opt, kAllApproaches[a]);
+          RunOptions mcu_opt = host_opt;
+          mcu_opt.pil = &link;
+          const RunResult mcu = simulate(ctx, scenarios[s], opt.seed + k, mcu_opt);
+          const RunResult host = simulate(ctx, scenarios[s], opt.seed + k, host_opt);
+          const Comparison c = compare(host, mcu);
+          jobs += c.jobs;
+          identical += std::min(c.identical_codes, c.identical_estimates);
+          per_seed_host[a][k] += host.cost.total() / static_cast<double>(scenarios.size());
+          per_seed_mcu[a][k] += mcu.cost.total() / static_cast<double>(scenarios.size());
+          bar.tick();
+        }
+  }
+  nlohmann::json j;
+  j["experiment"] = "pil_table1";
+  j["target"] = link.info().target;
+  j["number_format"] = link.info().format;
+  j["discretizer"] = link.info().discretizer;
+  j["scenarios"] = scenarios.size();
+  j["seeds"] = seeds;
+  j["jobs"] = jobs;
+  j["bit_identical_jobs"] = identical;
+  j["resends"] = link.resends();
+  j["wall_time_s"] = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  const Summary a_host = summarize(per_seed_host[0]);
+  const Summary a_mcu = summarize(per_seed_mcu[0]);
+  std::ostringstream md;
+  md << "| approach | host mean cost | 95 % CI | MCU mean cost | 95 % CI | MCU ratio to A |\n|---|---|---|---|---|---|\n";
+  for (std::size_t a = 0; a < na; ++a) {
+    const Summary h = summarize(per_seed_host[a]);
+    const Summary m = summarize(per_seed_mcu[a]);
+    const std::string letter(1, info(kAllApproaches[a]).letter);
+    j["approaches"][letter] = {{"host_cost_mean", h.mean}, {"host_cost_ci95", h.ci95}, {"cost_mean", m.mean},
+                               {"cost_ci95", m.ci95}, {"ratio_to_A", m.mean / a_mcu.mean},
+                               {"host_ratio_to_A", h.mean / a_host.mean}};
+    char line[200];
+    std::snprintf(line, sizeof line, "| %s | %.5f | ± %.5f | %.5f | ± %.5f | %.4f |\n", letter.c_str(), h.mean, h.ci95,
+                  m.mean, m.ci95, m.mean / a_mcu.mean);
+    md << line;
+  }
+  j["markdown"] = md.str();
+  return j;
+}
+
+nlohmann::json run_exectime_target(const SimContext& ctx, const CommonOptions& opt, const PilOptions& base) {
+  if (!ctx.generated()) throw std::invalid_argument("MCU instruction counts use the compiled-in plant: run without --plant");
+  // The jobs of 4 s of the reference jitter scenario, recorded on the host (as in exectime).
+  Scenario sc;
+  sc.name = "exectime";
+  sc.duration_s = 4.0;
+  sc.amplitude_volts = 0.2;
+  sc.change_period_s = 1.0;
+  sc.jitter.kind = JitterModel::Kind::kUniform;
+  sc.jitter.release_max_us = 20'000;
+  sc.jitter.exec_min_us = 200;
+  sc.jitter.exec_max_us = 600;
+  RunOptions rec = options_for(opt, Approach::kB);
+  rec.format = NumberFormat::kDouble;
+  const std::vector<JobRecord> jobs = simulate(ctx, sc, opt.seed, rec).job_records;
+  nlohmann::json j;
+  j["experiment"] = "exectime";
+  j["target"] = base.target;
+  j["jobs_per_4s"] = jobs.size();
+  j["noise_model"] = opt.noise == NoiseModel::kExact ? "exact" : "constant";
+  j["counter"] = "QEMU TCG plugin insn_window: guest instructions between the job markers, marker overhead subtracted";
+  for (const char* format : {"float", "fixed"}) {
+    for (const char* disc : {"table", "generic"}) {
+      PilOptions p = base;
+      p.format = format;
+      p.discretizer = disc;
+      p.count_instructions = true;
+      PilLink link(p);
+      // Marker overhead: begin/end back to back.
+      link.request(app::pil::Type::kCalibrate, app::pil::Frame{});
+      for (Approach a : {Approach::kB, Approach::kC}) {
+        app::pil::Frame cfg;
+        app::pil::Writer cw(cfg);
+        cw.u(static_cast<std::uint32_t>(a), 1);
+        cw.u(opt.noise == NoiseModel::kExact ? 1U : 0U, 1);
+        // Initial PWM code: the one nearest 0 V, as in simulate().
+        cw.u(static_cast<std::uint32_t>(std::lround(-ctx.design().u_min[0] * ctx.design().steps_per_volt[0])), 2);
+        link.request(app::pil::Type::kConfig, cfg);
+        for (const JobRecord& r : jobs) {
+          app::pil::Frame f;
+          app::pil::Writer w(f);
+          w.u(static_cast<std::uint32_t>(std::llround(r.t_sample_s * 1e6)), 4);
+          w.u(static_cast<std::uint32_t>(std::llround(r.t_apply_s * 1e6)), 4);
+          w.s(r.y_code, 2);
+          w.s(r.setpoint_code, 2);
+          link.request(app::pil::Type::kSample, f);
+        }
+      }
+      const std::vector<std::uint64_t> counts = link.instruction_counts();
+      if (counts.size() != 1 + 2 * jobs.size()) {
+        throw PilError("instruction counter: expected " + std::to_string(1 + 2 * jobs.size()) + " windows, got " +
+                       std::to_string(counts.size()));
+      }
+      const auto [flash, ram] = image_memory(link.image());
+      const std::uint64_t overhead = counts[0];
+      for (std::size_t v = 0; v < 2; ++v) {
+        std::vector<double> per_job;
+        for (std::size_t k = 0; k < jobs.size(); ++k) per_job.push_back(static_cast<double>(counts[1 + v * jobs.size() + k] - overhead));
+        const Summary s = summarize(per_job);
+        double total = 0;
+        for (double x : per_job) total += x;
+        const std::string name = std::string(v == 0 ? "half" : "complete") + "_" + disc + "_" + format;
+        j["variants"][name] = {{"instructions_per_job", s.mean},
+                               {"instructions_per_job_min", *std::min_element(per_job.begin(), per_job.end())},
+                               {"instructions_per_job_max", *std::max_element(per_job.begin(), per_job.end())},
+                               {"instructions_per_4s", total},
+                               {"flash_bytes", flash},
+                               {"ram_bytes", ram},
+                               {"image", link.image()}};
+      }
+      j["marker_overhead_instructions"] = overhead;
+    }
+  }
+  return j;
+}
+
+}  // namespace oneshot::sim
