@@ -74,7 +74,7 @@ function(oneshot_firmware_link target)
 endfunction()
 
 foreach(format float fixed)
-  foreach(disc table generic)
+  foreach(disc table nearest generic)
     set(image oneshot-${ONESHOT_FIRMWARE_TARGET}-${format}-${disc})
     add_executable(${image} firmware/app/mcu/main.cpp firmware/app/mcu/startup.cpp)
     # startup.cpp implements memcpy/memset: keep the compiler from turning their loops into calls to themselves.
@@ -86,7 +86,8 @@ foreach(format float fixed)
     target_compile_options(${image} PRIVATE ${fw_common_options})
     target_compile_definitions(${image} PRIVATE ${soc_define}
       ONESHOT_MCU_IRQ_COUNT=${irq_count} ONESHOT_MCU_ACTUATION_IRQ=8 ONESHOT_MCU_UART_IRQ=${uart_irq} ${extra_defines}
-      ONESHOT_FW_FIXED=$<STREQUAL:${format},fixed> ONESHOT_FW_GENERIC=$<STREQUAL:${disc},generic>)
+      ONESHOT_FW_FIXED=$<STREQUAL:${format},fixed>
+      ONESHOT_FW_DISC=$<IF:$<STREQUAL:${disc},generic>,1,$<IF:$<STREQUAL:${disc},nearest>,2,0>>)
     oneshot_firmware_link(${image})
     add_custom_command(TARGET ${image} POST_BUILD
       COMMAND arm-none-eabi-size $<TARGET_FILE:${image}>

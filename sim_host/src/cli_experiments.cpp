@@ -32,7 +32,9 @@ struct CliCommon {
   CommonOptions resolve() const {
     CommonOptions o = opt;
     o.format = format == "double" ? NumberFormat::kDouble : format == "fixed" ? NumberFormat::kFixed : NumberFormat::kFloat;
-    o.discretizer = discretizer == "generic" ? DiscretizerKind::kGeneric : DiscretizerKind::kTable;
+    o.discretizer = discretizer == "generic"   ? DiscretizerKind::kGeneric
+                    : discretizer == "nearest" ? DiscretizerKind::kNearest
+                                               : DiscretizerKind::kTable;
     o.noise = noise == "constant" ? NoiseModel::kConstant : NoiseModel::kExact;
     o.board.update = pwm == "period" ? PwmUpdate::kNextPeriod : PwmUpdate::kImmediate;
     o.plots = !no_plots;
@@ -51,8 +53,10 @@ void add_common(CLI::App* cmd, CliCommon& c, const std::string& default_out) {
   cmd->add_option("--number-format", c.format, "number format of the control job")
       ->check(CLI::IsMember({"float", "double", "fixed"}))
       ->capture_default_str();
-  cmd->add_option("--discretizer", c.discretizer, "Phi/Gamma/Qd of the one-shot filters: table or generic routine")
-      ->check(CLI::IsMember({"table", "generic"}))
+  cmd->add_option("--discretizer", c.discretizer,
+                  "Phi/Gamma/Qd of the one-shot filters: table (exact between grid points), nearest (table at "
+                  "the nearest grid point, the original design) or generic (matrix exponentials)")
+      ->check(CLI::IsMember({"table", "nearest", "generic"}))
       ->capture_default_str();
   cmd->add_option("--noise-model", c.noise, "process noise per prediction: exact Qd(tau) or the original constant Q")
       ->check(CLI::IsMember({"exact", "constant"}))

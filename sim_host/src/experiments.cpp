@@ -359,10 +359,12 @@ struct Variant {
   Approach approach;
   DiscretizerKind discretizer;
 };
-constexpr std::array<Variant, 4> kVariants = {{{"half_table", Approach::kB, DiscretizerKind::kTable},
+constexpr std::array<Variant, 6> kVariants = {{{"half_table", Approach::kB, DiscretizerKind::kTable},
                                                {"half_generic", Approach::kB, DiscretizerKind::kGeneric},
                                                {"complete_table", Approach::kC, DiscretizerKind::kTable},
-                                               {"complete_generic", Approach::kC, DiscretizerKind::kGeneric}}};
+                                               {"complete_generic", Approach::kC, DiscretizerKind::kGeneric},
+                                               {"half_nearest", Approach::kB, DiscretizerKind::kNearest},
+                                               {"complete_nearest", Approach::kC, DiscretizerKind::kNearest}}};
 
 /// The jobs of 4 s of operation of the reference jitter scenario (approach B).
 std::vector<JobRecord> exectime_jobs(const SimContext& ctx, const CommonOptions& opt) {
@@ -501,8 +503,9 @@ nlohmann::json run_exectime(const SimContext& ctx, const CommonOptions& opt, con
   if (opt.plots) {
     std::ostringstream g;
     g << png_terminal() << "set output 'exectime.png'\nset datafile separator ','\nset grid ytics\nset style fill solid 0.7\n"
-      << "set boxwidth 0.35\nset xtics (\"half\\ntable\" 0, \"half\\ngeneric\" 1, \"complete\\ntable\" 2, \"complete\\ngeneric\" 3)\n"
-      << "set xrange [-0.6:3.6]\nset yrange [0:*]\nset offsets 0,0,graph 0.08,0\nset bmargin 4\nset key top left\n"
+      << "set boxwidth 0.35\nset xtics (\"half\\ntable\" 0, \"half\\ngeneric\" 1, \"complete\\ntable\" 2, \"complete\\ngeneric\" 3, "
+         "\"half\\nnearest\" 4, \"complete\\nnearest\" 5)\n"
+      << "set xrange [-0.6:5.6]\nset yrange [0:*]\nset offsets 0,0,graph 0.08,0\nset bmargin 4\nset key top left\n"
       << "set multiplot layout 1,2 title 'Control job over 4 s of operation (" << jobs.size() << " jobs, "
       << to_string(opt.format) << ", host)'\n"
       << "set ylabel 'accumulated execution time (us)'\n"

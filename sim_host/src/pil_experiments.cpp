@@ -210,7 +210,7 @@ nlohmann::json run_exectime_target(const SimContext& ctx, const CommonOptions& o
   j["noise_model"] = opt.noise == NoiseModel::kExact ? "exact" : "constant";
   j["counter"] = "QEMU TCG plugin insn_window: guest instructions between the job markers, marker overhead subtracted";
   for (const char* format : {"float", "fixed"}) {
-    for (const char* disc : {"table", "generic"}) {
+    for (const char* disc : {"table", "nearest", "generic"}) {
       PilOptions p = base;
       p.format = format;
       p.discretizer = disc;

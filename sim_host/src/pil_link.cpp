@@ -112,7 +112,8 @@ PilLink::PilLink(const PilOptions& options) : options_(options), image_(firmware
   info_.protocol = static_cast<int>(r.u(1));
   info_.target = r.u(1) == 0 ? "cortex-m0" : "cortex-m4f";
   info_.format = r.u(1) == 0 ? "float" : "fixed";
-  info_.discretizer = r.u(1) == 0 ? "table" : "generic";
+  const std::uint32_t disc = r.u(1);
+  info_.discretizer = disc == 0 ? "table" : disc == 1 ? "generic" : "nearest";
   info_.n = static_cast<int>(r.u(1));
   info_.m = static_cast<int>(r.u(1));
   info_.p = static_cast<int>(r.u(1));

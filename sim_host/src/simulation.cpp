@@ -36,7 +36,14 @@ const char* to_string(NumberFormat f) {
   return "?";
 }
 
-const char* to_string(DiscretizerKind d) { return d == DiscretizerKind::kTable ? "table" : "generic"; }
+const char* to_string(DiscretizerKind d) {
+  switch (d) {
+    case DiscretizerKind::kTable: return "table";
+    case DiscretizerKind::kNearest: return "nearest";
+    case DiscretizerKind::kGeneric: return "generic";
+  }
+  return "?";
+}
 
 Approach parse_approach(const std::string& letter) {
   if (letter.size() == 1) {
@@ -369,28 +376,27 @@ decltype(auto) with_estimator(const RunOptions& opt, const Design& design, const
   constexpr std::size_t kN = Design::kStates;
   constexpr std::size_t kM = Design::kInputs;
   const TableDiscretizer<Fmt, Structure, Storage> table(view);
+  const TableDiscretizer<Fmt, Structure, Storage, OutOfRange::kExtend, SubGrid::kNearest> nearest(view);
   const GenericDiscretizer<Fmt, kN, kM> generic(model);
-  const bool use_table = opt.discretizer == DiscretizerKind::kTable;
   const Tag<Structure> tag;
+  // The one-shot filters over the chosen discretizer.
+  const auto one_shot = [&](const auto& disc) {
+    using Disc = std::decay_t<decltype(disc)>;
+    if (info(opt.approach).estimator == EstimatorKind::kHalfKalman) {
+      return f(tag, ModelTag<TaskModel::kOneShot>{}, design, HalfKalman<Fmt, Structure, Disc>(design, disc, opt.noise));
+    }
+    return f(tag, ModelTag<TaskModel::kOneShot>{}, design, CompleteKalman<Fmt, Structure, Disc>(design, disc, opt.noise));
+  };
   switch (info(opt.approach).estimator) {
     case EstimatorKind::kStandardKalman:
       return f(tag, ModelTag<TaskModel::kStandard>{}, design, StandardKalman<Fmt, Structure>(design, opt.noise));
     case EstimatorKind::kDeadbeat:
       return f(tag, ModelTag<TaskModel::kStandard>{}, design, DeadbeatObserver<Fmt, Structure>(design));
     case EstimatorKind::kHalfKalman:
-      if (use_table) {
-        return f(tag, ModelTag<TaskModel::kOneShot>{}, design,
-                 HalfKalman<Fmt, Structure, decltype(table)>(design, table, opt.noise));
-      }
-      return f(tag, ModelTag<TaskModel::kOneShot>{}, design,
-               HalfKalman<Fmt, Structure, decltype(generic)>(design, generic, opt.noise));
     case EstimatorKind::kCompleteKalman:
-      if (use_table) {
-        return f(tag, ModelTag<TaskModel::kOneShot>{}, design,
-                 CompleteKalman<Fmt, Structure, decltype(table)>(design, table, opt.noise));
-      }
-      return f(tag, ModelTag<TaskModel::kOneShot>{}, design,
-               CompleteKalman<Fmt, Structure, decltype(generic)>(design, generic, opt.noise));
+      if (opt.discretizer == DiscretizerKind::kTable) return one_shot(table);
+      if (opt.discretizer == DiscretizerKind::kNearest) return one_shot(nearest);
+      return one_shot(generic);
   }
   throw std::logic_error("unknown estimator");
 }

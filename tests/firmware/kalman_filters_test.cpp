@@ -191,6 +191,45 @@ TEST(KalmanFilters, HalfAndCompleteAreTheSameEstimator) {
   }
 }
 
+TEST(KalmanFilters, NearestPolicyFilterEqualsTheExactFilterOnRoundedTau) {
+  // GIVEN filters over the nearest-grid-point table and over the exact table
+  using K = PlantConstants<double>;
+  using Exact = TableDiscretizer<K::Format, PlantStructure, double>;
+  using Nearest = TableDiscretizer<K::Format, PlantStructure, double, OutOfRange::kExtend, SubGrid::kNearest>;
+  const Exact exact(K::kTable);
+  const Nearest nearest(K::kTable);
+  const std::int32_t g = K::kTable.granularity_us;
+  HalfKalman<K::Format, PlantStructure, Nearest> half_n(K::kDesign, nearest, NoiseModel::kExact);
+  HalfKalman<K::Format, PlantStructure, Exact> half_e(K::kDesign, exact, NoiseModel::kExact);
+  CompleteKalman<K::Format, PlantStructure, Nearest> comp_n(K::kDesign, nearest, NoiseModel::kExact);
+  CompleteKalman<K::Format, PlantStructure, Exact> comp_e(K::kDesign, exact, NoiseModel::kExact);
+  std::mt19937_64 rng(11);
+  std::uniform_int_distribution<std::int32_t> tau(0, K::kDesign.period_us);
+  std::normal_distribution<double> y(0.0, 0.1);
+  for (int k = 0; k < 2000; ++k) {
+    // WHEN the nearest filters get raw τ and the exact ones τ rounded to the grid
+    const std::int32_t t = tau(rng);
+    const std::int32_t rounded = ((t + g / 2) / g) * g;
+    Vector<double, 1> yk;
+    yk[0] = y(rng);
+    half_n.update(t, yk);
+    half_e.update(rounded, yk);
+    comp_n.update(t, yk);
+    comp_e.update(rounded, yk);
+    // THEN they are the same computation
+    for (std::size_t i = 0; i < 2; ++i) {
+      ASSERT_EQ(half_n.prediction()[i], half_e.prediction()[i]) << "job " << k;
+      ASSERT_EQ(comp_n.prediction()[i], comp_e.prediction()[i]) << "job " << k;
+    }
+    Vector<double, 1> u;
+    u[0] = y(rng);
+    half_n.set_applied_input(u);
+    half_e.set_applied_input(u);
+    comp_n.set_applied_input(u);
+    comp_e.set_applied_input(u);
+  }
+}
+
 TEST(KalmanFilters, JosephAndSymmetricFormsAgree) {
   using K = PlantConstants<double>;
   const TableDiscretizer<K::Format, PlantStructure, double> table(K::kTable);

@@ -157,6 +157,42 @@ TEST_F(OutOfRangeTest, ClampPolicyClampsToTheRange) {
   expect_equal_to_generic(at(lut, range_, Status::kOk), range_);
 }
 
+TEST(TableDiscretizer, NearestPolicyRoundsTauToTheGridAndIsExactThere) {
+  // GIVEN the reference table with the nearest-grid-point policy
+  using K = PlantConstants<double>;
+  const TableDiscretizer<F64, PlantStructure, double, OutOfRange::kExtend, SubGrid::kNearest> nearest(K::kTable);
+  const TableDiscretizer<F64, PlantStructure, double> exact(K::kTable);
+  const std::int32_t g = K::kTable.granularity_us;
+  // WHEN τ is quantized THEN it lands on the nearest multiple of g (ties up), negatives unchanged
+  EXPECT_EQ(nearest.quantize(0), 0);
+  EXPECT_EQ(nearest.quantize(g / 2 - 1), 0);
+  EXPECT_EQ(nearest.quantize(g / 2), g);
+  EXPECT_EQ(nearest.quantize(3 * g + g / 2 - 1), 3 * g);
+  EXPECT_EQ(nearest.quantize(3 * g + g / 2 + 1), 4 * g);
+  EXPECT_EQ(nearest.quantize(-17), -17);
+  EXPECT_EQ(exact.quantize(3 * g + 123), 3 * g + 123);
+  // AND on the grid (also beyond the range) both policies give the same triple bit for bit
+  for (std::int32_t k = 0; k <= 2 * K::kTable.range_us / g; ++k) {
+    Discretization<F64, 2, 1> a;
+    Discretization<F64, 2, 1> b;
+    EXPECT_EQ(nearest.discretize(k * g, a, WithQd::kYes), exact.discretize(k * g, b, WithQd::kYes));
+    for (std::size_t i = 0; i < 4; ++i) {
+      EXPECT_EQ(a.phi[i], b.phi[i]) << "tau " << k * g;
+      EXPECT_EQ(a.qd[i], b.qd[i]) << "tau " << k * g;
+    }
+    EXPECT_EQ(a.gamma[0], b.gamma[0]);
+    EXPECT_EQ(a.gamma[1], b.gamma[1]);
+  }
+}
+
+TEST(TableDiscretizer, NearestPolicyRefusesAnUnquantizedTau) {
+  // The filters quantize τ before asking; a caller that forgets is an invariant violation.
+  using K = PlantConstants<double>;
+  const TableDiscretizer<F64, PlantStructure, double, OutOfRange::kExtend, SubGrid::kNearest> nearest(K::kTable);
+  Discretization<F64, 2, 1> d;
+  EXPECT_THROW(nearest.discretize(K::kTable.granularity_us + 1, d, WithQd::kYes), test::InvariantViolation);
+}
+
 TEST(TableDiscretizer, StructuredAndDenseEvaluationAgreeBitForBit) {
   using K = PlantConstants<float>;
   const TableDiscretizer<K::Format, PlantStructure, float> structured(K::kTable);

@@ -76,15 +76,19 @@ struct StorageOf<TableView<S>> {
   using type = S;
 };
 
-#if ONESHOT_FW_GENERIC
+// ONESHOT_FW_DISC: 0 table (exact between grid points), 1 generic, 2 table at the nearest grid point.
+using Storage = StorageOf<std::remove_cv_t<decltype(K::kTable)>>::type;
+#if ONESHOT_FW_DISC == 1
 using Disc = GenericDiscretizer<Fmt, kN, kM>;
 const Disc g_disc(K::kModel);
-constexpr std::uint8_t kDiscId = 1;
-#else
-using Disc = TableDiscretizer<Fmt, Structure, StorageOf<std::remove_cv_t<decltype(K::kTable)>>::type>;
+#elif ONESHOT_FW_DISC == 2
+using Disc = TableDiscretizer<Fmt, Structure, Storage, OutOfRange::kExtend, SubGrid::kNearest>;
 const Disc g_disc(K::kTable);
-constexpr std::uint8_t kDiscId = 0;
+#else
+using Disc = TableDiscretizer<Fmt, Structure, Storage>;
+const Disc g_disc(K::kTable);
 #endif
+constexpr std::uint8_t kDiscId = ONESHOT_FW_DISC;
 
 #if defined(ONESHOT_MCU_NRF51)
 constexpr std::uint8_t kTargetId = 0;  // cortex-m0

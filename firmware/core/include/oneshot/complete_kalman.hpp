@@ -59,6 +59,7 @@ class CompleteKalman {
 
   /// Job with sample y taken tau_us before the next actuation instant.
   constexpr Status update(std::int32_t tau_us, const OutputVec& y) {
+    tau_us = disc_->quantize(tau_us);  // the discretizer's sub-grid policy
     using PhiP = typename Structure::PhiPattern;
     using GammaP = typename Structure::GammaPattern;
     using CovT = typename Fmt::Covariance;

@@ -59,6 +59,9 @@ class GenericDiscretizer {
   /// Uses `model` (copied).
   constexpr explicit GenericDiscretizer(const Model& model) : model_(model) {}
 
+  /// τ as the filters use it: exact.
+  constexpr std::int32_t quantize(std::int32_t tau_us) const { return tau_us; }
+
   /// Φ, Γ (and Q_d when asked) over τ_us ≥ 0 microseconds. Negative τ is clamped to 0
   /// (kClamped); kOutOfRange when the exponential cannot be scaled.
   constexpr Status discretize(std::int32_t tau_us, Discretization<Fmt, N, M>& out,

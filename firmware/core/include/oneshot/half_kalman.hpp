@@ -49,6 +49,7 @@ class HalfKalman {
 
   /// Job with sample y taken tau_us before the next actuation instant.
   constexpr Status update(std::int32_t tau_us, const OutputVec& y) {
+    tau_us = disc_->quantize(tau_us);  // the discretizer's sub-grid policy
     const WithQd with_qd = qd_needed(noise_);
     typename Disc::Triple d{NoInit{}};
     Status status = disc_->discretize(design_->period_us - tau_us, d, with_qd);

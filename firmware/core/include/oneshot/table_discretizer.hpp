@@ -23,6 +23,13 @@
 
 namespace oneshot {
 
+/// How τ between grid points is handled.
+enum class SubGrid : std::uint8_t {
+  kExact,    ///< Compose the grid entry with the residual's Taylor polynomial: exact.
+  kNearest,  ///< Round τ to the nearest grid point (the original design): no residual
+             ///< or composition, at the price of a timing error of up to g/2.
+};
+
 /// What to do with τ beyond the table range.
 enum class OutOfRange : std::uint8_t {
   kExtend,  ///< Exact composition up to kMaxExtensions extra ranges, then clamp.
@@ -30,7 +37,8 @@ enum class OutOfRange : std::uint8_t {
 };
 
 /// Table-driven discretizer for a plant with structure `Structure`.
-template <typename Fmt, typename Structure, typename Storage, OutOfRange kPolicy = OutOfRange::kExtend>
+template <typename Fmt, typename Structure, typename Storage, OutOfRange kPolicy = OutOfRange::kExtend,
+          SubGrid kSubGrid = SubGrid::kExact>
 class TableDiscretizer {
  public:
   static constexpr std::size_t kN = Structure::kStates;
@@ -62,6 +70,17 @@ class TableDiscretizer {
         if (!slot_matches<GammaP>(view.gamma_slot[i * kM + j], i, j, view.slots)) return false;
     }
     return true;
+  }
+
+  /// The τ the filters use: unchanged (kExact), or rounded to the nearest grid point
+  /// (kNearest; the filters round once, so that h − τ stays on the grid with τ).
+  constexpr std::int32_t quantize(std::int32_t tau_us) const {
+    if constexpr (kSubGrid == SubGrid::kNearest) {
+      const std::int32_t g = view_.granularity_us;
+      return tau_us <= 0 ? tau_us : ((tau_us + g / 2) / g) * g;
+    } else {
+      return tau_us;
+    }
   }
 
   /// Φ, Γ (and Q_d when asked) over τ_us, with the out-of-range policy above.
@@ -120,6 +139,7 @@ class TableDiscretizer {
     const std::int32_t residual_us = tau_us - index * g;
     bool have = false;
     if (residual_us > 0) {
+      ONESHOT_ASSERT(kSubGrid == SubGrid::kExact);  // kNearest: the filters quantize τ first
       residual(residual_us, with_qd, d);
       have = true;
     }

@@ -27,7 +27,11 @@
 namespace oneshot::sim {
 
 /// Φ/Γ/Q_d source of the one-shot filters.
-enum class DiscretizerKind : std::uint8_t { kTable, kGeneric };
+enum class DiscretizerKind : std::uint8_t {
+  kTable,    ///< Look-up table, exact between grid points.
+  kNearest,  ///< Look-up table at the nearest grid point (the original design).
+  kGeneric,  ///< Matrix exponentials at every call.
+};
 
 /// Number format of the control job.
 enum class NumberFormat : std::uint8_t {
@@ -38,7 +42,7 @@ enum class NumberFormat : std::uint8_t {
 
 /// Name of a number format ("float", "double", "fixed").
 const char* to_string(NumberFormat f);
-/// Name of a discretizer ("table", "generic").
+/// Name of a discretizer ("table", "nearest", "generic").
 const char* to_string(DiscretizerKind d);
 
 /// Options of one run.
