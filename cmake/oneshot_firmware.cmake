@@ -59,9 +59,15 @@ else()
   message(FATAL_ERROR "unknown firmware target ${ONESHOT_FIRMWARE_TARGET}")
 endif()
 
+# -O3 gives the fewest instructions per job; -Os the smallest flash and stack (see README).
+set(ONESHOT_FIRMWARE_OPT "-O3" CACHE STRING "optimisation of the firmware images: -O3, -O2 or -Os")
+set_property(CACHE ONESHOT_FIRMWARE_OPT PROPERTY STRINGS -O3 -O2 -Os)
+if(NOT ONESHOT_FIRMWARE_OPT MATCHES "^-O[23s]$")
+  message(FATAL_ERROR "ONESHOT_FIRMWARE_OPT must be -O3, -O2 or -Os (got '${ONESHOT_FIRMWARE_OPT}')")
+endif()
 set(fw_common_options
   -ffreestanding -fno-exceptions -fno-rtti -fno-threadsafe-statics -fno-use-cxa-atexit
-  -ffunction-sections -fdata-sections -g -O3
+  -ffunction-sections -fdata-sections -g ${ONESHOT_FIRMWARE_OPT} -fstack-usage
   -Wall -Wextra -Wconversion -Wsign-conversion -Wshadow -Wdouble-promotion)
 if(ONESHOT_WERROR)
   list(APPEND fw_common_options -Werror)

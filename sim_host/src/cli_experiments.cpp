@@ -147,6 +147,8 @@ void register_experiment_commands(CLI::App& app) {
     auto table1 = std::make_shared<bool>(false);
     auto seeds = std::make_shared<std::size_t>(2);
     auto fw_dir = std::make_shared<std::string>();
+    auto fault_every = std::make_shared<int>(0);
+    auto timeout_ms = std::make_shared<int>(2000);
     CLI::App* cmd = app.add_subcommand(
         "pil", "Processor in the loop: the control job runs in the firmware under QEMU, the harness plays the board; "
                "compared with the host run on the same seeds");
@@ -160,11 +162,20 @@ void register_experiment_commands(CLI::App& app) {
     cmd->add_flag("--table1", *table1, "run Table I (every approach and scenario) through the MCU");
     cmd->add_option("--seeds", *seeds, "seeds per scenario with --table1")->check(CLI::Range(2, 1000))->capture_default_str();
     cmd->add_option("--firmware-dir", *fw_dir, "build tree holding firmware-<target>/ (default: this build's)");
+    cmd->add_option("--inject-faults", *fault_every,
+                    "link test: damage every N-th request (corrupt byte, dropped byte, lost reply in turn); 0: never")
+        ->check(CLI::Range(0, 1'000'000))
+        ->capture_default_str();
+    cmd->add_option("--reply-timeout-ms", *timeout_ms, "wait this long for a reply before resending")
+        ->check(CLI::Range(10, 600'000))
+        ->capture_default_str();
     cmd->callback([=]() {
       const auto ctx = SimContext::load(c->plant);
       PilOptions p;
       p.target = *target;
       p.firmware_dir = *fw_dir;
+      p.fault_every = *fault_every;
+      p.timeout_ms = *timeout_ms;
       const CommonOptions o = c->resolve();
       nlohmann::json j;
       if (*table1) {
@@ -198,7 +209,11 @@ void register_experiment_commands(CLI::App& app) {
         ->check(CLI::IsMember({"host", "cortex-m0", "cortex-m4f"}))
         ->capture_default_str();
     cmd->add_option("--firmware-dir", *fw_dir, "build tree holding firmware-<target>/ (default: this build's)");
-    cmd->callback([c, target, fw_dir]() {
+    auto profile_dir = std::make_shared<std::string>();
+    cmd->add_option("--profile-dir", *profile_dir,
+                    "with an MCU target: also write, per image, how often each instruction address ran inside the "
+                    "jobs (<image>.profile; symbolize with arm-none-eabi-addr2line)");
+    cmd->callback([c, target, fw_dir, profile_dir]() {
       const auto ctx = SimContext::load(c->plant);
       if (*target == "host") {
         emit(*c, run_exectime(*ctx, c->resolve(), self_path()));
@@ -207,12 +222,14 @@ void register_experiment_commands(CLI::App& app) {
       PilOptions p;
       p.target = *target;
       p.firmware_dir = *fw_dir;
+      p.profile_dir = *profile_dir;
       const nlohmann::json j = run_exectime_target(*ctx, c->resolve(), p);
       if (c->json != "-") {
         for (const auto& [name, v] : j["variants"].items()) {
-          std::printf("%-24s %8.0f instructions/job  %8.0f per 4 s  flash %6zu B  RAM %5zu B\n", name.c_str(),
-                      v["instructions_per_job"].get<double>(), v["instructions_per_4s"].get<double>(),
-                      v["flash_bytes"].get<std::size_t>(), v["ram_bytes"].get<std::size_t>());
+          std::printf("%-24s %8.0f instructions/job  %8.0f per 4 s  flash %6zu B  RAM %5zu B + stack %5d B\n",
+                      name.c_str(), v["instructions_per_job"].get<double>(), v["instructions_per_4s"].get<double>(),
+                      v["flash_bytes"].get<std::size_t>(), v["ram_bytes"].get<std::size_t>(),
+                      v["stack_peak_bytes"].get<int>());
         }
       }
       if (!c->json.empty()) write_json(c->json, j);

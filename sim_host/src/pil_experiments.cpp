@@ -126,6 +126,7 @@ nlohmann::json run_pil_compare(const SimContext& ctx, const CommonOptions& opt, 
   j["resends"] = link.resends();
   j["pil_wall_time_s"] = wall;
   j["overruns"] = mcu.overruns;
+  j["stack_peak_bytes"] = link.stack_peak_bytes();
   return j;
 }
 
@@ -242,6 +243,7 @@ nlohmann::json run_exectime_target(const SimContext& ctx, const CommonOptions& o
                        std::to_string(counts.size()));
       }
       const auto [flash, ram] = image_memory(link.image());
+      const int stack = link.stack_peak_bytes();
       const std::uint64_t overhead = counts[0];
       for (std::size_t v = 0; v < 2; ++v) {
         std::vector<double> per_job;
@@ -256,6 +258,7 @@ nlohmann::json run_exectime_target(const SimContext& ctx, const CommonOptions& o
                                {"instructions_per_4s", total},
                                {"flash_bytes", flash},
                                {"ram_bytes", ram},
+                               {"stack_peak_bytes", stack},
                                {"image", link.image()}};
       }
       j["marker_overhead_instructions"] = overhead;

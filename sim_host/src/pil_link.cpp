@@ -76,6 +76,10 @@ PilLink::PilLink(const PilOptions& options) : options_(options), image_(firmware
     std::ostringstream p;
     p << plugin << ",begin=0x" << std::hex << elf_symbol_address(image_, "oneshot_job_begin") << ",end=0x"
       << elf_symbol_address(image_, "oneshot_job_end") << ",out=" << counts_path_;
+    if (!options.profile_dir.empty()) {
+      fs::create_directories(options.profile_dir);
+      p << ",profile=" << (fs::absolute(options.profile_dir) / (fs::path(image_).stem().string() + ".profile")).string();
+    }
     args.push_back("-plugin");
     args.push_back(p.str());
   }
@@ -108,17 +112,26 @@ PilLink::PilLink(const PilOptions& options) : options_(options), image_(firmware
   pid_ = pid;
   pil::Frame hello;
   if (!read_frame(hello, 10000) || static_cast<std::uint8_t>(hello.type) != 0x81) fail("no hello from the firmware");
-  pil::Reader r(hello);
-  info_.protocol = static_cast<int>(r.u(1));
-  info_.target = r.u(1) == 0 ? "cortex-m0" : "cortex-m4f";
-  info_.format = r.u(1) == 0 ? "float" : "fixed";
-  const std::uint32_t disc = r.u(1);
-  info_.discretizer = disc == 0 ? "table" : disc == 1 ? "generic" : "nearest";
-  info_.n = static_cast<int>(r.u(1));
-  info_.m = static_cast<int>(r.u(1));
-  info_.p = static_cast<int>(r.u(1));
+  info_ = parse_hello(hello);
   if (info_.protocol != pil::kProtocolVersion) fail("protocol version " + std::to_string(info_.protocol) + " not supported");
 }
+
+FirmwareInfo PilLink::parse_hello(const pil::Frame& hello) {
+  FirmwareInfo info;
+  pil::Reader r(hello);
+  info.protocol = static_cast<int>(r.u(1));
+  info.target = r.u(1) == 0 ? "cortex-m0" : "cortex-m4f";
+  info.format = r.u(1) == 0 ? "float" : "fixed";
+  const std::uint32_t disc = r.u(1);
+  info.discretizer = disc == 0 ? "table" : disc == 1 ? "generic" : "nearest";
+  info.n = static_cast<int>(r.u(1));
+  info.m = static_cast<int>(r.u(1));
+  info.p = static_cast<int>(r.u(1));
+  info.stack_peak_bytes = static_cast<int>(r.u(2));
+  return info;
+}
+
+int PilLink::stack_peak_bytes() { return parse_hello(request(pil::Type::kHello, pil::Frame{})).stack_peak_bytes; }
 
 PilLink::~PilLink() {
   if (to_qemu_ >= 0) ::close(to_qemu_);
@@ -191,6 +204,10 @@ pil::Frame PilLink::request(pil::Type type, const pil::Frame& payload) {
   q.seq = seq_++;
   std::uint8_t wire[2 * (pil::kMaxPayload + 5) + 2];
   const std::size_t n = pil::encode(q, wire);
+  if (options_.fault_every > 0 && q.seq % options_.fault_every == 0) {
+    static constexpr LinkFault kCycle[] = {LinkFault::kCorruptByte, LinkFault::kDropByte, LinkFault::kLoseReply};
+    fault_ = kCycle[(q.seq / options_.fault_every) % 3];
+  }
   for (int attempt = 0; attempt <= options_.retries; ++attempt) {
     if (attempt > 0) ++resends_;
     if (fault_ == LinkFault::kCorruptByte) {
@@ -220,7 +237,11 @@ pil::Frame PilLink::request(pil::Type type, const pil::Frame& payload) {
         got = read_frame(r, std::max(1, left));
       }
       if (!got) break;
-      if (r.seq == q.seq && static_cast<std::uint8_t>(r.type) == (static_cast<std::uint8_t>(type) | 0x80U)) return r;
+      if (r.seq == q.seq && static_cast<std::uint8_t>(r.type) == (static_cast<std::uint8_t>(type) | 0x80U)) {
+        if (fault_ != LinkFault::kLoseReply) return r;
+        fault_ = LinkFault::kNone;  // pretend it never arrived: time out and resend
+        continue;
+      }
       // A stale reply (to an earlier resend): ignore it.
     }
   }

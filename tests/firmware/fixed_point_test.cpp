@@ -25,12 +25,19 @@ class FixedPoint : public ::testing::Test {
   void SetUp() override { clear_saturation_flag(); }
 };
 
-TEST_F(FixedPoint, RoundsToNearestTiesAwayFromZero) {
+TEST_F(FixedPoint, RoundsToNearestTiesUpward) {
   using Half = Fixed<std::int16_t, 1>;
   using Whole = Fixed<std::int16_t, 0>;
   EXPECT_EQ(convert<Whole>(Half::from_raw(3)).raw(), 2);    // 1.5 → 2
-  EXPECT_EQ(convert<Whole>(Half::from_raw(-3)).raw(), -2);  // −1.5 → −2
+  EXPECT_EQ(convert<Whole>(Half::from_raw(-3)).raw(), -1);  // −1.5 → −1 (ties upward)
+  EXPECT_EQ(convert<Whole>(Half::from_raw(-5)).raw(), -2);  // −2.5 → −2
   EXPECT_EQ(convert<Whole>(Half::from_raw(1)).raw(), 1);    // 0.5 → 1
+  using Quarter = Fixed<std::int16_t, 2>;
+  EXPECT_EQ(convert<Whole>(Quarter::from_raw(-7)).raw(), -2);  // −1.75 → −2
+  EXPECT_EQ(convert<Whole>(Quarter::from_raw(-5)).raw(), -1);  // −1.25 → −1
+  // Integer codes round as std::lround does: halves away from zero.
+  EXPECT_EQ(ScalarTraits<Half>::round_to_int(Half::from_raw(-3)), -2);
+  EXPECT_EQ(ScalarTraits<Half>::round_to_int(Half::from_raw(3)), 2);
   EXPECT_EQ(mul<Q15>(T::from_double(0.5), T::from_double(0.5)).raw(), 8192);
   EXPECT_FALSE(saturation_flag());
 }

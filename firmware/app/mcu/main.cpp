@@ -42,6 +42,8 @@ PilRegisters g_pil;
 extern "C" __attribute__((noinline, used)) void oneshot_job_begin() { __asm__ volatile("" ::: "memory"); }
 /// See oneshot_job_begin().
 extern "C" __attribute__((noinline, used)) void oneshot_job_end() { __asm__ volatile("" ::: "memory"); }
+/// Deepest stack use since reset, bytes (startup.cpp paints the free stack).
+extern "C" std::uint32_t oneshot_stack_peak_bytes();
 
 namespace {
 
@@ -213,6 +215,7 @@ void hello(pil::Frame& r) {
   w.u(kN, 1);
   w.u(kM, 1);
   w.u(kP, 1);
+  w.u(oneshot_stack_peak_bytes(), 2);
 }
 
 void handle(const pil::Frame& q, pil::Frame& r) {

@@ -23,8 +23,27 @@ void oneshot_uart_rx_handler();
 void oneshot_idle_wakeup_handler();
 [[noreturn]] void oneshot_fault_handler();
 
-/// Reset: copy .data, clear .bss, enable the FPU (M4F), run constructors, main().
+/// Word written over the free stack at reset; the deepest overwritten word is the peak.
+constexpr std::uint32_t kStackPaint = 0x5AC3A53CU;
+
+/// Deepest stack use since reset (bytes), found by scanning the paint from below.
+std::uint32_t oneshot_stack_peak_bytes() {
+  const std::uint32_t* p = &__bss_end;
+  while (p < &__stack_top && *p == kStackPaint) ++p;
+  return static_cast<std::uint32_t>(reinterpret_cast<std::uintptr_t>(&__stack_top) - reinterpret_cast<std::uintptr_t>(p));
+}
+
+/// Reset: paint the free stack, copy .data, clear .bss, enable the FPU (M4F), run
+/// constructors, main().
 [[noreturn]] void reset_handler() {
+  {
+    // Everything between .bss and this frame (less a margin for it) is free stack.
+    std::uintptr_t sp = 0;
+    __asm__ volatile("mov %0, sp" : "=r"(sp));
+    for (auto* p = reinterpret_cast<volatile std::uint32_t*>(&__bss_end); reinterpret_cast<std::uintptr_t>(p) + 64U < sp; ++p) {
+      *p = kStackPaint;
+    }
+  }
   std::uint32_t* dst = &__data_start;
   const std::uint32_t* src = &__data_load;
   while (dst < &__data_end) *dst++ = *src++;

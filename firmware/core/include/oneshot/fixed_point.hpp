@@ -36,11 +36,25 @@ constexpr double pow2(int e) {
   return r;
 }
 
-/// v · 2^−shift rounded to nearest (ties away from zero); shift may be ≤ 0.
+/// v · 2^−shift rounded to nearest, ties upward (the DSPs' conventional rounding: add
+/// half an LSB, shift arithmetically; no branch on the sign); shift may be ≤ 0.
 constexpr std::int64_t round_shift(std::int64_t v, int shift) {
   if (shift <= 0) return v * (std::int64_t{1} << -shift);  // callers keep this in range
+  return (v + (std::int64_t{1} << (shift - 1))) >> shift;
+}
+
+/// v · 2^−shift rounded to nearest, ties away from zero (as std::lround: integer codes).
+constexpr std::int64_t round_shift_away(std::int64_t v, int shift) {
+  if (shift <= 0) return v * (std::int64_t{1} << -shift);
   const std::int64_t half = std::int64_t{1} << (shift - 1);
   return v >= 0 ? (v + half) >> shift : -((-v + half) >> shift);
+}
+
+/// v · 2^−shift rounded toward −∞ (shift may be ≤ 0): for terms entering an
+/// accumulator with guard bits, where the final rounding is the one that counts.
+constexpr std::int64_t floor_shift(std::int64_t v, int shift) {
+  if (shift <= 0) return v * (std::int64_t{1} << -shift);
+  return v >> shift;
 }
 
 /// v · 2^−shift for 32-bit v and 0 ≤ shift ≤ 31, rounded to nearest (ties upward),
@@ -50,20 +64,15 @@ constexpr std::int32_t round_shift32(std::int32_t v, int shift) {
   return ((v >> (shift - 1)) + 1) >> 1;
 }
 
-/// Clamps v into Storage, raising the sticky flag when it does not fit.
+/// Clamps v into Storage, raising the sticky flag when it does not fit. The fit test
+/// is one comparison: v fits when its narrowed value (GCC and Clang narrow modulo 2^n)
+/// sign-extends back to v.
 template <typename Storage>
 constexpr Storage saturate(std::int64_t v) {
-  constexpr std::int64_t lo = std::numeric_limits<Storage>::min();
-  constexpr std::int64_t hi = std::numeric_limits<Storage>::max();
-  if (v > hi) {
-    g_saturated = true;
-    return static_cast<Storage>(hi);
-  }
-  if (v < lo) {
-    g_saturated = true;
-    return static_cast<Storage>(lo);
-  }
-  return static_cast<Storage>(v);
+  const auto narrow = static_cast<Storage>(v);
+  if (static_cast<std::int64_t>(narrow) == v) return narrow;
+  g_saturated = true;
+  return v > 0 ? std::numeric_limits<Storage>::max() : std::numeric_limits<Storage>::min();
 }
 
 /// Exact product of two 16-bit or 32-bit integers; 32×16 uses two 16×16 products.
@@ -78,7 +87,19 @@ constexpr std::int64_t wide_product(A a, B b) {
   } else if constexpr (sizeof(A) <= 2 && sizeof(B) == 4) {
     return wide_product(b, a);
   } else {
+#if defined(__ARM_ARCH_6M__)
+    // ARMv6-M has no 32×32→64 multiply; libgcc's 64×64 routine costs about twice these
+    // four 16×16 products (each fits 32 bits: |high| ≤ 2^15, low < 2^16).
+    const std::int32_t ah = a >> 16;
+    const std::int32_t bh = b >> 16;
+    const std::int32_t al = static_cast<std::int32_t>(static_cast<std::uint32_t>(a) & 0xFFFFU);
+    const std::int32_t bl = static_cast<std::int32_t>(static_cast<std::uint32_t>(b) & 0xFFFFU);
+    const std::int64_t middle = static_cast<std::int64_t>(ah * bl) + static_cast<std::int64_t>(al * bh);
+    return static_cast<std::int64_t>(ah * bh) * (std::int64_t{1} << 32) + middle * 65536 +
+           static_cast<std::int64_t>(static_cast<std::uint32_t>(al) * static_cast<std::uint32_t>(bl));
+#else
     return static_cast<std::int64_t>(a) * static_cast<std::int64_t>(b);
+#endif
   }
 }
 }  // namespace detail
@@ -100,11 +121,12 @@ class Fixed {
   static constexpr int kFrac = kFracBits;       ///< Fractional bits.
   static constexpr int kBits = sizeof(Storage) * 8;  ///< Storage width.
 
-  /// Zero.
+  /// Like the built-in scalars: `Fixed x{}` is zero, `Fixed x;` is indeterminate, so a
+  /// Matrix built with NoInit costs no zero fill (a memset call per matrix on an MCU).
   constexpr Fixed() = default;
   /// From a raw mantissa (the only way to read an integer as this format).
   static constexpr Fixed from_raw(Storage raw) {
-    Fixed f;
+    Fixed f{};
     f.raw_ = raw;
     return f;
   }
@@ -136,7 +158,7 @@ class Fixed {
   friend constexpr bool operator==(Fixed a, Fixed b) { return a.raw_ == b.raw_; }
 
  private:
-  Storage raw_ = 0;
+  Storage raw_;
 };
 
 /// T from a raw mantissa given as a wide integer (generated constants): saturates, so a
@@ -199,9 +221,9 @@ struct ScalarTraits<Fixed<S, F>> {
   static constexpr double to_double(T v) { return static_cast<double>(v.raw()) * detail::pow2(-F); }
   /// |v| (saturating).
   static constexpr T abs(T v) { return v.raw() < 0 ? -v : v; }
-  /// Nearest integer, halves away from zero.
+  /// Nearest integer, halves away from zero (as std::lround on the floating formats).
   static constexpr std::int32_t round_to_int(T v) {
-    return static_cast<std::int32_t>(detail::round_shift(v.raw(), F));
+    return static_cast<std::int32_t>(detail::round_shift_away(v.raw(), F));
   }
   /// Precomputed 2^(F+16)/den for fraction() (one division, at construction).
   using FractionScale = std::uint32_t;
@@ -277,25 +299,28 @@ class Accumulator<Out, std::enable_if_t<kIsFixed<Out>>> {
   static constexpr int kGuard = 16;                 ///< Extra fractional bits kept.
   static constexpr int kAccFrac = Out::kFrac + kGuard;  ///< Fractional bits of the register.
 
+  // Terms are truncated to the register's kAccFrac bits: with kGuard guard bits the
+  // truncation error of a few terms stays far below the final rounding in value().
+
   /// value += a·b.
   template <typename A, typename B>
   constexpr void add_product(A a, B b) {
-    acc_ += detail::round_shift(detail::wide_product(a.raw(), b.raw()), A::kFrac + B::kFrac - kAccFrac);
+    acc_ += detail::floor_shift(detail::wide_product(a.raw(), b.raw()), A::kFrac + B::kFrac - kAccFrac);
   }
   /// value −= a·b.
   template <typename A, typename B>
   constexpr void sub_product(A a, B b) {
-    acc_ -= detail::round_shift(detail::wide_product(a.raw(), b.raw()), A::kFrac + B::kFrac - kAccFrac);
+    acc_ -= detail::floor_shift(detail::wide_product(a.raw(), b.raw()), A::kFrac + B::kFrac - kAccFrac);
   }
   /// value += x.
   template <typename X>
   constexpr void add(X x) {
-    acc_ += detail::round_shift(x.raw(), X::kFrac - kAccFrac);
+    acc_ += detail::floor_shift(x.raw(), X::kFrac - kAccFrac);
   }
   /// value −= x.
   template <typename X>
   constexpr void sub(X x) {
-    acc_ -= detail::round_shift(x.raw(), X::kFrac - kAccFrac);
+    acc_ -= detail::floor_shift(x.raw(), X::kFrac - kAccFrac);
   }
   /// The sum rounded into Out (saturated).
   constexpr Out value() const {

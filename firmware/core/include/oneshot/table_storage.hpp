@@ -13,9 +13,11 @@
 namespace oneshot {
 
 /// A slot value with its own scale (block fixed point): value = raw · 2^−frac.
+/// Trivial (no member initialisers): the discretizer's scratch array of slots is written
+/// before it is read, and a zero fill per job costs a memset call on small MCUs.
 struct ScaledValue {
-  std::int32_t raw = 0;  ///< Mantissa.
-  std::int8_t frac = 0;  ///< Scale.
+  std::int32_t raw;  ///< Mantissa.
+  std::int8_t frac;  ///< Scale.
 };
 
 /// Reading of a table with storage `Storage` (floating specialisation).

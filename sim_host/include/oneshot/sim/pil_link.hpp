@@ -27,8 +27,12 @@ struct PilOptions {
   std::string firmware_dir;          ///< Build tree holding firmware-<target>/ (default: this build's).
   bool count_instructions = false;   ///< Load the insn_window plugin.
   std::string plugin_path;           ///< The plugin (default: this build's).
+  std::string profile_dir;           ///< With count_instructions: write <image>.profile here
+                                     ///< (executions per instruction address inside the jobs).
   int timeout_ms = 2000;             ///< Per reply.
   int retries = 5;                   ///< Resends of one request.
+  int fault_every = 0;               ///< Link test: damage every n-th request (0: never), cycling
+                                     ///< through the faults of LinkFault.
 };
 
 /// What the firmware reports in kHello.
@@ -38,6 +42,7 @@ struct FirmwareInfo {
   std::string format;      ///< float / fixed.
   std::string discretizer; ///< table / generic.
   int n = 0, m = 0, p = 0; ///< Dimensions.
+  int stack_peak_bytes = 0; ///< Deepest stack use since reset when the kHello was sent.
 };
 
 /// Path of the image for `options` (firmware_dir/firmware-<target>/oneshot-<target>-<format>-<disc>.elf).
@@ -46,8 +51,9 @@ std::string firmware_image_path(const PilOptions& options);
 /// Address of symbol `name` in a 32-bit little-endian ELF file (PilError when absent).
 std::uint32_t elf_symbol_address(const std::string& elf_path, const std::string& name);
 
-/// Link faults for tests: corrupt one byte, or drop one byte, of the next request.
-enum class LinkFault { kNone, kCorruptByte, kDropByte };
+/// Link faults for tests: corrupt or drop one byte of the next request, or lose its reply
+/// (the firmware has run the job: the resend must not run it again).
+enum class LinkFault { kNone, kCorruptByte, kDropByte, kLoseReply };
 
 /// A running firmware image behind its UART.
 class PilLink {
@@ -58,8 +64,10 @@ class PilLink {
   PilLink(const PilLink&) = delete;
   PilLink& operator=(const PilLink&) = delete;
 
-  /// The image's self-description.
+  /// The image's self-description at boot.
   const FirmwareInfo& info() const { return info_; }
+  /// Deepest stack use of the firmware so far (asks it: one kHello round trip).
+  int stack_peak_bytes();
   /// Sends a request and returns the reply, resending on timeout (PilError when exhausted).
   app::pil::Frame request(app::pil::Type type, const app::pil::Frame& payload);
   /// Requests resent so far (timeouts and corrupted frames).
@@ -83,6 +91,8 @@ class PilLink {
   int pid_ = -1;
   int to_qemu_ = -1;
   int from_qemu_ = -1;
+  static FirmwareInfo parse_hello(const app::pil::Frame& hello);
+
   app::pil::Decoder decoder_;
   std::vector<app::pil::Frame> pending_;  // frames decoded after the one returned
   std::uint16_t seq_ = 1;

@@ -19,7 +19,7 @@ inline constexpr std::uint8_t kFlag = 0x7E;     ///< Frame delimiter.
 inline constexpr std::uint8_t kEscape = 0x7D;   ///< Escape byte.
 inline constexpr std::uint8_t kEscapeXor = 0x20;  ///< Escaped byte = original ^ 0x20.
 inline constexpr std::size_t kMaxPayload = 96;  ///< Largest payload in bytes.
-inline constexpr std::uint8_t kProtocolVersion = 1;  ///< Version carried by kHello.
+inline constexpr std::uint8_t kProtocolVersion = 2;  ///< Version carried by kHello.
 
 /// Message types (requests from the host; replies have bit 7 set).
 enum class Type : std::uint8_t {
