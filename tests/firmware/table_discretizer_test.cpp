@@ -80,7 +80,8 @@ TEST(TableDiscretizer, ReferenceFloatAtAndBetweenGridPoints) { check_reference_t
 TEST(TableDiscretizer, ReferenceDoubleAtAndBetweenGridPoints) { check_reference_table<double>(1e-14, 1e-13); }
 
 TEST(TableDiscretizer, ReferenceTableFitsTheBudget) {
-  EXPECT_LT(table_bytes(PlantConstants<float>::kTable, 2, 1), 1024U);
+  // The bound is 1024 B; the reference plant asks for 256 B (table.max_bytes).
+  EXPECT_LE(table_bytes(PlantConstants<float>::kTable, 2, 1), 256U);
   EXPECT_EQ(PlantConstants<float>::kTable.granularity_us, 1000);
   EXPECT_EQ(PlantConstants<float>::kTable.range_us, 50000);
 }

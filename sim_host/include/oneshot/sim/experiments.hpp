@@ -75,4 +75,17 @@ nlohmann::json run_pil_table1(const SimContext& ctx, const CommonOptions& opt, c
 /// table/generic × float/fixed over the jobs of 4 s, and flash/RAM of each image.
 nlohmann::json run_exectime_target(const SimContext& ctx, const CommonOptions& opt, const PilOptions& base);
 
+/// What `oneshot-sim report` runs besides the common options.
+struct ReportOptions {
+  std::vector<Scenario> scenarios;  ///< Table I scenarios.
+  std::size_t seeds = 20;           ///< Seeds per scenario.
+  std::string self_path;            ///< This executable (for callgrind).
+  std::string firmware_dir;         ///< Build tree with the firmware images (empty: this build's).
+  bool mcu = true;                  ///< Include the MCU section (instruction counts, PIL).
+};
+
+/// Every experiment, Table I in the three number formats, the table, the firmware on both
+/// MCUs and the product targets: writes OUTDIR/report.md and report.json.
+nlohmann::json run_report(const SimContext& ctx, const CommonOptions& opt, const ReportOptions& report);
+
 }  // namespace oneshot::sim
