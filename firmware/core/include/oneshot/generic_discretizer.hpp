@@ -42,7 +42,8 @@ template <typename Out, int kShift, typename S>
 constexpr Out unscale_qd(S v) {
   if constexpr (kIsFloating<S>) {
     static_assert(kShift >= 0 && kShift < 63, "scale shift out of range");
-    return convert<Out>(v * ScalarTraits<S>::from_ratio(1, std::int64_t{1} << kShift));
+    constexpr S kScale = ScalarTraits<S>::from_ratio(1, std::int64_t{1} << kShift);  // exact power of two
+    return convert<Out>(v * kScale);
   } else {
     return convert<Out>(Fixed<typename S::StorageType, S::kFrac + kShift>::from_raw(v.raw()));
   }

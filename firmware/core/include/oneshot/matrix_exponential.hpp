@@ -19,6 +19,21 @@ namespace oneshot {
 /// Maximum number of squarings; ‖M‖₁ above 2^(kMaxSquarings−1) is rejected.
 inline constexpr int kMaxSquarings = 40;
 
+namespace detail {
+/// 1/k in S for k = 1 … kTaylorDegree, rounded at compile time: the Horner loop then
+/// multiplies, with no run-time division (a soft-float or 64-bit division on small MCUs).
+template <typename S>
+struct TaylorReciprocals {
+  S value[ScalarTraits<S>::kTaylorDegree + 1];  ///< value[k] = 1/k (value[0] unused).
+  constexpr TaylorReciprocals() : value{} {
+    for (int k = 1; k <= ScalarTraits<S>::kTaylorDegree; ++k) value[k] = ScalarTraits<S>::from_ratio(1, k);
+  }
+};
+/// The reciprocals for S.
+template <typename S>
+inline constexpr TaylorReciprocals<S> kTaylorReciprocals{};
+}  // namespace detail
+
 /// ‖M‖₁ (largest absolute column sum).
 template <typename S, std::size_t N>
 constexpr S one_norm(const Matrix<S, N, N>& m) {
@@ -37,7 +52,7 @@ constexpr S one_norm(const Matrix<S, N, N>& m) {
 template <typename S, std::size_t N>
 constexpr Status matrix_exponential(const Matrix<S, N, N>& m, Matrix<S, N, N>& result) {
   using T = ScalarTraits<S>;
-  const S half = T::from_ratio(1, 2);
+  constexpr S half = T::from_ratio(1, 2);
   Matrix<S, N, N> x = m;
   S norm = one_norm(m);
   int squarings = 0;
@@ -49,7 +64,7 @@ constexpr Status matrix_exponential(const Matrix<S, N, N>& m, Matrix<S, N, N>& r
   const Matrix<S, N, N> eye = Matrix<S, N, N>::identity();
   Matrix<S, N, N> e = eye;
   for (int k = T::kTaylorDegree; k >= 1; --k) {
-    e = eye + (x * e) * T::from_ratio(1, k);  // E ← I + X·E/k
+    e = eye + (x * e) * detail::kTaylorReciprocals<S>.value[k];  // E ← I + X·E/k
   }
   for (int s = 0; s < squarings; ++s) e = e * e;
   result = e;
