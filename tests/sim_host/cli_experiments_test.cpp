@@ -52,7 +52,8 @@ TEST(CliExperiments, Table1JsonHasTheContractedKeys) {
   EXPECT_EQ(j["scenarios"].get<int>(), 10);
   EXPECT_EQ(j["seeds"].get<int>(), 3);
   for (const char* a : {"A", "B", "C", "D", "E"}) {
-    for (const char* k : {"cost_mean", "cost_ci95", "ratio_to_A"}) EXPECT_TRUE(j["approaches"][a].contains(k)) << a << k;
+    for (const char* k : {"cost_mean", "cost_ci95", "ratio_to_A", "ratio_scenario_weighted"})
+      EXPECT_TRUE(j["approaches"][a].contains(k)) << a << k;
     EXPECT_GT(j["approaches"][a]["cost_mean"].get<double>(), 0);
   }
   EXPECT_DOUBLE_EQ(j["approaches"]["A"]["ratio_to_A"].get<double>(), 1.0);
