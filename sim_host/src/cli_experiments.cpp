@@ -184,10 +184,7 @@ void register_experiment_commands(CLI::App& app) {
         j = run_pil_table1(*ctx, o, p, scenarios, *seeds);
         if (c->json != "-") std::cout << j["markdown"].get<std::string>();
       } else {
-        const std::vector<Scenario> all = default_scenarios();
-        auto it = std::find_if(all.begin(), all.end(), [&](const Scenario& s) { return s.name == *scenario; });
-        if (it == all.end()) throw ScenarioError("unknown scenario '" + *scenario + "'");
-        Scenario sc = *it;
+        Scenario sc = find_scenario(default_scenarios(), *scenario);
         sc.duration_s = *duration;
         j = run_pil_compare(*ctx, o, p, sc, parse_approach(*approach));
         if (c->json != "-") std::cout << j.dump(2) << "\n";
@@ -270,14 +267,7 @@ void register_experiment_commands(CLI::App& app) {
     cmd->add_option("--trace-step-us", *trace, "dense state trace step (0: none)")->check(CLI::Range(0, 1'000'000))->capture_default_str();
     cmd->callback([=]() {
       const auto ctx = SimContext::load(c->plant);
-      const std::vector<Scenario> all = scenarios_from(*file);
-      auto it = std::find_if(all.begin(), all.end(), [&](const Scenario& s) { return s.name == *scenario; });
-      if (it == all.end()) {
-        std::string names;
-        for (const Scenario& s : all) names += (names.empty() ? "" : ", ") + s.name;
-        throw ScenarioError("unknown scenario '" + *scenario + "' (available: " + names + ")");
-      }
-      Scenario sc = *it;
+      Scenario sc = find_scenario(scenarios_from(*file), *scenario);
       if (*duration > 0) sc.duration_s = *duration;
       if (*jitter_model == "none") sc.jitter = JitterModel{};
       if (*jitter_model == "uniform" || (jitter_model->empty() && *jitter_us >= 0)) {

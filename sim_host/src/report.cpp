@@ -115,9 +115,7 @@ nlohmann::json mcu_section(const SimContext& ctx, const CommonOptions& o, const 
     md << "\nProcessor in the loop: the job in the MCU, the board on the host, 20 s of scenario j20-a0.5-p1, seed "
        << o.seed << ", compared with the same run on the host.\n\n"
           "| target | format | approach | jobs | bit-identical | host cost | MCU cost | wall (s) |\n|---|---|---|---|---|---|---|---|\n";
-    Scenario sc;
-    for (const Scenario& s : default_scenarios())
-      if (s.name == "j20-a0.5-p1") sc = s;
+    const Scenario sc = find_scenario(default_scenarios(), "j20-a0.5-p1");
     bool all_identical = true;
     for (const char* target : {"cortex-m0", "cortex-m4f"})
       for (NumberFormat f : {NumberFormat::kFloat, NumberFormat::kFixed})

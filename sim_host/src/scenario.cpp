@@ -51,6 +51,15 @@ std::vector<Scenario> default_scenarios() {
   };
 }
 
+Scenario find_scenario(const std::vector<Scenario>& scenarios, const std::string& name) {
+  for (const Scenario& s : scenarios) {
+    if (s.name == name) return s;
+  }
+  std::string names;
+  for (const Scenario& s : scenarios) names += (names.empty() ? "" : ", ") + s.name;
+  throw ScenarioError("unknown scenario '" + name + "' (available: " + names + ")");
+}
+
 std::vector<Scenario> load_scenarios(const std::string& path) {
   std::ifstream in(path);
   if (!in) throw ScenarioError(path + ": cannot read the scenario file");

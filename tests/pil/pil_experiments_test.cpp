@@ -22,13 +22,9 @@ std::string out_dir(const std::string& name) {
 }
 
 Scenario scenario_named(const std::string& name, double duration_s) {
-  for (Scenario s : default_scenarios()) {
-    if (s.name == name) {
-      s.duration_s = duration_s;
-      return s;
-    }
-  }
-  throw std::invalid_argument(name);
+  Scenario s = find_scenario(default_scenarios(), name);
+  s.duration_s = duration_s;
+  return s;
 }
 
 CommonOptions common(NumberFormat format, DiscretizerKind disc, const std::string& name) {

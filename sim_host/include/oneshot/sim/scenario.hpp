@@ -29,6 +29,9 @@ struct Scenario {
 /// The ten scenarios of Table I (documented in the README).
 std::vector<Scenario> default_scenarios();
 
+/// The scenario called `name` in `scenarios` (ScenarioError listing the names otherwise).
+Scenario find_scenario(const std::vector<Scenario>& scenarios, const std::string& name);
+
 /// Reads {"scenarios": [{"name", "duration_s", "setpoint": {"amplitude_volts",
 /// "change_period_s"}, "jitter": {...}}, ...]} (ScenarioError naming the field).
 std::vector<Scenario> load_scenarios(const std::string& path);
