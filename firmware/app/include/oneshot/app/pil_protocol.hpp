@@ -37,7 +37,8 @@ enum class Type : std::uint8_t {
 constexpr std::uint16_t crc16(std::uint16_t crc, std::uint8_t byte) {
   crc = static_cast<std::uint16_t>(crc ^ (static_cast<std::uint16_t>(byte) << 8));
   for (int i = 0; i < 8; ++i) {
-    crc = (crc & 0x8000U) != 0U ? static_cast<std::uint16_t>((crc << 1) ^ 0x1021U) : static_cast<std::uint16_t>(crc << 1);
+    const unsigned shifted = static_cast<unsigned>(crc) << 1U;
+    crc = static_cast<std::uint16_t>((crc & 0x8000U) != 0U ? shifted ^ 0x1021U : shifted);
   }
   return crc;
 }
