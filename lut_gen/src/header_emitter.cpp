@@ -142,19 +142,8 @@ void emit_fixed(std::ostringstream& o, const PlantDescription& plant, const Desi
   const std::size_t n = plant.n();
   const std::size_t m = plant.m();
   const std::size_t p = plant.p();
-  const auto type_of = [](const std::string& name) {
-    std::string out;
-    bool up = true;
-    for (char c : name) {
-      if (c == '_') {
-        up = true;
-        continue;
-      }
-      out += up ? static_cast<char>(std::toupper(static_cast<unsigned char>(c))) : c;
-      up = false;
-    }
-    return out;
-  };
+  // snake_case quantity name -> PascalCase type name (constant_name without its 'k')
+  const auto type_of = [](const std::string& name) { return constant_name(name).substr(1); };
   o << "/// Fixed-point formats chosen by the design step from the plant's numbers.\n"
     << "struct FixedFormat {\n";
   for (const QuantityFormat& q : f.table) {

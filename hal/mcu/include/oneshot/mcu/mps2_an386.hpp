@@ -1,5 +1,5 @@
 /// @file mps2_an386.hpp
-/// @brief MPS2 AN386 (Cortex-M4F) CMSDK APB UART0 and timer 0 drivers.
+/// @brief MPS2 AN386 (Cortex-M4F) CMSDK APB UART0 and timers 0/1 drivers.
 ///
 /// Registers from the Cortex-M System Design Kit TRM (ARM DDI0479): APB UART, APB timer.
 #pragma once
@@ -42,28 +42,30 @@ struct Uart {
   }
 };
 
-/// CMSDK APB timer 0 at 0x40000000 (IRQ 8): a count-down of a few cycles raises the
-/// actuation interrupt.
-struct ActuationTimer {
-  static constexpr unsigned kIrq = 8;
-  static constexpr std::uintptr_t kBase = 0x40000000U;
-  static constexpr std::uintptr_t kCtrl = kBase + 0x0U;
-  static constexpr std::uintptr_t kValue = kBase + 0x4U;
-  static constexpr std::uintptr_t kReload = kBase + 0x8U;
-  static constexpr std::uintptr_t kIntClear = kBase + 0xCU;
+/// CMSDK APB timer at kBase raising IRQ kIrq: the register block both timers share.
+template <std::uintptr_t kTimerBase, unsigned kTimerIrq>
+struct CmsdkTimer {
+  static constexpr unsigned kIrq = kTimerIrq;
+  static constexpr std::uintptr_t kCtrl = kTimerBase + 0x0U;
+  static constexpr std::uintptr_t kValue = kTimerBase + 0x4U;
+  static constexpr std::uintptr_t kReload = kTimerBase + 0x8U;
+  static constexpr std::uintptr_t kIntClear = kTimerBase + 0xCU;
+  static constexpr std::uint32_t kEnableWithInterrupt = 0x9U;
 
   /// Stopped, interrupt line enabled in the NVIC.
   static void init() {
     reg(kCtrl) = 0U;
     nvic_enable(kIrq);
   }
-  /// Raises the interrupt a few cycles from now.
-  static void arm_once() {
+  /// Counts `cycles` down from now, then raises the interrupt.
+  static void start(std::uint32_t cycles) {
     reg(kCtrl) = 0U;
-    reg(kReload) = 16U;
-    reg(kValue) = 16U;
-    reg(kCtrl) = 0x9U;  // enable, interrupt enable
+    reg(kReload) = cycles;
+    reg(kValue) = cycles;
+    reg(kCtrl) = kEnableWithInterrupt;
   }
+  /// Stops it.
+  static void stop() { reg(kCtrl) = 0U; }
   /// In the handler: stops the timer and clears the interrupt.
   static void acknowledge() {
     reg(kCtrl) = 0U;
@@ -71,36 +73,22 @@ struct ActuationTimer {
   }
 };
 
-/// CMSDK APB timer 1 at 0x40001000 (IRQ 9), armed only while the firmware sleeps for
-/// input. QEMU's CMSDK UART model does not wake its main loop when the guest reads a
-/// byte, so with the CPU halted the rest of a frame would wait for an unrelated event;
-/// a pending timer gives the main loop its next iteration. Stopped before any job runs.
-struct IdleWakeup {
-  static constexpr unsigned kIrq = 9;
-  static constexpr std::uintptr_t kBase = 0x40001000U;
-  static constexpr std::uintptr_t kCtrl = kBase + 0x0U;
-  static constexpr std::uintptr_t kValue = kBase + 0x4U;
-  static constexpr std::uintptr_t kReload = kBase + 0x8U;
-  static constexpr std::uintptr_t kIntClear = kBase + 0xCU;
+/// Timer 0 at 0x40000000 (IRQ 8): a count-down of a few cycles raises the actuation
+/// interrupt.
+struct ActuationTimer : CmsdkTimer<0x40000000U, 8> {
+  /// Raises the interrupt a few cycles from now.
+  static void arm_once() { start(16U); }
+};
 
-  /// Interrupt line enabled in the NVIC.
-  static void init() {
-    reg(kCtrl) = 0U;
-    nvic_enable(kIrq);
-  }
+/// Timer 1 at 0x40001000 (IRQ 9), armed only while the firmware sleeps for input.
+/// QEMU's CMSDK UART model does not wake its main loop when the guest reads a byte, so
+/// with the CPU halted the rest of a frame would wait for an unrelated event; a pending
+/// timer gives the main loop its next iteration. Stopped before any job runs.
+struct IdleWakeup : CmsdkTimer<0x40001000U, 9> {
   /// Starts a 1 ms (25 000-cycle) one-shot.
-  static void arm() {
-    reg(kReload) = 25000U;
-    reg(kValue) = 25000U;
-    reg(kCtrl) = 0x9U;
-  }
+  static void arm() { start(25000U); }
   /// Stops it.
-  static void disarm() { reg(kCtrl) = 0U; }
-  /// In the handler.
-  static void acknowledge() {
-    reg(kCtrl) = 0U;
-    reg(kIntClear) = 1U;
-  }
+  static void disarm() { stop(); }
 };
 
 }  // namespace oneshot::mcu::mps2
