@@ -25,23 +25,10 @@ else()
   set(lut_gen_dep host_tools)
 endif()
 
-set(reference_plant ${PROJECT_SOURCE_DIR}/lut_gen/plants/reference_board.json)
 set(generated_dir ${CMAKE_BINARY_DIR}/generated)
-set(generated_header ${generated_dir}/oneshot/generated/plant_tables.hpp)
-if(ONESHOT_PLANT)
-  set(plant_args --plant ${ONESHOT_PLANT})
-  set(plant_dep ${ONESHOT_PLANT})
-else()
-  set(plant_args)
-  set(plant_dep ${reference_plant})
-endif()
-add_custom_command(
-  OUTPUT ${generated_header}
-  COMMAND ${CMAKE_COMMAND} -E make_directory ${generated_dir}/oneshot/generated
-  COMMAND ${lut_gen_exe} ${plant_args} --header ${generated_header} --report ${CMAKE_BINARY_DIR}/lut_report.json
-  DEPENDS ${lut_gen_dep} ${plant_dep}
-  COMMENT "lut_gen: design and tables for the firmware")
-add_custom_target(oneshot_generated DEPENDS ${generated_header})
+include(${PROJECT_SOURCE_DIR}/cmake/oneshot_generated_tables.cmake)
+oneshot_generated_tables(LUT_GEN ${lut_gen_exe} TOOL_DEPENDS ${lut_gen_dep} GENERATED_DIR ${generated_dir}
+                         REPORT ${CMAKE_BINARY_DIR}/lut_report.json)
 
 if(ONESHOT_FIRMWARE_TARGET STREQUAL "cortex-m0")
   set(soc_define ONESHOT_MCU_NRF51)
