@@ -55,29 +55,38 @@ std::string vec(const char* scalar, const std::vector<double>& v) {
   return matrix<S>(scalar, m);
 }
 
+/// A continuous-time matrix per second rescaled to per microsecond (times `extra`).
+DenseMatrix per_us(DenseMatrix m, double extra = 1.0) {
+  for (double& x : m.values) x *= 1e-6 * extra;
+  return m;
+}
+
+/// The table layout shared by every number format: level radices, slot maps, entry times.
+template <typename Storage>
+void emit_layout(std::ostringstream& o, const TableData<Storage>& t) {
+  o << "  static constexpr std::uint16_t kRadix[] = {" << int_list(t.radix) << "};\n"
+    << "  static constexpr std::uint16_t kLevelOffset[] = {" << int_list(t.level_offset) << "};\n"
+    << "  static constexpr std::int8_t kPhiSlot[] = {" << int_list(t.phi_slot) << "};\n"
+    << "  static constexpr std::int8_t kGammaSlot[] = {" << int_list(t.gamma_slot) << "};\n"
+    << "  static constexpr std::int8_t kQdSlot[] = {" << int_list(t.qd_slot) << "};\n"
+    << "  /// Entry times (us): " << int_list(t.entry_time_us) << ".\n";
+}
+
 template <typename S>
 void emit_constants(std::ostringstream& o, const char* scalar, const PlantDescription& plant, const DesignResult& d,
                     const TableData<S>& t) {
   const std::size_t n = plant.n();
   const std::size_t m = plant.m();
   const std::size_t p = plant.p();
-  DenseMatrix a_us = plant.a;
-  for (double& x : a_us.values) x *= 1e-6;
-  DenseMatrix b_us = plant.b;
-  for (double& x : b_us.values) x *= 1e-6;
-  DenseMatrix qc_us = d.qc;
-  for (double& x : qc_us.values) x *= 1e-6;
+  const DenseMatrix a_us = per_us(plant.a);
+  const DenseMatrix b_us = per_us(plant.b);
+  const DenseMatrix qc_us = per_us(d.qc);
   o << "/// Constants in " << scalar << ".\n"
     << "template <>\nstruct PlantConstants<" << scalar << "> {\n"
     << "  /// Number formats of every quantity.\n"
-    << "  using Format = ::oneshot::UniformFormat<" << scalar << ">;\n"
-    << "  static constexpr std::uint16_t kRadix[] = {" << int_list(t.radix) << "};\n"
-    << "  static constexpr std::uint16_t kLevelOffset[] = {" << int_list(t.level_offset) << "};\n"
-    << "  static constexpr std::int8_t kPhiSlot[] = {" << int_list(t.phi_slot) << "};\n"
-    << "  static constexpr std::int8_t kGammaSlot[] = {" << int_list(t.gamma_slot) << "};\n"
-    << "  static constexpr std::int8_t kQdSlot[] = {" << int_list(t.qd_slot) << "};\n"
-    << "  /// Entry times (us): " << int_list(t.entry_time_us) << ".\n"
-    << "  static constexpr " << scalar << " kValues[] = {\n      " << value_list(t.values, t.slots) << "};\n"
+    << "  using Format = ::oneshot::UniformFormat<" << scalar << ">;\n";
+  emit_layout(o, t);
+  o << "  static constexpr " << scalar << " kValues[] = {\n      " << value_list(t.values, t.slots) << "};\n"
     << "  static constexpr std::uint8_t kResidualLow[] = {" << int_list(t.residual_low) << "};\n"
     << "  static constexpr std::uint8_t kResidualHigh[] = {" << int_list(t.residual_high) << "};\n"
     << "  static constexpr std::uint8_t kResidualOffset[] = {" << int_list(t.residual_offset) << "};\n"
@@ -159,12 +168,9 @@ void emit_fixed(std::ostringstream& o, const PlantDescription& plant, const Desi
   }
   o << "\n/// Tag selecting the fixed-point constants.\nstruct FixedTag {};\n\n";
   const FixedEmitter e{f};
-  DenseMatrix a_us = plant.a;
-  for (double& x : a_us.values) x *= 1e-6;
-  DenseMatrix b_us = plant.b;
-  for (double& x : b_us.values) x *= 1e-6;
-  DenseMatrix qc_us = d.qc;
-  for (double& x : qc_us.values) x = std::ldexp(x * 1e-6, f.qd_scale_shift);
+  const DenseMatrix a_us = per_us(plant.a);
+  const DenseMatrix b_us = per_us(plant.b);
+  const DenseMatrix qc_us = per_us(d.qc, std::ldexp(1.0, f.qd_scale_shift));
   std::vector<std::string> values;
   for (const Mantissa16& v : t.values) values.push_back("{" + std::to_string(v.raw) + "}");
   std::vector<std::string> coeffs;
@@ -177,14 +183,9 @@ void emit_fixed(std::ostringstream& o, const PlantDescription& plant, const Desi
   o << "/// Constants in the fixed-point formats.\n"
     << "template <>\nstruct PlantConstants<FixedTag> {\n"
     << "  /// Number formats of every quantity.\n"
-    << "  using Format = FixedFormat;\n"
-    << "  static constexpr std::uint16_t kRadix[] = {" << int_list(t.radix) << "};\n"
-    << "  static constexpr std::uint16_t kLevelOffset[] = {" << int_list(t.level_offset) << "};\n"
-    << "  static constexpr std::int8_t kPhiSlot[] = {" << int_list(t.phi_slot) << "};\n"
-    << "  static constexpr std::int8_t kGammaSlot[] = {" << int_list(t.gamma_slot) << "};\n"
-    << "  static constexpr std::int8_t kQdSlot[] = {" << int_list(t.qd_slot) << "};\n"
-    << "  /// Entry times (us): " << int_list(t.entry_time_us) << ".\n"
-    << "  static constexpr ::oneshot::Mantissa16 kValues[] = {\n      " << join(values, t.slots) << "};\n"
+    << "  using Format = FixedFormat;\n";
+  emit_layout(o, t);
+  o << "  static constexpr ::oneshot::Mantissa16 kValues[] = {\n      " << join(values, t.slots) << "};\n"
     << "  static constexpr std::int8_t kValueFrac[] = {" << int_list(t.value_frac) << "};\n"
     << "  static constexpr std::uint8_t kResidualLow[] = {" << int_list(t.residual_low) << "};\n"
     << "  static constexpr std::uint8_t kResidualHigh[] = {" << int_list(t.residual_high) << "};\n"

@@ -44,16 +44,6 @@ Scenario demo_scenario(const std::string& name, std::int32_t jitter_us, double a
   return s;
 }
 
-RunOptions base_options(const CommonOptions& opt, Approach a) {
-  RunOptions r;
-  r.approach = a;
-  r.format = opt.format;
-  r.discretizer = opt.discretizer;
-  r.noise = opt.noise;
-  r.board = opt.board;
-  return r;
-}
-
 std::string path_in(const CommonOptions& opt, const std::string& name) {
   return (std::filesystem::path(opt.out_dir) / name).string();
 }
@@ -80,10 +70,20 @@ const char* png_terminal() { return "set terminal pngcairo size 1100,700 font 'S
 
 }  // namespace
 
+RunOptions run_options(const CommonOptions& opt, Approach a) {
+  RunOptions r;
+  r.approach = a;
+  r.format = opt.format;
+  r.discretizer = opt.discretizer;
+  r.noise = opt.noise;
+  r.board = opt.board;
+  return r;
+}
+
 nlohmann::json run_noise_experiment(const SimContext& ctx, const CommonOptions& opt, double duration_s) {
   make_directory(opt.out_dir);
   const Scenario sc = demo_scenario("noise-demo", 20'000, 0.2, 1.0, duration_s);
-  RunOptions ro = base_options(opt, Approach::kB);
+  RunOptions ro = run_options(opt, Approach::kB);
   ro.record_jobs = true;
   ro.trace_step_us = 1000;
   const RunResult r = simulate(ctx, sc, opt.seed, ro);
@@ -155,7 +155,7 @@ nlohmann::json run_jitter_experiment(const SimContext& ctx, const CommonOptions&
   const std::array<Approach, 4> approaches = {Approach::kA, Approach::kB, Approach::kD, Approach::kE};
   std::vector<RunResult> results(approaches.size());
   parallel_for(approaches.size(), worker_count(opt.threads), nullptr, [&](std::size_t i) {
-    RunOptions ro = base_options(opt, approaches[i]);
+    RunOptions ro = run_options(opt, approaches[i]);
     ro.trace_step_us = 1000;
     results[i] = simulate(ctx, sc, opt.seed, ro);
   });
@@ -193,7 +193,7 @@ nlohmann::json run_gain_experiment(const SimContext& ctx, const CommonOptions& o
   const std::array<Approach, 3> approaches = {Approach::kB, Approach::kC, Approach::kA};
   std::vector<RunResult> results(approaches.size());
   for (std::size_t i = 0; i < approaches.size(); ++i) {
-    RunOptions ro = base_options(opt, approaches[i]);
+    RunOptions ro = run_options(opt, approaches[i]);
     ro.record_jobs = true;
     ro.p0_scale = p0_scale;
     results[i] = simulate(ctx, sc, opt.seed, ro);
@@ -260,7 +260,7 @@ nlohmann::json run_table1(const SimContext& ctx, const CommonOptions& opt, const
       const std::size_t s = task / seeds;
       const std::size_t k = task % seeds;
       for (std::size_t a = 0; a < na; ++a) {
-        const RunResult r = simulate(ctx, scenarios[s], opt.seed + k, base_options(opt, kAllApproaches[a]));
+        const RunResult r = simulate(ctx, scenarios[s], opt.seed + k, run_options(opt, kAllApproaches[a]));
         cost[a][s][k] = r.cost.total();
         if (r.saturated) ++saturated_runs;
       }
@@ -380,7 +380,7 @@ constexpr std::array<Variant, 6> kVariants = {{{"half_table", Approach::kB, Disc
 /// The jobs of 4 s of operation of the reference jitter scenario (approach B).
 std::vector<JobRecord> exectime_jobs(const SimContext& ctx, const CommonOptions& opt) {
   const Scenario sc = demo_scenario("exectime", 20'000, 0.2, 1.0, 4.0);
-  RunOptions ro = base_options(opt, Approach::kB);
+  RunOptions ro = run_options(opt, Approach::kB);
   ro.record_jobs = true;
   return simulate(ctx, sc, opt.seed, ro).job_records;
 }
@@ -436,7 +436,7 @@ double callgrind_instructions(const std::string& self, const CommonOptions& opt,
 int run_exectime_probe(const SimContext& ctx, const CommonOptions& opt, const std::string& variant) {
   const Variant& v = find_variant(variant);
   const std::vector<JobRecord> jobs = exectime_jobs(ctx, opt);
-  RunOptions ro = base_options(opt, v.approach);
+  RunOptions ro = run_options(opt, v.approach);
   ro.discretizer = v.discretizer;
   with_job_replay(ctx, ro, jobs, [&](const std::function<void()>& replay) { oneshot_exectime_replay(&replay); });
   std::cout << jobs.size() << "\n";
@@ -459,7 +459,7 @@ nlohmann::json run_exectime(const SimContext& ctx, const CommonOptions& opt, con
     if (!ctx.generated()) extra += " --plant '" + ctx.plant().source + "'";
     nlohmann::json variants;
     for (const Variant& v : kVariants) {
-      RunOptions ro = base_options(o, v.approach);
+      RunOptions ro = run_options(o, v.approach);
       ro.discretizer = v.discretizer;
       double best_ns = 1e300;
       with_job_replay(ctx, ro, jobs, [&](const std::function<void()>& replay) {
@@ -535,7 +535,7 @@ nlohmann::json run_exectime(const SimContext& ctx, const CommonOptions& opt, con
 nlohmann::json run_single(const SimContext& ctx, const CommonOptions& opt, const Scenario& scenario, Approach approach,
                           std::int32_t trace_step_us) {
   make_directory(opt.out_dir);
-  RunOptions ro = base_options(opt, approach);
+  RunOptions ro = run_options(opt, approach);
   ro.record_jobs = true;
   ro.trace_step_us = trace_step_us;
   const RunResult r = simulate(ctx, scenario, opt.seed, ro);
@@ -603,7 +603,7 @@ nlohmann::json run_benchmark(const SimContext& ctx, const CommonOptions& opt, do
     double best = 0;
     for (int rep = 0; rep < 3; ++rep) {
       const auto t0 = Clock::now();
-      const RunResult r = simulate(ctx, sc, opt.seed + static_cast<std::uint64_t>(rep), base_options(opt, a));
+      const RunResult r = simulate(ctx, sc, opt.seed + static_cast<std::uint64_t>(rep), run_options(opt, a));
       const double wall = std::chrono::duration<double>(Clock::now() - t0).count();
       best = std::max(best, r.duration_s / wall);
     }

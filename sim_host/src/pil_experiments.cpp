@@ -16,13 +16,9 @@
 namespace oneshot::sim {
 namespace {
 
+/// Host run options that record every job, for the comparison with the MCU.
 RunOptions options_for(const CommonOptions& opt, Approach a) {
-  RunOptions r;
-  r.approach = a;
-  r.format = opt.format;
-  r.discretizer = opt.discretizer;
-  r.noise = opt.noise;
-  r.board = opt.board;
+  RunOptions r = run_options(opt, a);
   r.record_jobs = true;
   return r;
 }

@@ -25,6 +25,9 @@ struct CommonOptions {
   std::uint64_t seed = 1;                                  ///< Seed (first seed for sweeps).
 };
 
+/// The run options of approach `a` under the common options (format, discretizer, noise, board).
+RunOptions run_options(const CommonOptions& opt, Approach a);
+
 /// Experiment 1: noisy measured v1 beside the estimated states (half Kalman, one-shot).
 nlohmann::json run_noise_experiment(const SimContext& ctx, const CommonOptions& opt, double duration_s);
 
