@@ -184,6 +184,19 @@ TEST(Scenario, FileErrorsNameTheField) {
   EXPECT_THROW(load_scenarios(unknown), ScenarioError);
 }
 
+TEST(Scenario, ShippedScenarioFilesLoadAndFitTheReferenceBoard) {
+  const auto plant = design::reference_plant();
+  for (const char* name : {"amplitude_0.25V.json", "amplitude_0.35V.json"}) {
+    const std::vector<Scenario> set = load_scenarios(std::string(ONESHOT_SCENARIO_DIR) + "/" + name);
+    ASSERT_EQ(set.size(), 10U) << name;
+    for (const Scenario& s : set) {
+      EXPECT_NO_THROW(validate_scenario(s, plant)) << s.name;
+      EXPECT_EQ(s.jitter.kind, JitterModel::Kind::kUniform) << s.name;
+      EXPECT_NE(s.name.find("-a" + std::string(name).substr(10, 4)), std::string::npos) << s.name;
+    }
+  }
+}
+
 TEST(Scenario, TraceJitterIsReadAndChecked) {
   const std::string good = test::write_temp_file("trace.csv", "release_us,exec_us\n1000,300\n# comment\n15000,450\n");
   const auto t = load_jitter_trace(good);
