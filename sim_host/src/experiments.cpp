@@ -30,20 +30,6 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
-Scenario demo_scenario(const std::string& name, std::int32_t jitter_us, double amplitude, double change_period,
-                       double duration) {
-  Scenario s;
-  s.name = name;
-  s.duration_s = duration;
-  s.amplitude_volts = amplitude;
-  s.change_period_s = change_period;
-  s.jitter.kind = JitterModel::Kind::kUniform;
-  s.jitter.release_max_us = jitter_us;
-  s.jitter.exec_min_us = 200;
-  s.jitter.exec_max_us = 600;
-  return s;
-}
-
 std::string path_in(const CommonOptions& opt, const std::string& name) {
   return (std::filesystem::path(opt.out_dir) / name).string();
 }
@@ -82,7 +68,7 @@ RunOptions run_options(const CommonOptions& opt, Approach a) {
 
 nlohmann::json run_noise_experiment(const SimContext& ctx, const CommonOptions& opt, double duration_s) {
   make_directory(opt.out_dir);
-  const Scenario sc = demo_scenario("noise-demo", 20'000, 0.2, 1.0, duration_s);
+  const Scenario sc = uniform_scenario("noise-demo", 20'000, 0.2, 1.0, duration_s);
   RunOptions ro = run_options(opt, Approach::kB);
   ro.record_jobs = true;
   ro.trace_step_us = 1000;
@@ -151,7 +137,7 @@ nlohmann::json run_noise_experiment(const SimContext& ctx, const CommonOptions& 
 nlohmann::json run_jitter_experiment(const SimContext& ctx, const CommonOptions& opt, double duration_s,
                                      std::int32_t jitter_us) {
   make_directory(opt.out_dir);
-  const Scenario sc = demo_scenario("jitter-demo", jitter_us, 0.2, 1.0, duration_s);
+  const Scenario sc = uniform_scenario("jitter-demo", jitter_us, 0.2, 1.0, duration_s);
   const std::array<Approach, 4> approaches = {Approach::kA, Approach::kB, Approach::kD, Approach::kE};
   std::vector<RunResult> results(approaches.size());
   parallel_for(approaches.size(), worker_count(opt.threads), nullptr, [&](std::size_t i) {
@@ -189,7 +175,7 @@ nlohmann::json run_jitter_experiment(const SimContext& ctx, const CommonOptions&
 
 nlohmann::json run_gain_experiment(const SimContext& ctx, const CommonOptions& opt, double duration_s, double p0_scale) {
   make_directory(opt.out_dir);
-  const Scenario sc = demo_scenario("gain-demo", 20'000, 0.2, 1.0, duration_s);
+  const Scenario sc = uniform_scenario("gain-demo", 20'000, 0.2, 1.0, duration_s);
   const std::array<Approach, 3> approaches = {Approach::kB, Approach::kC, Approach::kA};
   std::vector<RunResult> results(approaches.size());
   for (std::size_t i = 0; i < approaches.size(); ++i) {
@@ -379,7 +365,7 @@ constexpr std::array<Variant, 6> kVariants = {{{"half_table", Approach::kB, Disc
 
 /// The jobs of 4 s of operation of the reference jitter scenario (approach B).
 std::vector<JobRecord> exectime_jobs(const SimContext& ctx, const CommonOptions& opt) {
-  const Scenario sc = demo_scenario("exectime", 20'000, 0.2, 1.0, 4.0);
+  const Scenario sc = uniform_scenario("exectime", 20'000, 0.2, 1.0, 4.0);
   RunOptions ro = run_options(opt, Approach::kB);
   ro.record_jobs = true;
   return simulate(ctx, sc, opt.seed, ro).job_records;
@@ -595,7 +581,7 @@ nlohmann::json run_single(const SimContext& ctx, const CommonOptions& opt, const
 }
 
 nlohmann::json run_benchmark(const SimContext& ctx, const CommonOptions& opt, double simulated_s) {
-  const Scenario sc = demo_scenario("benchmark", 20'000, 0.2, 1.0, simulated_s);
+  const Scenario sc = uniform_scenario("benchmark", 20'000, 0.2, 1.0, simulated_s);
   nlohmann::json j = common_json(ctx, opt);
   j["experiment"] = "benchmark";
   j["simulated_seconds_per_run"] = simulated_s;

@@ -11,20 +11,6 @@
 namespace oneshot::sim {
 namespace {
 
-Scenario make(const char* name, std::int32_t jitter_us, double amplitude, double change_period) {
-  Scenario s;
-  s.name = name;
-  s.duration_s = 20.0;
-  s.amplitude_volts = amplitude;
-  s.change_period_s = change_period;
-  s.jitter.kind = JitterModel::Kind::kUniform;
-  s.jitter.release_min_us = 0;
-  s.jitter.release_max_us = jitter_us;
-  s.jitter.exec_min_us = 200;  // a Kalman job on a 40-MIPS dsPIC
-  s.jitter.exec_max_us = 600;
-  return s;
-}
-
 double number(const nlohmann::json& j, const char* key, const std::string& field, double fallback, double lo,
               double hi) {
   const auto it = j.find(key);
@@ -39,15 +25,35 @@ double number(const nlohmann::json& j, const char* key, const std::string& field
 
 }  // namespace
 
+Scenario uniform_scenario(const std::string& name, std::int32_t jitter_us, double amplitude_volts,
+                          double change_period_s, double duration_s) {
+  Scenario s;
+  s.name = name;
+  s.duration_s = duration_s;
+  s.amplitude_volts = amplitude_volts;
+  s.change_period_s = change_period_s;
+  s.jitter.kind = JitterModel::Kind::kUniform;
+  s.jitter.release_min_us = 0;
+  s.jitter.release_max_us = jitter_us;
+  s.jitter.exec_min_us = 200;
+  s.jitter.exec_max_us = 600;
+  return s;
+}
+
 std::vector<Scenario> default_scenarios() {
-  // The brief's protocol: sampling jitter within 0–20 ms, set-point amplitudes and change
-  // frequencies around the ±0.2 V demonstration (README, "Table I scenarios").
+  // The brief's protocol: sampling jitter within 0–20 ms; set-point amplitudes from the
+  // ±0.2 V demonstration up to 1 V; change periods 0.5–2 s (README, "Scenarios").
   return {
-      make("j5-a0.2-p1", 5'000, 0.2, 1.0),    make("j10-a0.2-p1", 10'000, 0.2, 1.0),
-      make("j15-a0.2-p1", 15'000, 0.2, 1.0),  make("j20-a0.2-p1", 20'000, 0.2, 1.0),
-      make("j20-a0.5-p1", 20'000, 0.5, 1.0),  make("j20-a1.0-p1", 20'000, 1.0, 1.0),
-      make("j20-a0.2-p0.5", 20'000, 0.2, 0.5), make("j20-a0.2-p2", 20'000, 0.2, 2.0),
-      make("j10-a0.5-p0.5", 10'000, 0.5, 0.5), make("j15-a1.0-p2", 15'000, 1.0, 2.0),
+      uniform_scenario("j5-a0.2-p1", 5'000, 0.2, 1.0),
+      uniform_scenario("j10-a0.2-p1", 10'000, 0.2, 1.0),
+      uniform_scenario("j15-a0.2-p1", 15'000, 0.2, 1.0),
+      uniform_scenario("j20-a0.2-p1", 20'000, 0.2, 1.0),
+      uniform_scenario("j20-a0.5-p1", 20'000, 0.5, 1.0),
+      uniform_scenario("j20-a1.0-p1", 20'000, 1.0, 1.0),
+      uniform_scenario("j20-a0.2-p0.5", 20'000, 0.2, 0.5),
+      uniform_scenario("j20-a0.2-p2", 20'000, 0.2, 2.0),
+      uniform_scenario("j10-a0.5-p0.5", 10'000, 0.5, 0.5),
+      uniform_scenario("j15-a1.0-p2", 15'000, 1.0, 2.0),
   };
 }
 

@@ -26,6 +26,11 @@ struct Scenario {
   JitterModel jitter;                 ///< Job timing.
 };
 
+/// A scenario with uniform release jitter 0..jitter_us and a 0.2-0.6 ms job (a Kalman job
+/// on a 40-MIPS dsPIC), set-points within ±amplitude_volts changed every change_period_s.
+Scenario uniform_scenario(const std::string& name, std::int32_t jitter_us, double amplitude_volts,
+                          double change_period_s, double duration_s = 20.0);
+
 /// The ten scenarios of Table I (documented in the README).
 std::vector<Scenario> default_scenarios();
 

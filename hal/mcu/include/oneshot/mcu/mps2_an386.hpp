@@ -68,7 +68,7 @@ struct CmsdkTimer {
   static void stop() { reg(kCtrl) = 0U; }
   /// In the handler: stops the timer and clears the interrupt.
   static void acknowledge() {
-    reg(kCtrl) = 0U;
+    stop();
     reg(kIntClear) = 1U;
   }
 };
