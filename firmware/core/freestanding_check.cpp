@@ -12,6 +12,7 @@
 #include "oneshot/half_kalman.hpp"
 #include "oneshot/standard_kalman.hpp"
 #include "oneshot/table_discretizer.hpp"
+#include "oneshot/time_us.hpp"
 
 namespace {
 
