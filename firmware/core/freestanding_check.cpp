@@ -13,6 +13,7 @@
 #include "oneshot/standard_kalman.hpp"
 #include "oneshot/table_discretizer.hpp"
 #include "oneshot/time_us.hpp"
+#include "oneshot/dimension_limits.hpp"
 
 namespace {
 
