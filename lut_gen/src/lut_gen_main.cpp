@@ -61,6 +61,7 @@ int main(int argc, char** argv) {
   CLI11_PARSE(app, argc, argv);
   try {
     const d::PlantDescription plant = plant_path.empty() ? d::reference_plant() : d::load_plant_file(plant_path);
+    d::require_continuous_board_and_table(plant, "lut_gen (the Phi/Gamma/Qd table and the firmware constants)");
     const d::DesignResult design = d::synthesize(plant);
     const d::PlantPatterns patterns = d::analyse_structure(plant, design);
     const auto table_f = d::build_table<float>(plant, design, patterns);

@@ -67,6 +67,7 @@ std::shared_ptr<const SimContext> SimContext::reference() {
 std::shared_ptr<const SimContext> SimContext::from_plant(design::PlantDescription plant) {
   auto ctx = std::make_shared<SimContext>(SimContext{});
   ctx->plant_ = std::move(plant);
+  design::require_continuous_board_and_table(ctx->plant_, "the one-shot harness");
   ctx->design_ = design::synthesize(ctx->plant_);
   if (!ctx->design_.tracking) {
     throw design::DesignError(ctx->plant_.source + ": the harness needs set-point feed-forward (as many outputs as "
