@@ -134,20 +134,41 @@ void flush_tiny(DenseMatrix& a, double tiny) {
 SolveResult solve(const DenseMatrix& a, const DenseMatrix& b, double min_rcond) {
   if (a.rows != a.cols || b.rows != a.rows) throw std::logic_error("dense solve: shape mismatch");
   SolveResult r;
-  const auto n = static_cast<lapack_int>(a.rows);
+  const std::size_t n = a.rows;
+  const auto ni = static_cast<lapack_int>(n);
   const auto k = static_cast<lapack_int>(b.cols);
   if (n == 0 || !all_finite(a) || !all_finite(b)) return r;
+  // Equilibrate with powers of two (exact): rows by their largest entry, then columns, so a
+  // badly scaled but regular matrix (entries from 1e−5 to 1e5) is not called singular.
+  std::vector<double> row(n, 1.0);
+  std::vector<double> col(n, 1.0);
+  for (std::size_t i = 0; i < n; ++i) {
+    double big = 0;
+    for (std::size_t j = 0; j < n; ++j) big = std::max(big, std::fabs(a(i, j)));
+    if (big > 0) row[i] = std::exp2(-std::round(std::log2(big)));
+  }
+  for (std::size_t j = 0; j < n; ++j) {
+    double big = 0;
+    for (std::size_t i = 0; i < n; ++i) big = std::max(big, std::fabs(a(i, j) * row[i]));
+    if (big > 0) col[j] = std::exp2(-std::round(std::log2(big)));
+  }
   DenseMatrix lu = a;
+  for (std::size_t i = 0; i < n; ++i)
+    for (std::size_t j = 0; j < n; ++j) lu(i, j) = a(i, j) * row[i] * col[j];
   r.x = b;
-  std::vector<lapack_int> pivots(a.rows);
-  const double anorm = norm1(a);
-  if (LAPACKE_dgetrf(LAPACK_ROW_MAJOR, n, n, lu.values.data(), n, pivots.data()) != 0) return r;
-  if (LAPACKE_dgecon(LAPACK_ROW_MAJOR, '1', n, lu.values.data(), n, anorm, &r.rcond) != 0) return r;
+  for (std::size_t i = 0; i < n; ++i)
+    for (std::size_t j = 0; j < b.cols; ++j) r.x(i, j) = b(i, j) * row[i];
+  std::vector<lapack_int> pivots(n);
+  const double anorm = norm1(lu);
+  if (LAPACKE_dgetrf(LAPACK_ROW_MAJOR, ni, ni, lu.values.data(), ni, pivots.data()) != 0) return r;
+  if (LAPACKE_dgecon(LAPACK_ROW_MAJOR, '1', ni, lu.values.data(), ni, anorm, &r.rcond) != 0) return r;
   if (!(r.rcond >= min_rcond)) return r;
   if (k > 0 &&
-      LAPACKE_dgetrs(LAPACK_ROW_MAJOR, 'N', n, k, lu.values.data(), n, pivots.data(), r.x.values.data(), k) != 0) {
+      LAPACKE_dgetrs(LAPACK_ROW_MAJOR, 'N', ni, k, lu.values.data(), ni, pivots.data(), r.x.values.data(), k) != 0) {
     return r;
   }
+  for (std::size_t i = 0; i < n; ++i)
+    for (std::size_t j = 0; j < b.cols; ++j) r.x(i, j) = r.x(i, j) * col[i];
   r.ok = all_finite(r.x);
   return r;
 }

@@ -33,14 +33,36 @@ ModeCheck pbh(const DenseMatrix& a, const DenseMatrix& b, bool only_unstable) {
   if (a.rows != a.cols || b.rows != a.rows) throw std::logic_error("PBH test: shape mismatch");
   const std::size_t n = a.rows;
   const std::size_t m = b.cols;
+  // Rank is invariant under a similarity of A (with B ← D⁻¹B) and a scaling of B's
+  // columns: balance A (LAPACK dgebal, powers of two) and give each column of B the norm
+  // of A, so that the relative threshold means the same for every plant's units.
+  DenseMatrix abal = a;
+  std::vector<double> d(n, 1.0);
+  lapack_int ilo = 0;
+  lapack_int ihi = 0;
+  const auto ni = static_cast<lapack_int>(n);
+  if (n > 0 && LAPACKE_dgebal(LAPACK_ROW_MAJOR, 'S', ni, abal.values.data(), ni, &ilo, &ihi, d.data()) != 0) {
+    abal = a;
+    d.assign(n, 1.0);
+  }
+  DenseMatrix bbal = b;
+  const double anorm = std::max(norm_fro(abal), 1e-300);
+  for (std::size_t j = 0; j < m; ++j) {
+    double col = 0;
+    for (std::size_t i = 0; i < n; ++i) {
+      bbal(i, j) = b(i, j) / d[i];
+      col = std::max(col, std::fabs(bbal(i, j)));
+    }
+    for (std::size_t i = 0; i < n && col > 0; ++i) bbal(i, j) *= anorm / col;
+  }
   DenseMatrix ab = DenseMatrix::zeros(n, n + m);
-  set_block(ab, 0, 0, a);
-  set_block(ab, 0, n, b);
+  set_block(ab, 0, 0, abal);
+  set_block(ab, 0, n, bbal);
   std::vector<lapack_complex_double> work(n * (n + m));
   for (std::size_t k = 0; k < ab.values.size(); ++k) work[k] = lapack_complex_double(ab.values[k], 0.0);
   const double scale = singular_values(work, n, n + m).front();
   ModeCheck out;
-  for (const std::complex<double>& lambda : eigenvalues(a)) {
+  for (const std::complex<double>& lambda : eigenvalues(abal)) {
     if (only_unstable && std::abs(lambda) < 1.0 - kMarginalTolerance) continue;
     std::vector<lapack_complex_double> shifted = work;
     for (std::size_t i = 0; i < n; ++i) {

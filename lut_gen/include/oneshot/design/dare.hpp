@@ -45,6 +45,7 @@ struct DareSolution {
   DenseMatrix x;                            ///< Stabilising solution (symmetrised) when kOk/kInaccurate.
   double residual = 0;                      ///< ‖residual‖_F / (‖Q‖_F + ‖AᵀXA‖_F + ‖correction‖_F).
   double unit_circle_distance = 0;          ///< min over pencil eigenvalues of ||λ| − 1|.
+  double closed_loop_radius = 0;            ///< ρ(A − B K(X)), checked < 1 (kNoStabilizing otherwise).
 };
 
 /// Stabilising solution of the DARE above. S may be empty (no cross term).

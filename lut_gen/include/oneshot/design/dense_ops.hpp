@@ -51,11 +51,12 @@ void flush_tiny(DenseMatrix& a, double tiny);
 /// Result of a linear solve.
 struct SolveResult {
   bool ok = false;        ///< False when A is singular or its reciprocal condition is below the limit.
-  double rcond = 0;       ///< Reciprocal 1-norm condition estimate of A (LAPACK dgecon).
+  double rcond = 0;       ///< Reciprocal 1-norm condition estimate of the equilibrated A (LAPACK dgecon).
   DenseMatrix x;          ///< A⁻¹B when ok.
 };
 
-/// X = A⁻¹B by LU with partial pivoting (LAPACK dgesv); not ok when rcond(A) < min_rcond.
+/// X = A⁻¹B by LU with partial pivoting (LAPACK dgetrf/dgetrs) of A equilibrated by exact
+/// powers of two (rows, then columns); not ok when the equilibrated rcond < min_rcond.
 SolveResult solve(const DenseMatrix& a, const DenseMatrix& b, double min_rcond = 1e-14);
 
 /// e^M by scaling and squaring with the Taylor polynomial of the core's
