@@ -10,6 +10,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <iostream>
 #include <map>
 #include <sstream>
@@ -246,6 +247,10 @@ nlohmann::json run_table1(const SimContext& ctx, const CommonOptions& opt, const
       const std::size_t s = task / seeds;
       const std::size_t k = task % seeds;
       for (std::size_t a = 0; a < na; ++a) {
+        if (!approach_available(ctx, kAllApproaches[a])) {
+          cost[a][s][k] = std::numeric_limits<double>::quiet_NaN();  // skipped: reported unavailable below
+          continue;
+        }
         const RunResult r = simulate(ctx, scenarios[s], opt.seed + k, run_options(opt, kAllApproaches[a]));
         cost[a][s][k] = r.cost.total();
         if (r.saturated) ++saturated_runs;
@@ -265,8 +270,10 @@ nlohmann::json run_table1(const SimContext& ctx, const CommonOptions& opt, const
   j["seeds"] = seeds;
   double simulated = 0;
   for (const Scenario& s : scenarios) simulated += s.duration_s;
-  j["runs"] = na * ns * seeds;
-  j["simulated_seconds"] = simulated * static_cast<double>(na * seeds);
+  std::size_t runnable = 0;
+  for (Approach a : kAllApproaches) runnable += approach_available(ctx, a) ? 1U : 0U;
+  j["runs"] = runnable * ns * seeds;
+  j["simulated_seconds"] = simulated * static_cast<double>(runnable * seeds);
   j["wall_time_s"] = wall;
   j["threads"] = worker_count(opt.threads);
   j["saturated_runs"] = saturated_runs.load();
@@ -278,6 +285,16 @@ nlohmann::json run_table1(const SimContext& ctx, const CommonOptions& opt, const
         "|---|---|---|---|---|---|---|\n";
   std::vector<std::vector<double>> csv_rows;
   for (std::size_t a = 0; a < na; ++a) {
+    if (!approach_available(ctx, kAllApproaches[a])) {
+      const std::string letter(1, info(kAllApproaches[a]).letter);
+      const std::string why = ctx.design().deadbeat_unavailable_reason;
+      j["approaches"][letter] = {{"description", info(kAllApproaches[a]).description},
+                                 {"available", false},
+                                 {"unavailable_reason", "no deadbeat observer: " + why}};
+      md << "| " << letter << " | " << info(kAllApproaches[a]).description << " | unavailable: no deadbeat observer ("
+         << why << ") | | | | |\n";
+      continue;
+    }
     const Summary c = summarize(per_seed[a]);
     std::vector<double> ratios(seeds);
     for (std::size_t k = 0; k < seeds; ++k) ratios[k] = per_seed[a][k] / per_seed[0][k];
@@ -288,6 +305,7 @@ nlohmann::json run_table1(const SimContext& ctx, const CommonOptions& opt, const
     const Summary w = summarize(weighted);
     const std::string letter(1, info(kAllApproaches[a]).letter);
     j["approaches"][letter] = {{"description", info(kAllApproaches[a]).description},
+                               {"available", true},
                                {"cost_mean", c.mean},
                                {"cost_ci95", c.ci95},
                                {"ratio_to_A", c.mean / summarize(per_seed[0]).mean},
@@ -318,7 +336,9 @@ nlohmann::json run_table1(const SimContext& ctx, const CommonOptions& opt, const
     nlohmann::json e = {{"name", scenarios[s].name}, {"jitter", scenarios[s].jitter.describe()},
                         {"amplitude_volts", scenarios[s].amplitude_volts}, {"change_period_s", scenarios[s].change_period_s},
                         {"duration_s", scenarios[s].duration_s}};
-    for (std::size_t a = 0; a < na; ++a) e["cost_mean"][std::string(1, info(kAllApproaches[a]).letter)] = mean[a];
+    for (std::size_t a = 0; a < na; ++a) {
+      if (approach_available(ctx, kAllApproaches[a])) e["cost_mean"][std::string(1, info(kAllApproaches[a]).letter)] = mean[a];
+    }
     js.push_back(e);
   }
   j["per_scenario"] = js;

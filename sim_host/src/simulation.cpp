@@ -481,8 +481,14 @@ RunResult simulate_pil(const SimContext& ctx, const Scenario& scenario, std::uin
 
 }  // namespace
 
+bool approach_available(const SimContext& ctx, Approach a) { return a != Approach::kE || ctx.design().deadbeat; }
+
 RunResult simulate(const SimContext& ctx, const Scenario& scenario, std::uint64_t seed, const RunOptions& options) {
   validate_scenario(scenario, ctx.plant());
+  if (!approach_available(ctx, options.approach)) {
+    throw std::invalid_argument(std::string("approach ") + info(options.approach).letter +
+                                " is unavailable for this plant: " + ctx.design().deadbeat_unavailable_reason);
+  }
   if (options.pil != nullptr) return simulate_pil(ctx, scenario, seed, options);
   return with_controller_parts(ctx, options, [&](auto structure, auto model, const auto& design, const auto& estimator) {
     using Design = std::decay_t<decltype(design)>;

@@ -118,7 +118,11 @@ class SimContext {
   design::TableData<double> table_double_;
 };
 
-/// Runs `scenario` with `seed` under `options`.
+/// False when the plant's design cannot run approach `a` (E without a deadbeat observer).
+bool approach_available(const SimContext& ctx, Approach a);
+
+/// Runs `scenario` with `seed` under `options`; std::invalid_argument naming the reason
+/// when the approach is unavailable for the plant.
 RunResult simulate(const SimContext& ctx, const Scenario& scenario, std::uint64_t seed, const RunOptions& options);
 
 /// Builds the control job of `options` and calls use(replay); each replay() restores the
