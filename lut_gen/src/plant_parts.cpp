@@ -65,6 +65,7 @@ void parse_cost(const json& root, PlantDescription& p, const Checker& check) {
     check.covariance(qy, "cost.Qy", false);
     p.q1 = transpose(p.c) * qy * p.c;  // Q1 = Cᵀ Qy C
     symmetrize(p.q1);
+    for (double& v : p.q1.values) v = v + 0.0;  // −0 → +0
   }
   p.q2 = check.matrix(cost, "Q2", "cost.");
   check.shape(p.q2, "cost.Q2", m, m, "one row and column per input");

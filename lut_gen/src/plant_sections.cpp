@@ -3,6 +3,7 @@
 #include "oneshot/design/plant_sections.hpp"
 
 #include <cmath>
+#include <initializer_list>
 #include <stdexcept>
 
 #include "oneshot/design/dense_ops.hpp"
@@ -93,6 +94,14 @@ DiscreteSection notch_section(const std::string& name, double frequency_hz, doub
   return s;
 }
 
+namespace {
+/// −0 → +0 (products with structural zeros), so reports show plain zeros.
+void positive_zeros(std::initializer_list<DenseMatrix*> ms) {
+  for (DenseMatrix* m : ms)
+    for (double& v : m->values) v = v + 0.0;
+}
+}  // namespace
+
 SectionsRealization realize_sections(const SectionsDescription& spec, double period_s) {
   if (spec.continuous.empty() && spec.discrete.empty()) throw std::invalid_argument("sections: none given");
   SectionsRealization r;
@@ -133,6 +142,7 @@ SectionsRealization realize_sections(const SectionsDescription& spec, double per
   }
 
   const SectionsDisturbance& dist = spec.disturbance;
+  positive_zeros({&r.phi_p, &r.gamma_p, &r.c_p});
   if (dist.reading == DisturbanceReading::kNone) {
     r.phi = r.phi_p;
     r.gamma = r.gamma_p;
@@ -167,6 +177,7 @@ SectionsRealization realize_sections(const SectionsDescription& spec, double per
   set_block(r.c_bar, 0, np, r.c_d);
   for (std::size_t i = 0; i < nd; ++i) r.state_names.push_back("d_x" + std::to_string(i + 1));
   r.exogenous_states = nd;
+  positive_zeros({&r.phi, &r.gamma, &r.b_w, &r.c, &r.c_bar});
   return r;
 }
 
