@@ -3,7 +3,8 @@
 ///
 /// Events are ordered by (time, class, insertion sequence): at one instant the classes
 /// run in the physical order of EventClass (a discrete plant steps first, then reference
-/// changes, actuation, sampling, deliveries, computations, input latches, recording, end),
+/// changes, actuation, sampling, deliveries, computations, input latches, bus arbitration,
+/// recording, end),
 /// and events of one class run in the order they were scheduled. The sequence number is
 /// global to the queue, so the order never depends on the heap's internals or on the
 /// thread: the same run gives the same order every time.
@@ -26,8 +27,9 @@ enum class EventClass : std::uint8_t {
   kDelivery = 4,     ///< A message reaches its destination.
   kCompute = 5,      ///< A computation runs (controller on its timer, job completion).
   kLatch = 6,        ///< A discrete plant latches the input in force for its next step.
-  kRecord = 7,       ///< Monitors and recorders observe the instant.
-  kEnd = 8,          ///< End of the run.
+  kBus = 7,          ///< A bus arbitrates among the frames queued up to this instant.
+  kRecord = 8,       ///< Monitors and recorders observe the instant.
+  kEnd = 9,          ///< End of the run.
 };
 
 /// Index of a registered event handler.
