@@ -8,6 +8,7 @@ namespace oneshot::engine {
 
 Network::Network(Kernel& kernel) : kernel_(kernel) {
   deliver_id_ = kernel_.add_handler("network delivery", [this](std::uint64_t slot) { deliver(slot); });
+  fragment_id_ = kernel_.add_handler("network fragment", [](std::uint64_t) {});
 }
 
 NodePort& Network::add_node(std::uint8_t address, const std::string& name, Duration clock_offset,
@@ -84,12 +85,14 @@ void Network::run_node(std::uint8_t address, const std::function<void()>& f) {
       const auto arrival = r.link->transmit(kernel_.now());
       if (arrival) kernel_.schedule(*arrival, EventClass::kDelivery, deliver_id_, park(std::move(frame)));
     } else {
-      const std::size_t payload = frame.bytes.size();
-      if (payload > 8) {
-        throw std::logic_error("network: node '" + port.name + "' sent " + std::to_string(payload) +
-                               " bytes on CAN bus '" + r.bus->config().name + "' (at most 8 per frame)");
+      // Segmented over CAN frames of ≤ 8 bytes, queued back to back with the route's
+      // identifier (FIFO within an identifier): the message arrives with its last frame.
+      std::size_t left = frame.bytes.size();
+      while (left > 8) {
+        r.bus->queue(r.id, 8, fragment_id_, 0);
+        left -= 8;
       }
-      r.bus->queue(r.id, payload, deliver_id_, park(std::move(frame)));
+      r.bus->queue(r.id, left, deliver_id_, park(std::move(frame)));
     }
   }
 }

@@ -6,7 +6,8 @@
 /// Node logic (firmware/node/) runs inside run_node(): the node's HostNetworkState is made
 /// current (so Board::Net::send/receive reach it), and after the call every frame the node
 /// sent is routed: over a Link (loss, delay, FIFO or reordering) or queued on a CanBus
-/// with the route's identifier. An arrival is a kDelivery event that puts the frame into
+/// with the route's identifier (a message longer than 8 bytes goes as consecutive frames
+/// of ≤ 8 bytes with that identifier and arrives with its last one). An arrival is a kDelivery event that puts the frame into
 /// the destination's inbox and calls its receive handler inside run_node(). A node's
 /// clock reads t + its offset (node_clock()).
 #pragma once
@@ -82,6 +83,7 @@ class Network {
   std::vector<host::Frame> in_flight_;
   std::vector<std::uint64_t> free_slots_;
   HandlerId deliver_id_ = 0;
+  HandlerId fragment_id_ = 0;
   std::uint64_t frames_sent_ = 0;
 };
 
