@@ -186,6 +186,25 @@ TEST(Simulation, TraceAndJobRecordingDoNotChangeTheRun) {
   }
 }
 
+TEST(Simulation, TheTraceAtASamplingInstantIsTheSampledState) {
+  // A samples at k·h, on the 1 ms trace grid: the bridged trace point there is the state
+  // the job sampled (same deterministic path, the interval's own noise draw), up to the
+  // rounding of the piecewise walk (measured ≤ 2.6e-15 V over 19 seeds).
+  const auto ctx = SimContext::reference();
+  RunOptions o;
+  o.approach = Approach::kA;
+  o.record_jobs = true;
+  o.trace_step_us = 1000;
+  const RunResult r = simulate(*ctx, short_scenario(20'000), 7, o);
+  ASSERT_EQ(r.job_records.size(), 60U);
+  ASSERT_EQ(r.trace.size(), 3001U);
+  for (std::size_t k = 1; k < r.job_records.size(); ++k) {
+    const TracePoint& p = r.trace[50 * k];
+    ASSERT_NEAR(p.t_s, r.job_records[k].t_sample_s, 1e-12);
+    for (std::size_t i = 0; i < 2; ++i) EXPECT_NEAR(p.x[i], r.job_records[k].x_true[i], 1e-14) << k;
+  }
+}
+
 TEST(Scenario, JobLongerThanThePeriodIsRefused) {
   Scenario s = short_scenario(49'500);
   try {
