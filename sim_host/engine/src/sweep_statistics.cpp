@@ -3,6 +3,8 @@
 #include "oneshot/engine/sweep_statistics.hpp"
 
 #include <cmath>
+#include <filesystem>
+#include <sstream>
 #include <stdexcept>
 
 #include "oneshot/sim/output_files.hpp"
@@ -112,6 +114,35 @@ void write_runs_csv(const SweepResults& r, const std::string& path) {
         rows.push_back(row);
       }
   sim::write_csv(path, header, rows);
+}
+
+void write_summary_files(const SweepResults& r, const SweepSummary& sm, const std::string& dir, const std::string& prefix,
+                         bool plots) {
+  sim::make_directory(dir);
+  const auto in = [&](const std::string& name) { return (std::filesystem::path(dir) / name).string(); };
+  write_runs_csv(r, in(prefix + "_runs.csv"));
+  std::vector<std::vector<double>> rows;
+  for (std::size_t a = 0; a < r.spec.approaches.size(); ++a) {
+    rows.push_back({static_cast<double>(a), sm.value[a].mean, sm.value[a].ci95, sm.ratio[a].mean, sm.ratio[a].ci95});
+  }
+  sim::write_csv(in(prefix + "_summary.csv"), {"approach_index", "mean", "ci95", "ratio_mean", "ratio_ci95"}, rows);
+  if (!plots) return;
+  // Labels go to gnuplot as data-free tic labels with quotes removed (names are the study's).
+  std::ostringstream tics;
+  for (std::size_t a = 0; a < r.spec.approaches.size(); ++a) {
+    std::string name = r.spec.approaches[a];
+    for (char& c : name)
+      if (c == '\'' || c == '"' || c == '\\' || c == '\n') c = '_';
+    tics << (a ? ", " : "") << "'" << name << "' " << a;
+  }
+  std::ostringstream g;
+  g << "set terminal pngcairo size 1100,700 font 'Sans,11' noenhanced\nset output '" << prefix << ".png'\n"
+    << "set datafile separator ','\nset grid ytics\nset style fill solid 0.6\nset boxwidth 0.6\nset key off\n"
+    << "set xtics (" << tics.str() << ")\nset xrange [-0.6:" << static_cast<double>(r.spec.approaches.size()) - 0.4 << "]\nset yrange [0:*]\n"
+    << "set ylabel '" << r.spec.metrics[sm.metric] << " (mean over scenarios, 95 % CI over " << r.spec.seeds << " seeds)'\n"
+    << "plot '" << prefix << "_summary.csv' using 1:2 skip 1 with boxes lc rgb '#4c72b0', '' using 1:2:3 skip 1 with "
+    << "yerrorbars pt 0 lw 2 lc rgb 'black'\n";
+  sim::run_gnuplot(dir, prefix + ".gp", g.str());
 }
 
 }  // namespace oneshot::engine

@@ -5,6 +5,9 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
 
 #include "oneshot/engine/random_stream.hpp"
 #include "oneshot/engine/sweep.hpp"
@@ -94,6 +97,28 @@ TEST(SweepStatistics, PairedFiguresMatchHandComputation) {
   EXPECT_NEAR(s.paired[0].diff.mean, diff, 1e-14);
   EXPECT_EQ(s.paired.size(), 3U);
   EXPECT_LT(m0, m1);
+}
+
+TEST(SweepStatistics, SummaryFilesHoldTheRunsAndTheIntervals) {
+  const SweepResults r = run_sweep(spec(), Shard{}, 1, toy, "t");
+  const SweepSummary s = summarize_metric(r, 0, 0);
+  const std::string dir = (std::filesystem::temp_directory_path() / "oneshot_sweep_files").string();
+  std::filesystem::remove_all(dir);
+  write_summary_files(r, s, dir, "toy", false);
+  std::ifstream runs(dir + "/toy_runs.csv");
+  std::string header;
+  std::getline(runs, header);
+  EXPECT_EQ(header, "approach_index,scenario_index,seed,cost,packets");
+  std::size_t lines = 0;
+  for (std::string l; std::getline(runs, l);) ++lines;
+  EXPECT_EQ(lines, r.spec.runs());
+  std::ifstream summary(dir + "/toy_summary.csv");
+  std::getline(summary, header);
+  std::string first;
+  std::getline(summary, first);
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "0,%.9g,%.9g,", s.value[0].mean, s.value[0].ci95);
+  EXPECT_EQ(first.rfind(buf, 0), 0U) << first;
 }
 
 }  // namespace

@@ -56,8 +56,13 @@ SweepSummary summarize_metric(const SweepResults& results, std::size_t metric, s
 /// ratios are null.
 nlohmann::json summary_json(const SweepResults& results, const SweepSummary& summary);
 
-/// Writes "<prefix>_runs.csv" (approach_index, scenario_index, seed, one column per metric)
-/// into `dir`.
+/// Writes the raw runs as CSV: approach_index, scenario_index, seed, one column per metric.
 void write_runs_csv(const SweepResults& results, const std::string& path);
+
+/// Writes DIR/PREFIX_runs.csv (raw runs), DIR/PREFIX_summary.csv (approach_index, mean,
+/// ci95, ratio_mean, ratio_ci95 of the summarized metric) and, with `plots`, DIR/PREFIX.png
+/// (bars with 95 % intervals, drawn by gnuplot).
+void write_summary_files(const SweepResults& results, const SweepSummary& summary, const std::string& dir,
+                         const std::string& prefix, bool plots);
 
 }  // namespace oneshot::engine
