@@ -9,11 +9,18 @@
 
 namespace oneshot::engine {
 
+namespace {
+/// Deepest nesting accepted (the study schema needs 6; a bound keeps hostile input cheap).
+constexpr int kMaxDepth = 32;
+}  // namespace
+
 nlohmann::json parse_json_strict(const std::string& text, const std::string& source) {
   // Key sets of the objects being parsed (one per nesting level of objects).
   std::vector<std::set<std::string>> keys;
   std::string duplicate;
-  const nlohmann::json::parser_callback_t check = [&](int, nlohmann::json::parse_event_t event, nlohmann::json& parsed) {
+  const nlohmann::json::parser_callback_t check = [&](int depth, nlohmann::json::parse_event_t event,
+                                                      nlohmann::json& parsed) {
+    if (depth > kMaxDepth) throw InputError(source + ": nested deeper than " + std::to_string(kMaxDepth) + " levels");
     switch (event) {
       case nlohmann::json::parse_event_t::object_start:
         keys.emplace_back();

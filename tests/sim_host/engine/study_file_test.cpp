@@ -102,6 +102,7 @@ TEST(StudyFile, MalformedFilesNameTheField) {
       {edited("\"sigma\": 0.6", "\"sigma\": \"wide\""), "scenarios[1].links.sc.delay.sigma"},
       {"{\"schema\": ", "not valid JSON"},
       {"[]", "must be an object"},
+      {std::string(40, '[') + std::string(40, ']'), "nested deeper than 32"},
   };
   for (const Case& c : cases) {
     try {

@@ -17,8 +17,8 @@ class InputError : public std::invalid_argument {
   using std::invalid_argument::invalid_argument;
 };
 
-/// Parses JSON text, refusing duplicate keys in any object ("source: line L: duplicate key
-/// 'k'") and reporting syntax errors with their position.
+/// Parses JSON text, refusing duplicate keys in any object ("source: duplicate key 'k'") and
+/// nesting deeper than 32 levels, and reporting syntax errors with their position.
 nlohmann::json parse_json_strict(const std::string& text, const std::string& source);
 
 /// `where` must be an object whose keys are all in `known` (InputError naming the first other).
