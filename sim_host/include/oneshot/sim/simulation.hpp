@@ -1,13 +1,14 @@
 /// @file simulation.hpp
-/// @brief One closed-loop run: the emulated board driving the firmware's control task.
+/// @brief One closed-loop run of the one-shot study (seed 000): the board plant driving
+///        the firmware's control task on the discrete-event engine.
 ///
 /// The harness plays the board through the host port (hal/host_sim): at each actuation
 /// instant it raises the timer interrupt of the task, at each sampling instant it sets
 /// the clock, the ADC code (circuit output + measurement noise, 12-bit) and the
-/// set-point, and calls the task's job; PWM writes go back into the emulator at the
-/// instant the task model gives them effect. Random streams (jitter, measurement noise,
-/// set-points) are shared by every approach for a given seed; process noise has its own
-/// stream per run.
+/// set-point, and calls the task's job; PWM writes go back into the board plant at the
+/// instant the task model gives them effect (sim_host/oneshot/board_loop.hpp). Random
+/// streams (jitter, measurement noise, set-points) are shared by every approach for a
+/// given seed; process noise has its own stream, drawn once per physical event.
 #pragma once
 
 #include <cstdint>
@@ -91,6 +92,7 @@ struct RunResult {
   bool saturated = false;          ///< The fixed-point saturation flag was raised.
   std::vector<JobRecord> job_records;  ///< When requested.
   std::vector<TracePoint> trace;       ///< When requested.
+  std::uint64_t events = 0;            ///< Engine events run.
 };
 
 /// Plant, design and tables shared (read-only) by every run of an experiment.
