@@ -6,6 +6,7 @@
 #include <memory>
 #include <nlohmann/json.hpp>
 
+#include "oneshot/design/c_job_emitter.hpp"
 #include "oneshot/design/controller_synthesis.hpp"
 #include "oneshot/design/design_report.hpp"
 #include "oneshot/design/fixed_formats.hpp"
@@ -55,9 +56,11 @@ int main(int argc, char** argv) {
   std::string plant_path;
   std::string header_path;
   std::string report_path;
+  std::string c_job_dir;
   app.add_option("--plant", plant_path, "plant description JSON (default: the built-in reference board)");
   app.add_option("--header", header_path, "generated C++ header to write")->required();
   app.add_option("--report", report_path, "lut_report.json to write")->required();
+  app.add_option("--c-job-dir", c_job_dir, "also write the C99 job oneshot_job.h / oneshot_job.c into this directory");
   CLI11_PARSE(app, argc, argv);
   try {
     const d::PlantDescription plant = plant_path.empty() ? d::reference_plant() : d::load_plant_file(plant_path);
@@ -83,6 +86,11 @@ int main(int argc, char** argv) {
     }
     write_file(header_path, d::emit_header(plant, design, patterns, table_f, table_d, formats.get(), table_q.get(),
                                            fixed_reason, "lut_gen"));
+    if (!c_job_dir.empty()) {
+      const d::CJobSources job = d::emit_c_job(plant, design, patterns, table_f, formats.get(), table_q.get(), "lut_gen");
+      write_file(c_job_dir + "/oneshot_job.h", job.header);
+      write_file(c_job_dir + "/oneshot_job.c", job.source);
+    }
     nlohmann::json report = table_json(table_f, acc_f);  // top level: the float table the MCU uses
     report["generated_by"] = "lut_gen";
     report["plant"] = plant.name;
