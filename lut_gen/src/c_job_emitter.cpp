@@ -229,7 +229,15 @@ CJobSources emit_c_job(const PlantDescription& plant, const DesignResult& design
   c.line("typedef char oneshot_job_needs_arithmetic_shift[(INT32_C(-2) >> 1) == INT32_C(-1) ? 1 : -1];");
   c.line("");
   const std::string body = variants_c.str();
-  out.source = c.str() + (fixed_arith ? fixed_helpers(body) + "\n" : std::string()) + body;
+  std::string helpers;
+  if (fixed_arith) {
+    // Only when a fixed variant is compiled in (the seed table would be an unused constant).
+    std::string guard;
+    for (const std::string& v : out.variants)
+      if (v.rfind("fixed_", 0) == 0) guard += (guard.empty() ? "" : " || ") + std::string("!defined(ONESHOT_JOB_WITHOUT_") + upper_identifier(v) + ")";
+    helpers = "#if " + guard + "\n" + fixed_helpers(body) + "#endif\n\n";
+  }
+  out.source = c.str() + helpers + body;
   return out;
 }
 

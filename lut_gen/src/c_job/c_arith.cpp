@@ -259,20 +259,20 @@ std::string FixedArith::slot_to(Qty q, const std::string& raw, int frac, int raw
 void FixedArith::emit_helpers(CodeWriter& w) {
   w.line("/* Exact products (detail::wide_product): 16x16->32 multiplies only, so that 16-bit");
   w.line("   targets use their native multiplier and ARMv6-M needs no 64-bit multiply routine. */");
-  w.open("static int32_t os_m16(int16_t a, int16_t b) {").line("return (int32_t)a * (int32_t)b;").close();
+  w.open("static inline int32_t os_m16(int16_t a, int16_t b) {").line("return (int32_t)a * (int32_t)b;").close();
   w.line("/* |a * b| < 2^31 for a signed 16-bit a and b in [0, 65535]. */");
-  w.open("static int32_t os_m16u(int16_t a, uint16_t b) {").line("return (int32_t)a * (int32_t)b;").close();
-  w.open("static int64_t os_m32x16(int32_t a, int16_t b) {")
+  w.open("static inline int32_t os_m16u(int16_t a, uint16_t b) {").line("return (int32_t)a * (int32_t)b;").close();
+  w.open("static inline int64_t os_m32x16(int32_t a, int16_t b) {")
       .line("const int32_t hi = (int32_t)(int16_t)(a >> 16) * (int32_t)b;")
       .line("const int32_t lo = (int32_t)(uint16_t)((uint32_t)a & UINT32_C(0xFFFF)) * (int32_t)b;")
       .line("return (int64_t)hi * INT64_C(65536) + (int64_t)lo;")
       .close();
-  w.open("static int64_t os_m32xu16(int32_t a, uint16_t b) {")
+  w.open("static inline int64_t os_m32xu16(int32_t a, uint16_t b) {")
       .line("const int32_t hi = (int32_t)(int16_t)(a >> 16) * (int32_t)b;")
       .line("const uint32_t lo = (uint32_t)(uint16_t)((uint32_t)a & UINT32_C(0xFFFF)) * (uint32_t)b;")
       .line("return (int64_t)hi * INT64_C(65536) + (int64_t)lo;")
       .close();
-  w.open("static int64_t os_m32x32(int32_t a, int32_t b) {")
+  w.open("static inline int64_t os_m32x32(int32_t a, int32_t b) {")
       .line("const int32_t ah = (int32_t)(int16_t)(a >> 16);")
       .line("const int32_t bh = (int32_t)(int16_t)(b >> 16);")
       .line("const uint32_t al = (uint32_t)a & UINT32_C(0xFFFF);")
@@ -281,17 +281,17 @@ void FixedArith::emit_helpers(CodeWriter& w) {
       .line("return (int64_t)(ah * bh) * INT64_C(4294967296) + middle * INT64_C(65536) + (int64_t)(al * bl);")
       .close();
   w.line("/* Saturation (detail::saturate): clamps and raises the sticky flag. */");
-  w.open("static int32_t os_sat32(int64_t v, uint8_t *sat) {")
+  w.open("static inline int32_t os_sat32(int64_t v, uint8_t *sat) {")
       .open("if (v > (int64_t)INT32_MAX) {").line("*sat = 1u;").line("return INT32_MAX;").close()
       .open("if (v < (int64_t)INT32_MIN) {").line("*sat = 1u;").line("return INT32_MIN;").close()
       .line("return (int32_t)v;")
       .close();
-  w.open("static int16_t os_sat16(int32_t v, uint8_t *sat) {")
+  w.open("static inline int16_t os_sat16(int32_t v, uint8_t *sat) {")
       .open("if (v > (int32_t)INT16_MAX) {").line("*sat = 1u;").line("return INT16_MAX;").close()
       .open("if (v < (int32_t)INT16_MIN) {").line("*sat = 1u;").line("return INT16_MIN;").close()
       .line("return (int16_t)v;")
       .close();
-  w.open("static int16_t os_sat16_64(int64_t v, uint8_t *sat) {")
+  w.open("static inline int16_t os_sat16_64(int64_t v, uint8_t *sat) {")
       .open("if (v > (int64_t)INT16_MAX) {").line("*sat = 1u;").line("return INT16_MAX;").close()
       .open("if (v < (int64_t)INT16_MIN) {").line("*sat = 1u;").line("return INT16_MIN;").close()
       .line("return (int16_t)v;")
@@ -300,7 +300,7 @@ void FixedArith::emit_helpers(CodeWriter& w) {
 
 void FixedArith::emit_division_helpers(CodeWriter& w) {
   w.line("/* Bit length of v > 0 (no CLZ instruction on ARMv6-M, none in C99). */");
-  w.open("static int16_t os_bitlen(uint32_t v) {")
+  w.open("static inline int16_t os_bitlen(uint32_t v) {")
       .line("int16_t n = 1;")
       .open("if (v >= UINT32_C(0x10000)) {").line("v >>= 16;").line("n += 16;").close()
       .open("if (v >= UINT32_C(0x100)) {").line("v >>= 8;").line("n += 8;").close()
@@ -318,7 +318,7 @@ void FixedArith::emit_division_helpers(CodeWriter& w) {
   w.line("   arithmetic, then the remainder n - y m (|.| < 2^31, read through its sign bit) is brought");
   w.line("   into [0, m), which makes the quotient exact whatever the estimate. */");
   w.line("static ONESHOT_CONST_TABLE const uint16_t os_recip_seed[16] = {" + seeds + "};");
-  w.open("static uint32_t os_div31(uint32_t m) {")
+  w.open("static inline uint32_t os_div31(uint32_t m) {")
       .line("const uint32_t n = UINT32_C(0x80000000) + (m >> 1);")
       .line("uint32_t y = os_recip_seed[(m >> 11) - 16u];")
       .line("uint32_t t = m * y;")
