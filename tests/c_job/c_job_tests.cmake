@@ -51,8 +51,23 @@ if(ONESHOT_AVR_GCC AND ONESHOT_SIMAVR_LIBRARY AND ONESHOT_SIMAVR_INCLUDE)
   target_link_libraries(c_job_avr_harness PRIVATE ${ONESHOT_SIMAVR_LIBRARY})
   target_compile_options(c_job_avr_harness PRIVATE -Wall -Wextra)
   add_dependencies(c_job_avr_harness c_job_avr_image)
-  add_test(NAME CJob.AvrSimavrBitIdentical COMMAND c_job_avr_harness ${avr_elf} ${c_job_avr_mcu} ${c_job_ref} 300)
+  add_test(NAME CJob.AvrSimavrBitIdentical COMMAND c_job_avr_harness ${avr_elf} ${c_job_avr_mcu} ${c_job_ref} 4000)
   set_tests_properties(CJob.AvrSimavrBitIdentical PROPERTIES FIXTURES_REQUIRED c_job_reference TIMEOUT 300)
+  # The tables in program memory through ONESHOT_CONST_TABLE = __flash (GNU C; avr-gcc 5.4's
+  # -Wuninitialized wrongly flags initialised __flash data, hence -Wno-uninitialized).
+  set(avr_flash_elf ${CMAKE_CURRENT_BINARY_DIR}/c_job_avr_flash.elf)
+  add_custom_command(
+    OUTPUT ${avr_flash_elf}
+    COMMAND ${ONESHOT_AVR_GCC} -mmcu=${c_job_avr_mcu} -std=gnu99 -Wall -Wextra -Wconversion -Werror -Wno-uninitialized
+            -O2 -ffunction-sections -fdata-sections -Wl,--gc-sections -I${c_job_dir} -DONESHOT_CONST_TABLE=__flash
+            ${CMAKE_CURRENT_SOURCE_DIR}/c_job/avr/c_job_avr_main.c ${c_job_dir}/oneshot_job.c -o ${avr_flash_elf} -lm
+    DEPENDS ${CMAKE_CURRENT_SOURCE_DIR}/c_job/avr/c_job_avr_main.c ${c_job_dir}/oneshot_job.c
+            ${c_job_dir}/oneshot_job.h oneshot_generated
+    COMMENT "avr-gcc: the generated C job with its tables in flash (__flash)")
+  add_custom_target(c_job_avr_flash_image ALL DEPENDS ${avr_flash_elf})
+  add_dependencies(c_job_avr_harness c_job_avr_flash_image)
+  add_test(NAME CJob.AvrSimavrFlashTables COMMAND c_job_avr_harness ${avr_flash_elf} ${c_job_avr_mcu} ${c_job_ref} 1000)
+  set_tests_properties(CJob.AvrSimavrFlashTables PROPERTIES FIXTURES_REQUIRED c_job_reference TIMEOUT 300)
 elseif(ONESHOT_REQUIRE_AVR)
   message(FATAL_ERROR "ONESHOT_REQUIRE_AVR is ON but avr-gcc or libsimavr was not found "
                       "(apt-get install gcc-avr avr-libc simavr libsimavr-dev)")
