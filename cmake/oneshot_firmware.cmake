@@ -103,13 +103,14 @@ foreach(variant fixed_table fixed_nearest float_table float_nearest)
   add_dependencies(${image} oneshot_generated)
   target_include_directories(${image} PRIVATE firmware/core/include ${generated_dir}/oneshot_c)
   target_compile_options(${image} PRIVATE ${fw_common_options})
+  string(TOUPPER ${variant} variant_upper)
   set(others fixed_table fixed_nearest float_table float_nearest)
   list(REMOVE_ITEM others ${variant})
   list(TRANSFORM others TOUPPER)
   list(TRANSFORM others PREPEND ONESHOT_JOB_WITHOUT_)
   target_compile_definitions(${image} PRIVATE ${soc_define} ONESHOT_MCU_IRQ_COUNT=${irq_count}
     ONESHOT_MCU_ACTUATION_IRQ=8 ONESHOT_MCU_UART_IRQ=${uart_irq} ${extra_defines}
-    ONESHOT_CJOB_VARIANT=${variant} ${others})
+    ONESHOT_CJOB_VARIANT=${variant} ONESHOT_CJOB_HAS=ONESHOT_JOB_HAS_${variant_upper} ${others})
   oneshot_firmware_link(${image})
   add_custom_command(TARGET ${image} POST_BUILD
     COMMAND arm-none-eabi-size $<TARGET_FILE:${image}>

@@ -10,6 +10,8 @@
 #define ONESHOT_CJOB_CAT(a, b) ONESHOT_CJOB_CAT2(a, b)
 #define ONESHOT_CJOB(name) ONESHOT_CJOB_CAT(ONESHOT_CJOB_CAT(ONESHOT_CJOB_CAT(oneshot_job_, ONESHOT_CJOB_VARIANT), _), name)
 
+// ONESHOT_CJOB_HAS names the header's ONESHOT_JOB_HAS_<VARIANT>: 0 when the plant lacks it.
+#if ONESHOT_CJOB_HAS
 namespace {
 ONESHOT_CJOB(t) g_job;
 volatile std::int32_t g_tau_us;       // stands for the timer capture
@@ -29,7 +31,7 @@ extern "C" [[noreturn]] void oneshot_fault_handler() {
 }
 
 int main() {
-  ONESHOT_CJOB(init)(&g_job, 1000);
+  ONESHOT_CJOB(init)(&g_job, static_cast<std::uint16_t>(ONESHOT_JOB_PWM_STEPS / 2));
   for (;;) {
     if (g_run) {
       g_run = false;
@@ -37,3 +39,13 @@ int main() {
     }
   }
 }
+#else
+extern "C" void oneshot_actuation_timer_handler() {}
+extern "C" void oneshot_uart_rx_handler() {}
+extern "C" void oneshot_idle_wakeup_handler() {}
+extern "C" [[noreturn]] void oneshot_fault_handler() {
+  for (;;) {
+  }
+}
+int main() {}  // this plant has no such variant
+#endif

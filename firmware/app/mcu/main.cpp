@@ -144,19 +144,19 @@ struct Loop {
   }
 };
 
-#if ONESHOT_FW_DISC != 1
 // The generated C99 job of this image's format and sub-grid policy, as approach 5: the same
 // job as B (half Kalman, one-shot) behind the same task interface, for instruction counts and
-// the comparison with the C++ job on the MCU.
-#if ONESHOT_FW_FIXED && ONESHOT_FW_DISC == 2
+// the comparison with the C++ job on the MCU (table images, when the plant has that variant).
+#if ONESHOT_FW_FIXED && ONESHOT_FW_DISC == 2 && defined(ONESHOT_JOB_HAS_FIXED_NEAREST)
 #define ONESHOT_CJOB(name) oneshot_job_fixed_nearest_##name
-#elif ONESHOT_FW_FIXED
+#elif ONESHOT_FW_FIXED && ONESHOT_FW_DISC == 0 && defined(ONESHOT_JOB_HAS_FIXED_TABLE)
 #define ONESHOT_CJOB(name) oneshot_job_fixed_table_##name
-#elif ONESHOT_FW_DISC == 2
+#elif !ONESHOT_FW_FIXED && ONESHOT_FW_DISC == 2 && defined(ONESHOT_JOB_HAS_FLOAT_NEAREST)
 #define ONESHOT_CJOB(name) oneshot_job_float_nearest_##name
-#else
+#elif !ONESHOT_FW_FIXED && ONESHOT_FW_DISC == 0 && defined(ONESHOT_JOB_HAS_FLOAT_TABLE)
 #define ONESHOT_CJOB(name) oneshot_job_float_table_##name
 #endif
+#ifdef ONESHOT_CJOB
 static_assert(kM == 1 && kP == 1, "the C job adapter serves one input and one output");
 
 struct CJobLoop {
@@ -261,7 +261,7 @@ decltype(auto) with_loop(F&& f) {
     case 1: return f(g_half);
     case 2: return f(g_complete);
     case 4: return f(g_deadbeat);
-#if ONESHOT_FW_DISC != 1
+#ifdef ONESHOT_CJOB
     case 5: return f(g_cjob);
 #endif
     default: return f(g_standard);
@@ -315,7 +315,7 @@ void handle(const pil::Frame& q, pil::Frame& r) {
       g_complete.configure(CompleteEst(K::kDesign, g_disc, noise), codes);
       g_standard.configure(StandardEst(K::kDesign, noise), codes);
       g_deadbeat.configure(DeadbeatEst(K::kDesign), codes);
-#if ONESHOT_FW_DISC != 1
+#ifdef ONESHOT_CJOB
       g_cjob.configure(codes);
 #endif
       clear_saturation_flag();

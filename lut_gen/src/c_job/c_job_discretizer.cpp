@@ -13,6 +13,8 @@ VariantEmitter::VariantEmitter(const PlantDescription& plant, const DesignResult
                                const PlantPatterns& patterns, const VariantSpec& spec)
     : plant_(plant), design_(design), pat_(patterns), spec_(spec), n_(plant.n()), m_(plant.m()), p_(plant.p()) {
   if (p_ != 1) throw DesignError("C job: the generated job supports one measured output (p = 1)");
+  if (design_.actuator_steps > 65535) throw DesignError("C job: PWM codes are uint16_t, board.pwm_duty_steps must be <= 65535");
+  if (plant_.board.adc_bits > 16) throw DesignError("C job: ADC codes are uint16_t, board.adc_bits must be <= 16");
   for (std::size_t i = 0; i < n_; ++i) {
     for (std::size_t j = 0; j < n_; ++j)
       if (pat_.phi.is_free(i, j)) phi_free_.emplace_back(i, j);
