@@ -167,5 +167,15 @@ int main(int argc, char **argv) {
     if (n == 0 || stats[v].identical != n) ++failed;
   }
   printf("avr: marker overhead %lu cycles (subtracted)\n", (unsigned long)overhead);
+  /* What elf_read_firmware allocated (the sanitizer build checks for leaks). */
+  free(firmware.flash);
+  free(firmware.eeprom);
+#if ELF_SYMBOLS
+  {
+    uint32_t i;
+    for (i = 0; i < firmware.symbolcount; ++i) free(firmware.symbol[i]);
+    free(firmware.symbol);
+  }
+#endif
   return failed == 0 ? 0 : 1;
 }
