@@ -10,6 +10,7 @@
 #include <sstream>
 
 #include "oneshot/sim/experiments.hpp"
+#include "oneshot/sim/study_report.hpp"
 #include "oneshot/sim/output_files.hpp"
 #include "oneshot/sim/parallel.hpp"
 #include "oneshot/sim/pil_link.hpp"
@@ -250,9 +251,25 @@ nlohmann::json run_report(const SimContext& ctx, const CommonOptions& o, const R
   nlohmann::json targets;
   targets_section(table1, lut, mcu, bench, targets, md);
 
+  // The networked and event-based studies, each on its built-in defaults (study_report.hpp).
+  nlohmann::json studies = nlohmann::json::object();
+  for (const StudyReportSection& section : study_report_sections()) {
+    std::cerr << "report: " << section.study << "\n";
+    StudyReportContext sc;
+    sc.out_dir = (std::filesystem::path(o.out_dir) / section.study).string();
+    sc.rel_dir = section.study;
+    sc.threads = o.threads;
+    sc.seed = o.seed;
+    sc.plots = o.plots;
+    make_directory(sc.out_dir);
+    StudyReportResult res = section.run(sc);
+    md << res.markdown << "\n";
+    studies[section.study] = std::move(res.json);
+  }
+
   nlohmann::json all = {{"noise", noise},      {"jitter", jitter}, {"gain", gain},     {"table1", table1},
                         {"formats", formats},  {"table", lut},     {"mcu", mcu},       {"exectime", exectime},
-                        {"benchmark", bench},  {"targets", targets}};
+                        {"benchmark", bench},  {"targets", targets}, {"studies", studies}};
   all["wall_time_s"] = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   write_json((std::filesystem::path(o.out_dir) / "report.json").string(), all);
   std::ofstream(std::filesystem::path(o.out_dir) / "report.md") << md.str();
