@@ -255,10 +255,10 @@ TEST(KalmanEstimator, StepsOfADiscretePlantMatchEigen) {
     tc.x_ = t.phi * tc.x_ + t.gamma * EstimatorCase<12, 2, 2>::to_eigen(u);
     tc.p_ = t.phi * tc.p_ * t.phi.transpose() + t.qd;
   }
-  // Same Φ, Γ, Q; only the operation order differs.
+  // Same Φ, Γ, Q; only the operation order differs. Measured: x 1.6e-16, P 9.1e-17 (relative).
   std::cout << "7 steps: rel err x " << tc.state_error() << " P " << tc.covariance_error() << "\n";
-  EXPECT_LT(tc.covariance_error(), 1e-14);
-  EXPECT_LT(tc.state_error(), 1e-14);
+  EXPECT_LT(tc.covariance_error(), 1e-15);
+  EXPECT_LT(tc.state_error(), 1e-15);
 }
 
 TEST(KalmanEstimator, SingularOutputIsSkippedAndReportedOthersStillCorrect) {
