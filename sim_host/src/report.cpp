@@ -25,7 +25,6 @@ std::string fmt(const char* f, double v) {
 CommonOptions in_subdir(const CommonOptions& o, const std::string& sub) {
   CommonOptions r = o;
   r.out_dir = (std::filesystem::path(o.out_dir) / sub).string();
-  make_directory(r.out_dir);
   return r;
 }
 
@@ -189,7 +188,8 @@ void targets_section(const nlohmann::json& table1, const nlohmann::json& lut, co
 }  // namespace
 
 nlohmann::json run_report(const SimContext& ctx, const CommonOptions& o, const ReportOptions& r) {
-  make_directory(o.out_dir);
+  // Refuse bad scenarios before anything is run or written.
+  for (const Scenario& s : r.scenarios) validate_scenario(s, ctx.plant());
   const auto t0 = std::chrono::steady_clock::now();
   std::cerr << "report: noise\n";
   const nlohmann::json noise = run_noise_experiment(ctx, o, 5.0);
@@ -236,7 +236,7 @@ nlohmann::json run_report(const SimContext& ctx, const CommonOptions& o, const R
     for (const auto& [k, v] : variants.items()) {
       md << "| " << model << " | " << k << " | " << v["host_ns_per_job"].get<double>() << " | "
          << v["host_us_per_4s"].get<double>() << " | "
-         << (v["host_instructions_per_job"].is_null() ? std::string("n/a")
+         << (!v.contains("host_instructions_per_job") ? std::string("n/a")
                                                       : std::to_string(std::lround(v["host_instructions_per_job"].get<double>())))
          << " |\n";
     }
@@ -248,12 +248,14 @@ nlohmann::json run_report(const SimContext& ctx, const CommonOptions& o, const R
   nlohmann::json targets;
   targets_section(table1, lut, mcu, bench, targets, md);
 
-  nlohmann::json all = {{"noise", noise},      {"jitter", jitter}, {"gain", gain},     {"table1", table1},
-                        {"formats", formats},  {"table", lut},     {"mcu", mcu},       {"exectime", exectime},
-                        {"benchmark", bench},  {"targets", targets}};
+  nlohmann::json all = {{"noise", noise},         {"jitter", jitter},     {"gain", gain},
+                        {"table1", table1},       {"formats", formats},   {"exectime", exectime},
+                        {"benchmark", bench},     {"targets", targets}};
+  if (!lut.is_null()) all["table"] = lut;  // sections that did not run are left out, not null
+  if (!mcu.is_null()) all["mcu"] = mcu;
   all["wall_time_s"] = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   write_json((std::filesystem::path(o.out_dir) / "report.json").string(), all);
-  std::ofstream(std::filesystem::path(o.out_dir) / "report.md") << md.str();
+  write_text((std::filesystem::path(o.out_dir) / "report.md").string(), md.str());
   return all;
 }
 
