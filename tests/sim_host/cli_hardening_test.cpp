@@ -37,12 +37,6 @@ std::string read(const std::string& path) {
   return s.str();
 }
 
-std::size_t entries_in(const std::string& dir) {
-  std::size_t n = 0;
-  for ([[maybe_unused]] const auto& e : fs::recursive_directory_iterator(dir)) ++n;
-  return n;
-}
-
 /// A scenario file whose only scenario is called `name` (1 s, default jitter).
 std::string scenario_named(const std::string& file, const std::string& name) {
   const nlohmann::json j = {{"scenarios", {{{"name", name}, {"duration_s", 1}}}}};
@@ -172,18 +166,25 @@ TEST(CliHardening, AFailedWriteIsAnError) {
 }
 
 TEST(CliHardening, AFullDiskAtTheLastFlushIsAnErrorAndLeavesNoPartialFile) {
-  // A file size limit makes the disk "full" after 300 bytes: the design JSON (a few KB)
-  // used to fit in the stream buffer, fail at the final flush and still exit 0.
+  // A file size limit makes the disk "full" after 300 bytes. The jobs CSV of a short run
+  // (about 2 KB) used to sit in the stream buffer, fail at the final flush unchecked, and
+  // leave a truncated file with exit status 0.
   const std::string dir = fresh_dir("fsize");
   test::CommandOptions limited;
   limited.file_size_limit_bytes = 300;
-  const auto r = run_command({sim(), "design", "--json", dir + "/design.json"}, limited);
+  const std::vector<std::string> run = {sim(), "run", "--duration", "0.5", "--trace-step-us", "0", "--no-plots",
+                                        "--out", dir + "/o"};
+  const auto r = run_command(run, limited);
   EXPECT_NE(r.exit_code, 0) << r.output;
-  EXPECT_NE(r.output.find("design.json: write failed"), std::string::npos) << r.output;
-  EXPECT_EQ(entries_in(dir), 0U) << "neither the file nor a temporary one may stay";
+  EXPECT_NE(r.output.find("run_jobs.csv: write failed"), std::string::npos) << r.output;
+  std::size_t files = 0;
+  if (fs::exists(dir + "/o")) {
+    for (const auto& e : fs::recursive_directory_iterator(dir + "/o")) files += e.is_regular_file() ? 1U : 0U;
+  }
+  EXPECT_EQ(files, 0U) << "neither a truncated file nor a temporary one may stay";
   // The same run without the limit writes the file.
-  ASSERT_EQ(run_command({sim(), "design", "--json", dir + "/design.json"}).exit_code, 0);
-  EXPECT_GT(read(dir + "/design.json").size(), 300U);
+  ASSERT_EQ(run_command(run).exit_code, 0);
+  EXPECT_GT(read(dir + "/o/run_jobs.csv").size(), 300U);
 }
 
 TEST(CliHardening, ANonFiniteResultIsAnErrorNotNull) {

@@ -35,10 +35,11 @@ struct ChildFailure {
   ::setpgid(0, 0);
   ::prctl(PR_SET_PDEATHSIG, SIGKILL);
   if (::getppid() != parent) ::_exit(127);  // the parent is already gone
-  for (int sig : {SIGINT, SIGTERM, SIGHUP}) {
+  for (int sig : {SIGINT, SIGTERM, SIGHUP}) {  // our handlers are not the child's; an ignored signal stays ignored
     struct sigaction cur {};
     if (::sigaction(sig, nullptr, &cur) == 0 && cur.sa_handler != SIG_IGN) ::signal(sig, SIG_DFL);
   }
+  ::signal(SIGPIPE, SIG_DFL);  // oneshot-sim ignores it for itself only
   sigset_t none;
   sigemptyset(&none);
   ::sigprocmask(SIG_SETMASK, &none, nullptr);
