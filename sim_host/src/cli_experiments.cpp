@@ -1,10 +1,10 @@
 /// @file cli_experiments.cpp
 /// @brief Subcommands noise, jitter, gain, table1, exectime, run, benchmark and report.
 #include <algorithm>
-#include <cmath>
-#include <cstdlib>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <iostream>

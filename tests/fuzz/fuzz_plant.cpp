@@ -1,10 +1,12 @@
 /// @file fuzz_plant.cpp
 /// @brief libFuzzer harness of the plant parser: parse_plant(text, source), then the design.
 ///
-/// Oracle: a plant that parse_plant accepts either gets a clean DesignError from the
-/// design step, or a design whose JSON holds no NaN, Inf or null, with a stable estimator
-/// (spectral radius of (I − K C) Φ(h) below 1, computed here with Eigen, independently of
-/// the design's own figure) and a stable closed loop (Φ − Γ L).
+/// Oracle: a plant that parse_plant accepts has a board the emulator can run (PWM period
+/// of at least 1 ns and at most h, duty steps of at least 1 ns, a table covering h: issue
+/// 11), and either gets a clean DesignError from the design step, or a design whose JSON
+/// holds no NaN, Inf or null, with a stable estimator (spectral radius of (I − K C) Φ(h)
+/// below 1, computed here with Eigen, independently of the design's own figure) and a
+/// stable closed loop (Φ − Γ L).
 #include <Eigen/Dense>
 #include <cstdint>
 #include <string>
@@ -42,6 +44,12 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   } catch (const d::PlantError&) {
     return 0;  // refused with a message: fine
   }
+  const double pwm_period_ns = 1e9 / plant.board.pwm_frequency_hz;
+  require(pwm_period_ns >= 1.0 && pwm_period_ns <= 1e3 * plant.period_us,
+          "accepted PWM period of " + std::to_string(pwm_period_ns) + " ns (period " + std::to_string(plant.period_us) +
+              " us)");
+  require(pwm_period_ns / plant.board.pwm_duty_steps >= 1.0, "accepted sub-nanosecond PWM duty steps");
+  require(plant.table_range_us >= plant.period_us, "accepted a table range below the period");
   d::DesignResult design;
   try {
     design = d::synthesize(plant);

@@ -117,6 +117,33 @@ TEST(CliHardening, NonsenseOptionsAreRefusedWithTheReason) {
   }
 }
 
+TEST(CliHardening, AmbiguousOrMalformedInputFilesAreRefusedByName) {
+  const std::string dir = fresh_dir("input_files");
+  const std::string dup_key =
+      test::write_temp_file("hard_dup_key.json", R"({"scenarios": [{"name": "a", "duration_s": 20, "duration_s": 1}]})");
+  const std::string dup_name =
+      test::write_temp_file("hard_dup_name.json", R"({"scenarios": [{"name": "a"}, {"name": "a", "duration_s": 1}]})");
+  const std::string trailing = test::write_temp_file("hard_trailing.csv", "release_us,exec_us\n1000,300 # ms?\n");
+  const std::string trace_dir =
+      test::write_temp_file("hard_trace_dir.json", R"({"scenarios": [{"name": "a", "jitter": {"model": "trace", "file": ")" +
+                                                       dir + R"("}}]})");
+  const std::vector<Refusal> cases = {
+      {{"run", "--scenarios", dup_key, "--scenario", "a"}, "field 'scenarios[0].duration_s': duplicate key"},
+      {{"run", "--scenarios", dup_name, "--scenario", "a"}, "'a' is already the name of scenarios[0]"},
+      {{"run", "--jitter", "trace", "--jitter-trace", trailing}, "line 2: expected 'release_us,exec_us'"},
+      {{"run", "--scenarios", trace_dir, "--scenario", "a"}, "is a directory, not a jitter trace"},
+  };
+  for (const Refusal& c : cases) {
+    std::vector<std::string> argv = {sim()};
+    argv.insert(argv.end(), c.args.begin(), c.args.end());
+    argv.insert(argv.end(), {"--duration", "0.5", "--no-plots", "--out", dir + "/o"});
+    const auto r = run_command(argv);
+    EXPECT_NE(r.exit_code, 0) << c.args[2];
+    EXPECT_NE(r.output.find(c.expected), std::string::npos) << c.args[2] << ": " << r.output;
+    EXPECT_EQ(r.output.find("not valid JSON"), std::string::npos) << r.output;
+  }
+}
+
 TEST(CliHardening, JitterTraceAloneSelectsTheTraceModel) {
   const std::string trace = test::write_temp_file("hard_trace2.csv", "release_us,exec_us\n1000,300\n2000,300\n");
   const auto r = run_command({sim(), "run", "--duration", "0.5", "--jitter-trace", trace, "--no-plots", "--json", "-",
