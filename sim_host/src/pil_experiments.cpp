@@ -3,10 +3,10 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
-#include <fstream>
 #include <iostream>
 #include <sstream>
 
+#include "oneshot/host/file_io.hpp"
 #include "oneshot/sim/experiments.hpp"
 #include "oneshot/sim/output_files.hpp"
 #include "oneshot/sim/pil_link.hpp"
@@ -59,8 +59,7 @@ Comparison compare(const RunResult& host, const RunResult& mcu) {
 
 /// Flash (text + rodata + initialised data) and RAM (data + bss) of an ELF image.
 std::pair<std::size_t, std::size_t> image_memory(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  const std::string d((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const std::string d = host::read_text_file(path, "firmware image", kMaxImageBytes);
   const auto u16 = [&](std::size_t o) {
     return static_cast<std::uint32_t>(static_cast<unsigned char>(d.at(o)) | static_cast<unsigned char>(d.at(o + 1)) << 8);
   };

@@ -7,13 +7,13 @@
 #include <chrono>
 #include <cstring>
 #include <filesystem>
-#include <fstream>
 #include <poll.h>
 #include <sstream>
 #include <sys/mman.h>
 #include <unistd.h>
 
 #include "oneshot/host/child_process.hpp"
+#include "oneshot/host/file_io.hpp"
 
 namespace oneshot::sim {
 
@@ -27,9 +27,12 @@ std::string firmware_image_path(const PilOptions& o) {
 }
 
 std::uint32_t elf_symbol_address(const std::string& path, const std::string& name) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw PilError(path + ": cannot read the firmware image");
-  const std::string data((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  std::string data;
+  try {
+    data = host::read_text_file(path, "firmware image", kMaxImageBytes);
+  } catch (const host::FileError& e) {
+    throw PilError(e.what());
+  }
   const auto u16 = [&](std::size_t off) {
     if (off + 2 > data.size()) throw PilError(path + ": truncated ELF");
     return static_cast<std::uint32_t>(static_cast<unsigned char>(data[off]) | static_cast<unsigned char>(data[off + 1]) << 8);

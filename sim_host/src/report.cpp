@@ -5,10 +5,10 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
-#include <fstream>
 #include <iostream>
 #include <sstream>
 
+#include "oneshot/host/file_io.hpp"
 #include "oneshot/sim/experiments.hpp"
 #include "oneshot/sim/output_files.hpp"
 #include "oneshot/sim/pil_link.hpp"
@@ -60,13 +60,20 @@ nlohmann::json number_formats(const SimContext& ctx, const CommonOptions& o, con
 /// The generated table of the build (built-in plant only).
 nlohmann::json table_section(const SimContext& ctx, std::ostringstream& md) {
   md << "## 6. The Phi/Gamma/Q_d table\n\n";
-  std::ifstream in(ONESHOT_LUT_REPORT_PATH);
-  if (!ctx.generated() || !in) {
+  std::string text;
+  if (ctx.generated()) {
+    try {
+      text = host::read_text_file(ONESHOT_LUT_REPORT_PATH, "table report");
+    } catch (const host::FileError&) {
+      text.clear();  // a build without the generated table: reported below
+    }
+  }
+  if (text.empty()) {
     md << "The build-time table belongs to the built-in plant; see `lut_report.json` of a build with "
           "`-DONESHOT_PLANT=FILE`.\n\n";
     return nullptr;
   }
-  const nlohmann::json lut = nlohmann::json::parse(in);
+  const nlohmann::json lut = nlohmann::json::parse(text);
   const auto& f = lut["formats"];
   md << "| format | bytes | levels | entries | max abs error vs double generic |\n|---|---|---|---|---|\n"
      << "| float | " << f["float"]["bytes"] << " | " << f["float"]["levels"] << " | " << f["float"]["entries"] << " | "

@@ -52,6 +52,9 @@ struct FirmwareInfo {
 /// Path of the image for `options` (firmware_dir/firmware-<target>/oneshot-<target>-<format>-<disc>.elf).
 std::string firmware_image_path(const PilOptions& options);
 
+/// Largest firmware image read (ELF with debug information): 64 MiB.
+inline constexpr std::size_t kMaxImageBytes = std::size_t{64} << 20;
+
 /// Address of symbol `name` in a 32-bit little-endian ELF file (PilError when absent).
 std::uint32_t elf_symbol_address(const std::string& elf_path, const std::string& name);
 
