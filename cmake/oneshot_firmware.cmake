@@ -53,9 +53,13 @@ if(NOT ONESHOT_FIRMWARE_OPT MATCHES "^-O[23s]$")
   message(FATAL_ERROR "ONESHOT_FIRMWARE_OPT must be -O3, -O2 or -Os (got '${ONESHOT_FIRMWARE_OPT}')")
 endif()
 set(fw_common_options
-  -ffreestanding -fno-exceptions -fno-rtti -fno-threadsafe-statics -fno-use-cxa-atexit
+  -ffreestanding $<$<COMPILE_LANGUAGE:CXX>:-fno-exceptions -fno-rtti -fno-threadsafe-statics -fno-use-cxa-atexit>
+  $<$<COMPILE_LANGUAGE:C>:-pedantic>
   -ffunction-sections -fdata-sections -g ${ONESHOT_FIRMWARE_OPT} -fstack-usage
   -Wall -Wextra -Wconversion -Wsign-conversion -Wshadow -Wdouble-promotion)
+# The generated C99 job (lut_gen --c-job-dir), compiled as strict C99 beside the C++ job.
+set(c_job_source ${generated_dir}/oneshot_c/oneshot_job.c)
+set_source_files_properties(${c_job_source} PROPERTIES GENERATED TRUE)
 if(ONESHOT_WERROR)
   list(APPEND fw_common_options -Werror)
 endif()
@@ -69,13 +73,14 @@ endfunction()
 foreach(format float fixed)
   foreach(disc table nearest generic)
     set(image oneshot-${ONESHOT_FIRMWARE_TARGET}-${format}-${disc})
-    add_executable(${image} firmware/app/mcu/main.cpp firmware/app/mcu/startup.cpp)
+    add_executable(${image} firmware/app/mcu/main.cpp firmware/app/mcu/startup.cpp ${c_job_source})
+    set_target_properties(${image} PROPERTIES C_STANDARD 99 C_STANDARD_REQUIRED ON C_EXTENSIONS OFF)
     # startup.cpp implements memcpy/memset: keep the compiler from turning their loops into calls to themselves.
     set_source_files_properties(firmware/app/mcu/startup.cpp PROPERTIES COMPILE_OPTIONS "-fno-builtin;-fno-tree-loop-distribute-patterns")
     set_target_properties(${image} PROPERTIES SUFFIX ".elf")
     add_dependencies(${image} oneshot_generated)
     target_include_directories(${image} PRIVATE
-      firmware/core/include firmware/app/include hal/include hal/mcu/include ${generated_dir})
+      firmware/core/include firmware/app/include hal/include hal/mcu/include ${generated_dir} ${generated_dir}/oneshot_c)
     target_compile_options(${image} PRIVATE ${fw_common_options})
     target_compile_definitions(${image} PRIVATE ${soc_define}
       ONESHOT_MCU_IRQ_COUNT=${irq_count} ONESHOT_MCU_ACTUATION_IRQ=8 ONESHOT_MCU_UART_IRQ=${uart_irq} ${extra_defines}
@@ -86,6 +91,32 @@ foreach(format float fixed)
       COMMAND arm-none-eabi-size $<TARGET_FILE:${image}>
       COMMENT "size of ${image}")
   endforeach()
+endforeach()
+
+# Job-only images of the generated C job (no PIL link), one per variant, for flash and RAM:
+# oneshot-<target>-cjob-<variant>.elf; <image>.stack.txt bounds the stack by the sum of every
+# frame in the image (-fstack-usage; no recursion, so no call chain can need more).
+foreach(variant fixed_table fixed_nearest float_table float_nearest)
+  set(image oneshot-${ONESHOT_FIRMWARE_TARGET}-cjob-${variant})
+  add_executable(${image} firmware/app/mcu/c_job_only.cpp firmware/app/mcu/startup.cpp ${c_job_source})
+  set_target_properties(${image} PROPERTIES SUFFIX ".elf" C_STANDARD 99 C_STANDARD_REQUIRED ON C_EXTENSIONS OFF)
+  add_dependencies(${image} oneshot_generated)
+  target_include_directories(${image} PRIVATE firmware/core/include ${generated_dir}/oneshot_c)
+  target_compile_options(${image} PRIVATE ${fw_common_options})
+  string(TOUPPER ${variant} variant_upper)
+  set(others fixed_table fixed_nearest float_table float_nearest)
+  list(REMOVE_ITEM others ${variant})
+  list(TRANSFORM others TOUPPER)
+  list(TRANSFORM others PREPEND ONESHOT_JOB_WITHOUT_)
+  target_compile_definitions(${image} PRIVATE ${soc_define} ONESHOT_MCU_IRQ_COUNT=${irq_count}
+    ONESHOT_MCU_ACTUATION_IRQ=8 ONESHOT_MCU_UART_IRQ=${uart_irq} ${extra_defines}
+    ONESHOT_CJOB_VARIANT=${variant} ONESHOT_CJOB_HAS=ONESHOT_JOB_HAS_${variant_upper} ${others})
+  oneshot_firmware_link(${image})
+  add_custom_command(TARGET ${image} POST_BUILD
+    COMMAND arm-none-eabi-size $<TARGET_FILE:${image}>
+    COMMAND ${CMAKE_COMMAND} -DDIR=${CMAKE_CURRENT_BINARY_DIR}/CMakeFiles/${image}.dir
+            -DOUT=$<TARGET_FILE:${image}>.stack.txt -P ${PROJECT_SOURCE_DIR}/cmake/oneshot_stack_bound.cmake
+    COMMENT "size and stack bound of ${image}")
 endforeach()
 
 # A heap use must fail the link: this probe allocates and is never part of ALL.
@@ -100,11 +131,11 @@ oneshot_firmware_link(oneshot-heap-probe-${ONESHOT_FIRMWARE_TARGET})
 # constants are integer-exact): the fixed table image built at -Og, never part of ALL; a
 # test builds it and checks its symbols (tests/pil/og_no_floating_point.cmake).
 set(og_probe oneshot-og-probe-${ONESHOT_FIRMWARE_TARGET})
-add_executable(${og_probe} EXCLUDE_FROM_ALL firmware/app/mcu/main.cpp firmware/app/mcu/startup.cpp)
-set_target_properties(${og_probe} PROPERTIES SUFFIX ".elf")
+add_executable(${og_probe} EXCLUDE_FROM_ALL firmware/app/mcu/main.cpp firmware/app/mcu/startup.cpp ${c_job_source})
+set_target_properties(${og_probe} PROPERTIES SUFFIX ".elf" C_STANDARD 99 C_STANDARD_REQUIRED ON C_EXTENSIONS OFF)
 add_dependencies(${og_probe} oneshot_generated)
 target_include_directories(${og_probe} PRIVATE
-  firmware/core/include firmware/app/include hal/include hal/mcu/include ${generated_dir})
+  firmware/core/include firmware/app/include hal/include hal/mcu/include ${generated_dir} ${generated_dir}/oneshot_c)
 set(og_options ${fw_common_options})
 list(REMOVE_ITEM og_options ${ONESHOT_FIRMWARE_OPT} -Werror)
 target_compile_options(${og_probe} PRIVATE ${og_options} -Og)

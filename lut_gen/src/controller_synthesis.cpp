@@ -3,189 +3,158 @@
 #include "oneshot/design/controller_synthesis.hpp"
 
 #include <cmath>
+#include <cstdio>
 
-#include "oneshot/design/dimension_dispatch.hpp"
-#include "oneshot/design/fixed_size.hpp"
-#include "oneshot/design/riccati.hpp"
-#include "oneshot/generic_discretizer.hpp"
-#include "oneshot/linear_solve.hpp"
-#include "oneshot/matrix_exponential.hpp"
+#include "oneshot/design/dare.hpp"
+#include "oneshot/design/dense_ops.hpp"
+#include "oneshot/design/sampled_model.hpp"
+#include "oneshot/design/spectrum.hpp"
+#include "synthesis_parts.hpp"
 
 namespace oneshot::design {
 namespace {
 
-using F64 = UniformFormat<double>;
-
-template <std::size_t N>
-void symmetrize(Matrix<double, N, N>& m) {
-  for (std::size_t i = 0; i < N; ++i)
-    for (std::size_t j = i + 1; j < N; ++j) m(i, j) = m(j, i) = 0.5 * (m(i, j) + m(j, i));
+std::string sci(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.6g", v);
+  return buf;
 }
 
-template <std::size_t N, std::size_t M, std::size_t P>
-DesignResult synthesize_fixed(const PlantDescription& plant) {
-  DesignResult out;
-  const double h = static_cast<double>(plant.period_us) * 1e-6;
-  out.period_s = h;
-  const auto a = to_fixed<double, N, N>(plant.a);
-  const auto b = to_fixed<double, N, M>(plant.b);
-  const auto c = to_fixed<double, P, N>(plant.c);
-  const auto qn = to_fixed<double, N, N>(plant.process_covariance);
-  const auto r = to_fixed<double, P, P>(plant.measurement_covariance);
-
-  // Q_c = Qn / h; Φ(h), Γ(h), Q_d(h) by the generic routine.
-  out.qc = to_dense(qn * (1.0 / h));
-  const GenericDiscretizer<F64, N, M> generic(continuous_model_per_us<double, N, M>(plant, out));
-  Discretization<F64, N, M> dh;
-  if (generic.discretize(plant.period_us, dh, WithQd::kYes) != Status::kOk) {
-    throw DesignError("design: the matrix exponential of A·h cannot be evaluated (‖A‖·h too large)");
+/// LQR on the plant states (all states, or the leading n − exogenous ones), then the
+/// input-disturbance cancellation L_d = C_d for an exogenous model.
+void design_lqr(const PlantDescription& plant, DesignResult& d) {
+  const std::size_t n = plant.n();
+  const std::size_t m = plant.m();
+  d.l = DenseMatrix::zeros(m, n);
+  if (plant.cost_form == CostForm::kNone) {
+    d.lqr_unavailable_reason = "the plant file has no cost";
+    return;
   }
-  const Matrix<double, N, N> phi = dh.phi;
-  const Matrix<double, N, M> gamma = dh.gamma;
-  out.phi_h = to_dense(phi);
-  out.gamma_h = to_dense(gamma);
-  out.qd_h = to_dense(dh.qd);
-
-  // Sampled cost by Van Loan on F = [[A, B], [0, 0]].
-  constexpr std::size_t K = N + M;
-  Matrix<double, K, K> f;
-  f.template set_block<0, 0>(a);
-  f.template set_block<0, N>(b);
-  Matrix<double, K, K> w;
-  w.template set_block<0, 0>(to_fixed<double, N, N>(plant.q1c));
-  w.template set_block<N, N>(to_fixed<double, M, M>(plant.q2c));
-  Matrix<double, 2 * K, 2 * K> vl;
-  vl.template set_block<0, 0>(-(f.transposed()) * h);
-  vl.template set_block<0, K>(w * h);
-  vl.template set_block<K, K>(f * h);
-  Matrix<double, 2 * K, 2 * K> e;
-  if (matrix_exponential(vl, e) != Status::kOk) throw DesignError("design: cannot sample the cost (exponential)");
-  Matrix<double, K, K> qs = e.template block<K, K, K, K>().transposed() * e.template block<0, K, K, K>();
-  symmetrize(qs);
-  const Matrix<double, N, N> q1 = qs.template block<0, 0, N, N>();
-  const Matrix<double, N, M> q12 = qs.template block<0, N, N, M>();
-  const Matrix<double, M, M> q2 = qs.template block<N, N, M, M>();
-  out.q1 = to_dense(q1);
-  out.q12 = to_dense(q12);
-  out.q2 = to_dense(q2);
-
-  // LQR with cross term.
-  Matrix<double, M, M> q2_inv;
-  if (invert(q2, q2_inv) != Status::kOk) throw DesignError("design: sampled input weight Q2 is singular");
-  const Matrix<double, N, N> a_tilde = phi - gamma * q2_inv * q12.transposed();
-  Matrix<double, N, N> q1_tilde = q1 - q12 * q2_inv * q12.transposed();
-  symmetrize(q1_tilde);
-  Matrix<double, N, N> g = gamma * q2_inv * gamma.transposed();
-  symmetrize(g);
-  Matrix<double, N, N> s;
-  const Status lqr = solve_dare(a_tilde, g, q1_tilde, s);
-  if (lqr != Status::kOk) {
-    throw DesignError(std::string("design: LQR Riccati equation failed (") + to_string(lqr) +
-                      "): is (A, B) stabilisable?");
+  const std::size_t np = n - plant.exogenous_states;
+  const DenseMatrix phi = block(d.phi_h, 0, 0, np, np);
+  const DenseMatrix gamma = block(d.gamma_h, 0, 0, np, m);
+  if (plant.exogenous_states != 0) {
+    // Exogenous block: Φ = [[Φ_p, Φ_pd], [0, A_d]], Γ = [Γ_p; 0]; matched iff Φ_pd = Γ_p C_d.
+    const DenseMatrix c_d = block(plant.c_bar, 0, np, m, n - np);
+    const DenseMatrix mismatch = block(d.phi_h, 0, np, np, n - np) - gamma * c_d;
+    if (max_abs(mismatch) > 1e-12 * std::max(1.0, max_abs(d.phi_h))) {
+      throw DesignError("design: LQR: the exogenous disturbance does not enter at the input (Phi_pd != Gamma_p C_d)");
+    }
+    const DenseMatrix q1_d = block(d.q1, 0, np, n, n - np);
+    if (max_abs(q1_d) != 0) {
+      throw DesignError("design: LQR: the cost weights the exogenous disturbance states, which no input can "
+                        "regulate; weight the plant states only (e.g. cost.Qy)");
+    }
+    d.exogenous_states = plant.exogenous_states;
+    d.exogenous_radius = spectral_radius(block(d.phi_h, np, np, n - np, n - np));
   }
-  const Matrix<double, M, M> lhs = q2 + gamma.transposed() * s * gamma;
-  const Matrix<double, M, N> rhs = gamma.transposed() * s * phi + q12.transposed();
-  Matrix<double, M, N> l;
-  if (solve(lhs, rhs, l) != Status::kOk) throw DesignError("design: LQR gain equation is singular");
-  out.riccati = to_dense(s);
-  out.l = to_dense(l);
-  out.closed_loop_radius = spectral_radius(Matrix<double, N, N>(phi - gamma * l));
-  if (!(out.closed_loop_radius < 1.0)) {
-    throw DesignError("design: the LQR closed loop is not stable (spectral radius " +
-                      std::to_string(out.closed_loop_radius) + ")");
+  const ModeCheck stab = stabilizable(phi, gamma);
+  if (!stab.ok) {
+    throw DesignError("design: LQR: (Phi, Gamma) is not stabilizable: the modes " + stab.describe() +
+                      " are not controllable from the input");
   }
+  const DenseMatrix q1 = block(d.q1, 0, 0, np, np);
+  const DenseMatrix q12 = block(d.q12, 0, 0, np, m);
+  const DareSolution sol = solve_dare(phi, gamma, q1, d.q2, q12);
+  d.lqr_residual = sol.residual;
+  if (sol.status != DareStatus::kOk) {
+    throw DesignError(std::string("design: LQR Riccati equation failed: ") + to_string(sol.status) +
+                      " (relative residual " + sci(sol.residual) + ", nearest pencil eigenvalue at ||l| - 1| = " +
+                      sci(sol.unit_circle_distance) + "): a marginal mode the cost does not weight?");
+  }
+  const DenseMatrix s = sol.x;
+  const DenseMatrix gt = transpose(gamma);
+  const SolveResult gain = solve(d.q2 + gt * s * gamma, gt * s * phi + transpose(q12));
+  if (!gain.ok) throw DesignError("design: LQR gain equation is singular");
+  d.riccati = s;
+  set_block(d.l, 0, 0, gain.x);
+  if (plant.exogenous_states != 0) set_block(d.l, 0, np, block(plant.c_bar, 0, np, m, n - np));
+  d.closed_loop_radius = spectral_radius(phi - gamma * gain.x);
+  if (!(d.closed_loop_radius < 1.0)) {
+    throw DesignError("design: the LQR closed loop is not stable (spectral radius " + sci(d.closed_loop_radius) + ")");
+  }
+  d.lqr_available = true;
+}
 
-  // Steady-state Kalman filter (dual DARE) with Q_d(h).
-  Matrix<double, P, P> r_inv;
-  if (invert(r, r_inv) != Status::kOk) throw DesignError("design: R is singular");
-  Matrix<double, N, N> gk = c.transposed() * r_inv * c;
-  symmetrize(gk);
-  Matrix<double, N, N> prior;
-  const Status kal = solve_dare(Matrix<double, N, N>(phi.transposed()), gk, dh.qd, prior);
-  if (kal != Status::kOk) {
-    throw DesignError(std::string("design: Kalman Riccati equation failed (") + to_string(kal) +
-                      "): is (A, C) detectable?");
+/// Steady-state Kalman filter for one period with Q_d(h).
+void design_kalman(const PlantDescription& plant, DesignResult& d) {
+  const std::size_t n = plant.n();
+  const ModeCheck det = detectable(d.phi_h, plant.c);
+  if (!det.ok) {
+    throw DesignError("design: Kalman filter: (Phi, C) is not detectable: the modes " + det.describe() +
+                      " (|l| >= 1) are invisible in the outputs, so no stable estimator exists");
   }
+  const DareSolution sol = solve_dare(transpose(d.phi_h), transpose(plant.c), d.qd_h, plant.measurement_covariance);
+  d.kalman_residual = sol.residual;
+  if (sol.status != DareStatus::kOk) {
+    throw DesignError(std::string("design: Kalman Riccati equation failed: ") + to_string(sol.status) +
+                      " (relative residual " + sci(sol.residual) + ", nearest pencil eigenvalue at ||l| - 1| = " +
+                      sci(sol.unit_circle_distance) + "): a marginal mode the process noise does not excite?");
+  }
+  DenseMatrix prior = sol.x;
   symmetrize(prior);
-  const Matrix<double, P, P> sk = c * prior * c.transposed() + r;
-  Matrix<double, P, N> kt;
-  if (solve(sk, Matrix<double, P, N>(c * prior), kt) != Status::kOk) {
-    throw DesignError("design: innovation covariance is singular");
-  }
-  const Matrix<double, N, P> k = kt.transposed();
-  Matrix<double, N, N> posterior = (Matrix<double, N, N>::identity() - k * c) * prior;
+  const SolveResult kt = solve(plant.c * prior * transpose(plant.c) + plant.measurement_covariance, plant.c * prior);
+  if (!kt.ok) throw DesignError("design: Kalman filter: the innovation covariance is singular");
+  const DenseMatrix k = transpose(kt.x);
+  DenseMatrix posterior = (identity(n) - k * plant.c) * prior;
   symmetrize(posterior);
-  out.kalman_prior = to_dense(prior);
-  out.kalman_posterior = to_dense(posterior);
-  out.kalman_gain = to_dense(k);
-  out.estimator_radius = spectral_radius(Matrix<double, N, N>((Matrix<double, N, N>::identity() - k * c) * phi));
-
-  // Set-point feed-forward.
-  out.nx = DenseMatrix::zeros(N, P);
-  out.nu = DenseMatrix::zeros(M, P);
-  if constexpr (P == M) {
-    Matrix<double, N + M, N + M> sys;
-    sys.template set_block<0, 0>(a);
-    sys.template set_block<0, N>(b);
-    sys.template set_block<N, 0>(c);
-    Matrix<double, N + M, P> rhs_ff;
-    for (std::size_t i = 0; i < P; ++i) rhs_ff(N + i, i) = 1.0;
-    Matrix<double, N + M, P> sol;
-    if (solve(sys, rhs_ff, sol) == Status::kOk) {
-      out.tracking = true;
-      out.nx = to_dense(Matrix<double, N, P>(sol.template block<0, 0, N, P>()));
-      out.nu = to_dense(Matrix<double, M, P>(sol.template block<N, 0, M, P>()));
-      for (double& v : out.nx.values) v = std::fabs(v) < 1e-14 ? 0.0 : v;  // exact zeros, not −0/rounding
-      for (double& v : out.nu.values) v = std::fabs(v) < 1e-14 ? 0.0 : v;
-    }
+  d.kalman_prior = prior;
+  d.kalman_posterior = posterior;
+  d.kalman_gain = k;
+  d.estimator_radius = spectral_radius((identity(n) - k * plant.c) * d.phi_h);
+  if (!(d.estimator_radius < 1.0)) {
+    throw DesignError("design: Kalman filter: the steady-state estimator (I - K C) Phi is not stable (spectral radius " +
+                      sci(d.estimator_radius) + ")");
   }
+}
 
-  // Current deadbeat observer (single output).
-  out.deadbeat_gain = DenseMatrix::zeros(N, P);
-  if constexpr (P == 1) {
-    Matrix<double, N, N> obs;
-    Matrix<double, N, N> phi_pow = phi;  // Φ^k
-    for (std::size_t i = 0; i < N; ++i) {
-      const Matrix<double, 1, N> row = c * phi_pow;
-      for (std::size_t j = 0; j < N; ++j) obs(i, j) = row(0, j);
-      if (i + 1 < N) phi_pow = phi_pow * phi;
-    }
-    // phi_pow = Φⁿ now.
-    Vector<double, N> en;
-    en[N - 1] = 1.0;
-    Vector<double, N> o_inv_en;
-    if (solve(obs, en, o_inv_en) == Status::kOk) {
-      out.deadbeat = true;
-      out.deadbeat_gain = to_dense(Matrix<double, N, 1>(phi_pow * o_inv_en));
-    }
-  }
-
-  out.p0 = plant.has_initial_covariance ? plant.initial_covariance : out.kalman_prior;
-  out.q_constant = plant.process_covariance;
-  out.r = plant.measurement_covariance;
-
+/// Actuator and sensor models from the board, or the actuator range alone.
+void converters(const PlantDescription& plant, DesignResult& d) {
+  d.u_min = plant.u_min;
+  d.u_max = plant.u_max;
+  if (!plant.has_board) return;
   const BoardDescription& bd = plant.board;
-  for (std::size_t j = 0; j < M; ++j) {
+  for (std::size_t j = 0; j < plant.m(); ++j) {
     const double span = bd.pwm_high_volts[j] - bd.pwm_low_volts[j];
-    out.u_min.push_back(bd.pwm_low_volts[j]);
-    out.volts_per_step.push_back(span / bd.pwm_duty_steps);
-    out.steps_per_volt.push_back(bd.pwm_duty_steps / span);
+    d.volts_per_step.push_back(span / bd.pwm_duty_steps);
+    d.steps_per_volt.push_back(bd.pwm_duty_steps / span);
   }
-  out.actuator_steps = bd.pwm_duty_steps;
-  for (std::size_t o = 0; o < P; ++o) {
+  d.actuator_steps = bd.pwm_duty_steps;
+  for (std::size_t o = 0; o < plant.p(); ++o) {
     const double lsb = (bd.adc_max_volts[o] - bd.adc_min_volts[o]) / std::ldexp(1.0, bd.adc_bits);
-    out.volts_per_code.push_back(lsb);
-    out.y_offset.push_back(bd.adc_min_volts[o] + 0.5 * lsb);
+    d.volts_per_code.push_back(lsb);
+    d.y_offset.push_back(bd.adc_min_volts[o] + 0.5 * lsb);
   }
-  return out;
 }
 
 }  // namespace
 
 DesignResult synthesize(const PlantDescription& plant) {
-  return with_dimensions(plant.n(), plant.m(), plant.p(), [&](auto n, auto m, auto p) {
-    return synthesize_fixed<decltype(n)::value, decltype(m)::value, decltype(p)::value>(plant);
-  });
+  DesignResult d;
+  d.period_s = static_cast<double>(plant.period_us) * 1e-6;
+  try {
+    const SampledModel s = sample_plant(plant);
+    d.phi_h = s.phi;
+    d.gamma_h = s.gamma;
+    d.gamma_w_h = s.gamma_w;
+    d.qd_h = s.qd;
+    d.qc = s.qc;
+    d.q_constant = s.q_constant;
+    const SampledCost c = sample_cost(plant);
+    d.q1 = c.q1;
+    d.q12 = c.q12;
+    d.q2 = c.q2;
+  } catch (const std::domain_error& e) {
+    throw DesignError(e.what());
+  }
+  design_lqr(plant, d);
+  design_kalman(plant, d);
+  detail::design_feedforward(plant, d);
+  detail::design_deadbeat(plant, d);
+  d.p0 = plant.has_initial_covariance ? plant.initial_covariance : d.kalman_prior;
+  d.r = plant.measurement_covariance;
+  converters(plant, d);
+  return d;
 }
 
 }  // namespace oneshot::design

@@ -23,6 +23,8 @@ nlohmann::json design_json(const PlantDescription& plant, const DesignResult& d)
   nlohmann::json j;
   j["plant"] = plant.name;
   j["source"] = plant.source;
+  j["form"] = to_string(plant.form);
+  j["states"] = plant.states;
   j["h_s"] = d.period_s;
   j["Phi_h"] = matrix_json(d.phi_h);
   j["Gamma_h"] = flat_json(d.gamma_h);
@@ -33,19 +35,46 @@ nlohmann::json design_json(const PlantDescription& plant, const DesignResult& d)
   j["Q1"] = matrix_json(d.q1);
   j["Q12"] = matrix_json(d.q12);
   j["Q2"] = matrix_json(d.q2);
+  j["lqr_available"] = d.lqr_available;
+  if (!d.lqr_available) j["lqr_unavailable_reason"] = d.lqr_unavailable_reason;
   j["riccati_S"] = matrix_json(d.riccati);
+  j["lqr_riccati_residual"] = d.lqr_residual;
   j["closed_loop_spectral_radius"] = d.closed_loop_radius;
+  j["exogenous_states"] = d.exogenous_states;
+  j["exogenous_spectral_radius"] = d.exogenous_radius;
   j["kalman_prior_P"] = matrix_json(d.kalman_prior);
   j["kalman_posterior_P"] = matrix_json(d.kalman_posterior);
   j["estimator_spectral_radius"] = d.estimator_radius;
+  j["kalman_riccati_residual"] = d.kalman_residual;
   j["setpoint_tracking"] = d.tracking;
+  if (!d.tracking) j["setpoint_tracking_unavailable_reason"] = d.tracking_unavailable_reason;
+  nlohmann::json tracked = nlohmann::json::array();
+  for (std::size_t o : d.tracked_outputs) tracked.push_back(plant.outputs[o]);
+  j["tracked_outputs"] = tracked;
   j["Nx"] = matrix_json(d.nx);
   j["Nu"] = matrix_json(d.nu);
   j["deadbeat_available"] = d.deadbeat;
+  if (!d.deadbeat) j["deadbeat_unavailable_reason"] = d.deadbeat_unavailable_reason;
   j["deadbeat_gain"] = flat_json(d.deadbeat_gain);
+  j["deadbeat_residual"] = d.deadbeat_residual;
   j["P0"] = matrix_json(d.p0);
   j["Q_constant"] = matrix_json(d.q_constant);
   j["R"] = matrix_json(d.r);
+  if (plant.q() != 0) {
+    nlohmann::json dist;
+    dist["names"] = plant.disturbances;
+    dist["B_w"] = matrix_json(plant.b_w);
+    dist["input"] = plant.continuous() ? "continuous" : "per step";
+    dist["Gamma_w_h"] = matrix_json(d.gamma_w_h);
+    if (plant.disturbance_intensity.rows != 0) dist["intensity"] = matrix_json(plant.disturbance_intensity);
+    if (plant.disturbance_covariance_per_period.rows != 0) {
+      dist["covariance_per_period"] = matrix_json(plant.disturbance_covariance_per_period);
+    }
+    if (plant.c_bar.rows != 0) dist["C_bar"] = matrix_json(plant.c_bar);
+    j["disturbance"] = dist;  // absent without disturbance inputs (outputs hold no null)
+  }
+  j["u_min"] = d.u_min;
+  j["u_max"] = d.u_max;
   return j;
 }
 
@@ -65,18 +94,29 @@ void print_matrix(std::ostream& out, const char* name, const DenseMatrix& m) {
 }  // namespace
 
 void print_design(std::ostream& out, const PlantDescription& plant, const DesignResult& d) {
-  out << "Design of '" << plant.name << "' (" << plant.source << "), h = " << d.period_s * 1e3 << " ms\n";
-  out << "Discrete model (exact zero-order hold):\n";
+  out << "Design of '" << plant.name << "' (" << plant.source << ", " << to_string(plant.form)
+      << " form), h = " << d.period_s * 1e3 << " ms\n";
+  out << (plant.continuous() ? "Discrete model (exact zero-order hold):\n" : "Discrete model:\n");
   print_matrix(out, "Phi(h)", d.phi_h);
   print_matrix(out, "Gamma(h)", d.gamma_h);
   print_matrix(out, "Qd(h)", d.qd_h);
-  out << "Sampled cost of J = integral(x'Q1c x + u'Q2c u) dt:\n";
+  if (plant.q() != 0) print_matrix(out, "Gamma_w(h)", d.gamma_w_h);
+  out << (plant.cost_form == CostForm::kContinuous ? "Sampled cost of J = integral(x'Q1c x + u'Q2c u) dt:\n"
+                                                    : "Cost weights per step:\n");
   print_matrix(out, "Q1", d.q1);
   print_matrix(out, "Q12", d.q12);
   print_matrix(out, "Q2", d.q2);
   out << "LQR (u = -L x):\n";
-  print_matrix(out, "L", d.l);
-  out << "  closed-loop spectral radius = " << d.closed_loop_radius << "\n";
+  if (d.lqr_available) {
+    print_matrix(out, "L", d.l);
+    out << "  closed-loop spectral radius = " << d.closed_loop_radius << "\n";
+    if (d.exogenous_states != 0) {
+      out << "  (" << d.exogenous_states << " exogenous disturbance states cancelled at the input, spectral radius "
+          << d.exogenous_radius << ")\n";
+    }
+  } else {
+    out << "  not designed: " << d.lqr_unavailable_reason << "\n";
+  }
   out << "Steady-state Kalman filter:\n";
   print_matrix(out, "K", d.kalman_gain);
   print_matrix(out, "P prior", d.kalman_prior);
@@ -87,12 +127,12 @@ void print_design(std::ostream& out, const PlantDescription& plant, const Design
     print_matrix(out, "Nx", d.nx);
     print_matrix(out, "Nu", d.nu);
   } else {
-    out << "Set-point feed-forward: not available (needs as many outputs as inputs and a unique equilibrium)\n";
+    out << "Set-point feed-forward: not available: " << d.tracking_unavailable_reason << "\n";
   }
   if (d.deadbeat) {
     print_matrix(out, "K deadbeat", d.deadbeat_gain);
   } else {
-    out << "Deadbeat observer: not available (needs one output and an observable pair)\n";
+    out << "Deadbeat observer: not available: " << d.deadbeat_unavailable_reason << "\n";
   }
 }
 

@@ -1,300 +1,253 @@
 /// @file plant_description.cpp
-/// @brief Parsing and validation of plant description files.
+/// @brief Parsing and validation of plant description files: the dynamics of each form.
 #include "oneshot/design/plant_description.hpp"
 
-#include <algorithm>
 #include <cmath>
-#include <fstream>
-#include <limits>
-#include <nlohmann/json.hpp>
-#include <set>
-#include <sstream>
+
+#include "plant_json_reader.hpp"
+#include "plant_parts.hpp"
 
 namespace oneshot::design {
 namespace {
 
 using nlohmann::json;
+using detail::Checker;
 
-/// Builds errors that name the source and the field.
-class Checker {
- public:
-  explicit Checker(std::string source) : source_(std::move(source)) {}
-
-  [[noreturn]] void fail(const std::string& field, const std::string& what) const {
-    throw PlantError(source_ + ": field '" + field + "': " + what);
+/// Refuses a dimension beyond its limit, naming the limit.
+void within_limit(const Checker& check, const std::string& field, std::size_t value, std::size_t limit,
+                  const char* what, const char* limit_name) {
+  if (value > limit) {
+    check.fail(field, std::to_string(value) + " " + what + " exceed the supported maximum of " +
+                          std::to_string(limit) + " (" + limit_name + ", firmware/core/include/oneshot/dimension_limits.hpp)");
   }
+}
 
-  const json& require(const json& obj, const std::string& key, const std::string& path) const {
-    const auto it = obj.find(key);
-    if (it == obj.end()) fail(path + key, "is missing");
-    return *it;
-  }
-
-  void only_keys(const json& obj, const std::string& path, std::initializer_list<const char*> allowed) const {
-    for (const auto& item : obj.items()) {
-      const bool known = std::any_of(allowed.begin(), allowed.end(),
-                                     [&](const char* k) { return item.key() == k; });
-      if (!known) {
-        std::string list;
-        for (const char* k : allowed) list += std::string(list.empty() ? "" : ", ") + k;
-        fail(path + item.key(), "unknown field (expected one of: " + list + ")");
-      }
+/// Continuous (A, B) or discrete (Phi, Gamma) dynamics, C and B_w.
+void parse_matrices(const json& root, PlantDescription& p, const Checker& check) {
+  const bool cont = p.continuous();
+  const char* ka = cont ? "A" : "Phi";
+  const char* kb = cont ? "B" : "Gamma";
+  const std::vector<std::string> others = cont ? std::vector<std::string>{"Phi", "Gamma"}
+                                               : std::vector<std::string>{"A", "B"};
+  for (const std::string& other : others) {
+    if (root.contains(other)) {
+      check.fail(other, std::string("belongs to the ") + (cont ? "discrete" : "continuous") + " form; this plant is " +
+                            to_string(p.form) + " (field 'form')");
     }
   }
-
-  const json& object(const json& obj, const std::string& key, const std::string& path) const {
-    const json& v = require(obj, key, path);
-    if (!v.is_object()) fail(path + key, "must be an object");
-    return v;
+  DenseMatrix a = check.matrix(root, ka, "");
+  const std::size_t n = a.rows;
+  check.shape(a, ka, n, n, std::string(ka) + " must be square");
+  within_limit(check, ka, n, kMaxStates, "states", "kMaxStates");
+  DenseMatrix b = check.matrix(root, kb, "");
+  if (b.rows != n) check.shape(b, kb, n, b.cols, "one row per state");
+  within_limit(check, kb, b.cols, kMaxInputs, "inputs", "kMaxInputs");
+  p.c = check.matrix(root, "C", "");
+  if (p.c.cols != n) check.shape(p.c, "C", p.c.rows, n, "one column per state");
+  within_limit(check, "C", p.c.rows, kMaxOutputs, "outputs", "kMaxOutputs");
+  p.inputs = check.names(root, "inputs", b.cols, "u");
+  if (cont) {
+    p.a = std::move(a);
+    p.b = std::move(b);
+  } else {
+    p.phi = std::move(a);
+    p.gamma = std::move(b);
   }
-
-  double number(const json& v, const std::string& field) const {
-    if (!v.is_number()) fail(field, "must be a number, got " + std::string(v.type_name()));
-    const double d = v.get<double>();
-    if (!std::isfinite(d)) fail(field, "must be finite");
-    return d;
+  if (root.contains("B_w")) {
+    p.b_w = check.matrix(root, "B_w", "");
+    if (p.b_w.rows != n) check.shape(p.b_w, "B_w", n, p.b_w.cols, "one row per state");
+    within_limit(check, "B_w", p.b_w.cols, kMaxDisturbances, "disturbance inputs", "kMaxDisturbances");
   }
+}
 
-  std::int32_t integer(const json& obj, const std::string& key, const std::string& path,
-                       std::int64_t min_value, std::int64_t max_value) const {
-    const json& v = require(obj, key, path);
-    if (!v.is_number_integer()) fail(path + key, "must be an integer");
-    const std::int64_t i = v.get<std::int64_t>();
-    if (i < min_value || i > max_value) {
-      fail(path + key, "must be in [" + std::to_string(min_value) + ", " + std::to_string(max_value) +
-                           "], got " + std::to_string(i));
-    }
-    return static_cast<std::int32_t>(i);
+/// The section's name: an identifier (it prefixes the names of the section's states).
+std::string section_name(const json& s, const std::string& path, const Checker& check) {
+  const std::string name = check.optional_string(s, "name", path + ".");
+  if (!detail::is_identifier(name)) {
+    check.fail(path + ".name", "must be an identifier ([A-Za-z_][A-Za-z0-9_]*): it names the section's states");
   }
+  return name;
+}
 
-  DenseMatrix matrix(const json& obj, const std::string& key, const std::string& path) const {
-    const std::string field = path + key;
-    const json& v = require(obj, key, path);
-    if (!v.is_array() || v.empty()) fail(field, "must be a non-empty array of rows");
-    DenseMatrix m;
-    m.rows = v.size();
-    for (std::size_t i = 0; i < v.size(); ++i) {
-      const json& row = v[i];
-      const std::string row_field = field + "[" + std::to_string(i) + "]";
-      if (!row.is_array() || row.empty()) fail(row_field, "must be a non-empty array of numbers");
-      if (i == 0) m.cols = row.size();
-      if (row.size() != m.cols) {
-        fail(row_field, "has " + std::to_string(row.size()) + " entries, row 0 has " + std::to_string(m.cols));
-      }
-      for (std::size_t j = 0; j < row.size(); ++j)
-        m.values.push_back(number(row[j], row_field + "[" + std::to_string(j) + "]"));
-    }
-    return m;
+/// A 2nd-order continuous section: {name, numerator, denominator [1, a1, a0]} or
+/// {name, gain, frequency_hz, damping} (gain·ω²/(s² + 2ζωs + ω²)).
+ContinuousSection parse_continuous_section(const json& s, const std::string& path, const Checker& check) {
+  if (!s.is_object()) check.fail(path, "must be an object");
+  ContinuousSection c;
+  c.name = section_name(s, path, check);
+  if (s.contains("frequency_hz")) {
+    check.only_keys(s, path + ".", {"name", "gain", "frequency_hz", "damping"});
+    const double f = check.number_in(s, "frequency_hz", path + ".", 1e-9, 1e12);
+    const double zeta = check.number_in(s, "damping", path + ".", 0, 1e3);
+    const double k = check.number(check.require(s, "gain", path + "."), path + ".gain");
+    const double w = 2.0 * 3.14159265358979323846 * f;
+    c.numerator = k * w * w;
+    c.a1 = 2.0 * zeta * w;
+    c.a0 = w * w;
+  } else {
+    check.only_keys(s, path + ".", {"name", "numerator", "denominator"});
+    c.numerator = check.number(check.require(s, "numerator", path + "."), path + ".numerator");
+    const std::vector<double> den = check.vector_of(s, "denominator", path + ".", 3);
+    if (den[0] != 1.0) check.fail(path + ".denominator", "must be monic: [1, a1, a0]");
+    if (!(den[2] > 0)) check.fail(path + ".denominator", "a0 must be positive (omega_n = sqrt(a0))");
+    c.a1 = den[1];
+    c.a0 = den[2];
   }
+  return c;
+}
 
-  std::vector<double> vector_of(const json& obj, const std::string& key, const std::string& path,
-                                std::size_t expected) const {
-    const std::string field = path + key;
-    const json& v = require(obj, key, path);
-    if (!v.is_array()) fail(field, "must be an array of numbers");
-    if (v.size() != expected) {
-      fail(field, "must have " + std::to_string(expected) + " entries, has " + std::to_string(v.size()));
-    }
-    std::vector<double> out;
-    for (std::size_t i = 0; i < v.size(); ++i) out.push_back(number(v[i], field + "[" + std::to_string(i) + "]"));
-    return out;
+/// A discrete biquad: {name, notch: {frequency_hz, alpha, beta}} or {name, numerator [b0, b1, b2],
+/// denominator [1, a1, a2]}.
+DiscreteSection parse_discrete_section(const json& s, const std::string& path, double period_s, const Checker& check) {
+  if (!s.is_object()) check.fail(path, "must be an object");
+  const std::string name = section_name(s, path, check);
+  if (s.contains("notch")) {
+    check.only_keys(s, path + ".", {"name", "notch"});
+    const json& nt = check.object(s, "notch", path + ".");
+    const std::string np = path + ".notch.";
+    check.only_keys(nt, np, {"frequency_hz", "alpha", "beta"});
+    const double f = check.number_in(nt, "frequency_hz", np, 0, 0.5 / period_s);
+    const double alpha = check.number_in(nt, "alpha", np, 0, 1e3);
+    const double beta = check.number_in(nt, "beta", np, 0, 1.0 - 1e-12);
+    return notch_section(name, f, alpha, beta, period_s);
   }
+  check.only_keys(s, path + ".", {"name", "numerator", "denominator"});
+  const std::vector<double> num = check.vector_of(s, "numerator", path + ".", 3);
+  const std::vector<double> den = check.vector_of(s, "denominator", path + ".", 3);
+  if (den[0] != 1.0) check.fail(path + ".denominator", "must be monic: [1, a1, a2]");
+  return DiscreteSection{name, num[0], num[1], num[2], den[1], den[2]};
+}
 
-  void shape(const DenseMatrix& m, const std::string& field, std::size_t rows, std::size_t cols,
-             const std::string& why) const {
-    if (m.rows != rows || m.cols != cols) {
-      fail(field, "must be " + std::to_string(rows) + "x" + std::to_string(cols) + " (" + why + "), got " +
-                      std::to_string(m.rows) + "x" + std::to_string(m.cols));
-    }
-  }
-
-  /// Symmetric and positive (semi)definite, by Cholesky on M (+ a tiny shift for semi).
-  void covariance(const DenseMatrix& m, const std::string& field, bool definite) const {
-    const std::size_t n = m.rows;
-    double scale = 0;
-    for (double x : m.values) scale = std::max(scale, std::fabs(x));
-    for (std::size_t i = 0; i < n; ++i)
-      for (std::size_t j = i + 1; j < n; ++j)
-        if (std::fabs(m(i, j) - m(j, i)) > 1e-12 * scale) fail(field, "must be symmetric");
-    double trace = 0;
-    for (std::size_t i = 0; i < n; ++i) trace += m(i, i);
-    if (!(trace > 0)) {
-      fail(field, definite ? "must be positive definite (its trace is not positive)"
-                           : "must be positive semidefinite and non-zero (its trace is not positive)");
-    }
-    DenseMatrix l = m;
-    const double shift = definite ? 0.0 : 1e-12 * trace;
-    for (std::size_t i = 0; i < n; ++i) l(i, i) += shift;
-    for (std::size_t j = 0; j < n; ++j) {
-      double d = l(j, j);
-      for (std::size_t k = 0; k < j; ++k) d -= l(j, k) * l(j, k);
-      if (!(d > 1e-14 * trace)) {
-        fail(field, definite ? "must be positive definite" : "must be positive semidefinite");
-      }
-      l(j, j) = std::sqrt(d);
-      for (std::size_t i = j + 1; i < n; ++i) {
-        double s = l(i, j);
-        for (std::size_t k = 0; k < j; ++k) s -= l(i, k) * l(j, k);
-        l(i, j) = s / l(j, j);
-      }
+/// The "sections" object → spec, realized into Φ, Γ, C, B_w, C̄.
+void parse_sections(const json& root, PlantDescription& p, const Checker& check) {
+  for (const char* k : {"A", "B", "Phi", "Gamma", "C", "B_w", "states"})
+    if (root.contains(k)) check.fail(k, "is generated from 'sections' in the sections form; remove it");
+  const json& sec = check.object(root, "sections", "");
+  check.only_keys(sec, "sections.", {"continuous", "discrete", "disturbance"});
+  const double t = static_cast<double>(p.period_us) * 1e-6;
+  SectionsDescription& spec = p.sections;
+  for (const char* key : {"continuous", "discrete"}) {
+    if (!sec.contains(key)) continue;
+    const json& list = sec[key];
+    if (!list.is_array()) check.fail(std::string("sections.") + key, "must be an array of sections");
+    for (std::size_t i = 0; i < list.size(); ++i) {
+      const std::string path = std::string("sections.") + key + "[" + std::to_string(i) + "]";
+      if (key[0] == 'c') spec.continuous.push_back(parse_continuous_section(list[i], path, check));
+      else spec.discrete.push_back(parse_discrete_section(list[i], path, t, check));
     }
   }
-
-  std::vector<std::string> names(const json& obj, const std::string& key, std::size_t expected,
-                                 const std::string& prefix) const {
-    const auto it = obj.find(key);
-    std::vector<std::string> out;
-    if (it == obj.end()) {
-      for (std::size_t i = 0; i < expected; ++i) out.push_back(prefix + std::to_string(i + 1));
-      return out;
+  if (spec.continuous.empty()) check.fail("sections.continuous", "needs at least one continuous section (strictly proper plant)");
+  if (sec.contains("disturbance")) {
+    const json& d = check.object(sec, "disturbance", "sections.");
+    const std::string dp = "sections.disturbance.";
+    const std::string reading = check.optional_string(d, "reading", dp);
+    if (reading == "oscillator") {
+      check.only_keys(d, dp, {"reading", "frequency_rad_s", "input_gain", "output_gain"});
+      spec.disturbance.reading = DisturbanceReading::kOscillator;
+      spec.disturbance.frequency_rad_s = check.number_in(d, "frequency_rad_s", dp, 1e-12, 1e12);
+      spec.disturbance.input_gain = check.number(check.require(d, "input_gain", dp), dp + "input_gain");
+      spec.disturbance.output_gain = check.number(check.require(d, "output_gain", dp), dp + "output_gain");
+    } else if (reading == "literal") {
+      check.only_keys(d, dp, {"reading", "A_d", "B_d", "C_d"});
+      spec.disturbance.reading = DisturbanceReading::kLiteral;
+      spec.disturbance.a_d = check.matrix(d, "A_d", dp);
+      const std::size_t nd = spec.disturbance.a_d.rows;
+      check.shape(spec.disturbance.a_d, dp + "A_d", nd, nd, "square");
+      spec.disturbance.b_d = check.matrix(d, "B_d", dp);
+      check.shape(spec.disturbance.b_d, dp + "B_d", nd, spec.disturbance.b_d.cols, "one row per disturbance state");
+      spec.disturbance.c_d = check.matrix(d, "C_d", dp);
+      check.shape(spec.disturbance.c_d, dp + "C_d", 1, nd, "one row (the input), one column per disturbance state");
+    } else {
+      check.fail(dp + "reading", "must be \"oscillator\" or \"literal\"");
     }
-    if (!it->is_array()) fail(key, "must be an array of names");
-    if (it->size() != expected) {
-      fail(key, "must have " + std::to_string(expected) + " names, has " + std::to_string(it->size()));
-    }
-    std::set<std::string> seen;
-    for (std::size_t i = 0; i < it->size(); ++i) {
-      const json& v = (*it)[i];
-      const std::string field = key + "[" + std::to_string(i) + "]";
-      if (!v.is_string()) fail(field, "must be a string");
-      const std::string s = v.get<std::string>();
-      const bool ident = !s.empty() && (std::isalpha(static_cast<unsigned char>(s[0])) != 0 || s[0] == '_') &&
-                         std::all_of(s.begin(), s.end(), [](char ch) {
-                           return std::isalnum(static_cast<unsigned char>(ch)) != 0 || ch == '_';
-                         });
-      if (!ident) fail(field, "must be an identifier ([A-Za-z_][A-Za-z0-9_]*), got '" + s + "'");
-      if (!seen.insert(s).second) fail(field, "duplicate name '" + s + "'");
-      out.push_back(s);
-    }
-    return out;
   }
-
- private:
-  std::string source_;
-};
-
-std::string optional_string(const json& obj, const char* key, const Checker& check) {
-  const auto it = obj.find(key);
-  if (it == obj.end()) return {};
-  if (!it->is_string()) check.fail(key, "must be a string");
-  return it->get<std::string>();
+  const std::size_t states = 2 * (spec.continuous.size() + spec.discrete.size()) +
+                             (spec.disturbance.reading == DisturbanceReading::kNone ? 0
+                              : spec.disturbance.reading == DisturbanceReading::kOscillator ? 2
+                                                                                          : spec.disturbance.a_d.rows);
+  within_limit(check, "sections", states, kMaxStates, "states", "kMaxStates");
+  p.has_sections = true;
+  SectionsRealization r;
+  try {
+    r = realize_sections(spec, t);
+  } catch (const std::exception& e) {
+    check.fail("sections", e.what());
+  }
+  p.phi = r.phi;
+  p.gamma = r.gamma;
+  p.c = r.c;
+  p.b_w = r.b_w;
+  p.c_bar = r.c_bar;
+  p.exogenous_states = r.exogenous_states;
+  p.states = r.state_names;
+  p.inputs = check.names(root, "inputs", 1, "u");
+  within_limit(check, "sections.disturbance", p.b_w.cols, kMaxDisturbances, "disturbance inputs", "kMaxDisturbances");
 }
 
 }  // namespace
 
+const char* to_string(PlantForm f) {
+  switch (f) {
+    case PlantForm::kContinuous: return "continuous";
+    case PlantForm::kDiscrete: return "discrete";
+    case PlantForm::kSections: return "sections";
+  }
+  return "?";
+}
+
 PlantDescription parse_plant(const std::string& json_text, const std::string& source) {
   const Checker check(source);
-  json root;
-  try {
-    root = json::parse(json_text);
-  } catch (const json::exception& e) {
-    throw PlantError(source + ": not valid JSON: " + e.what());
-  }
+  const json root = detail::parse_strict(json_text, source);
   if (!root.is_object()) throw PlantError(source + ": the plant description must be a JSON object");
-  check.only_keys(root, "", {"name", "description", "states", "inputs", "outputs", "A", "B", "C",
-                             "period_us", "cost", "noise", "table", "board"});
+  check.only_keys(root, "", {"name", "description", "form", "states", "inputs", "outputs", "disturbances", "A", "B",
+                             "Phi", "Gamma", "C", "B_w", "sections", "period_us", "cost", "noise", "tracked_outputs",
+                             "table", "board", "actuator"});
   PlantDescription p;
   p.source = source;
-  p.name = optional_string(root, "name", check);
+  p.name = check.optional_string(root, "name", "");
   if (p.name.empty()) p.name = "plant";
-  p.description = optional_string(root, "description", check);
+  p.description = check.optional_string(root, "description", "");
+  const std::string form = check.optional_string(root, "form", "");
+  if (form.empty() || form == "continuous") {
+    p.form = PlantForm::kContinuous;
+  } else if (form == "discrete") {
+    p.form = PlantForm::kDiscrete;
+  } else if (form == "sections") {
+    p.form = PlantForm::kSections;
+  } else {
+    check.fail("form", "must be \"continuous\", \"discrete\" or \"sections\", got \"" + form + "\"");
+  }
+  if (p.form != PlantForm::kSections && root.contains("sections")) check.fail("sections", "needs \"form\": \"sections\"");
+  // The period first: the sections are realized at it, the table and board are checked against it.
+  p.period_us = static_cast<std::int32_t>(check.integer(root, "period_us", "", 1, 60'000'000));
+  if (p.form == PlantForm::kSections) {
+    parse_sections(root, p, check);
+  } else {
+    parse_matrices(root, p, check);
+    p.states = check.names(root, "states", p.n(), "x");
+  }
+  p.outputs = check.names(root, "outputs", p.p(), "y");
+  p.disturbances = check.names(root, "disturbances", p.q(), "w");
 
-  p.a = check.matrix(root, "A", "");
-  const std::size_t n = p.a.rows;
-  check.shape(p.a, "A", n, n, "A must be square");
-  if (n > kMaxStates) {
-    check.fail("A", std::to_string(n) + " states exceed the supported maximum of " + std::to_string(kMaxStates));
-  }
-  p.b = check.matrix(root, "B", "");
-  if (p.b.rows != n) check.shape(p.b, "B", n, p.b.cols, "one row per state");
-  const std::size_t m = p.b.cols;
-  if (m > kMaxInputs) {
-    check.fail("B", std::to_string(m) + " inputs exceed the supported maximum of " + std::to_string(kMaxInputs));
-  }
-  p.c = check.matrix(root, "C", "");
-  if (p.c.cols != n) check.shape(p.c, "C", p.c.rows, n, "one column per state");
-  const std::size_t outs = p.c.rows;
-  if (outs > kMaxOutputs) {
-    check.fail("C", std::to_string(outs) + " outputs exceed the supported maximum of " +
-                        std::to_string(kMaxOutputs));
-  }
-  p.states = check.names(root, "states", n, "x");
-  p.inputs = check.names(root, "inputs", m, "u");
-  p.outputs = check.names(root, "outputs", outs, "y");
-
-  p.period_us = check.integer(root, "period_us", "", 1, 60'000'000);
-
-  const json& cost = check.object(root, "cost", "");
-  check.only_keys(cost, "cost.", {"Q1c", "Q2c"});
-  p.q1c = check.matrix(cost, "Q1c", "cost.");
-  check.shape(p.q1c, "cost.Q1c", n, n, "one row and column per state");
-  check.covariance(p.q1c, "cost.Q1c", false);
-  p.q2c = check.matrix(cost, "Q2c", "cost.");
-  check.shape(p.q2c, "cost.Q2c", m, m, "one row and column per input");
-  check.covariance(p.q2c, "cost.Q2c", true);
-
-  const json& noise = check.object(root, "noise", "");
-  check.only_keys(noise, "noise.", {"process_covariance", "measurement_covariance", "initial_covariance"});
-  p.process_covariance = check.matrix(noise, "process_covariance", "noise.");
-  check.shape(p.process_covariance, "noise.process_covariance", n, n, "one row and column per state");
-  check.covariance(p.process_covariance, "noise.process_covariance", false);
-  p.measurement_covariance = check.matrix(noise, "measurement_covariance", "noise.");
-  check.shape(p.measurement_covariance, "noise.measurement_covariance", outs, outs, "one row and column per output");
-  check.covariance(p.measurement_covariance, "noise.measurement_covariance", true);
-  if (noise.contains("initial_covariance")) {
-    p.has_initial_covariance = true;
-    p.initial_covariance = check.matrix(noise, "initial_covariance", "noise.");
-    check.shape(p.initial_covariance, "noise.initial_covariance", n, n, "one row and column per state");
-    check.covariance(p.initial_covariance, "noise.initial_covariance", true);
-  }
-
-  const json& table = check.object(root, "table", "");
-  check.only_keys(table, "table.", {"granularity_us", "range_us", "max_bytes"});
-  p.table_granularity_us = check.integer(table, "granularity_us", "table.", 1, 10'000'000);
-  p.table_range_us = check.integer(table, "range_us", "table.", 1, 60'000'000);
-  if (p.table_range_us % p.table_granularity_us != 0) {
-    check.fail("table.range_us", "must be a multiple of table.granularity_us (" +
-                                     std::to_string(p.table_granularity_us) + ")");
-  }
-  if (p.table_range_us / p.table_granularity_us > 4096) {
-    check.fail("table.range_us", "more than 4096 grid steps of table.granularity_us");
-  }
-  p.table_max_bytes = check.integer(table, "max_bytes", "table.", 1, 1 << 20);
-
-  const json& board = check.object(root, "board", "");
-  check.only_keys(board, "board.", {"pwm_frequency_hz", "pwm_duty_steps", "pwm_low_volts", "pwm_high_volts",
-                                    "adc_bits", "adc_min_volts", "adc_max_volts"});
-  BoardDescription& bd = p.board;
-  bd.pwm_frequency_hz = check.number(check.require(board, "pwm_frequency_hz", "board."), "board.pwm_frequency_hz");
-  if (!(bd.pwm_frequency_hz > 0) || bd.pwm_frequency_hz > 1e7) {
-    check.fail("board.pwm_frequency_hz", "must be in (0, 1e7] Hz");
-  }
-  bd.pwm_duty_steps = check.integer(board, "pwm_duty_steps", "board.", 1, 1 << 20);
-  bd.pwm_low_volts = check.vector_of(board, "pwm_low_volts", "board.", m);
-  bd.pwm_high_volts = check.vector_of(board, "pwm_high_volts", "board.", m);
-  for (std::size_t j = 0; j < m; ++j)
-    if (!(bd.pwm_low_volts[j] < bd.pwm_high_volts[j])) {
-      check.fail("board.pwm_high_volts[" + std::to_string(j) + "]", "must be above board.pwm_low_volts");
-    }
-  bd.adc_bits = check.integer(board, "adc_bits", "board.", 1, 24);
-  bd.adc_min_volts = check.vector_of(board, "adc_min_volts", "board.", outs);
-  bd.adc_max_volts = check.vector_of(board, "adc_max_volts", "board.", outs);
-  for (std::size_t j = 0; j < outs; ++j)
-    if (!(bd.adc_min_volts[j] < bd.adc_max_volts[j])) {
-      check.fail("board.adc_max_volts[" + std::to_string(j) + "]", "must be above board.adc_min_volts");
-    }
+  detail::parse_cost(root, p, check);
+  detail::parse_noise(root, p, check);
+  detail::parse_tracked_outputs(root, p, check);
+  detail::parse_table(root, p, check);
+  detail::parse_board_or_actuator(root, p, check);
   return p;
 }
 
-PlantDescription load_plant_file(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw PlantError(path + ": cannot read the plant file");
-  std::ostringstream text;
-  text << in.rdbuf();
-  if (in.bad()) throw PlantError(path + ": error while reading the plant file");
-  return parse_plant(text.str(), path);
-}
+PlantDescription load_plant_file(const std::string& path) { return parse_plant(detail::read_plant_text(path), path); }
 
 PlantDescription reference_plant() { return parse_plant(reference_plant_json(), "built-in reference board"); }
+
+void require_continuous_board_and_table(const PlantDescription& plant, const std::string& user) {
+  std::string missing;
+  if (!plant.continuous()) missing = "a continuous plant (this one is " + std::string(to_string(plant.form)) + ")";
+  else if (!plant.has_table) missing = "a 'table' section";
+  else if (!plant.has_board) missing = "a PWM 'board' section";
+  else if (plant.cost_form == CostForm::kNone) missing = "a 'cost' section (an LQR gain)";
+  if (!missing.empty()) throw PlantError(plant.source + ": " + user + " needs " + missing);
+}
 
 }  // namespace oneshot::design

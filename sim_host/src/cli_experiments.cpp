@@ -15,6 +15,7 @@
 #include "oneshot/sim/cli_commands.hpp"
 #include "oneshot/sim/experiments.hpp"
 #include "oneshot/sim/output_files.hpp"
+#include "oneshot/sim/parallel.hpp"
 #include "oneshot/sim/pil_link.hpp"
 
 namespace oneshot::sim {
@@ -119,6 +120,12 @@ void emit(const CliCommon& c, const nlohmann::json& j) {
   }
 }
 
+/// Wall time and threads of a sweep, kept out of the deterministic results: OUT/timing.json.
+void write_timing(const CommonOptions& o, const std::string& experiment, double wall_time_s) {
+  write_json((std::filesystem::path(o.out_dir) / "timing.json").string(),
+             {{"experiment", experiment}, {"wall_time_s", wall_time_s}, {"threads", worker_count(o.threads)}});
+}
+
 std::vector<Scenario> scenarios_from(const std::string& path) { return path.empty() ? default_scenarios() : load_scenarios(path); }
 
 std::string self_path() {
@@ -175,10 +182,22 @@ void register_experiment_commands(CLI::App& app) {
     add_common(cmd, *c, "out/table1");
     cmd->add_option("--seeds", *seeds, "seeds per scenario")->check(CLI::Range(2, 100000))->capture_default_str();
     cmd->add_option("--scenarios", *file, "scenario file (default: the ten built-in scenarios)")->check(CLI::ExistingFile);
-    cmd->callback([c, seeds, file]() {
+    auto shard = std::make_shared<std::string>("0/1");
+    cmd->add_option("--shard", *shard,
+                    "run only part i/N of the sweep (0 <= i < N) and write OUT/table1.shard-i-of-N.json; "
+                    "`oneshot-sim merge` joins the shards into the same result as one run")
+        ->capture_default_str();
+    cmd->callback([c, seeds, file, shard]() {
       const auto ctx = SimContext::load(c->plant);
-      const nlohmann::json j = run_table1(*ctx, c->resolve(), scenarios_from(*file), *seeds);
-      if (c->json != "-") std::cout << j["markdown"].get<std::string>() << "wall time " << j["wall_time_s"].get<double>() << " s\n";
+      const engine::Shard part = engine::parse_shard(*shard);
+      double wall = 0;
+      const CommonOptions o = c->resolve();
+      const nlohmann::json j = run_table1(*ctx, o, scenarios_from(*file), *seeds, part, &wall);
+      write_timing(o, "table1", wall);
+      if (c->json != "-") {
+        if (part.whole()) std::cout << j["markdown"].get<std::string>();
+        std::cout << "wall time " << wall << " s on " << worker_count(o.threads) << " threads\n";
+      }
       emit(*c, j);
     });
   }

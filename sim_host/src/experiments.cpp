@@ -10,10 +10,12 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <iostream>
 #include <map>
 #include <sstream>
 
+#include "oneshot/engine/engine_benchmark.hpp"
 #include "oneshot/host/child_process.hpp"
 #include "oneshot/host/file_io.hpp"
 #include "oneshot/sim/output_files.hpp"
@@ -224,126 +226,6 @@ nlohmann::json run_gain_experiment(const SimContext& ctx, const CommonOptions& o
                    {"standard", results[2].job_records.back().gain0}};
   j["K1_spread_second_half"] = {{"half", spread[0]}, {"complete", spread[1]}, {"standard", spread[2]}};
   j["files"] = {"gain.csv", "gain.png"};
-  return j;
-}
-
-nlohmann::json run_table1(const SimContext& ctx, const CommonOptions& opt, const std::vector<Scenario>& scenarios,
-                          std::size_t seeds) {
-  if (seeds < 2) throw std::invalid_argument("table1 needs at least 2 seeds for confidence intervals");
-  for (const Scenario& s : scenarios) validate_scenario(s, ctx.plant());
-  const std::size_t na = kAllApproaches.size();
-  const std::size_t ns = scenarios.size();
-  // cost[a][s][seed]
-  std::vector<std::vector<std::vector<double>>> cost(na, std::vector<std::vector<double>>(ns, std::vector<double>(seeds)));
-  std::atomic<std::size_t> saturated_runs{0};
-  const auto start = Clock::now();
-  {
-    ProgressBar bar("table1", ns * seeds);
-    parallel_for(ns * seeds, worker_count(opt.threads), &bar, [&](std::size_t task) {
-      const std::size_t s = task / seeds;
-      const std::size_t k = task % seeds;
-      for (std::size_t a = 0; a < na; ++a) {
-        const RunResult r = simulate(ctx, scenarios[s], opt.seed + k, run_options(opt, kAllApproaches[a]));
-        cost[a][s][k] = r.cost.total();
-        if (r.saturated) ++saturated_runs;
-      }
-    });
-  }
-  const double wall = std::chrono::duration<double>(Clock::now() - start).count();
-  // Per seed: mean over scenarios; then mean and CI over seeds; ratios paired per seed.
-  std::vector<std::vector<double>> per_seed(na, std::vector<double>(seeds, 0));
-  for (std::size_t a = 0; a < na; ++a)
-    for (std::size_t k = 0; k < seeds; ++k) {
-      for (std::size_t s = 0; s < ns; ++s) per_seed[a][k] += cost[a][s][k] / static_cast<double>(ns);
-    }
-  nlohmann::json j = common_json(ctx, opt);
-  j["experiment"] = "table1";
-  j["scenarios"] = ns;
-  j["seeds"] = seeds;
-  double simulated = 0;
-  for (const Scenario& s : scenarios) simulated += s.duration_s;
-  j["runs"] = na * ns * seeds;
-  j["simulated_seconds"] = simulated * static_cast<double>(na * seeds);
-  j["wall_time_s"] = wall;
-  j["threads"] = worker_count(opt.threads);
-  j["saturated_runs"] = saturated_runs.load();
-  std::ostringstream md;
-  // Costs grow with the set-point amplitude squared, so the mean cost is dominated by the
-  // large-amplitude scenarios; the scenario-weighted ratio gives every scenario one vote:
-  // per seed, the mean over scenarios of cost/cost_A.
-  md << "| approach | description | mean cost J | 95 % CI | ratio to A | ratio 95 % CI | scenario-weighted ratio |\n"
-        "|---|---|---|---|---|---|---|\n";
-  std::vector<std::vector<double>> csv_rows;
-  for (std::size_t a = 0; a < na; ++a) {
-    const Summary c = summarize(per_seed[a]);
-    std::vector<double> ratios(seeds);
-    for (std::size_t k = 0; k < seeds; ++k) ratios[k] = per_seed[a][k] / per_seed[0][k];
-    const Summary r = summarize(ratios);
-    std::vector<double> weighted(seeds, 0);
-    for (std::size_t k = 0; k < seeds; ++k)
-      for (std::size_t s = 0; s < ns; ++s) weighted[k] += cost[a][s][k] / cost[0][s][k] / static_cast<double>(ns);
-    const Summary w = summarize(weighted);
-    const std::string letter(1, info(kAllApproaches[a]).letter);
-    j["approaches"][letter] = {{"description", info(kAllApproaches[a]).description},
-                               {"cost_mean", c.mean},
-                               {"cost_ci95", c.ci95},
-                               {"ratio_to_A", c.mean / summarize(per_seed[0]).mean},
-                               {"ratio_mean", r.mean},
-                               {"ratio_ci95", r.ci95},
-                               {"ratio_scenario_weighted", w.mean},
-                               {"ratio_scenario_weighted_ci95", w.ci95}};
-    char line[320];
-    std::snprintf(line, sizeof line, "| %s | %s | %.5f | ± %.5f | %.4f | ± %.4f | %.4f ± %.4f |\n", letter.c_str(),
-                  info(kAllApproaches[a]).description, c.mean, c.ci95, c.mean / summarize(per_seed[0]).mean, r.ci95,
-                  w.mean, w.ci95);
-    md << line;
-    csv_rows.push_back({static_cast<double>(a), c.mean, c.ci95, r.mean, r.ci95});
-  }
-  // Per-scenario table: mean cost and ratio to A.
-  std::ostringstream per;
-  per << "| scenario | jitter | amplitude (V) | change period (s) | A | B/A | C/A | D/A | E/A |\n|---|---|---|---|---|---|---|---|---|\n";
-  nlohmann::json js = nlohmann::json::array();
-  for (std::size_t s = 0; s < ns; ++s) {
-    std::vector<double> mean(na);
-    for (std::size_t a = 0; a < na; ++a) mean[a] = summarize(cost[a][s]).mean;
-    char line[320];
-    std::snprintf(line, sizeof line, "| %s | %s | %.2f | %.2f | %.5f | %.4f | %.4f | %.4f | %.4f |\n",
-                  scenarios[s].name.c_str(), scenarios[s].jitter.describe().c_str(), scenarios[s].amplitude_volts,
-                  scenarios[s].change_period_s, mean[0], mean[1] / mean[0], mean[2] / mean[0], mean[3] / mean[0],
-                  mean[4] / mean[0]);
-    per << line;
-    nlohmann::json e = {{"name", scenarios[s].name}, {"jitter", scenarios[s].jitter.describe()},
-                        {"amplitude_volts", scenarios[s].amplitude_volts}, {"change_period_s", scenarios[s].change_period_s},
-                        {"duration_s", scenarios[s].duration_s}};
-    for (std::size_t a = 0; a < na; ++a) e["cost_mean"][std::string(1, info(kAllApproaches[a]).letter)] = mean[a];
-    js.push_back(e);
-  }
-  j["per_scenario"] = js;
-  j["markdown"] = md.str();
-  j["markdown_per_scenario"] = per.str();
-  {
-    std::ostringstream out;
-    out << "Table I: mean cost over " << ns << " scenarios, " << seeds << " seeds each (" << to_string(opt.format)
-        << ", " << to_string(opt.discretizer) << ")\n\n" << md.str() << "\nPer scenario (mean over seeds):\n\n" << per.str();
-    write_text(path_in(opt, "table1.md"), out.str());
-  }
-  std::vector<std::vector<double>> raw;
-  for (std::size_t a = 0; a < na; ++a)
-    for (std::size_t s = 0; s < ns; ++s)
-      for (std::size_t k = 0; k < seeds; ++k)
-        raw.push_back({static_cast<double>(a), static_cast<double>(s), static_cast<double>(opt.seed + k), cost[a][s][k]});
-  write_csv(path_in(opt, "table1_runs.csv"), {"approach_index", "scenario_index", "seed", "cost"}, raw);
-  write_csv(path_in(opt, "table1.csv"), {"approach_index", "cost_mean", "cost_ci95", "ratio_mean", "ratio_ci95"}, csv_rows);
-  if (opt.plots) {
-    std::ostringstream g;
-    g << png_terminal() << "set output 'table1.png'\nset datafile separator ','\nset grid ytics\nset style fill solid 0.6\n"
-      << "set boxwidth 0.6\nset xtics ('A' 0, 'B' 1, 'C' 2, 'D' 3, 'E' 4)\nset xrange [-0.6:4.6]\nset yrange [0:*]\n"
-      << "set title 'Table I: mean control cost over " << ns << " scenarios x " << seeds << " seeds (95 % CI)'\n"
-      << "set ylabel 'cost J'\nset key off\n"
-      << "plot 'table1.csv' using 1:2 skip 1 with boxes lc rgb '#4c72b0', '' using 1:2:3 skip 1 with yerrorbars pt 0 lw 2 lc rgb 'black'\n";
-    run_gnuplot(opt.out_dir, "table1.gp", g.str());
-  }
-  j["files"] = {"table1.md", "table1.csv", "table1_runs.csv", "table1.png"};
   return j;
 }
 
@@ -576,14 +458,24 @@ nlohmann::json run_benchmark(const SimContext& ctx, const CommonOptions& opt, do
   j["simulated_seconds_per_run"] = simulated_s;
   for (Approach a : {Approach::kA, Approach::kB, Approach::kE}) {
     double best = 0;
+    double events_per_s = 0;
     for (int rep = 0; rep < 3; ++rep) {
       const auto t0 = Clock::now();
       const RunResult r = simulate(ctx, sc, opt.seed + static_cast<std::uint64_t>(rep), run_options(opt, a));
       const double wall = std::chrono::duration<double>(Clock::now() - t0).count();
       best = std::max(best, r.duration_s / wall);
+      events_per_s = std::max(events_per_s, static_cast<double>(r.events) / wall);
     }
     j["real_time_factor_one_core"][std::string(1, info(a).letter)] = best;
+    j["events_per_second_one_core"][std::string(1, info(a).letter)] = events_per_s;
   }
+  // The engine on a networked loop (firmware nodes, a lossy link, a CAN bus with background traffic).
+  nlohmann::json best_net;
+  for (int rep = 0; rep < 3; ++rep) {
+    const nlohmann::json n = engine::networked_loop_benchmark(simulated_s, opt.seed + static_cast<std::uint64_t>(rep));
+    if (best_net.is_null() || n["events_per_second"].get<double>() > best_net["events_per_second"].get<double>()) best_net = n;
+  }
+  j["networked_loop"] = best_net;
   return j;
 }
 

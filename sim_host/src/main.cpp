@@ -14,10 +14,14 @@ int main(int argc, char** argv) {
   // died must give an error on write, not kill us with SIGPIPE.
   oneshot::host::install_termination_handlers();
   std::signal(SIGPIPE, SIG_IGN);
-  CLI::App app{"oneshot-sim: host simulator of the one-shot task model with an embedded Kalman filter"};
+  CLI::App app{"oneshot-sim: discrete-event simulator of control loops on small MCUs and over networks.\n"
+               "Studies: oneshot-sim <study> <experiment> (oneshot-sim <study> --help); the one-shot study's\n"
+               "experiments are also top-level commands (design, noise, jitter, gain, table1, ...)"};
   app.require_subcommand(1);
   oneshot::sim::register_design_command(app);
   oneshot::sim::register_experiment_commands(app);
+  oneshot::sim::register_studies(app);
+  oneshot::sim::register_merge_command(app);
   const auto known = [&](const std::string& name) {
     for (const CLI::App* sub : app.get_subcommands({})) {
       if (sub->get_name() == name) return true;

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <filesystem>
 #include <iostream>
 #include <sstream>
 
@@ -85,6 +86,32 @@ std::pair<std::size_t, std::size_t> image_memory(const std::string& path) {
     if (write && nobits) ram += size;
   }
   return {flash, ram};
+}
+
+/// Approach id of the generated C99 job in the firmware (main.cpp).
+constexpr std::uint32_t kCJobApproach = 5;
+
+/// Flash, RAM and stack bound of the job-only image of the C job variant (no PIL link).
+nlohmann::json c_job_only_image(const PilOptions& base, const std::string& format, const std::string& disc) {
+  const std::string variant = format + "_" + disc;
+  PilOptions p = base;
+  const std::string dir = std::filesystem::path(firmware_image_path(p)).parent_path().string();
+  const std::string image = dir + "/oneshot-" + base.target + "-cjob-" + variant + ".elf";
+  if (!std::filesystem::exists(image)) return nlohmann::json{{"image", image}, {"available", false}};
+  const auto [flash, ram] = image_memory(image);
+  nlohmann::json j{{"image", image}, {"flash_bytes", flash}, {"ram_static_bytes", ram}};
+  std::string stack_text;  // the build's stack bound, when it computed one
+  if (std::filesystem::is_regular_file(image + ".stack.txt"))
+    stack_text = host::read_text_file(image + ".stack.txt", "stack bound", 4096);
+  std::istringstream stack(stack_text);
+  std::size_t bound = 0;
+  if (stack >> bound) {
+    j["stack_bound_bytes"] = bound;
+    j["ram_total_bound_bytes"] = ram + bound;
+  }
+  j["flash_target_bytes"] = 12 * 1024;
+  j["ram_target_bytes"] = 1024;
+  return j;
 }
 
 }  // namespace
@@ -214,10 +241,17 @@ nlohmann::json run_exectime_target(const SimContext& ctx, const CommonOptions& o
       PilLink link(p);
       // Marker overhead: begin/end back to back.
       link.request(app::pil::Type::kCalibrate, app::pil::Frame{});
-      for (Approach a : {Approach::kB, Approach::kC}) {
+      // B, C, and on table images the generated C99 job (approach id 5, B's job).
+      const bool c_job = std::string(disc) != "generic";
+      std::vector<std::uint32_t> approaches = {static_cast<std::uint32_t>(Approach::kB),
+                                               static_cast<std::uint32_t>(Approach::kC)};
+      if (c_job) approaches.push_back(kCJobApproach);
+      std::vector<std::vector<std::uint8_t>> replies_b;
+      std::size_t c_job_identical = 0;
+      for (std::uint32_t a : approaches) {
         app::pil::Frame cfg;
         app::pil::Writer cw(cfg);
-        cw.u(static_cast<std::uint32_t>(a), 1);
+        cw.u(a, 1);
         cw.u(opt.noise == NoiseModel::kExact ? 1U : 0U, 1);
         // Initial PWM code: the one nearest 0 V, as in simulate().
         cw.u(static_cast<std::uint32_t>(std::lround(-ctx.design().u_min[0] * ctx.design().steps_per_volt[0])), 2);
@@ -229,24 +263,29 @@ nlohmann::json run_exectime_target(const SimContext& ctx, const CommonOptions& o
           w.u(static_cast<std::uint32_t>(std::llround(r.t_apply_s * 1e6)), 4);
           w.s(r.y_code, 2);
           w.s(r.setpoint_code, 2);
-          link.request(app::pil::Type::kSample, f);
+          const app::pil::Frame reply = link.request(app::pil::Type::kSample, f);
+          const std::vector<std::uint8_t> bytes(reply.payload, reply.payload + reply.length);
+          if (a == static_cast<std::uint32_t>(Approach::kB)) replies_b.push_back(bytes);
+          // Same inputs, same job: status, τ, saturation, estimate, gain and applied input byte for byte.
+          if (a == kCJobApproach && bytes == replies_b.at(static_cast<std::size_t>(&r - jobs.data()))) ++c_job_identical;
         }
       }
       const std::vector<std::uint64_t> counts = link.instruction_counts();
-      if (counts.size() != 1 + 2 * jobs.size()) {
-        throw PilError("instruction counter: expected " + std::to_string(1 + 2 * jobs.size()) + " windows, got " +
-                       std::to_string(counts.size()));
+      if (counts.size() != 1 + approaches.size() * jobs.size()) {
+        throw PilError("instruction counter: expected " + std::to_string(1 + approaches.size() * jobs.size()) +
+                       " windows, got " + std::to_string(counts.size()));
       }
       const auto [flash, ram] = image_memory(link.image());
       const int stack = link.stack_peak_bytes();
       const std::uint64_t overhead = counts[0];
-      for (std::size_t v = 0; v < 2; ++v) {
+      for (std::size_t v = 0; v < approaches.size(); ++v) {
         std::vector<double> per_job;
         for (std::size_t k = 0; k < jobs.size(); ++k) per_job.push_back(static_cast<double>(counts[1 + v * jobs.size() + k] - overhead));
         const Summary s = summarize(per_job);
         double total = 0;
         for (double x : per_job) total += x;
-        const std::string name = std::string(v == 0 ? "half" : "complete") + "_" + disc + "_" + format;
+        const std::string name =
+            std::string(v == 0 ? "half" : v == 1 ? "complete" : "c99_half") + "_" + disc + "_" + format;
         j["variants"][name] = {{"instructions_per_job", s.mean},
                                {"instructions_per_job_min", *std::min_element(per_job.begin(), per_job.end())},
                                {"instructions_per_job_max", *std::max_element(per_job.begin(), per_job.end())},
@@ -255,6 +294,17 @@ nlohmann::json run_exectime_target(const SimContext& ctx, const CommonOptions& o
                                {"ram_bytes", ram},
                                {"stack_peak_bytes", stack},
                                {"image", link.image()}};
+        if (v == 2) {
+          // The C job always predicts with the exact Q_d(τ): compared with B only under that model.
+          j["variants"][name]["noise_model"] = "exact";
+          if (opt.noise == NoiseModel::kExact) {
+            j["variants"][name]["bit_identical_to_cpp_jobs"] = c_job_identical;
+          } else {
+            j["variants"][name]["note"] = "B ran with the constant Q: use --noise-model exact to compare";
+          }
+          j["variants"][name]["jobs"] = jobs.size();
+          j["variants"][name]["job_only_image"] = c_job_only_image(base, format, disc);
+        }
       }
       j["marker_overhead_instructions"] = overhead;
     }

@@ -35,8 +35,10 @@ void ProgressBar::draw(std::size_t done) {
   const double f = total_ == 0 ? 1.0 : static_cast<double>(done) / static_cast<double>(total_);
   const int fill = static_cast<int>(f * width);
   const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
-  std::fprintf(stderr, "\r%-10s [%.*s%*s] %5.1f%% %zu/%zu %6.1fs", label_.c_str(), fill,
-               "########################################", width - fill, "", 100 * f, done, total_, elapsed);
+  // ETA from the mean rate so far: elapsed · (total − done) / done.
+  const double eta = done == 0 ? 0.0 : elapsed * static_cast<double>(total_ - done) / static_cast<double>(done);
+  std::fprintf(stderr, "\r%-10s [%.*s%*s] %5.1f%% %zu/%zu %6.1fs ETA %6.1fs", label_.c_str(), fill,
+               "########################################", width - fill, "", 100 * f, done, total_, elapsed, eta);
   std::fflush(stderr);
 }
 

@@ -10,7 +10,9 @@
 
 #include "oneshot/host/file_io.hpp"
 #include "oneshot/sim/experiments.hpp"
+#include "oneshot/sim/study_report.hpp"
 #include "oneshot/sim/output_files.hpp"
+#include "oneshot/sim/parallel.hpp"
 #include "oneshot/sim/pil_link.hpp"
 
 namespace oneshot::sim {
@@ -205,7 +207,8 @@ nlohmann::json run_report(const SimContext& ctx, const CommonOptions& o, const R
   std::cerr << "report: gain\n";
   const nlohmann::json gain = run_gain_experiment(ctx, o, 3.0, 100.0);
   std::cerr << "report: table1\n";
-  const nlohmann::json table1 = run_table1(ctx, o, r.scenarios, r.seeds);
+  double table1_wall_s = 0;
+  const nlohmann::json table1 = run_table1(ctx, o, r.scenarios, r.seeds, engine::Shard{}, &table1_wall_s);
   std::cerr << "report: exectime\n";
   CommonOptions oe = o;
   oe.noise = NoiseModel::kConstant;  // experiment 5 measures the original design; exact Q_d beside it
@@ -229,7 +232,7 @@ nlohmann::json run_report(const SimContext& ctx, const CommonOptions& o, const R
      << ", complete " << gain["K1_spread_second_half"]["complete"].get<double>() << ", standard "
      << gain["K1_spread_second_half"]["standard"].get<double>() << ".\n\n"
      << "## 4. Table I\n\n" << table1["seeds"].get<std::size_t>() << " seeds x " << table1["scenarios"].get<std::size_t>()
-     << " scenarios, " << table1["wall_time_s"].get<double>() << " s wall on " << table1["threads"].get<unsigned>()
+     << " scenarios, " << table1_wall_s << " s wall on " << worker_count(o.threads)
      << " threads.\n\n" << table1["markdown"].get<std::string>() << "\n![table1](table1.png)\n\nPer scenario:\n\n"
      << table1["markdown_per_scenario"].get<std::string>() << "\n";
   std::cerr << "report: number formats\n";
@@ -250,14 +253,30 @@ nlohmann::json run_report(const SimContext& ctx, const CommonOptions& o, const R
   }
   md << "\n![exectime](exectime.png)\n\n## Benchmark\n\nReal-time factor of the board emulation on one core: ";
   for (const auto& [k, v] : bench["real_time_factor_one_core"].items()) md << k << " " << static_cast<long>(v.get<double>()) << "x; ";
-  md << "full Table I: " << fmt("%.2f", table1["wall_time_s"].get<double>()) << " s wall.\n\n";
+  md << "full Table I: " << fmt("%.2f", table1_wall_s) << " s wall.\n\n";
 
   nlohmann::json targets;
   targets_section(table1, lut, mcu, bench, targets, md);
 
+  // The networked and event-based studies, each on its built-in defaults (study_report.hpp).
+  nlohmann::json studies = nlohmann::json::object();
+  for (const StudyReportSection& section : study_report_sections()) {
+    std::cerr << "report: " << section.study << "\n";
+    StudyReportContext sc;
+    sc.out_dir = (std::filesystem::path(o.out_dir) / section.study).string();
+    sc.rel_dir = section.study;
+    sc.threads = o.threads;
+    sc.seed = o.seed;
+    sc.plots = o.plots;
+    make_directory(sc.out_dir);
+    StudyReportResult res = section.run(sc);
+    md << res.markdown << "\n";
+    studies[section.study] = std::move(res.json);
+  }
+
   nlohmann::json all = {{"noise", noise},         {"jitter", jitter},     {"gain", gain},
                         {"table1", table1},       {"formats", formats},   {"exectime", exectime},
-                        {"benchmark", bench},     {"targets", targets}};
+                        {"benchmark", bench},     {"targets", targets},   {"studies", studies}};
   if (!lut.is_null()) all["table"] = lut;  // sections that did not run are left out, not null
   if (!mcu.is_null()) all["mcu"] = mcu;
   all["wall_time_s"] = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();

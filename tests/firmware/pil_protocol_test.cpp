@@ -51,7 +51,10 @@ TEST(PilProtocol, AConfigNeedsAKnownApproachAndNoiseModel) {
   EXPECT_TRUE(c.exact_noise);
   EXPECT_EQ(c.codes[0], 2000);
   Frame bad = f;
-  bad.payload[0] = 5;  // no approach F
+  bad.payload[0] = kMaxApproach;  // the generated C job
+  EXPECT_TRUE(decode(bad, c));
+  EXPECT_EQ(c.approach, kMaxApproach);
+  bad.payload[0] = kMaxApproach + 1;  // nothing beyond it
   EXPECT_FALSE(decode(bad, c));
   bad = f;
   bad.payload[1] = 2;

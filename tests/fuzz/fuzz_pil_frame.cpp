@@ -40,7 +40,7 @@ void check_config(const pil::Frame& f) {
   pil::ConfigRequest<M> c;
   if (!pil::decode(f, c)) return;
   require(f.length == pil::ConfigRequest<M>::kLength, "config accepted at a wrong length");
-  require(c.approach <= 4, "unknown approach accepted");
+  require(c.approach <= pil::kMaxApproach, "unknown approach accepted");
   pil::Frame g;
   pil::Writer w(g);
   w.u(c.approach, 1);

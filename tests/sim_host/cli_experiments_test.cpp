@@ -61,6 +61,26 @@ TEST(CliExperiments, Table1JsonHasTheContractedKeys) {
   EXPECT_TRUE(std::filesystem::exists(dir + "/table1_runs.csv"));
 }
 
+TEST(CliExperiments, RunAndTable1GiveTheSameCostForTheSameSeed) {
+  // issue 11: `run` records a dense trace, `table1` does not; the costs must agree.
+  const std::string dir = fresh_dir("run_vs_table1");
+  const auto t = test::run_command(sim() + " table1 --seeds 2 --seed 4 --no-plots --json - --out " + dir);
+  ASSERT_EQ(t.exit_code, 0) << t.output;
+  // Table I's raw costs: approach_index,scenario_index,seed,cost (approach B = 1, j20-a0.2-p1 = 3).
+  std::istringstream csv(read(dir + "/table1_runs.csv"));
+  std::string line;
+  double table_cost = -1;
+  while (std::getline(csv, line)) {
+    if (line.rfind("1,3,5,", 0) == 0) table_cost = std::stod(line.substr(6));
+  }
+  ASSERT_GT(table_cost, 0);
+  const auto r = test::run_command(sim() + " run --approach B --scenario j20-a0.2-p1 --seed 5 --no-plots --json - --out " +
+                                   fresh_dir("run_vs_table1_run"));
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const double run_cost = nlohmann::json::parse(r.output)["cost"]["total"].get<double>();
+  EXPECT_NEAR(run_cost, table_cost, 1e-8 * table_cost);  // the CSV keeps 9 significant digits
+}
+
 TEST(CliExperiments, ExectimeJsonHasEveryVariant) {
   const std::string dir = fresh_dir("exectime");
   const auto r = test::run_command(sim() + " exectime --no-plots --json - --out " + dir);

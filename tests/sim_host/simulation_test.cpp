@@ -151,6 +151,60 @@ TEST(Simulation, FixedPointNeedsTheCompiledPlant) {
   EXPECT_THROW(simulate(*runtime, short_scenario(0), 1, o), std::invalid_argument);
 }
 
+TEST(Simulation, PwmUpdateAtThePeriodStartsFromTheInitialInput) {
+  // issue 11: with a double-buffered duty register the initial duty was still pending when
+  // the controller read it back, so every run started from u0 = duty 0 (-1.65 V), and B
+  // reached tens of volts. The board now starts with the initial duty in effect.
+  const auto ctx = SimContext::reference();
+  // A duty written inside a 50 us PWM period acts at its end: measured |ΔJ|/J = 0.07 % (B)
+  // and 0.66 % (D, whose writes land at jittered instants); before the fix 2.8e5 (B), 2.7 % (D).
+  for (const auto& [a, tolerance] : {std::pair{Approach::kB, 0.003}, std::pair{Approach::kD, 0.02}}) {
+    RunOptions o;
+    o.approach = a;
+    const double immediate = simulate(*ctx, short_scenario(20'000), 2, o).cost.total();
+    o.board.update = PwmUpdate::kNextPeriod;
+    const double period = simulate(*ctx, short_scenario(20'000), 2, o).cost.total();
+    EXPECT_NEAR(period, immediate, tolerance * immediate) << info(a).letter;
+  }
+}
+
+TEST(Simulation, TraceAndJobRecordingDoNotChangeTheRun) {
+  // issue 11: the process noise was drawn per trace step, so `run` (traced) and `table1`
+  // (untraced) gave different costs for the same seed. Noise is drawn per physical event.
+  const auto ctx = SimContext::reference();
+  for (Approach a : {Approach::kB, Approach::kD}) {
+    RunOptions o;
+    o.approach = a;
+    const RunResult plain = simulate(*ctx, short_scenario(20'000), 5, o);
+    for (std::int32_t step_us : {1000, 333, 50'000}) {
+      o.trace_step_us = step_us;
+      o.record_jobs = true;
+      const RunResult traced = simulate(*ctx, short_scenario(20'000), 5, o);
+      EXPECT_EQ(traced.cost.total(), plain.cost.total()) << info(a).letter << " step " << step_us;
+      EXPECT_FALSE(traced.trace.empty());
+    }
+  }
+}
+
+TEST(Simulation, TheTraceAtASamplingInstantIsTheSampledState) {
+  // A samples at k·h, on the 1 ms trace grid: the bridged trace point there is the state
+  // the job sampled (same deterministic path, the interval's own noise draw), up to the
+  // rounding of the piecewise walk (measured ≤ 2.6e-15 V over 19 seeds).
+  const auto ctx = SimContext::reference();
+  RunOptions o;
+  o.approach = Approach::kA;
+  o.record_jobs = true;
+  o.trace_step_us = 1000;
+  const RunResult r = simulate(*ctx, short_scenario(20'000), 7, o);
+  ASSERT_EQ(r.job_records.size(), 60U);
+  ASSERT_EQ(r.trace.size(), 3001U);
+  for (std::size_t k = 1; k < r.job_records.size(); ++k) {
+    const TracePoint& p = r.trace[50 * k];
+    ASSERT_NEAR(p.t_s, r.job_records[k].t_sample_s, 1e-12);
+    for (std::size_t i = 0; i < 2; ++i) EXPECT_NEAR(p.x[i], r.job_records[k].x_true[i], 1e-14) << k;
+  }
+}
+
 TEST(Scenario, JobLongerThanThePeriodIsRefused) {
   Scenario s = short_scenario(49'500);
   try {

@@ -31,7 +31,7 @@ std::string plant_json(const std::string& a, const std::string& b, const std::st
   j.erase("inputs");
   j.erase("outputs");
   j["cost"]["Q1c"] = eye_n;
-  j["noise"]["process_covariance"] = qn;
+  j["noise"]["process_covariance_per_period"] = qn;
   nlohmann::json r = nlohmann::json::array();
   nlohmann::json umin = nlohmann::json::array();
   nlohmann::json umax = nlohmann::json::array();

@@ -23,6 +23,7 @@
 #include "oneshot/mcu/rx_ring.hpp"
 #include "oneshot/standard_kalman.hpp"
 #include "oneshot/table_discretizer.hpp"
+#include "oneshot_job.h"  // the generated C99 job (lut_gen --c-job-dir), approach 5
 
 #if defined(ONESHOT_MCU_NRF51)
 #include "oneshot/mcu/nrf51.hpp"
@@ -144,6 +145,78 @@ struct Loop {
   }
 };
 
+// The generated C99 job of this image's format and sub-grid policy, as approach 5: the same
+// job as B (half Kalman, one-shot) behind the same task interface, for instruction counts and
+// the comparison with the C++ job on the MCU (table images, when the plant has that variant).
+#if ONESHOT_FW_FIXED && ONESHOT_FW_DISC == 2 && defined(ONESHOT_JOB_HAS_FIXED_NEAREST)
+#define ONESHOT_CJOB(name) oneshot_job_fixed_nearest_##name
+#elif ONESHOT_FW_FIXED && ONESHOT_FW_DISC == 0 && defined(ONESHOT_JOB_HAS_FIXED_TABLE)
+#define ONESHOT_CJOB(name) oneshot_job_fixed_table_##name
+#elif !ONESHOT_FW_FIXED && ONESHOT_FW_DISC == 2 && defined(ONESHOT_JOB_HAS_FLOAT_NEAREST)
+#define ONESHOT_CJOB(name) oneshot_job_float_nearest_##name
+#elif !ONESHOT_FW_FIXED && ONESHOT_FW_DISC == 0 && defined(ONESHOT_JOB_HAS_FLOAT_TABLE)
+#define ONESHOT_CJOB(name) oneshot_job_float_table_##name
+#endif
+#ifdef ONESHOT_CJOB
+static_assert(kM == 1 && kP == 1, "the C job adapter serves one input and one output");
+
+struct CJobLoop {
+  ONESHOT_CJOB(t) state{};
+  struct Task {
+    CJobLoop* self;
+    volatile std::int32_t prepared = 0;  // shared with the interrupt
+    volatile bool ready = false;
+    app::TaskStatistics stats{};
+    Status run_job() {
+      const std::uint32_t t_sample = PilBoard::Clock::now_us();
+      const std::uint32_t t_apply = PilBoard::Timer::next_actuation_us();
+      const auto tau_us = static_cast<std::int32_t>(t_apply - t_sample);
+      const auto adc = static_cast<std::uint16_t>(PilBoard::Adc::sample(0));
+      const auto sp = static_cast<std::uint16_t>(PilBoard::Setpoint::setpoint_code(0, t_apply));
+      prepared = ONESHOT_CJOB(run)(&self->state, tau_us, adc, sp);
+      ready = true;
+      ++stats.jobs;
+      stats.last_tau_us = tau_us;
+      stats.last_status = static_cast<Status>(self->state.status);
+#if ONESHOT_FW_FIXED
+      if (self->state.saturated != 0U) detail::g_saturated = true;  // the reply's flag, as for the C++ job
+#endif
+      if (!is_exact(stats.last_status)) ++stats.faults;
+      return stats.last_status;
+    }
+    void on_actuation_interrupt() {
+      if (!ready) {
+        ++stats.overruns;
+        return;
+      }
+      PilBoard::Pwm::write_duty(0, prepared);
+      ready = false;
+    }
+    const app::TaskStatistics& statistics() const { return stats; }
+  } task{this};
+
+  void configure(const std::int32_t (&codes)[kM]) {
+    ONESHOT_CJOB(init)(&state, static_cast<std::uint16_t>(codes[0]));
+    task.ready = false;
+    task.stats = app::TaskStatistics{};
+  }
+  template <typename T>
+  static std::uint32_t raw(T v) {
+    if constexpr (std::is_floating_point_v<T>) {
+      return raw32(v);
+    } else {
+      return static_cast<std::uint32_t>(static_cast<std::int32_t>(v));
+    }
+  }
+  void results(pil::Writer& w) const {
+    w.u(raw(state.u[0]), 4);
+    for (std::size_t i = 0; i < kN; ++i) w.u(raw(state.x[i]), 4);
+    w.u(raw(state.k[0]), 4);
+  }
+};
+CJobLoop g_cjob;
+#endif
+
 using HalfEst = HalfKalman<Fmt, Structure, Disc>;
 using CompleteEst = CompleteKalman<Fmt, Structure, Disc>;
 using StandardEst = StandardKalman<Fmt, Structure>;
@@ -160,7 +233,8 @@ struct JobOutcome {
   std::int32_t tau_us;
 };
 
-/// Approach letters A–E as 0–4: A, D standard Kalman; B half; C complete; E deadbeat.
+/// Approach letters A–E as 0–4: A, D standard Kalman; B half; C complete; E deadbeat; 5: the
+/// generated C99 job (B's job, table images only).
 std::uint8_t g_approach = 1;
 volatile bool g_tick_done = false;
 mcu::RxRing g_rx;
@@ -195,6 +269,9 @@ decltype(auto) with_loop(F&& f) {
     case 1: return f(g_half);
     case 2: return f(g_complete);
     case 4: return f(g_deadbeat);
+#ifdef ONESHOT_CJOB
+    case 5: return f(g_cjob);
+#endif
     default: return f(g_standard);
   }
 }
@@ -254,12 +331,18 @@ void handle(const pil::Frame& q, pil::Frame& r) {
     case pil::Type::kConfig: {
       pil::ConfigRequest<kM> c;
       if (!pil::decode(q, c)) return malformed(r);
+#ifndef ONESHOT_CJOB
+      if (c.approach == pil::kMaxApproach) return malformed(r);  // no generated C job in this image
+#endif
       const NoiseModel noise = c.exact_noise ? NoiseModel::kExact : NoiseModel::kConstant;
       g_approach = c.approach;
       g_half.configure(HalfEst(K::kDesign, g_disc, noise), c.codes);
       g_complete.configure(CompleteEst(K::kDesign, g_disc, noise), c.codes);
       g_standard.configure(StandardEst(K::kDesign, noise), c.codes);
       g_deadbeat.configure(DeadbeatEst(K::kDesign), c.codes);
+#ifdef ONESHOT_CJOB
+      g_cjob.configure(c.codes);
+#endif
       clear_saturation_flag();
       w.u(g_approach, 1);
       return;

@@ -43,6 +43,10 @@ DenseMatrix to_dense(const Matrix<double, R, C>& m) {
 /// The continuous model in per-microsecond units for the generic routine.
 template <typename S, std::size_t N, std::size_t M>
 ContinuousModelPerUs<S, N, M> continuous_model_per_us(const PlantDescription& plant, const DesignResult& design) {
+  if (!plant.continuous()) {
+    throw DesignError(plant.source + ": the generic discretizer needs a continuous plant (A, B); this one is " +
+                      to_string(plant.form));
+  }
   ContinuousModelPerUs<S, N, M> model;
   model.a_per_us = to_fixed<S, N, N>(plant.a) * ScalarTraits<S>::from_double(1e-6);
   model.b_per_us = to_fixed<S, N, M>(plant.b) * ScalarTraits<S>::from_double(1e-6);
@@ -54,6 +58,8 @@ ContinuousModelPerUs<S, N, M> continuous_model_per_us(const PlantDescription& pl
 template <typename S, std::size_t N, std::size_t M, std::size_t P>
 ControllerDesign<UniformFormat<S>, N, M, P> controller_design(const PlantDescription& plant,
                                                               const DesignResult& d) {
+  if (!d.lqr_available) throw DesignError(plant.source + ": no LQR gain: " + d.lqr_unavailable_reason);
+  if (!plant.has_board) throw DesignError(plant.source + ": the controller's converter models need a PWM 'board'");
   ControllerDesign<UniformFormat<S>, N, M, P> c{};
   c.period_us = plant.period_us;
   c.c = to_fixed<S, P, N>(plant.c);

@@ -8,9 +8,15 @@
 #include "oneshot/design/controller_synthesis.hpp"
 #include "oneshot/design/fixed_size.hpp"
 #include "oneshot/design/plant_description.hpp"
-#include "oneshot/sim/board_emulator.hpp"
+#include "oneshot/engine/board_plant.hpp"
+#include "oneshot/sim/random_stream.hpp"
 
 namespace oneshot::sim {
+
+using engine::BoardPlant;
+using engine::CircuitConfig;
+using engine::CostBreakdown;
+using engine::PwmUpdate;
 
 /// Emulator options not in the plant file.
 struct BoardOptions {

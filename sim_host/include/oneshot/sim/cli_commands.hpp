@@ -12,4 +12,13 @@ void register_design_command(CLI::App& app);
 /// noise, jitter, gain, table1, exectime, run, benchmark, report.
 void register_experiment_commands(CLI::App& app);
 
+/// `merge SHARD...`: joins the shard files of a sweep (any study) into its result.
+void register_merge_command(CLI::App& app);
+
+/// Every study under `oneshot-sim <study> <experiment>` (sim_host/src/studies.cpp).
+void register_studies(CLI::App& app);
+
+/// `oneshot <experiment>`: the one-shot study, seed 000 (sim_host/oneshot/).
+void register_oneshot_study(CLI::App& app);
+
 }  // namespace oneshot::sim

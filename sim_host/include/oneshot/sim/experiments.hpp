@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "oneshot/engine/sweep.hpp"
 #include "oneshot/sim/scenario.hpp"
 #include "oneshot/sim/simulation.hpp"
 
@@ -39,9 +40,14 @@ nlohmann::json run_jitter_experiment(const SimContext& ctx, const CommonOptions&
 nlohmann::json run_gain_experiment(const SimContext& ctx, const CommonOptions& opt, double duration_s,
                                    double p0_scale);
 
-/// Experiment 4: approaches A–E on the scenarios, `seeds` seeds each, 95 % intervals.
+/// Experiment 4: approaches A–E on the scenarios, `seeds` seeds each, 95 % intervals and
+/// paired differences (sim_host/oneshot/table1.cpp). The JSON holds no wall time (it would
+/// differ between identical runs): `wall_time_s` receives it when given. With a shard
+/// other than 0/1 only that part runs: its raw results go to
+/// OUT/table1.shard-i-of-N.json, and the shard JSON is returned (merge them with
+/// `oneshot-sim merge`).
 nlohmann::json run_table1(const SimContext& ctx, const CommonOptions& opt, const std::vector<Scenario>& scenarios,
-                          std::size_t seeds);
+                          std::size_t seeds, const engine::Shard& shard = {}, double* wall_time_s = nullptr);
 
 /// Experiment 5: execution time of the control job, half/complete × table/generic, over
 /// the jobs of 4 s of operation: steady-clock time on this host, and instruction counts

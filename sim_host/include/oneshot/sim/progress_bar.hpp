@@ -1,6 +1,6 @@
 /// @file progress_bar.hpp
-/// @brief Progress bar on standard error, shown only on a terminal and only once a task
-///        has taken more than a second.
+/// @brief Progress bar on standard error with the time elapsed and an ETA, shown only on
+///        a terminal and only once a task has taken more than a second.
 #pragma once
 
 #include <atomic>

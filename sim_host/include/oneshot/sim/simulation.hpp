@@ -1,13 +1,14 @@
 /// @file simulation.hpp
-/// @brief One closed-loop run: the emulated board driving the firmware's control task.
+/// @brief One closed-loop run of the one-shot study (seed 000): the board plant driving
+///        the firmware's control task on the discrete-event engine.
 ///
 /// The harness plays the board through the host port (hal/host_sim): at each actuation
 /// instant it raises the timer interrupt of the task, at each sampling instant it sets
 /// the clock, the ADC code (circuit output + measurement noise, 12-bit) and the
-/// set-point, and calls the task's job; PWM writes go back into the emulator at the
-/// instant the task model gives them effect. Random streams (jitter, measurement noise,
-/// set-points) are shared by every approach for a given seed; process noise has its own
-/// stream per run.
+/// set-point, and calls the task's job; PWM writes go back into the board plant at the
+/// instant the task model gives them effect (sim_host/oneshot/board_loop.hpp). Random
+/// streams (jitter, measurement noise, set-points) are shared by every approach for a
+/// given seed; process noise has its own stream, drawn once per physical event.
 #pragma once
 
 #include <cstdint>
@@ -91,6 +92,7 @@ struct RunResult {
   bool saturated = false;          ///< The fixed-point saturation flag was raised.
   std::vector<JobRecord> job_records;  ///< When requested.
   std::vector<TracePoint> trace;       ///< When requested.
+  std::uint64_t events = 0;            ///< Engine events run.
 };
 
 /// Plant, design and tables shared (read-only) by every run of an experiment.
@@ -118,7 +120,11 @@ class SimContext {
   design::TableData<double> table_double_;
 };
 
-/// Runs `scenario` with `seed` under `options`.
+/// False when the plant's design cannot run approach `a` (E without a deadbeat observer).
+bool approach_available(const SimContext& ctx, Approach a);
+
+/// Runs `scenario` with `seed` under `options`; std::invalid_argument naming the reason
+/// when the approach is unavailable for the plant.
 RunResult simulate(const SimContext& ctx, const Scenario& scenario, std::uint64_t seed, const RunOptions& options);
 
 /// Builds the control job of `options` and calls use(replay); each replay() restores the

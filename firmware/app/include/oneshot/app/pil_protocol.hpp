@@ -200,10 +200,14 @@ inline constexpr std::uint32_t kFaultHard = 0xFFFFFFFFU;              ///< Hard 
 inline constexpr std::uint32_t kFaultUnknownRequest = 0xFFFFFFFEU;    ///< Request type not known.
 inline constexpr std::uint32_t kFaultMalformedRequest = 0xFFFFFFFDU;  ///< Wrong payload length or value.
 
-/// kConfig: approach (0–4, A–E), noise model (0 constant, 1 exact), initial PWM code per input.
+/// Largest approach id of kConfig: 0–4 are A–E, 5 the generated C99 job (B's job; an image
+/// without one refuses it).
+inline constexpr std::uint8_t kMaxApproach = 5;
+
+/// kConfig: approach (0–5), noise model (0 constant, 1 exact), initial PWM code per input.
 template <std::size_t M>
 struct ConfigRequest {
-  std::uint8_t approach = 0;       ///< Approach A–E as 0–4.
+  std::uint8_t approach = 0;       ///< Approach A–E as 0–4, the generated C job as 5.
   bool exact_noise = false;        ///< Exact Q_d(τ) instead of the constant Q.
   std::int32_t codes[M] = {};      ///< Initial PWM code of each input (0–65535).
   /// Exact payload length: 1 + 1 + 2·M bytes.
@@ -237,7 +241,7 @@ constexpr bool decode(const Frame& f, ConfigRequest<M>& out) {
   ConfigRequest<M> r;
   const std::uint32_t approach = in.u(1);
   const std::uint32_t noise = in.u(1);
-  if (approach > 4 || noise > 1) return false;
+  if (approach > kMaxApproach || noise > 1) return false;
   r.approach = static_cast<std::uint8_t>(approach);
   r.exact_noise = noise == 1;
   for (std::size_t j = 0; j < M; ++j) r.codes[j] = static_cast<std::int32_t>(in.u(2));

@@ -1,10 +1,11 @@
-/// @file board_emulator.hpp
-/// @brief The emulated reference board: PWM-driven linear circuit, ADC, process noise,
-///        and the exact control cost along the trajectory.
+/// @file board_plant.hpp
+/// @brief The reference board as an engine plant: PWM-driven linear circuit, ADC, process
+///        noise, and the exact control cost along the trajectory.
 ///
 /// PWM: edge-aligned, common carrier of period T; channel j is high on the first
 /// T_h,j = round(code_j·T/steps) ns of every period (duty saturated to 0–100 %), its
-/// level v_low or v_high. A new duty acts immediately or from the next period start.
+/// level v_low or v_high. A new duty acts immediately or from the next period start; the
+/// duty in force at power-on is set with initialize_duty(), whatever the register mode.
 ///
 /// Propagation is exact between PWM edges: on a segment of length d with constant
 /// levels v, in deviation coordinates e = x − x_ref, ṽ = v − u_ref (A x_ref + B u_ref = 0),
@@ -13,14 +14,13 @@
 /// W = blkdiag(Q1c, 0). A full PWM period is the affine map w ↦ S w on w = [e; 1] with cost
 /// wᵀ C w; n periods use S^(2^j) and C_(2^j) = C_j + S_jᵀ C_j S_j (binary powers), so a
 /// 50 ms interval costs about ten small products rather than 2000 edges, with the same
-/// result (tests/sim_host/board_emulator_test.cpp checks it edge by edge).
+/// result (tests/sim_host/engine/board_plant_test.cpp checks it edge by edge).
 ///
-/// Process noise is continuous white noise of intensity Q_c: at the end of each advance
-/// over Δ the state receives an exact N(0, Q_d(Δ)) draw, and the cost receives the exact
-/// expected contribution of the noise path inside the interval,
-///     E ∫₀^Δ nᵀ Q1c n ds = Σ_{k≥1} tr(Q1c M_k) Δ^{k+1}/(k+1)!,  M₁ = Q_c, M_{k+1} = A M_k + M_k Aᵀ.
-/// The input term of the cost uses the commanded input (the duty-cycle average
-/// u_min + code·(u_max − u_min)/steps), not the switching waveform.
+/// advance_to() is a physical event: the interval since the last one receives one exact
+/// N(0, Q_d(Δ)) draw and its expected noise cost (process_noise.hpp). The input term of
+/// the cost uses the commanded input (the duty-cycle average), not the switching waveform.
+/// A state trace (record_trace) is filled from a separate stream by bridge draws, so it
+/// never changes the run.
 #pragma once
 
 #include <algorithm>
@@ -28,13 +28,17 @@
 #include <cstddef>
 #include <cstdint>
 #include <unordered_map>
+#include <vector>
 
 #include "oneshot/assert_handler.hpp"
+#include "oneshot/engine/cost.hpp"
+#include "oneshot/engine/process_noise.hpp"
+#include "oneshot/engine/sim_time.hpp"
 #include "oneshot/matrix.hpp"
 #include "oneshot/matrix_exponential.hpp"
-#include "oneshot/sim/random_stream.hpp"
+#include "oneshot/engine/random_stream.hpp"
 
-namespace oneshot::sim {
+namespace oneshot::engine {
 
 /// When a new PWM duty takes effect.
 enum class PwmUpdate : std::uint8_t {
@@ -42,7 +46,7 @@ enum class PwmUpdate : std::uint8_t {
   kNextPeriod,  ///< At the next period start (double-buffered register).
 };
 
-/// Board and plant parameters of the emulator (SI units, times in ns).
+/// Board and plant parameters (SI units, times in ns).
 template <std::size_t N, std::size_t M, std::size_t P>
 struct CircuitConfig {
   Matrix<double, N, N> a;        ///< A (1/s).
@@ -64,47 +68,36 @@ struct CircuitConfig {
   bool process_noise = true;     ///< Inject process noise (off for deterministic tests).
 };
 
-/// Cost accumulated along the trajectory.
-struct CostBreakdown {
-  double state = 0;  ///< ∫ eᵀ Q1c e dt along the deterministic switching trajectory.
-  double noise = 0;  ///< Expected contribution of the noise path inside intervals.
-  double input = 0;  ///< ∫ ṽᵀ Q2c ṽ dt of the commanded input.
-  /// The total cost J.
-  double total() const { return state + noise + input; }
+/// One point of a recorded state trace (values just before the events of instant t).
+template <std::size_t N, std::size_t M, std::size_t P>
+struct TraceSample {
+  SimTime t{0};            ///< Instant.
+  Vector<double, N> x;     ///< True state.
+  Vector<double, P> r;     ///< Reference in force.
+  Vector<double, M> u;     ///< Commanded input in force.
 };
 
 /// Exact emulation of the PWM-driven circuit.
 template <std::size_t N, std::size_t M, std::size_t P>
-class BoardEmulator {
+class BoardPlant {
  public:
+  static constexpr std::size_t kStates = N;   ///< n.
+  static constexpr std::size_t kInputs = M;   ///< m.
+  static constexpr std::size_t kOutputs = P;  ///< p.
   static constexpr std::size_t kK = N + M;
   using State = Vector<double, N>;
   using Aug = Matrix<double, N + 1, N + 1>;
+  using Sample = TraceSample<N, M, P>;
 
-  /// Emulator at t = 0, state 0, duty 0, set-point 0; `noise` feeds the process noise.
-  BoardEmulator(const CircuitConfig<N, M, P>& config, RandomStream noise)
-      : cfg_(config), noise_(std::move(noise)) {
+  /// Board at t = 0, state 0, duty 0, set-point 0; `noise` feeds the process noise.
+  BoardPlant(const CircuitConfig<N, M, P>& config, RandomStream noise)
+      : cfg_(config), noise_rng_(std::move(noise)), noise_(config.a, config.qc, config.q1c) {
     ONESHOT_ASSERT(cfg_.pwm_period_ns > 0 && cfg_.duty_steps > 0);
-    for (std::size_t j = 0; j < M; ++j) codes_[j] = 0;
-    // Series coefficients of the expected in-interval noise cost.
-    Matrix<double, N, N> mk = cfg_.qc;
-    for (std::size_t k = 0; k < kNoiseTerms; ++k) {
-      double tr = 0;
-      const Matrix<double, N, N> prod = cfg_.q1c * mk;
-      for (std::size_t i = 0; i < N; ++i) tr += prod(i, i);
-      noise_coeff_[k] = tr;  // tr(Q1c M_{k+1})
-      mk = cfg_.a * mk + mk * cfg_.a.transposed();
-    }
-    for (std::size_t j = 0; j < N; ++j) {
-      double col = 0;
-      for (std::size_t i = 0; i < N; ++i) col += std::fabs(cfg_.a(i, j));
-      a_norm_ = std::max(a_norm_, col);
-    }
     set_setpoint(Vector<double, P>{});
   }
 
-  /// Current time (ns).
-  std::int64_t now_ns() const { return now_ns_; }
+  /// Current time.
+  SimTime now() const { return now_; }
   /// Current state x (absolute).
   const State& state() const { return x_; }
   /// Sets the state (tests).
@@ -117,6 +110,14 @@ class BoardEmulator {
   double commanded_input(std::size_t j) const { return level_average(j, codes_[j]); }
   /// Current set-point.
   const Vector<double, P>& setpoint() const { return r_; }
+  /// Recorded trace (record_trace).
+  const std::vector<Sample>& trace() const { return trace_; }
+
+  /// The duty in force now on channel j, whatever the register mode (power-on state).
+  void initialize_duty(std::size_t j, std::int32_t code) {
+    codes_[j] = std::clamp(code, 0, cfg_.duty_steps);
+    invalidate();
+  }
 
   /// Writes the duty register of channel j at the current time (saturated to [0, steps]).
   void set_duty(std::size_t j, std::int32_t code) {
@@ -133,7 +134,7 @@ class BoardEmulator {
     }
     pending_codes_[j] = code;
     pending_ = true;
-    pending_at_ns_ = (now_ns_ / cfg_.pwm_period_ns + 1) * cfg_.pwm_period_ns;
+    pending_at_ = Duration{(now_.count() / cfg_.pwm_period_ns + 1) * cfg_.pwm_period_ns};
   }
 
   /// Changes the set-point at the current time.
@@ -144,35 +145,52 @@ class BoardEmulator {
     invalidate();
   }
 
+  /// Records the true state every `step` from now on; bridge draws come from `rng`.
+  void record_trace(Duration step, RandomStream rng) {
+    ONESHOT_ASSERT(step.count() > 0);
+    trace_step_ = step;
+    trace_rng_ = std::move(rng);
+    trace_.push_back(Sample{now_, x_, r_, inputs(codes_)});
+    trace_next_ = now_ + step;
+  }
+
   /// Advances to t1 ≥ now: exact propagation, cost, then the interval's process noise.
-  void advance_to(std::int64_t t1) {
-    ONESHOT_ASSERT(t1 >= now_ns_);
-    const std::int64_t start = now_ns_;
+  void advance_to(SimTime t1) {
+    ONESHOT_ASSERT(t1 >= now_);
+    const SimTime start = now_;
+    const std::size_t first_new = trace_.size();
+    if (trace_step_.count() > 0) trace_deterministic(t1);
     State e = x_ - x_ref_;
-    std::int64_t t = now_ns_;
+    SimTime t = now_;
     while (t < t1) {
-      std::int64_t stop = t1;
-      if (pending_ && pending_at_ns_ > t && pending_at_ns_ < stop) stop = pending_at_ns_;
-      propagate(e, t, stop);
+      SimTime stop = t1;
+      if (pending_ && pending_at_ > t && pending_at_ < stop) stop = pending_at_;
+      propagate(e, t.count(), stop.count(), true);
       double u_cost = 0;
       Vector<double, M> dv;
       for (std::size_t j = 0; j < M; ++j) dv[j] = level_average(j, codes_[j]) - u_ref_[j];
       for (std::size_t i = 0; i < M; ++i)
         for (std::size_t k = 0; k < M; ++k) u_cost += dv[i] * cfg_.q2c(i, k) * dv[k];
-      cost_.input += u_cost * seconds(stop - t);
+      cost_.input += u_cost * seconds((stop - t).count());
       t = stop;
-      if (pending_ && t >= pending_at_ns_) {
+      if (pending_ && t >= pending_at_) {
         for (std::size_t j = 0; j < M; ++j) codes_[j] = pending_codes_[j];
         pending_ = false;
         invalidate();
       }
     }
     x_ = e + x_ref_;
-    now_ns_ = t1;
-    if (cfg_.process_noise && t1 > start) add_process_noise(t1 - start);
+    now_ = t1;
+    State n_end{};
+    if (cfg_.process_noise && t1 > start) {
+      n_end = noise_.draw(t1 - start, noise_rng_);
+      x_ = x_ + n_end;
+      cost_.noise += noise_.interval_cost(t1 - start);
+    }
+    if (trace_.size() > first_new) trace_noise(start, first_new, n_end);
   }
 
-  /// ADC code of output o for the current state plus `noise_volts` (12-bit saturating).
+  /// ADC code of output o for the current state plus `noise_volts` (saturating).
   std::int32_t adc_code(std::size_t o, double noise_volts) const {
     double v = noise_volts;
     for (std::size_t i = 0; i < N; ++i) v += cfg_.c(o, i) * x_[i];
@@ -182,55 +200,11 @@ class BoardEmulator {
   }
 
   /// Q_d(Δ) of the process noise (Van Loan).
-  Matrix<double, N, N> process_covariance(std::int64_t delta_ns) const {
-    const double d = seconds(delta_ns);
-    Matrix<double, 2 * N, 2 * N> v;
-    v.template set_block<0, 0>(-(cfg_.a * d));
-    v.template set_block<0, N>(cfg_.qc * d);
-    v.template set_block<N, N>(cfg_.a.transposed() * d);
-    Matrix<double, 2 * N, 2 * N> f;
-    ONESHOT_ASSERT(matrix_exponential(v, f) == Status::kOk);
-    Matrix<double, N, N> q = f.template block<N, N, N, N>().transposed() * f.template block<0, N, N, N>();
-    mirror_upper(q);
-    return q;
-  }
-
-  /// E ∫₀^Δ nᵀ Q1c n ds for the noise path n started at 0 (series, or quadrature when
-  /// ‖A‖Δ is large).
-  double expected_noise_cost(std::int64_t delta_ns) const {
-    const double d = seconds(delta_ns);
-    if (2 * a_norm_ * d <= 8) {
-      double sum = 0;
-      double power = d;  // Δ^{k+1}/(k+1)!
-      for (std::size_t k = 0; k < kNoiseTerms; ++k) {
-        power *= d / static_cast<double>(k + 2);
-        const double term = noise_coeff_[k] * power;
-        sum += term;
-        if (k > 4 && std::fabs(term) <= 1e-18 * std::fabs(sum)) break;
-      }
-      return sum;
-    }
-    // Gauss–Legendre on ∫₀^Δ tr(Q1c Q_d(s)) ds, 16 panels × 5 nodes.
-    static constexpr double kX[5] = {-0.9061798459386640, -0.5384693101056831, 0.0, 0.5384693101056831,
-                                     0.9061798459386640};
-    static constexpr double kW[5] = {0.2369268850561891, 0.4786286704993665, 0.5688888888888889,
-                                     0.4786286704993665, 0.2369268850561891};
-    double sum = 0;
-    const double hp = d / 16;
-    for (int p = 0; p < 16; ++p)
-      for (int k = 0; k < 5; ++k) {
-        const double s = hp * (p + 0.5 + 0.5 * kX[k]);
-        const Matrix<double, N, N> prod = cfg_.q1c * process_covariance(static_cast<std::int64_t>(std::llround(s * 1e9)));
-        double tr = 0;
-        for (std::size_t i = 0; i < N; ++i) tr += prod(i, i);
-        sum += 0.5 * hp * kW[k] * tr;
-      }
-    return sum;
-  }
+  Matrix<double, N, N> process_covariance(Duration delta) const { return noise_.covariance(delta); }
+  /// E ∫₀^Δ nᵀ Q1c n ds for the noise path n started at 0.
+  double expected_noise_cost(Duration delta) const { return noise_.expected_cost(delta); }
 
  private:
-  static constexpr std::size_t kNoiseTerms = 40;
-
   struct Segment {
     Matrix<double, N, N> phi;
     Matrix<double, N, M> gamma;
@@ -241,6 +215,11 @@ class BoardEmulator {
 
   double level_average(std::size_t j, std::int32_t code) const {
     return cfg_.v_low[j] + (cfg_.v_high[j] - cfg_.v_low[j]) * code / cfg_.duty_steps;
+  }
+  Vector<double, M> inputs(const std::int32_t (&codes)[M]) const {
+    Vector<double, M> u;
+    for (std::size_t j = 0; j < M; ++j) u[j] = level_average(j, codes[j]);
+    return u;
   }
 
   std::int64_t high_ns(std::size_t j) const {
@@ -297,12 +276,14 @@ class BoardEmulator {
     }
   }
 
-  void apply_segment(State& e, std::int64_t d, const Vector<double, M>& dv) {
+  void apply_segment(State& e, std::int64_t d, const Vector<double, M>& dv, bool cost) {
     const Segment& s = segment(d);
-    Vector<double, kK> z;
-    z.template set_block<0, 0>(e);
-    z.template set_block<N, 0>(dv);
-    cost_.state += quadratic(s.g, z);
+    if (cost) {
+      Vector<double, kK> z;
+      z.template set_block<0, 0>(e);
+      z.template set_block<N, 0>(dv);
+      cost_.state += quadratic(s.g, z);
+    }
     e = s.phi * e + s.gamma * dv;
   }
 
@@ -317,19 +298,21 @@ class BoardEmulator {
     return q;
   }
 
-  void propagate(State& e, std::int64_t t0, std::int64_t t1) {
+  /// e over [t0, t1] with the duties in force; the state cost is added when `cost`.
+  void propagate(State& e, std::int64_t t0, std::int64_t t1, bool cost) {
     const std::int64_t period = cfg_.pwm_period_ns;
     const std::int64_t base0 = (t0 / period) * period;
     const std::int64_t boundary = base0 + period;
+    const auto apply = [&](std::int64_t d, const Vector<double, M>& dv) { apply_segment(e, d, dv, cost); };
     if (t1 <= boundary) {
-      for_each_segment(base0, t0, t1, [&](std::int64_t d, const Vector<double, M>& dv) { apply_segment(e, d, dv); });
+      for_each_segment(base0, t0, t1, apply);
       return;
     }
-    for_each_segment(base0, t0, boundary, [&](std::int64_t d, const Vector<double, M>& dv) { apply_segment(e, d, dv); });
+    for_each_segment(base0, t0, boundary, apply);
     const std::int64_t n = (t1 - boundary) / period;
-    if (n > 0) full_periods(e, n);
+    if (n > 0) full_periods(e, n, cost);
     const std::int64_t tail = boundary + n * period;
-    for_each_segment(tail, tail, t1, [&](std::int64_t d, const Vector<double, M>& dv) { apply_segment(e, d, dv); });
+    for_each_segment(tail, tail, t1, apply);
   }
 
   /// The per-period map S and cost C on w = [e; 1] for the current duties and set-point.
@@ -355,7 +338,7 @@ class BoardEmulator {
     powers_ = 1;
   }
 
-  void full_periods(State& e, std::int64_t n) {
+  void full_periods(State& e, std::int64_t n, bool cost) {
     if (powers_ == 0) build_period();
     Vector<double, N + 1> w;
     w.template set_block<0, 0>(e);
@@ -371,38 +354,61 @@ class BoardEmulator {
         ++powers_;
       }
       if ((n & 1) != 0) {
-        cost_.state += quadratic(c_pow_[j], w);
+        if (cost) cost_.state += quadratic(c_pow_[j], w);
         w = s_pow_[j] * w;
       }
     }
     e = w.template block<0, 0, N, 1>();
   }
 
-  void add_process_noise(std::int64_t delta_ns) {
-    const Matrix<double, N, N> q = process_covariance(delta_ns);
-    // Cholesky with zero pivots allowed (Q_d may be singular).
-    Matrix<double, N, N> l;
-    for (std::size_t j = 0; j < N; ++j) {
-      double d = q(j, j);
-      for (std::size_t k = 0; k < j; ++k) d -= l(j, k) * l(j, k);
-      l(j, j) = d > 0 ? std::sqrt(d) : 0;
-      for (std::size_t i = j + 1; i < N; ++i) {
-        double s = q(i, j);
-        for (std::size_t k = 0; k < j; ++k) s -= l(i, k) * l(j, k);
-        l(i, j) = l(j, j) > 0 ? s / l(j, j) : 0;
+  /// Appends the trace points in (now, t1] with their noise-free states (no cost, no draw).
+  void trace_deterministic(SimTime t1) {
+    State e = x_ - x_ref_;
+    SimTime t = now_;
+    bool switched = false;
+    while (trace_next_ <= t1) {
+      const SimTime s = trace_next_;
+      if (pending_ && !switched && pending_at_ > t && pending_at_ < s) {
+        propagate(e, t.count(), pending_at_.count(), false);
+        t = pending_at_;
+        switched = true;
+        swap_pending();
       }
+      propagate(e, t.count(), s.count(), false);
+      t = s;
+      trace_.push_back(Sample{s, e + x_ref_, r_, inputs(switched ? pending_codes_ : codes_)});
+      trace_next_ = s + trace_step_;
     }
-    State w;
-    for (std::size_t i = 0; i < N; ++i) w[i] = noise_.normal();
-    x_ = x_ + l * w;
-    cost_.noise += expected_noise_cost(delta_ns);
+    if (switched) swap_pending();
+  }
+  /// Exchanges the duties in force with the pending ones (trace walks only).
+  void swap_pending() {
+    for (std::size_t j = 0; j < M; ++j) std::swap(codes_[j], pending_codes_[j]);
+    invalidate();
+  }
+
+  /// Adds the bridged noise path to the trace points from index `first` (interval from `start`).
+  void trace_noise(SimTime start, std::size_t first, const State& n_end) {
+    if (!cfg_.process_noise) return;
+    State n_prev{};
+    SimTime t_prev = start;
+    for (std::size_t i = first; i < trace_.size(); ++i) {
+      const SimTime s = trace_[i].t;
+      // Noise still to come after t_prev given n(t_prev): n_end − Φ(now − t_prev) n(t_prev).
+      const State rest = n_end - noise_.transition(now_ - t_prev) * n_prev;
+      const State n_s = noise_.transition(s - t_prev) * n_prev + noise_.bridge(s - t_prev, now_ - t_prev, rest, trace_rng_);
+      trace_[i].x = trace_[i].x + n_s;
+      n_prev = n_s;
+      t_prev = s;
+    }
   }
 
   static constexpr std::size_t kMaxPowers = 48;
 
   CircuitConfig<N, M, P> cfg_;
-  RandomStream noise_;
-  std::int64_t now_ns_ = 0;
+  RandomStream noise_rng_;
+  ProcessNoise<N> noise_;
+  SimTime now_{0};
   State x_{};
   Vector<double, P> r_{};
   State x_ref_{};
@@ -410,14 +416,16 @@ class BoardEmulator {
   std::int32_t codes_[M] = {};
   std::int32_t pending_codes_[M] = {};
   bool pending_ = false;
-  std::int64_t pending_at_ns_ = 0;
+  SimTime pending_at_{0};
   CostBreakdown cost_{};
-  double noise_coeff_[kNoiseTerms] = {};
-  double a_norm_ = 0;
   std::unordered_map<std::int64_t, Segment> segments_;
   Aug s_pow_[kMaxPowers];
   Aug c_pow_[kMaxPowers];
   std::size_t powers_ = 0;
+  Duration trace_step_{0};
+  SimTime trace_next_{0};
+  RandomStream trace_rng_{0, "trace"};
+  std::vector<Sample> trace_;
 };
 
-}  // namespace oneshot::sim
+}  // namespace oneshot::engine

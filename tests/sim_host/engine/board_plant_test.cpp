@@ -1,5 +1,5 @@
-/// @file board_emulator_test.cpp
-/// @brief The emulated board against an edge-by-edge oracle (Eigen exponential per PWM
+/// @file board_plant_test.cpp
+/// @brief The board plant against an edge-by-edge oracle (Eigen exponential per PWM
 ///        segment, cost by quadrature), the latched PWM mode, and the noise statistics.
 #include <gtest/gtest.h>
 
@@ -76,13 +76,13 @@ class EdgeOracle {
   double cost_ = 0;
 };
 
-TEST(BoardEmulator, AggregatedPeriodsEqualEdgeByEdge) {
+TEST(BoardPlant, AggregatedPeriodsEqualEdgeByEdge) {
   // GIVEN the reference board without process noise
   const auto plant = design::reference_plant();
   const auto d = design::synthesize(plant);
   BoardOptions opt;
   opt.process_noise = false;
-  BoardEmulator<2, 1, 1> emu(circuit_config<2, 1, 1>(plant, d, opt), RandomStream(1, "noise"));
+  BoardPlant<2, 1, 1> emu(circuit_config<2, 1, 1>(plant, d, opt), RandomStream(1, "noise"));
   EdgeOracle oracle(plant, d);
   std::mt19937_64 rng(5);
   std::uniform_int_distribution<std::int64_t> step(1, 60'000'000);  // up to 60 ms, ns resolution
@@ -92,7 +92,7 @@ TEST(BoardEmulator, AggregatedPeriodsEqualEdgeByEdge) {
   // WHEN both see the same duty writes, set-point changes and arbitrary event times
   for (int k = 0; k < 120; ++k) {
     t += step(rng);
-    emu.advance_to(t);
+    emu.advance_to(engine::SimTime{t});
     oracle.advance_to(t);
     // THEN state and accumulated cost agree
     EXPECT_NEAR(emu.state()[0], oracle.state()[0], 1e-12 * (1 + std::fabs(oracle.state()[0]))) << "event " << k;
@@ -110,33 +110,33 @@ TEST(BoardEmulator, AggregatedPeriodsEqualEdgeByEdge) {
   }
 }
 
-TEST(BoardEmulator, LatchedDutyActsAtTheNextPeriod) {
+TEST(BoardPlant, LatchedDutyActsAtTheNextPeriod) {
   const auto plant = design::reference_plant();
   const auto d = design::synthesize(plant);
   BoardOptions opt;
   opt.process_noise = false;
   opt.update = PwmUpdate::kNextPeriod;
-  BoardEmulator<2, 1, 1> latched(circuit_config<2, 1, 1>(plant, d, opt), RandomStream(1, "noise"));
+  BoardPlant<2, 1, 1> latched(circuit_config<2, 1, 1>(plant, d, opt), RandomStream(1, "noise"));
   opt.update = PwmUpdate::kImmediate;
-  BoardEmulator<2, 1, 1> immediate(circuit_config<2, 1, 1>(plant, d, opt), RandomStream(1, "noise"));
-  latched.advance_to(10'010);  // inside the period [0, 50 µs)
-  immediate.advance_to(10'010);
+  BoardPlant<2, 1, 1> immediate(circuit_config<2, 1, 1>(plant, d, opt), RandomStream(1, "noise"));
+  latched.advance_to(engine::SimTime{10'010});  // inside the period [0, 50 µs)
+  immediate.advance_to(engine::SimTime{10'010});
   latched.set_duty(0, 1500);
   EXPECT_EQ(latched.duty(0), 0);
-  latched.advance_to(49'999);
+  latched.advance_to(engine::SimTime{49'999});
   EXPECT_EQ(latched.duty(0), 0);
-  latched.advance_to(50'000);
+  latched.advance_to(engine::SimTime{50'000});
   EXPECT_EQ(latched.duty(0), 1500);
   // Same trajectory as an immediate write made at the period start.
-  immediate.advance_to(50'000);
+  immediate.advance_to(engine::SimTime{50'000});
   immediate.set_duty(0, 1500);
-  latched.advance_to(3'000'000);
-  immediate.advance_to(3'000'000);
+  latched.advance_to(engine::SimTime{3'000'000});
+  immediate.advance_to(engine::SimTime{3'000'000});
   EXPECT_NEAR(latched.state()[0], immediate.state()[0], 1e-15);
   EXPECT_NEAR(latched.state()[1], immediate.state()[1], 1e-15);
 }
 
-TEST(BoardEmulator, ProcessNoiseHasTheExactCovariance) {
+TEST(BoardPlant, ProcessNoiseHasTheExactCovariance) {
   const auto plant = design::reference_plant();
   const auto d = design::synthesize(plant);
   const auto cfg = circuit_config<2, 1, 1>(plant, d, BoardOptions{});
@@ -145,15 +145,15 @@ TEST(BoardEmulator, ProcessNoiseHasTheExactCovariance) {
   // The PWM ripple itself moves the double integrator: subtract the noise-free trajectory.
   auto quiet_cfg = cfg;
   quiet_cfg.process_noise = false;
-  BoardEmulator<2, 1, 1> quiet(quiet_cfg, RandomStream(0, "noise"));
+  BoardPlant<2, 1, 1> quiet(quiet_cfg, RandomStream(0, "noise"));
   quiet.set_duty(0, 1000);
-  quiet.advance_to(delta);
+  quiet.advance_to(engine::SimTime{delta});
   const VecX x_det = test::to_eigen(quiet.state());
   MatX sum = MatX::Zero(2, 2);
   for (int k = 0; k < runs; ++k) {
-    BoardEmulator<2, 1, 1> emu(cfg, RandomStream(static_cast<std::uint64_t>(k), "noise"));
+    BoardPlant<2, 1, 1> emu(cfg, RandomStream(static_cast<std::uint64_t>(k), "noise"));
     emu.set_duty(0, 1000);
-    emu.advance_to(delta);
+    emu.advance_to(engine::SimTime{delta});
     const VecX x = test::to_eigen(emu.state()) - x_det;
     sum += x * x.transpose();
   }
@@ -165,10 +165,10 @@ TEST(BoardEmulator, ProcessNoiseHasTheExactCovariance) {
   EXPECT_NEAR(cov(0, 1), qd(0, 1), 0.08 * std::fabs(qd(0, 1)));
 }
 
-TEST(BoardEmulator, ExpectedNoiseCostMatchesQuadrature) {
+TEST(BoardPlant, ExpectedNoiseCostMatchesQuadrature) {
   const auto plant = design::reference_plant();
   const auto d = design::synthesize(plant);
-  const BoardEmulator<2, 1, 1> emu(circuit_config<2, 1, 1>(plant, d, BoardOptions{}), RandomStream(1, "noise"));
+  const BoardPlant<2, 1, 1> emu(circuit_config<2, 1, 1>(plant, d, BoardOptions{}), RandomStream(1, "noise"));
   for (std::int64_t delta : {1'000'000LL, 20'000'000LL, 50'000'000LL}) {
     // ∫₀^Δ tr(Q1c Q_d(s)) ds with Q_d by Eigen quadrature.
     const double dd = static_cast<double>(delta) * 1e-9;
@@ -178,14 +178,14 @@ TEST(BoardEmulator, ExpectedNoiseCostMatchesQuadrature) {
       const double s = dd * (i + 0.5) / n;
       ref += dd / n * (test::to_eigen(plant.q1c) * test::qd_by_quadrature(test::to_eigen(plant.a), test::to_eigen(d.qc), s, 20)).trace();
     }
-    EXPECT_NEAR(emu.expected_noise_cost(delta), ref, 1e-4 * ref) << delta;
+    EXPECT_NEAR(emu.expected_noise_cost(engine::Duration{delta}), ref, 1e-4 * ref) << delta;
   }
 }
 
-TEST(BoardEmulator, AdcQuantisesAndSaturates) {
+TEST(BoardPlant, AdcQuantisesAndSaturates) {
   const auto plant = design::reference_plant();
   const auto d = design::synthesize(plant);
-  BoardEmulator<2, 1, 1> emu(circuit_config<2, 1, 1>(plant, d, BoardOptions{}), RandomStream(1, "noise"));
+  BoardPlant<2, 1, 1> emu(circuit_config<2, 1, 1>(plant, d, BoardOptions{}), RandomStream(1, "noise"));
   Vector<double, 2> x;
   x[0] = 0.0;
   emu.set_state(x);

@@ -1,0 +1,90 @@
+/// @file network.hpp
+/// @brief The simulated network between nodes: addressed node ports (the host port of the
+///        HAL network contract), routes from one address to another over a link or a CAN
+///        bus, and the delivery events.
+///
+/// Node logic (firmware/node/) runs inside run_node(): the node's HostNetworkState is made
+/// current (so Board::Net::send/receive reach it), and after the call every frame the node
+/// sent is routed: over a Link (loss, delay, FIFO or reordering) or queued on a CanBus
+/// with the route's identifier (a message longer than 8 bytes goes as consecutive frames
+/// of ≤ 8 bytes with that identifier and arrives with its last one). An arrival is a kDelivery event that puts the frame into
+/// the destination's inbox and calls its receive handler inside run_node(). A node's
+/// clock reads t + its offset (node_clock()).
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <map>
+#include <memory>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "oneshot/engine/can_bus.hpp"
+#include "oneshot/engine/kernel.hpp"
+#include "oneshot/engine/link.hpp"
+#include "oneshot/host/host_network.hpp"
+
+namespace oneshot::engine {
+
+/// A node's attachment to the network.
+struct NodePort {
+  std::string name;                     ///< For messages.
+  host::HostNetworkState interface;     ///< What Board::Net sees inside run_node().
+  Duration clock_offset{0};             ///< The node's clock reads t + offset.
+  std::function<void()> on_receive;     ///< Called (inside run_node) after each arrival.
+};
+
+/// Nodes, links, buses and routes of one run.
+class Network {
+ public:
+  /// Network of one run on `kernel`.
+  explicit Network(Kernel& kernel);
+  Network(const Network&) = delete;
+  Network& operator=(const Network&) = delete;
+
+  /// Adds node `address` (unique); `on_receive` runs after each arrival.
+  NodePort& add_node(std::uint8_t address, const std::string& name, Duration clock_offset,
+                     std::function<void()> on_receive);
+  /// Adds a link (its random streams come from the kernel's seed and the link's name).
+  Link& add_link(const LinkConfig& config);
+  /// Adds a CAN bus.
+  CanBus& add_can_bus(const CanBusConfig& config);
+  /// Frames from `source` to `destination` travel over `link`.
+  void route(std::uint8_t source, std::uint8_t destination, Link& link);
+  /// Frames from `source` to `destination` are queued on `bus` with identifier `id`.
+  void route(std::uint8_t source, std::uint8_t destination, CanBus& bus, std::uint32_t id);
+
+  /// Runs `f` as node `address` (its interface current), then routes what it sent.
+  void run_node(std::uint8_t address, const std::function<void()>& f);
+  /// The node's clock now (wrapping 32-bit µs, with its offset).
+  McuInstant node_clock(std::uint8_t address) const;
+  /// The node's port.
+  NodePort& node(std::uint8_t address);
+
+  /// Frames sent, frames refused because no route exists (a configuration error: counted,
+  /// and run_node() throws on the first).
+  std::uint64_t frames_sent() const { return frames_sent_; }
+
+ private:
+  struct Route {
+    Link* link = nullptr;
+    CanBus* bus = nullptr;
+    std::uint32_t id = 0;
+  };
+  void deliver(std::uint64_t slot);
+  std::uint64_t park(host::Frame frame);
+
+  Kernel& kernel_;
+  std::map<std::uint8_t, std::unique_ptr<NodePort>> nodes_;
+  std::vector<std::unique_ptr<Link>> links_;
+  std::vector<std::unique_ptr<CanBus>> buses_;
+  std::map<std::pair<std::uint8_t, std::uint8_t>, Route> routes_;
+  std::vector<host::Frame> in_flight_;
+  std::vector<std::uint64_t> free_slots_;
+  HandlerId deliver_id_ = 0;
+  HandlerId fragment_id_ = 0;
+  std::uint64_t frames_sent_ = 0;
+};
+
+}  // namespace oneshot::engine

@@ -1,0 +1,151 @@
+/// @file study_file.hpp
+/// @brief The study file: plant + nodes + links (+ CAN buses) + approaches + scenarios, in
+///        JSON, parsed strictly (docs/engine.md has the schema with an example).
+///
+/// parse_study() takes the text and a source name only (no other input), so a fuzzing
+/// harness can call it on any string; delay-trace files named inside are read relative to
+/// `base_dir`. Every error is an InputError naming the field ("links[1].delay.max_us:
+/// below min_us"). Unknown and duplicate keys are refused, numbers are range-checked,
+/// names are unique, and every link connects declared nodes. What a study does with its
+/// approaches and scenarios is its own code: a StudySchema lists the approach kinds and
+/// the numeric parameters it accepts (range, integer or not, required or default), and
+/// parse_study() checks the file against it; without a schema any kind and any finite
+/// numeric parameter pass.
+#pragma once
+
+#include <cstdint>
+#include <map>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "oneshot/engine/can_analysis.hpp"
+#include "oneshot/engine/can_bus.hpp"
+#include "oneshot/engine/delay_model.hpp"
+#include "oneshot/engine/json_fields.hpp"
+#include "oneshot/engine/link.hpp"
+#include "oneshot/engine/loss_model.hpp"
+#include "oneshot/engine/plant_model.hpp"
+
+namespace oneshot::engine {
+
+/// The version string the "schema" field must hold.
+inline constexpr const char* kStudySchemaVersion = "oneshot-study/1";
+
+/// A numeric parameter a study accepts for its approaches or scenarios.
+struct ParamSpec {
+  std::string name;         ///< Key in "params".
+  double min = 0;           ///< Smallest value.
+  double max = 0;           ///< Largest value.
+  bool integer = false;     ///< Must be a whole number.
+  bool required = false;    ///< Must be given (else `fallback`).
+  double fallback = 0;      ///< Value when absent.
+};
+
+/// What a study accepts in its file.
+struct StudySchema {
+  std::string study;                        ///< The "study" field must equal this.
+  std::vector<std::string> approach_kinds;  ///< Allowed "kind" values of approaches.
+  std::vector<ParamSpec> approach_params;   ///< Allowed approach "params".
+  std::vector<ParamSpec> scenario_params;   ///< Allowed scenario "params".
+};
+
+/// Where the plant comes from.
+struct PlantSpec {
+  /// Form of the plant.
+  enum class Kind : std::uint8_t { kFile, kContinuous, kDiscrete };
+  Kind kind = Kind::kFile;     ///< Form.
+  std::string file;            ///< kFile: a plant description file (lut_gen's format).
+  ContinuousModel continuous;  ///< kContinuous: the matrices.
+  DiscreteModel discrete;      ///< kDiscrete: the matrices and period.
+};
+
+/// A node's trigger rule.
+struct TriggerSpec {
+  /// Rule.
+  enum class Rule : std::uint8_t { kPeriodic, kSendOnDelta, kMtm };
+  Rule rule = Rule::kPeriodic;   ///< Rule.
+  std::uint32_t every = 1;       ///< Periodic: every n-th sample.
+  std::vector<double> delta;     ///< Send-on-delta: δy per component.
+  std::uint32_t time_steps = 0;  ///< Send-on-delta: n_t (0: plain send-on-delta).
+  double sigma = 0;              ///< MTM: σ.
+  double mtm_delta = 0;          ///< MTM: δ.
+  std::uint32_t k_max = 0;       ///< MTM: safety after k_max samples (0: off).
+  std::uint32_t k_ref_max = 0;   ///< MTM: send k_ref,max samples after a reference change.
+};
+
+/// A node.
+struct NodeSpec {
+  std::string name;              ///< Unique name.
+  std::string role;              ///< "sensor", "controller" or "actuator".
+  std::uint8_t address = 0;      ///< Network address (unique).
+  std::string mode;              ///< "timer" or "arrival".
+  Duration period{0};            ///< Timer period (mode timer; 0 otherwise).
+  Duration clock_offset{0};      ///< Its clock reads t + offset.
+  std::optional<TriggerSpec> trigger;  ///< Sensors (and event-triggered controllers).
+};
+
+/// A link between two nodes: its own delay/loss models, or a CAN bus identifier.
+struct LinkSpec {
+  std::string name;       ///< Unique name (names its random streams).
+  std::string from;       ///< Sending node.
+  std::string to;         ///< Receiving node.
+  std::string bus;        ///< CAN bus name (empty: a point-to-point link).
+  std::uint32_t id = 0;   ///< CAN identifier (bus only).
+  DelayModel delay;       ///< Point-to-point: delay.
+  LossModel loss;         ///< Point-to-point: loss.
+  bool fifo = false;      ///< Point-to-point: "order": "fifo" (else "any": reordering allowed).
+};
+
+/// A CAN bus with optional periodic background traffic.
+struct BusSpec {
+  CanBusConfig config;                ///< Name, bit rate, identifier length.
+  std::vector<CanStream> background;  ///< Other traffic on the bus.
+  std::vector<Duration> offsets;      ///< First release of each background stream.
+};
+
+/// An approach: a name, a study-defined kind, numeric parameters.
+struct ApproachSpec {
+  std::string name;                       ///< Unique name (table column).
+  std::string kind;                       ///< What the study runs.
+  std::map<std::string, double> params;   ///< Parameters (schema defaults filled in).
+};
+
+/// A scenario: a name, numeric parameters, per-link model overrides.
+struct ScenarioSpec {
+  std::string name;                          ///< Unique name.
+  std::optional<double> duration_s;          ///< Overrides the study's duration.
+  std::map<std::string, double> params;      ///< Parameters (schema defaults filled in).
+  std::map<std::string, DelayModel> delays;  ///< Link name → delay override.
+  std::map<std::string, LossModel> losses;   ///< Link name → loss override.
+};
+
+/// A parsed study file.
+struct StudyFile {
+  std::string source;                   ///< Where it came from.
+  std::string study;                    ///< Study code that runs it.
+  std::string description;              ///< Free text.
+  PlantSpec plant;                      ///< The plant.
+  double duration_s = 0;                ///< Simulated time per run.
+  std::uint64_t first_seed = 1;         ///< Seed of the first replication.
+  std::size_t seeds = 0;                ///< Replications.
+  std::vector<NodeSpec> nodes;          ///< Nodes.
+  std::vector<LinkSpec> links;          ///< Links.
+  std::vector<BusSpec> buses;           ///< CAN buses.
+  std::vector<ApproachSpec> approaches; ///< Approaches.
+  std::vector<ScenarioSpec> scenarios;  ///< Scenarios.
+
+  /// The node called `name` (InputError otherwise).
+  const NodeSpec& node(const std::string& name) const;
+  /// The link called `name`, with scenario `s`'s overrides applied (InputError otherwise).
+  LinkConfig link_config(const std::string& name, const ScenarioSpec* s = nullptr) const;
+};
+
+/// Parses and validates a study file's text; `schema` may be null (any kinds and params).
+StudyFile parse_study(const std::string& text, const std::string& source, const StudySchema* schema,
+                      const std::string& base_dir = {});
+
+/// Reads, parses and validates a study file (InputError naming the file and field).
+StudyFile load_study(const std::string& path, const StudySchema* schema);
+
+}  // namespace oneshot::engine

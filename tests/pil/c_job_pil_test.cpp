@@ -1,0 +1,44 @@
+/// @file c_job_pil_test.cpp
+/// @brief The generated C99 job inside the firmware images (approach 5): on each MCU under
+///        QEMU it gives the C++ half-Kalman job's replies byte for byte on the exectime jobs,
+///        costs fewer instructions than it, and its job-only image fits 12 KB flash / 1 KB RAM.
+#include <gtest/gtest.h>
+
+#include <string>
+
+#include "oneshot/sim/experiments.hpp"
+#include "oneshot/sim/pil_link.hpp"
+
+namespace oneshot::sim {
+namespace {
+
+TEST(CJobOnMcu, SameRepliesAsTheCppJobAndFewerInstructions) {
+  const auto ctx = SimContext::reference();
+  for (const std::string target : {"cortex-m0", "cortex-m4f"}) {
+    SCOPED_TRACE(target);
+    PilOptions p;
+    p.target = target;
+    CommonOptions o;
+    o.plots = false;
+    o.noise = NoiseModel::kExact;  // the C job's model
+    const auto j = run_exectime_target(*ctx, o, p);
+    for (const char* fmt : {"fixed", "float"}) {
+      for (const char* disc : {"table", "nearest"}) {
+        const std::string c = std::string("c99_half_") + disc + "_" + fmt;
+        const std::string cpp = std::string("half_") + disc + "_" + fmt;
+        ASSERT_TRUE(j["variants"].contains(c)) << c;
+        const auto& v = j["variants"][c];
+        EXPECT_GT(v["jobs"].get<int>(), 50) << c;
+        EXPECT_EQ(v["bit_identical_to_cpp_jobs"].get<int>(), v["jobs"].get<int>()) << c;
+        EXPECT_LT(v["instructions_per_job"].get<double>(), j["variants"][cpp]["instructions_per_job"].get<double>()) << c;
+        const auto& image = v["job_only_image"];
+        ASSERT_TRUE(image.contains("flash_bytes")) << c;
+        EXPECT_LE(image["flash_bytes"].get<int>(), 12 * 1024) << c;
+        EXPECT_LE(image["ram_total_bound_bytes"].get<int>(), 1024) << c;
+      }
+    }
+  }
+}
+
+}  // namespace
+}  // namespace oneshot::sim

@@ -1,0 +1,166 @@
+/// @file study_file_test.cpp
+/// @brief The study file: the documented example parses to what it says, a study's
+///        schema is enforced, and every malformed input is refused with its field named.
+#include <gtest/gtest.h>
+
+#include <fstream>
+#include <sstream>
+
+#include "oneshot/engine/study_file.hpp"
+
+namespace oneshot::engine {
+namespace {
+
+std::string example_text() {
+  std::ifstream in(std::string(ONESHOT_SOURCE_DIR) + "/sim_host/engine/examples/example_study.json");
+  std::ostringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+StudySchema example_schema() {
+  StudySchema s;
+  s.study = "example";
+  s.approach_kinds = {"ideal", "kalman"};
+  s.approach_params = {{"process_noise_scale", 0, 100, false, false, 1}};
+  s.scenario_params = {{"amplitude", 0, 1.65, false, true, 0}, {"period_s", 0.1, 100, false, false, 2}};
+  return s;
+}
+
+TEST(StudyFile, TheDocumentedExampleParses) {
+  const StudySchema schema = example_schema();
+  const StudyFile f = parse_study(example_text(), "example_study.json", &schema);
+  EXPECT_EQ(f.study, "example");
+  ASSERT_EQ(f.plant.kind, PlantSpec::Kind::kContinuous);
+  EXPECT_EQ(f.plant.continuous.a(0, 1), -23.8);
+  EXPECT_EQ(f.seeds, 50U);
+  ASSERT_EQ(f.nodes.size(), 3U);
+  EXPECT_EQ(f.node("sensor").period, from_us(50000));
+  ASSERT_TRUE(f.node("sensor").trigger.has_value());
+  EXPECT_EQ(f.node("sensor").trigger->time_steps, 10U);
+  EXPECT_EQ(f.node("controller").clock_offset, from_us(120));
+  ASSERT_EQ(f.links.size(), 2U);
+  EXPECT_EQ(f.links[1].bus, "can0");
+  EXPECT_EQ(f.buses[0].background[0].deadline, from_us(5000));  // deadline defaults to the period
+  EXPECT_EQ(f.approaches[0].params.at("process_noise_scale"), 1.0);  // schema default
+  EXPECT_EQ(f.scenarios[0].params.at("period_s"), 2.0);
+  const LinkConfig base = f.link_config("sc");
+  const LinkConfig heavy = f.link_config("sc", &f.scenarios[1]);
+  EXPECT_EQ(base.delay.kind, DelayModel::Kind::kUniform);
+  EXPECT_EQ(heavy.delay.kind, DelayModel::Kind::kLognormal);
+  EXPECT_EQ(heavy.loss.kind, LossModel::Kind::kBernoulli);
+  EXPECT_EQ(*f.scenarios[1].duration_s, 10.0);
+  // Without a schema any kind and finite parameter passes.
+  EXPECT_NO_THROW(parse_study(example_text(), "x", nullptr));
+}
+
+/// The example with `from` replaced by `to` (must occur).
+std::string edited(const std::string& from, const std::string& to) {
+  std::string s = example_text();
+  const auto at = s.find(from);
+  EXPECT_NE(at, std::string::npos) << from;
+  return s.replace(at, from.size(), to);
+}
+
+TEST(StudyFile, MalformedFilesNameTheField) {
+  const StudySchema schema = example_schema();
+  struct Case {
+    std::string text;
+    const char* expected;
+  };
+  const Case cases[] = {
+      {edited("\"duration_s\": 20,", "\"duration_s\": 20, \"duration_s\": 30,"), "duplicate key 'duration_s'"},
+      {edited("\"duration_s\": 20,", "\"duratoin_s\": 20,"), "study file.duratoin_s"},
+      {edited("\"duration_s\": 20,", "\"duration_s\": -1,"), "duration_s"},
+      {edited("\"count\": 50", "\"count\": 1"), "seeds.count"},
+      {edited("oneshot-study/1", "oneshot-study/2"), "schema"},
+      {edited("\"study\": \"example\"", "\"study\": \"ncs\""), "study"},
+      {edited("\"A\": [[0, -23.8], [0, 0]]", "\"A\": [[0, -23.8], [0]]"), "plant.continuous.A"},
+      {edited("\"C\": [[1, 0], [0, 1]]", "\"C\": [[1, 0, 0]]"), "plant.continuous.C"},
+      {edited("\"Q_c\": [[4e-6, 0], [0, 4e-6]]", "\"Q_c\": [[4e-6, 1], [1, 4e-6]]"), "plant.continuous.Q_c"},
+      {edited("\"Q_c\": [[4e-6, 0], [0, 4e-6]]", "\"Q_c\": [[4e-6, 0], [1, 4e-6]]"), "not symmetric"},
+      {edited("\"address\": 2", "\"address\": 1"), "nodes[1].address"},
+      {edited("\"address\": 3", "\"address\": 300"), "nodes[2].address"},
+      {edited("\"role\": \"actuator\"", "\"role\": \"relay\""), "nodes[2].role"},
+      {edited("\"mode\": \"arrival\", \"clock_offset_us\"", "\"mode\": \"arrival\", \"period_us\": 5, \"clock_offset_us\""),
+       "nodes[1].period_us"},
+      {edited("\"time_steps\": 10", "\"time_steps\": -10"), "nodes[0].trigger.time_steps"},
+      {edited("\"rule\": \"send_on_delta\"", "\"rule\": \"sometimes\""), "nodes[0].trigger.rule"},
+      {edited("\"to\": \"controller\"", "\"to\": \"plant\""), "no node 'plant'"},
+      {edited("\"max_us\": 4000", "\"max_us\": 400"), "links[0].delay.max_us"},
+      {edited("\"p_bad_to_good\": 0.3", "\"p_bad_to_good\": 1.3"), "links[0].loss.p_bad_to_good"},
+      {edited("\"order\": \"any\"", "\"order\": \"lifo\""), "links[0].order"},
+      {edited("\"bus\": \"can0\", \"id\": 16", "\"bus\": \"can0\", \"id\": 256"), "links[1].id"},
+      {edited("\"bus\": \"can0\", \"id\": 16", "\"bus\": \"can1\", \"id\": 16"), "links[1].bus"},
+      {edited("\"bit_rate\": 500000", "\"bit_rate\": 300000"), "buses[0].bit_rate"},
+      {edited("\"kind\": \"kalman\"", "\"kind\": \"magic\""), "approaches[1].kind"},
+      {edited("\"process_noise_scale\": 1", "\"process_noise_scale\": 1000"), "approaches[1].params.process_noise_scale"},
+      {edited("{\"amplitude\": 0.2}", "{\"amplitude\": 0.2, \"gain\": 3}"), "scenarios[0].params.gain"},
+      {edited("{\"amplitude\": 0.2}", "{}"), "scenarios[0].params.amplitude"},
+      {edited("\"name\": \"d4\"", "\"name\": \"d14-heavy\""), "scenarios[1].name"},
+      {edited("\"links\": {\"sc\"", "\"links\": {\"ca\""), "link 'ca' runs on CAN bus"},
+      {edited("\"sigma\": 0.6", "\"sigma\": \"wide\""), "scenarios[1].links.sc.delay.sigma"},
+      {"{\"schema\": ", "not valid JSON"},
+      {"[]", "must be an object"},
+      {std::string(40, '[') + std::string(40, ']'), "nested deeper than 32"},
+  };
+  for (const Case& c : cases) {
+    try {
+      parse_study(c.text, "f.json", &schema);
+      ADD_FAILURE() << "accepted; expected an error naming " << c.expected;
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find(c.expected), std::string::npos) << e.what();
+      EXPECT_EQ(std::string(e.what()).rfind("f.json", 0), 0U) << e.what();
+    }
+  }
+}
+
+TEST(StudyFile, DiscretePlantsAndDimensionLimits) {
+  const std::string discrete = edited(
+      R"("continuous": {
+      "A": [[0, -23.8], [0, 0]],
+      "B": [[0], [-23.8]],
+      "C": [[1, 0], [0, 1]],
+      "Q_c": [[4e-6, 0], [0, 4e-6]],
+      "Q1c": [[1, 0], [0, 1]],
+      "Q2c": [[1]]
+    })",
+      R"("discrete": {"Phi": [[1.25, 1, 0], [0, 0.9, 7], [0, 0, 0.6]], "Gamma": [[2.2], [1], [0.1]],
+                   "C": [[1, 0, 2]], "Q": [[20, 0, 0], [0, 20, 0], [0, 0, 20]], "period_us": 10000})");
+  const StudyFile f = parse_study(discrete, "d.json", nullptr);
+  ASSERT_EQ(f.plant.kind, PlantSpec::Kind::kDiscrete);
+  EXPECT_EQ(f.plant.discrete.period, from_us(10000));
+  const auto cfg = make_discrete_config<3, 1, 1, 1>(f.plant.discrete, "dropping");
+  EXPECT_EQ(cfg.phi(0, 0), 1.25);
+  EXPECT_THROW((make_discrete_config<2, 1, 1, 1>(f.plant.discrete, "dropping")), std::invalid_argument);
+  std::ostringstream a;
+  a << "[";
+  for (int i = 0; i < 17; ++i) {
+    a << (i ? "," : "") << "[";
+    for (int j = 0; j < 17; ++j) a << (j ? "," : "") << 0;
+    a << "]";
+  }
+  a << "]";
+  std::ostringstream b;
+  b << "[";
+  for (int i = 0; i < 17; ++i) b << (i ? "," : "") << "[1]";
+  b << "]";
+  std::ostringstream c;
+  c << "[[";
+  for (int j = 0; j < 17; ++j) c << (j ? "," : "") << 1;
+  c << "]]";
+  const std::string huge = edited(R"("A": [[0, -23.8], [0, 0]],
+      "B": [[0], [-23.8]],
+      "C": [[1, 0], [0, 1]],
+      "Q_c": [[4e-6, 0], [0, 4e-6]],)",
+                                  "\"A\": " + a.str() + ", \"B\": " + b.str() + ", \"C\": " + c.str() + ", \"Q_c\": " + a.str() + ",");
+  try {
+    parse_study(huge, "h.json", nullptr);
+    FAIL();
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("kMaxStates"), std::string::npos) << e.what();
+  }
+}
+
+}  // namespace
+}  // namespace oneshot::engine
