@@ -145,6 +145,20 @@ TEST_P(PilLinkTest, AConfigWithAnUnknownApproachIsRefused) {
   EXPECT_NE(refusal(link, pil::Type::kConfig, cfg).find("refused a malformed request"), std::string::npos);
 }
 
+TEST_P(PilLinkTest, TheGeneratedCJobIsRefusedByAnImageWithoutIt) {
+  // Approach 5 (the C99 job) exists on table images only; the generic image refuses it
+  // instead of running another approach in its place.
+  PilOptions o = options_for(GetParam());
+  o.discretizer = "generic";
+  PilLink link(o);
+  pil::Frame cfg;
+  pil::Writer w(cfg);
+  w.u(pil::kMaxApproach, 1);
+  w.u(1, 1);
+  w.u(2000, 2);
+  EXPECT_NE(refusal(link, pil::Type::kConfig, cfg).find("refused a malformed request"), std::string::npos);
+}
+
 INSTANTIATE_TEST_SUITE_P(Targets, PilLinkTest, ::testing::Values("cortex-m0", "cortex-m4f"),
                          [](const ::testing::TestParamInfo<std::string>& param_info) {
                            return std::string(param_info.param == "cortex-m0" ? "M0" : "M4F");

@@ -247,5 +247,25 @@ TEST(CliHardening, ReportWritesWhereOutSays) {
   EXPECT_FALSE(fs::exists(cwd + "/out"));
 }
 
+TEST(CliHardening, AShardFileIsReadStrictlyAndBounded) {
+  const std::string dir = fresh_dir("shards");
+  // A valid shard of a two-seed table1, then the same file with a key given twice.
+  const std::string one = scenario_named("hard_shard_scenario.json", "short");
+  const auto made = run_command({sim(), "table1", "--seeds", "2", "--scenarios", one, "--shard", "0/2", "--no-plots",
+                                 "--out", dir});
+  ASSERT_EQ(made.exit_code, 0) << made.output;
+  const std::string shard = dir + "/table1.shard-0-of-2.json";
+  std::string text = read(shard);
+  ASSERT_EQ(text.rfind("{", 0), 0U);
+  text.insert(1, "\"format\": \"x\",");
+  const std::string twice = test::write_temp_file("hard_shard_twice.json", text);
+  for (const std::string& bad : {twice, dir}) {
+    const auto r = run_command({sim(), "merge", bad, "--no-plots", "--out", dir + "/merged"});
+    EXPECT_NE(r.exit_code, 0) << bad;
+    EXPECT_NE(r.output.find(bad == dir ? "is a directory" : "duplicate key"), std::string::npos) << r.output;
+  }
+  EXPECT_FALSE(fs::exists(dir + "/merged"));
+}
+
 }  // namespace
 }  // namespace oneshot
