@@ -22,7 +22,8 @@ struct TableOptions {
   bool noise_free = false;         ///< No noise: the invariant A = I, S degrading with d.
   unsigned threads = 0;            ///< Worker threads (0: every core).
   std::vector<Approach> approaches{kAllApproaches.begin(), kAllApproaches.end()};  ///< I must be first.
-  double duration_s = 20;          ///< Run length per scenario.
+  std::vector<Scenario> scenarios;  ///< Scenarios (empty: the ten defaults, with duration_s).
+  double duration_s = 20;          ///< Run length per default scenario.
 };
 
 /// Runs the table's sweep (or one shard of it).

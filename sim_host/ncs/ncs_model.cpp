@@ -4,11 +4,15 @@
 
 #include <cmath>
 #include <cstdio>
+#include <fstream>
+#include <set>
+#include <sstream>
 #include <stdexcept>
 
 #include "oneshot/design/dare.hpp"
 #include "oneshot/design/dense_ops.hpp"
 #include "oneshot/design/fixed_size.hpp"
+#include "oneshot/engine/json_fields.hpp"
 
 #ifndef ONESHOT_NCS_PLANT_FILE
 #error "ONESHOT_NCS_PLANT_FILE must name lut_gen/plants/networked_board.json"
@@ -75,6 +79,43 @@ std::vector<Scenario> default_scenarios() {
     out.push_back(s);
   }
   return out;
+}
+
+std::vector<Scenario> parse_scenarios(const std::string& text, const std::string& source) {
+  using engine::InputError;
+  const nlohmann::json j = engine::parse_json_strict(text, source);
+  std::vector<Scenario> out;
+  try {
+    engine::require_keys(j, "file", {"description", "scenarios"});
+    const nlohmann::json& list = engine::member(j, "file", "scenarios");
+    if (!list.is_array() || list.empty()) throw InputError("field 'scenarios': must be a non-empty array");
+    std::set<std::string> names;
+    for (std::size_t i = 0; i < list.size(); ++i) {
+      const std::string where = "scenarios[" + std::to_string(i) + "]";
+      const nlohmann::json& e = list[i];
+      engine::require_keys(e, where, {"name", "amplitude_volts", "period_s", "max_delay_ms", "noise_scale", "duration_s"});
+      Scenario s;
+      s.name = engine::string_of(e, where, "name");
+      if (s.name.empty() || !names.insert(s.name).second) throw InputError("field '" + where + ".name': empty or repeated");
+      s.amplitude_volts = engine::number_in(e, where, "amplitude_volts", 0, 100);
+      s.period_s = engine::number_in(e, where, "period_s", 1e-3, 1e6);
+      s.max_delay_ms = engine::number_in(e, where, "max_delay_ms", 0.5, 1e6);
+      s.noise_scale = engine::number_in(e, where, "noise_scale", 0, 1e6);
+      s.duration_s = engine::number_in(e, where, "duration_s", 1e-3, 1e6, true, 20);
+      out.push_back(s);
+    }
+  } catch (const InputError& e) {
+    throw InputError(source + ": " + e.what());
+  }
+  return out;
+}
+
+std::vector<Scenario> load_scenarios(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw engine::InputError(path + ": cannot read the scenario file");
+  std::ostringstream text;
+  text << in.rdbuf();
+  return parse_scenarios(text.str(), path);
 }
 
 std::string describe(const Scenario& s) {

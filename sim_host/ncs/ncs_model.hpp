@@ -53,7 +53,13 @@ struct Scenario {
 };
 /// The ten scenarios of brief §3.
 std::vector<Scenario> default_scenarios();
-/// Every scenario's fields as JSON-ready text ("A_r 0.2 V, T_r 2 s, d 4 ms, s 1").
+/// Scenarios from the text of a scenario file {"description", "scenarios": [{"name",
+/// "amplitude_volts", "period_s", "max_delay_ms", "noise_scale", "duration_s"}]}, every
+/// field checked (engine::InputError naming it); `source` names the file in errors.
+std::vector<Scenario> parse_scenarios(const std::string& text, const std::string& source);
+/// Scenarios from a file (sim_host/ncs/scenarios.json holds the defaults).
+std::vector<Scenario> load_scenarios(const std::string& path);
+/// Every scenario's fields as text ("A_r 0.2 V, T_r 2 s, d 4 ms, s 1").
 std::string describe(const Scenario& s);
 
 /// Network and computation timing of the study (µs).

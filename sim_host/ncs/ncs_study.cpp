@@ -112,17 +112,21 @@ void register_ncs_study(CLI::App& app) {
     auto t = std::make_shared<ncs::TableOptions>();
     auto shard = std::make_shared<std::string>("0/1");
     auto approaches = std::make_shared<std::vector<std::string>>();
+    auto scenario_file = std::make_shared<std::string>();
     CLI::App* cmd = study->add_subcommand("table", "E4: every approach on the ten scenarios (95 % CI, paired differences)");
     add_common(cmd, *c, "out/ncs");
     cmd->add_option("--seeds", t->seeds, "seeds per scenario")->check(CLI::Range(2, 100000))->capture_default_str();
     cmd->add_flag("--noise-free", t->noise_free, "no process or measurement noise (delays stay): A must equal I");
     cmd->add_option("--duration", t->duration_s, "seconds per run")->check(CLI::Range(0.1, 3600.0))->capture_default_str();
+    cmd->add_option("--scenarios", *scenario_file, "scenario file (default: the ten of the brief, sim_host/ncs/scenarios.json)")
+        ->check(CLI::ExistingFile);
     cmd->add_option("--threads", t->threads, "worker threads (0: every core)")->capture_default_str();
     cmd->add_option("--approaches", *approaches, "approaches, I first (default: I S A AK AKx AKl SK S+ IK)");
     cmd->add_option("--shard", *shard, "run part i/N of the sweep and write OUT/table.shard-i-of-N.json (`oneshot-sim merge`)")
         ->capture_default_str();
-    cmd->callback([c, t, shard, approaches]() {
+    cmd->callback([c, t, shard, approaches, scenario_file]() {
       const auto ctx = ncs::Context::load(c->plant);
+      if (!scenario_file->empty()) t->scenarios = ncs::load_scenarios(*scenario_file);
       if (!approaches->empty()) {
         t->approaches.clear();
         for (const auto& a : *approaches) t->approaches.push_back(ncs::parse_approach(a));

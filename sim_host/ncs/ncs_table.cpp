@@ -38,8 +38,11 @@ engine::SweepResults table_sweep(const Context& ctx, const TableOptions& opt, co
   if (opt.approaches.empty() || opt.approaches.front() != Approach::kI) {
     throw std::invalid_argument("ncs table: the approaches must start with I (the reference of every ratio)");
   }
-  std::vector<Scenario> scenarios = default_scenarios();
-  for (Scenario& s : scenarios) s.duration_s = opt.duration_s;
+  std::vector<Scenario> scenarios = opt.scenarios;
+  if (scenarios.empty()) {
+    scenarios = default_scenarios();
+    for (Scenario& s : scenarios) s.duration_s = opt.duration_s;
+  }
   engine::SweepSpec spec;
   spec.study = "ncs";
   spec.experiment = "table";

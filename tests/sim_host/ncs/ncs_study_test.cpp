@@ -99,6 +99,28 @@ TEST(NcsStudy, TracingNeverChangesTheRun) {
   }
 }
 
+TEST(NcsStudy, TheShippedScenarioFileIsTheBuiltInDefaultsAndBadFieldsAreNamed) {
+  const std::vector<Scenario> file = load_scenarios(ONESHOT_NCS_SCENARIO_FILE);
+  const std::vector<Scenario> builtin = default_scenarios();
+  ASSERT_EQ(file.size(), builtin.size());
+  for (std::size_t i = 0; i < file.size(); ++i) {
+    EXPECT_EQ(file[i].name, builtin[i].name);
+    EXPECT_EQ(file[i].amplitude_volts, builtin[i].amplitude_volts);
+    EXPECT_EQ(file[i].period_s, builtin[i].period_s);
+    EXPECT_EQ(file[i].max_delay_ms, builtin[i].max_delay_ms);
+    EXPECT_EQ(file[i].noise_scale, builtin[i].noise_scale);
+    EXPECT_EQ(file[i].duration_s, builtin[i].duration_s);
+  }
+  try {
+    parse_scenarios(R"({"scenarios": [{"name": "x", "amplitude_volts": 1, "period_s": 2, "max_delay_ms": 0.1, "noise_scale": 1}]})",
+                    "f.json");
+    FAIL() << "a delay below 0.5 ms was accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("max_delay_ms"), std::string::npos) << e.what();
+  }
+  EXPECT_THROW(parse_scenarios(R"({"scenarios": [{"name": "x", "bogus": 1}]})", "f.json"), std::invalid_argument);
+}
+
 TEST(NcsStudy, TableSummaryHasTheIssueFields) {
   TableOptions t;
   t.seeds = 2;
