@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
 #include <iostream>
 #include <memory>
 #include <sstream>
@@ -165,6 +166,25 @@ void register_ncs_study(CLI::App& app) {
   trace_cmd("e1", "E1 (Fig. 6): noisy y1, y2 beside AK's estimates", 5, &ncs::run_e1);
   trace_cmd("e2", "E2 (Fig. 7): delays only, I, S and A on the square wave", 4, &ncs::run_e2);
   trace_cmd("e3", "E3 (Fig. 8): delays, noise and disturbance, S, A and AK", 4, &ncs::run_e3);
+  {
+    auto c = std::make_shared<NcsCli>();
+    CLI::App* cmd = study->add_subcommand("report", "This study's section of `oneshot-sim report` alone: OUT/ncs.md, OUT/ncs.json");
+    add_common(cmd, *c, "out/ncs-report");
+    cmd->callback([c]() {
+      StudyReportContext rc;
+      rc.out_dir = c->out;
+      rc.rel_dir = ".";
+      rc.seed = c->seed;
+      rc.plots = !c->no_plots;
+      make_directory(rc.out_dir);
+      const StudyReportResult r = report_section(rc);
+      std::ofstream((std::filesystem::path(c->out) / "ncs.md").string()) << r.markdown;
+      write_json((std::filesystem::path(c->out) / "ncs.json").string(), r.json);
+      nlohmann::json j = r.json;
+      j["experiment"] = "report";
+      emit(*c, j);
+    });
+  }
   engine::register_summarizer("ncs", "table", [](const engine::SweepResults& r, const std::string& out, bool plots) {
     return ncs::table_outputs(r, out, plots);
   });
