@@ -11,6 +11,14 @@
 #include "oneshot/node/periodic_trigger.hpp"
 #include "oneshot/node/send_on_delta_trigger.hpp"
 #include "oneshot/node/sensor_node.hpp"
+#include "oneshot/generic_discretizer.hpp"
+#include "oneshot/number_format.hpp"
+#include "oneshot/node/sampling_sync_laws.hpp"
+#include "oneshot/node/sync_actuator_node.hpp"
+#include "oneshot/node/sync_controller_node.hpp"
+#include "oneshot/node/sync_estimators.hpp"
+#include "oneshot/node/sync_sensor_node.hpp"
+#include "oneshot/plant_structure.hpp"
 
 namespace {
 
@@ -57,10 +65,52 @@ void exercise() {
   static_cast<void>(act.take_output(u));
 }
 
+/// The actuation-synchronized nodes and the baseline laws of the networked-actuation study.
+template <typename S>
+void exercise_sync() {
+  using namespace oneshot;
+  using namespace oneshot::node;
+  using Fmt = UniformFormat<S>;
+  using Structure = DenseStructure<2, 1, 2>;
+  using Disc = GenericDiscretizer<Fmt, 2, 1>;
+  using Ref = SquareWaveReference<S, 2, 1>;
+  static const typename Disc::Model model{};
+  static const Disc disc(model);
+  static const ControllerDesign<Fmt, 2, 1, 2> design{};
+  const Ref ref(ScalarTraits<S>::one(), 20, Vector<S, 2>{}, Vector<S, 1>{});
+  const Vector<S, 1> lo{};
+  const Vector<S, 1> hi{};
+  const McuInstant now(7);
+  SyncActuatorNode<NullBoard, S, 1> act(1, lo);
+  act.start(now);
+  act.on_receive();
+  act.on_timer(1, now);
+  SyncSensorNode<NullBoard, S, 2, 1> sensor(2, 5000);
+  McuInstant at;
+  if (sensor.on_receive(now, at)) sensor.on_sample(at, Vector<S, 2>{});
+  SyncControllerNode<NullBoard, HalfKalmanEstimator<Fmt, Structure, Disc>, Ref, S, 2, 2, 1> ak(
+      3, design.l, lo, hi, HalfKalmanEstimator<Fmt, Structure, Disc>(design, disc, NoiseModel::kExact), ref);
+  ak.on_receive(now);
+  SyncControllerNode<NullBoard, SampledStatePredictor<Fmt, Structure, Disc>, Ref, S, 2, 2, 1> a(
+      3, design.l, lo, hi, SampledStatePredictor<Fmt, Structure, Disc>(disc), ref);
+  a.on_receive(now);
+  ControllerNode<NullBoard, StateFeedbackLaw<S, 2, 1, Ref>, S, 2, 1> s(
+      3, ControllerMode::kOnArrival, StateFeedbackLaw<S, 2, 1, Ref>{design.l, lo, hi, ref});
+  s.on_receive(now);
+  ControllerNode<NullBoard, PeriodicKalmanLaw<Fmt, Structure, Ref>, S, 2, 1> sk(
+      3, ControllerMode::kOnArrival, PeriodicKalmanLaw<Fmt, Structure, Ref>(design, NoiseModel::kConstant, lo, hi, ref));
+  sk.on_receive(now);
+  ControllerNode<NullBoard, DelayCompensatedLaw<S, 2, 1, Ref>, S, 2, 1> sp(
+      3, ControllerMode::kOnArrival, DelayCompensatedLaw<S, 2, 1, Ref>{design.l, Matrix<S, 1, 1>{}, lo, hi, ref});
+  sp.on_receive(now);
+}
+
 }  // namespace
 
 /// Referenced so the instantiations are compiled.
 void oneshot_node_freestanding_check() {
   exercise<float>();
   exercise<double>();
+  exercise_sync<float>();
+  exercise_sync<double>();
 }

@@ -37,6 +37,9 @@ Duration DelayModel::draw(RandomStream& rng, std::uint64_t index, bool& clamped)
     case Kind::kConstant:
       return constant;
     case Kind::kUniform:
+      if (resolution.count() > 1) {
+        return min + resolution * rng.uniform_int(0, (max - min).count() / resolution.count());
+      }
       return Duration{rng.uniform_int(min.count(), max.count())};
     case Kind::kPoissonPeriods:
       return shift + period * rng.poisson(mean_periods);
@@ -128,11 +131,13 @@ DelayModel parse_delay_model(const nlohmann::json& j, const std::string& field, 
     d.kind = DelayModel::Kind::kConstant;
     d.constant = us("delay_us", false, 0);
   } else if (model == "uniform") {
-    require_keys(j, field, {"model", "min_us", "max_us"});
+    require_keys(j, field, {"model", "min_us", "max_us", "resolution_us"});
     d.kind = DelayModel::Kind::kUniform;
     d.min = us("min_us", false, 0);
     d.max = us("max_us", false, 0);
     if (d.max < d.min) throw InputError("field '" + field + ".max_us': below min_us");
+    d.resolution = us("resolution_us", true, 0.001);
+    if (d.resolution.count() <= 0) throw InputError("field '" + field + ".resolution_us': must be positive");
   } else if (model == "poisson_periods") {
     require_keys(j, field, {"model", "mean_periods", "period_us", "offset_us"});
     d.kind = DelayModel::Kind::kPoissonPeriods;

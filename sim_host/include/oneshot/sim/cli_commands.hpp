@@ -21,4 +21,7 @@ void register_studies(CLI::App& app);
 /// `oneshot <experiment>`: the one-shot study, seed 000 (sim_host/oneshot/).
 void register_oneshot_study(CLI::App& app);
 
+/// `ncs <experiment>`: networked actuation sync, seed 001 (sim_host/ncs/).
+void register_ncs_study(CLI::App& app);
+
 }  // namespace oneshot::sim
