@@ -21,4 +21,7 @@ void register_studies(CLI::App& app);
 /// `oneshot <experiment>`: the one-shot study, seed 000 (sim_host/oneshot/).
 void register_oneshot_study(CLI::App& app);
 
+/// `dropping <experiment>`: the over-delay dropping Kalman study, seed 002 (sim_host/dropping/).
+void register_dropping_study(CLI::App& app);
+
 }  // namespace oneshot::sim
