@@ -120,6 +120,14 @@ RunMetrics run_impl(const DroppingPlant& plant, const RunConfig& cfg, std::uint6
   const auto model_unaware = filter_model(plant, r_unaware);
   Filter filter(model, StateVec{}, plant.p0);
   UnawareKalman unaware(model_unaware, plant.p0);
+  // Shadows: the delay-unaware KF (R = 0.05 and 2.5) fed the same packets and inputs while the
+  // buffered filter closes the loop: an estimation-only comparison on the same trajectory.
+  Matrix<double, kP, kP> r_small, r_nominal;
+  r_small(0, 0) = 0.05;
+  r_nominal(0, 0) = 2.5;
+  const auto model_small = filter_model(plant, r_small), model_nominal = filter_model(plant, r_nominal);
+  UnawareKalman shadow_small(model_small, plant.p0), shadow_nominal(model_nominal, plant.p0);
+  double sum_shadow_small = 0, sum_shadow_nominal = 0;
   const bool buffered = cfg.estimator == EstimatorKind::kBuffered;
 
   engine::Link link(sensor_link(cfg.mean_delay_periods, cfg.loss, period), seed);
@@ -145,9 +153,8 @@ RunMetrics run_impl(const DroppingPlant& plant, const RunConfig& cfg, std::uint6
       const node::ArrivalVerdict v = filter.receive(static_cast<std::uint32_t>(j), y);
       if (v == node::ArrivalVerdict::kOverDelayed) out.over_delayed += 1;
       if (v == node::ArrivalVerdict::kDuplicate) out.duplicates += 1;
-    } else if (!newest || j > *newest) {
-      newest = static_cast<std::uint32_t>(j);
     }
+    if (!newest || j > *newest) newest = static_cast<std::uint32_t>(j);
   });
   const engine::HandlerId sample = kernel.add_handler("sample", [&](std::uint64_t k) {
     xs[k] = sys.state();
@@ -169,7 +176,18 @@ RunMetrics run_impl(const DroppingPlant& plant, const RunConfig& cfg, std::uint6
     Cov p;
     Status st;
     std::uint32_t corr;
+    std::optional<OutputVec> y_newest;
+    if (newest) {
+      OutputVec v;
+      v[0] = ys[*newest];
+      y_newest = v;
+    }
+    newest.reset();
     if (buffered) {
+      static_cast<void>(shadow_small.step(y_newest));
+      static_cast<void>(shadow_nominal.step(y_newest));
+      sum_shadow_small += sq_err(sys.state(), shadow_small.estimate());
+      sum_shadow_nominal += sq_err(sys.state(), shadow_nominal.estimate());
       st = filter.step();
       xhat = filter.estimate();
       p = filter.covariance();
@@ -181,14 +199,7 @@ RunMetrics run_impl(const DroppingPlant& plant, const RunConfig& cfg, std::uint6
         sum_err_a += sq_err(xs[filter.anchor_index()], filter.anchor());
       }
     } else {
-      std::optional<OutputVec> y;
-      if (newest) {
-        OutputVec v;
-        v[0] = ys[*newest];
-        y = v;
-      }
-      newest.reset();
-      st = unaware.step(y);
+      st = unaware.step(y_newest);
       xhat = unaware.estimate();
       p = unaware.covariance();
       corr = unaware.last_corrections();
@@ -198,7 +209,13 @@ RunMetrics run_impl(const DroppingPlant& plant, const RunConfig& cfg, std::uint6
     InputVec u = -(plant.l * xhat);
     u[0] += r_k;
     sys.set_input(u);
-    if (buffered) filter.set_applied_input(u); else unaware.set_applied_input(u);
+    if (buffered) {
+      filter.set_applied_input(u);
+      shadow_small.set_applied_input(u);
+      shadow_nominal.set_applied_input(u);
+    } else {
+      unaware.set_applied_input(u);
+    }
     const double tr = trace_of(p), e = sq_err(sys.state(), xhat);
     sum_tr += tr;
     sum_err += e;
@@ -224,6 +241,8 @@ RunMetrics run_impl(const DroppingPlant& plant, const RunConfig& cfg, std::uint6
   const double nan = std::numeric_limits<double>::quiet_NaN();
   out.trace_p_anchor = buffered && anchors > 0 ? sum_tr_a / static_cast<double>(anchors) : nan;
   out.err_anchor = buffered && anchors > 0 ? sum_err_a / static_cast<double>(anchors) : nan;
+  out.err_shadow_small_r = buffered ? sum_shadow_small / n : nan;
+  out.err_shadow_nominal_r = buffered ? sum_shadow_nominal / n : nan;
   out.gamma = buffered && anchors > 0 ? sum_gamma / static_cast<double>(anchors) : nan;
   return out;
 }

@@ -61,6 +61,8 @@ struct RunMetrics {
   double trace_p_anchor = 0;   ///< mean_n tr P(n|n) (buffered only; NaN otherwise).
   double err = 0;              ///< mean_k |x_k − x̂(k|Y_k)|².
   double err_anchor = 0;       ///< mean_n |x_n − x̂(n|n)|² (buffered only; NaN otherwise).
+  double err_shadow_small_r = 0;    ///< mean_k |x_k − x̂_unaware(k)|², unaware KF with R = 0.05 run beside the buffered loop.
+  double err_shadow_nominal_r = 0;  ///< The same with R = 2.5 (NaN unless the buffered filter closes the loop).
   double gamma = 0;            ///< Fraction of anchor steps with γ_n = 1 (buffered only).
   double cost = 0;             ///< Plant cost per step (xᵀQ1x + uᵀQ2u).
   double corrections = 0;      ///< Corrections per step.

@@ -155,7 +155,8 @@ nlohmann::json run_closed_loop_experiment(const DroppingPlant& plant, const Stud
   }
   spec.first_seed = opt.seed;
   spec.seeds = opt.seeds;
-  spec.metrics = {"err", "err_anchor", "trace_p", "trace_p_anchor", "gamma", "cost", "reordered", "failed"};
+  spec.metrics = {"err", "err_anchor", "trace_p", "trace_p_anchor", "gamma", "cost", "reordered", "failed",
+                  "err_shadow_R0.05", "err_shadow_R2.5"};
   spec.config = {{"plant", plant.plant.name}, {"plant_digest", plant_digest(plant)}, {"loss", opt.loss},
                  {"steps", opt.steps}, {"t_hold", 1}, {"scenarios", sc}};
   const engine::SweepResults r = engine::run_sweep(
@@ -171,8 +172,9 @@ nlohmann::json run_closed_loop_experiment(const DroppingPlant& plant, const Stud
         c.estimator = a >= 2 ? EstimatorKind::kUnaware : EstimatorKind::kBuffered;
         c.unaware_r = a == 2 ? 0.05 : 2.5;
         const RunMetrics m = run_closed_loop(plant, c, seed);
-        return std::vector<double>{m.err, m.err_anchor, m.trace_p, m.trace_p_anchor, m.gamma, m.cost, m.reordered,
-                                   m.failed ? 1.0 : 0.0};
+        return std::vector<double>{m.err,       m.err_anchor, m.trace_p,       m.trace_p_anchor,
+                                   m.gamma,     m.cost,       m.reordered,     m.failed ? 1.0 : 0.0,
+                                   m.err_shadow_small_r,  m.err_shadow_nominal_r};
       },
       "dropping closed-loop");
   nlohmann::json j = finish(r, opt, "closed-loop", closed_loop_outputs);
@@ -256,14 +258,42 @@ nlohmann::json closed_loop_outputs(const engine::SweepResults& r, const std::str
       md << "| " << c.at("lambda").get<double>() << " | " << r.spec.approaches[a] << " | " << band_md(te) << " | "
          << mean_md(te) << " | " << band_md(tp) << " | " << mean_md(tp) << " | "
          << (std::isnan(ta.median) ? std::string("—") : fmt_g(ta.median)) << " | "
-         << (std::isnan(tg.mean.mean) ? std::string("—") : fmt_f(tg.mean.mean, 4)) << " | "
-         << (a == 0 ? std::string("—") : fmt_g(tr.median) + " [" + fmt_g(tr.p10) + ", " + fmt_g(tr.p90) + "]") << " |\n";
+         << (tg.mean.n == 0 ? std::string("—") : fmt_f(tg.mean.mean, 4)) << " | "
+         << (a == 0 ? std::string("—") : band_md(tr)) << " |\n";
       csv.push_back({c.at("lambda").get<double>(), static_cast<double>(a), te.median, te.p10, te.p90, te.mean.mean,
                      te.mean.ci95, tp.median, tp.p10, tp.p90, tp.mean.mean, tp.mean.ci95});
     }
     j["per_lambda"].push_back(js);
   }
   j["failed_runs"] = failed;
+  // E5: the delay-unaware KF beside the buffered filter on the same trajectory (shadow), and
+  // closing the loop itself (diverged: time-mean error above 1e100 or not finite).
+  std::ostringstream m5;
+  m5 << "| λ | buffered \\|x − x̂\\|² median [10–90 %] | unaware R = 0.05 (shadow) | per-seed ratio to buffered | "
+        "unaware R = 2.5 (shadow) | per-seed ratio to buffered | unaware closing the loop: runs diverged (R = 0.05 / 2.5) |\n"
+        "|---|---|---|---|---|---|---|\n";
+  for (std::size_t s = 0; s < ns; ++s) {
+    const nlohmann::json& c = cfg.at("scenarios").at(s);
+    const std::vector<double> e = cell(r, 0, s, r.metric("err"));
+    m5 << "| " << c.at("lambda").get<double>() << " | " << band_md(engine::tail_summary(e));
+    nlohmann::json js;
+    for (const char* name : {"err_shadow_R0.05", "err_shadow_R2.5"}) {
+      const std::vector<double> sh = cell(r, 0, s, r.metric(name));
+      std::vector<double> ratio(sh.size());
+      for (std::size_t k = 0; k < sh.size(); ++k) ratio[k] = sh[k] / e[k];
+      const engine::TailSummary ts = engine::tail_summary(sh), tr = engine::tail_summary(ratio);
+      js[name] = tail_json(ts);
+      js[std::string(name) + "_ratio_to_buffered"] = tail_json(tr);
+      m5 << " | " << band_md(ts) << " | " << band_md(tr);
+    }
+    std::size_t div[2] = {0, 0};
+    for (std::size_t a = 2; a < 4 && a < na; ++a)
+      for (double v : cell(r, a, s, r.metric("err"))) div[a - 2] += (!std::isfinite(v) || v > 1e100) ? 1U : 0U;
+    js["unaware_closed_loop_diverged"] = {div[0], div[1]};
+    m5 << " | " << div[0] << " / " << div[1] << " of " << r.spec.seeds << " |\n";
+    j["e5"].push_back(js);
+  }
+  j["markdown_e5"] = m5.str();
   j["markdown"] = md.str();
   sim::write_csv(path_in(out_dir, "closed_loop.csv"),
                  {"lambda", "approach", "err_median", "err_p10", "err_p90", "err_mean", "err_ci95", "trp_median", "trp_p10",

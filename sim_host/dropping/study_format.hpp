@@ -44,6 +44,7 @@ inline std::string band_md(const engine::TailSummary& t) {
 /// "mean ± ci95".
 inline std::string mean_md(const engine::TailSummary& t) {
   if (t.mean.n == 0) return "—";
+  if (!std::isfinite(t.mean.mean)) return "overflow (not finite)";
   return fmt_g(t.mean.mean) + " ± " + fmt_g(t.mean.ci95);
 }
 
