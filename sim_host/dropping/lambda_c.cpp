@@ -32,6 +32,9 @@ nlohmann::json mare_point_json(const DroppingPlant& plant, double lambda, const 
                       {"iterations", o.iterations}};
   if (o.converged) {
     j["trace_p"] = o.trace;
+    // Sinopoli's MARE iterates the prior P(n+1|n) = Φ P̄ Φᵀ + Q of the same fixed point.
+    const Matrix<double, kN, kN> prior = mare_prior(m, p);
+    j["trace_p_prior_form"] = prior(0, 0) + prior(1, 1) + prior(2, 2);
     j["P"] = matrix_json(p);
     j["K"] = matrix_json(mare_gain(m, p));
   } else {

@@ -288,6 +288,7 @@ Certificate certify(const MareModel<N, P>& m, double lambda, double eps_rel = 1e
     c.epsilon = eps;
     c.dimension = 5 * N + P;
     c.reason = "no_fixed_point";
+    c.min_pivot = std::numeric_limits<double>::quiet_NaN();  // no candidate was factorized
     return c;
   }
   Certificate c = check_lmi(m, lambda, p, mare_gain(m, p));
