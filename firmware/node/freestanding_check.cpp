@@ -6,6 +6,7 @@
 
 #include "oneshot/hal/network_contract.hpp"
 #include "oneshot/node/actuator_node.hpp"
+#include "oneshot/node/buffered_kalman.hpp"
 #include "oneshot/node/controller_node.hpp"
 #include "oneshot/node/mtm_trigger.hpp"
 #include "oneshot/node/periodic_trigger.hpp"
@@ -63,6 +64,15 @@ void exercise() {
   act.on_timer(0);
   V u;
   static_cast<void>(act.take_output(u));
+  // The buffered intermittent filter (threshold buffer, anchor, re-run), 3 states, T_hold = 4.
+  using Fmt = oneshot::UniformFormat<S>;
+  using Structure = oneshot::DenseStructure<3, 1, 1>;
+  using Filter = BufferedKalman<Fmt, Structure, 4>;
+  typename Filter::Model model{};
+  Filter filter(model, typename Filter::StateVec{}, typename Filter::Cov{});
+  static_cast<void>(filter.receive(0, typename Filter::OutputVec{}));
+  static_cast<void>(filter.step());
+  filter.set_applied_input(typename Filter::InputVec{});
 }
 
 /// The actuation-synchronized nodes and the baseline laws of the networked-actuation study.

@@ -23,5 +23,7 @@ void register_oneshot_study(CLI::App& app);
 
 /// `ncs <experiment>`: networked actuation sync, seed 001 (sim_host/ncs/).
 void register_ncs_study(CLI::App& app);
+/// `dropping <experiment>`: the over-delay dropping Kalman study, seed 002 (sim_host/dropping/).
+void register_dropping_study(CLI::App& app);
 
 }  // namespace oneshot::sim
