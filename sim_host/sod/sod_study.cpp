@@ -1,11 +1,14 @@
 /// @file sod_study.cpp
 /// @brief The send-on-delta study (seed 004) under `oneshot-sim sod …`: its commands, the
 ///        table's merge summarizer and its report section.
+#include <filesystem>
+#include <fstream>
 #include <memory>
 #include <sstream>
 
 #include "oneshot/engine/sweep_registry.hpp"
 #include "oneshot/sim/cli_commands.hpp"
+#include "oneshot/sim/output_files.hpp"
 #include "oneshot/sim/study_report.hpp"
 #include "sod_experiments.hpp"
 #include "sod_report.hpp"
@@ -117,6 +120,27 @@ void register_sod_study(CLI::App& app) {
     cmd->callback([c, loss] {
       const sod::SodModel m = model_of(*c);
       sod::emit_json(sod::run_traces(m, c->opt, *loss), c->json);
+    });
+  }
+  {
+    auto c = std::make_shared<Cli>();
+    CLI::App* cmd = study->add_subcommand("report", "the study's report section alone (design, E1-E4 on the defaults) in OUT/report.md");
+    cmd->add_option("--out", c->opt.out_dir, "output folder")->capture_default_str();
+    cmd->add_option("--seed", c->opt.seed, "first seed")->capture_default_str();
+    cmd->add_option("--threads", c->opt.threads, "worker threads (0: every core)")->capture_default_str();
+    cmd->add_option("--json", c->json, "write the section's JSON to PATH ('-' for standard output)");
+    cmd->add_flag("--no-plots", c->no_plots, "CSV files only (no gnuplot)");
+    cmd->callback([c] {
+      make_directory(c->opt.out_dir);
+      StudyReportContext ctx;
+      ctx.out_dir = c->opt.out_dir;
+      ctx.rel_dir = ".";
+      ctx.threads = c->opt.threads;
+      ctx.seed = c->opt.seed;
+      ctx.plots = !c->no_plots;
+      const StudyReportResult r = sod::report_section(ctx);
+      std::ofstream(std::filesystem::path(c->opt.out_dir) / "report.md") << r.markdown;
+      sod::emit_json(r.json, c->json);
     });
   }
   engine::register_summarizer("sod", "table", [](const engine::SweepResults& r, const std::string& out, bool plots) {
