@@ -105,6 +105,7 @@ TEST(SodEstimator, RecordedRunMatchesEigenOracle) {
       p = (0.5 * (p + p.transpose())).eval();
     }
     for (std::size_t i = 0; i < 2; ++i) {
+      ASSERT_LE(tr.dropouts[i][k], tr.true_lost_run[i][k]) << "k " << k;  // d is a lower bound
       const auto e = static_cast<Eigen::Index>(i);
       worst_x = std::max(worst_x, std::abs(x(e) - tr.x_hat[i][k]) / (1 + std::abs(x(e))));
       worst_p = std::max(worst_p, std::abs(p(e, e) - tr.p[i][k]) / p(e, e));
