@@ -100,7 +100,7 @@ DeltaTDesign design_delta_t(const SodModel& model, const DesignInputs& in) {
       hi *= 2;
       if (hi > 1e15) throw std::runtime_error("sod design: feasible set unbounded but infinity infeasible");
     }
-    while (hi - lo > 1e-10 * hi) {
+    while (hi - lo > 1e-9 * hi) {
       const double mid = 0.5 * (lo + hi);
       (pred(mid) ? lo : hi) = mid;
     }
@@ -124,7 +124,7 @@ DeltaTDesign design_delta_t(const SodModel& model, const DesignInputs& in) {
     // Log grid of d̄1 along the edge, then golden section around the best point.
     std::vector<double> grid;
     const double top = std::isinf(d1max) ? 1e6 : d1max;
-    for (int k = 0; k <= 48; ++k) grid.push_back(top * std::pow(10.0, -6.0 + 6.0 * k / 48));
+    for (int k = 0; k <= 24; ++k) grid.push_back(top * std::pow(10.0, -6.0 + 6.0 * k / 24));
     if (std::isinf(d1max)) grid.push_back(kInf);
     std::size_t arg = 0;
     double fbest = kInf;
@@ -142,7 +142,7 @@ DeltaTDesign design_delta_t(const SodModel& model, const DesignInputs& in) {
       const double phi = 0.5 * (std::sqrt(5.0) - 1);
       double x1 = b - phi * (b - a), x2 = a + phi * (b - a);
       double f1 = f(std::exp(x1)), f2 = f(std::exp(x2));
-      for (int it = 0; it < 40; ++it) {
+      for (int it = 0; it < 30; ++it) {
         if (f1 < f2) {
           b = x2; x2 = x1; f2 = f1; x1 = b - phi * (b - a); f1 = f(std::exp(x1));
         } else {

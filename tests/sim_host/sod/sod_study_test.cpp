@@ -154,9 +154,10 @@ TEST(SodDesign, DeltaTTimesLossIsConstantAndTheOptimumIsChecked) {
   in.mean_gap_s[0] = 1.3;
   in.mean_gap_s[1] = 0.7;
   double dtxi[2] = {0, 0};
+  DeltaTDesign d;
   for (double xi : {0.05, 0.1, 0.15, 0.2}) {
     in.loss[0] = in.loss[1] = xi;
-    const DeltaTDesign d = design_delta_t(model(), in);
+    d = design_delta_t(model(), in);
     EXPECT_TRUE(d.grid_check_passed) << d.packets_per_s << " vs grid " << d.grid_best_packets_per_s;
     EXPECT_FALSE(d.active.empty());
     for (std::size_t i = 0; i < 2; ++i) {
@@ -173,7 +174,6 @@ TEST(SodDesign, DeltaTTimesLossIsConstantAndTheOptimumIsChecked) {
     rb(e, e) = model().r_diag[i] + in.delta_y[i] * in.delta_y[i] / 3;
   }
   const Eigen::MatrixXd prior = riccati_fixed_point(rb).first;
-  const DeltaTDesign d = design_delta_t(model(), in);
   for (std::size_t i = 0; i < 2; ++i) {
     const auto e = static_cast<Eigen::Index>(i);
     EXPECT_NEAR(d.p0_diag[i], prior(e, e), 1e-9 * prior(e, e));
