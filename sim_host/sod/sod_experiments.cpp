@@ -1,5 +1,6 @@
 /// @file sod_experiments.cpp
 /// @brief E1 (ΔT), the design command and E2 (δt* over δy × ξ); see sod_experiments.hpp.
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <cstdio>
@@ -158,6 +159,8 @@ nlohmann::json run_grid(const SodModel& model, const StudyOptions& opt, const st
     }
     j["rows"].push_back(row);
   }
+  // Grouped by loss rate, so that gnuplot draws one connected line per ξ.
+  std::stable_sort(rows.begin(), rows.end(), [](const std::vector<double>& a, const std::vector<double>& b) { return a[1] < b[1]; });
   sim::make_directory(opt.out_dir);
   const std::string csv = (std::filesystem::path(opt.out_dir) / "e2_delta_t.csv").string();
   sim::write_csv(csv, {"delta_y", "loss", "delta_t1_s", "delta_t2_s", "mean_gap1_s", "mean_gap2_s"}, rows);
@@ -166,7 +169,7 @@ nlohmann::json run_grid(const SodModel& model, const StudyOptions& opt, const st
     std::ostringstream g;
     g << "set terminal pngcairo size 1100,500 font 'Sans,11' noenhanced\nset output 'e2_delta_t.png'\n"
       << "set datafile separator ','\nset datafile missing 'nan'\nset grid\nset multiplot layout 1,2\n"
-      << "set xlabel 'delta_y'\nset logscale y\nset key top left\n";
+      << "set xlabel 'delta_y'\nset logscale y\nset key top left\nset xrange [0:*]\n";
     for (int node = 1; node <= 2; ++node) {
       g << "set title 'E2: delta_t*_" << node << " (s), mu = " << opt.mu << " (missing: unbounded)'\nset ylabel 'delta_t* (s)'\nplot ";
       for (std::size_t s = 0; s < losses.size(); ++s) {
