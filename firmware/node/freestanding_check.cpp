@@ -8,6 +8,9 @@
 #include "oneshot/node/actuator_node.hpp"
 #include "oneshot/node/buffered_kalman.hpp"
 #include "oneshot/node/controller_node.hpp"
+#include "oneshot/node/dropout_detector.hpp"
+#include "oneshot/node/held_measurement.hpp"
+#include "oneshot/node/held_measurement_estimator.hpp"
 #include "oneshot/node/mtm_trigger.hpp"
 #include "oneshot/node/periodic_trigger.hpp"
 #include "oneshot/node/send_on_delta_trigger.hpp"
@@ -113,6 +116,25 @@ void exercise_sync() {
   ControllerNode<NullBoard, DelayCompensatedLaw<S, 2, 1, Ref>, S, 2, 1> sp(
       3, ControllerMode::kOnArrival, DelayCompensatedLaw<S, 2, 1, Ref>{design.l, Matrix<S, 1, 1>{}, lo, hi, ref});
   sp.on_receive(now);
+  // Receiver and estimator of send-on-delta nodes (two nodes, two states).
+  using V2 = oneshot::Vector<S, 2>;
+  using M2 = oneshot::Matrix<S, 2, 2>;
+  const std::uint32_t n_t[2] = {0, 100};
+  V2 dy;
+  dy[0] = delta[0];
+  dy[1] = delta[0];
+  HeldMeasurementReceiver<S, 2> rx(dy, dy, n_t, SilencePolicy::kHeld);
+  rx.on_packet(0, 0, delta[0]);
+  M2 eye;
+  eye(0, 0) = oneshot::ScalarTraits<S>::one();
+  eye(1, 1) = oneshot::ScalarTraits<S>::one();
+  HeldMeasurementEstimator<S, 2, 1, 2> est(eye, oneshot::Matrix<S, 2, 1>{}, eye, eye);
+  est.reset(V2{}, eye);
+  est.predict(V{});
+  for (std::size_t i = 0; i < 2; ++i) {
+    const HeldMeasurement<S> m = rx.measurement(i, 1);
+    if (m.present) static_cast<void>(est.correct(i, m.z, m.r_bar));
+  }
 }
 
 }  // namespace

@@ -15,6 +15,9 @@ void register_experiment_commands(CLI::App& app);
 /// `merge SHARD...`: joins the shard files of a sweep (any study) into its result.
 void register_merge_command(CLI::App& app);
 
+/// `sod …`: the send-on-delta study (sim_host/sod/).
+void register_sod_study(CLI::App& app);
+
 /// Every study under `oneshot-sim <study> <experiment>` (sim_host/src/studies.cpp).
 void register_studies(CLI::App& app);
 
