@@ -7,7 +7,12 @@
 #include "oneshot/hal/network_contract.hpp"
 #include "oneshot/node/actuator_node.hpp"
 #include "oneshot/node/controller_node.hpp"
+#include "oneshot/node/disturbance_observer.hpp"
+#include "oneshot/node/interlaced_controller.hpp"
 #include "oneshot/node/mtm_trigger.hpp"
+#include "oneshot/node/numre_estimator.hpp"
+#include "oneshot/node/packet_buffer.hpp"
+#include "oneshot/node/petc_controller.hpp"
 #include "oneshot/node/periodic_trigger.hpp"
 #include "oneshot/node/send_on_delta_trigger.hpp"
 #include "oneshot/node/sensor_node.hpp"
@@ -55,6 +60,23 @@ void exercise() {
   act.on_timer(0);
   V u;
   static_cast<void>(act.take_output(u));
+
+  // PETC: NUMRE, interlaced law, both disturbance estimates, packet buffer.
+  using Law = InterlacedController<S, 1, 2>;
+  InterlacedConfig<S, 1, 2> lc{};
+  lc.ratio = 2;
+  NumreModel<S, 4> model{};
+  const MtmTrigger<S, 1> trig(delta[0], delta[0], 8, 0);
+  PetcController<S, 4, 8, Law, ModelDisturbance<S>> petc(model, NoiseAccumulation::kSum, Law(lc), ModelDisturbance<S>{},
+                                                         trig, delta[0]);
+  static_cast<void>(petc.on_arrival(0, delta[0]));
+  DisturbanceObserverConfig<S, 2, 4> oc{};
+  using Dob = DisturbanceObserver<S, 2, 4>;
+  PetcController<S, 4, 8, Law, Dob> petc_dob(model, NoiseAccumulation::kFrozen, Law(lc), Dob(oc), trig, delta[0]);
+  static_cast<void>(petc_dob.on_arrival(0, delta[0]));
+  PacketBuffer<S, 8> buffer;
+  static_cast<void>(buffer.accept(0, petc.packet()));
+  static_cast<void>(buffer.value(3));
 }
 
 }  // namespace

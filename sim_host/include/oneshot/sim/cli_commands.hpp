@@ -20,5 +20,7 @@ void register_studies(CLI::App& app);
 
 /// `oneshot <experiment>`: the one-shot study, seed 000 (sim_host/oneshot/).
 void register_oneshot_study(CLI::App& app);
+/// `petc <experiment>`: NUMRE periodic event-triggered control, seed 003 (sim_host/petc/).
+void register_petc_study(CLI::App& app);
 
 }  // namespace oneshot::sim
