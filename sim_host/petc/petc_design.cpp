@@ -142,10 +142,30 @@ MrciDesign design_mrci(double gain, const std::vector<double>& zeros, const std:
       ++d.slow_count;
     } else {
       ++d.fast_count;
-      d.fast_b0 = d.feedthrough;
-      d.fast_b1 = m.residue - d.feedthrough * m.pole;
     }
     d.modes.push_back(m);
+  }
+  // Fast part as one fraction: num = D Π(z − p) + Σ_f r_f Π_{l≠f}(z − p_l), den = Π(z − p).
+  auto times_root = [](const std::vector<double>& poly, double root) {  // poly · (z − root)
+    std::vector<double> out(poly.size() + 1, 0.0);
+    for (std::size_t i = 0; i < poly.size(); ++i) {
+      out[i] += poly[i];
+      out[i + 1] -= root * poly[i];
+    }
+    return out;
+  };
+  d.fast_denominator = {1.0};
+  for (const MrciMode& m : d.modes)
+    if (!m.slow) d.fast_denominator = times_root(d.fast_denominator, m.pole);
+  d.fast_numerator = d.fast_denominator;
+  for (double& c : d.fast_numerator) c *= d.feedthrough;
+  for (std::size_t f = 0; f < d.modes.size(); ++f) {
+    if (d.modes[f].slow) continue;
+    std::vector<double> term = {d.modes[f].residue};
+    for (std::size_t l = 0; l < d.modes.size(); ++l)
+      if (l != f && !d.modes[l].slow) term = times_root(term, d.modes[l].pole);
+    const std::size_t off = d.fast_numerator.size() - term.size();
+    for (std::size_t i = 0; i < term.size(); ++i) d.fast_numerator[off + i] += term[i];
   }
   const std::size_t s = d.slow_count;
   const std::size_t groups = (s + ratio - 1) / ratio;
@@ -308,7 +328,8 @@ nlohmann::json design_json(const PlantFacts& plant, const MrciDesign& mrci, cons
                {"feedthrough", mrci.feedthrough},
                {"slow_modes", slow},
                {"fast_modes", fast},
-               {"fast_part", {{"b0", mrci.fast_b0}, {"b1", mrci.fast_b1}, {"printed_b1", 1.84}}},
+               {"fast_part", {{"numerator", mrci.fast_numerator}, {"denominator", mrci.fast_denominator},
+                              {"printed", "(1.0882 z + 1.84)/(z - 0.6137) at m = 2"}}},
                {"slow_count", mrci.slow_count},
                {"fast_count", mrci.fast_count},
                {"cs", mrci.cs}};

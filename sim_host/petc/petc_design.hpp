@@ -67,7 +67,8 @@ struct MrciDesign {
   std::size_t slow_count = 0;      ///< s.
   std::size_t fast_count = 0;      ///< n.
   double cs = 0;                   ///< (s − ⌈s/m⌉)/(s + n).
-  double fast_b0 = 0, fast_b1 = 0; ///< Fast part D + Σ_fast r/(z − p) as (b0 z + b1)/(z − p) (one fast mode).
+  std::vector<double> fast_numerator;    ///< Fast part D + Σ_fast r/(z − p): numerator, highest power first.
+  std::vector<double> fast_denominator;  ///< Its denominator Π (z − p_fast), monic, highest power first.
 };
 
 /// Partial fractions, slow/fast split and slow modes; std::invalid_argument for a

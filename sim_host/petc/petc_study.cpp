@@ -69,8 +69,8 @@ std::string design_text(const nlohmann::json& d) {
   for (const auto& s : m.at("slow_modes"))
     o << "  slow: " << s.at("numerator") << "/(z^m - " << s.at("slow_pole") << ")  [pole " << s.at("pole")
       << ", residue " << s.at("residue") << ", phase " << s.at("phase") << "]\n";
-  o << "  fast: (" << m.at("fast_part").at("b0") << " z + " << m.at("fast_part").at("b1") << ")/(z - "
-    << m.at("fast_modes").at(0).at("pole") << ")\n";
+  o << "  fast: numerator " << m.at("fast_part").at("numerator").dump() << " / denominator "
+    << m.at("fast_part").at("denominator").dump() << " (powers of z, highest first)\n";
   const auto& b = d.at("dob");
   o << "DOB: Q cutoff " << b.at("cutoff_hz") << " Hz, rho = " << b.at("delay") << ", gamma (d->d-dhat) "
     << b.at("gamma_d_to_error") << ", (u->d-dhat) " << b.at("gamma_u_to_error") << "\n";

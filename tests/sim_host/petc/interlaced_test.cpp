@@ -62,8 +62,10 @@ TEST(Mrci, DecompositionMatchesPrintedModes) {
   EXPECT_NEAR(d.modes[1].slow_numerator / -1.6365, 1.0, 5e-3);
   EXPECT_NEAR(d.modes[1].slow_pole, 0.7218, 5e-5);
   EXPECT_DOUBLE_EQ(d.modes[0].slow_pole, 1.0);
-  EXPECT_NEAR(d.fast_b1 / 1.84, 1.0, 5e-3);
-  EXPECT_DOUBLE_EQ(d.fast_b0, 1.0882);
+  ASSERT_EQ(d.fast_numerator.size(), 2U);
+  EXPECT_NEAR(d.fast_numerator[1] / 1.84, 1.0, 5e-3);
+  EXPECT_DOUBLE_EQ(d.fast_numerator[0], 1.0882);
+  EXPECT_DOUBLE_EQ(d.fast_denominator[1], -0.6137);
   // Residues rebuild C_D: at z = 2, D + Σ r/(z − p) equals the factored form.
   double sum = d.feedthrough;
   for (const MrciMode& m : d.modes) sum += m.residue / (2.0 - m.pole);
@@ -73,6 +75,12 @@ TEST(Mrci, DecompositionMatchesPrintedModes) {
   const MrciDesign d3 = brief_mrci(3);
   EXPECT_EQ(d3.slow_count, 1U);
   EXPECT_DOUBLE_EQ(d3.cs, 0.0);
+  // Its fast part D + r₂/(z − p₂) + r₃/(z − p₃) over (z − p₂)(z − p₃), checked at z = 2.
+  ASSERT_EQ(d3.fast_numerator.size(), 3U);
+  const auto& fn = d3.fast_numerator;
+  const auto& fd = d3.fast_denominator;
+  const double at2 = (fn[0] * 4 + fn[1] * 2 + fn[2]) / (fd[0] * 4 + fd[1] * 2 + fd[2]);
+  EXPECT_NEAR(at2, d3.feedthrough + d3.modes[1].residue / (2 - 0.8496) + d3.modes[2].residue / (2 - 0.6137), 1e-12);
   EXPECT_THROW(brief_mrci(0), std::invalid_argument);
 }
 
