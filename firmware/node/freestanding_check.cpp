@@ -11,7 +11,12 @@
 #include "oneshot/node/dropout_detector.hpp"
 #include "oneshot/node/held_measurement.hpp"
 #include "oneshot/node/held_measurement_estimator.hpp"
+#include "oneshot/node/disturbance_observer.hpp"
+#include "oneshot/node/interlaced_controller.hpp"
 #include "oneshot/node/mtm_trigger.hpp"
+#include "oneshot/node/numre_estimator.hpp"
+#include "oneshot/node/packet_buffer.hpp"
+#include "oneshot/node/petc_controller.hpp"
 #include "oneshot/node/periodic_trigger.hpp"
 #include "oneshot/node/send_on_delta_trigger.hpp"
 #include "oneshot/node/sensor_node.hpp"
@@ -135,6 +140,22 @@ void exercise_sync() {
     const HeldMeasurement<S> m = rx.measurement(i, 1);
     if (m.present) static_cast<void>(est.correct(i, m.z, m.r_bar));
   }
+  // PETC: NUMRE, interlaced law, both disturbance estimates, packet buffer.
+  using Law = InterlacedController<S, 1, 2>;
+  InterlacedConfig<S, 1, 2> lc{};
+  lc.ratio = 2;
+  NumreModel<S, 4> model{};
+  const MtmTrigger<S, 1> trig(delta[0], delta[0], 8, 0);
+  PetcController<S, 4, 8, Law, ModelDisturbance<S>> petc(model, NoiseAccumulation::kSum, Law(lc), ModelDisturbance<S>{},
+                                                         trig, delta[0]);
+  static_cast<void>(petc.on_arrival(0, delta[0]));
+  DisturbanceObserverConfig<S, 2, 4> oc{};
+  using Dob = DisturbanceObserver<S, 2, 4>;
+  PetcController<S, 4, 8, Law, Dob> petc_dob(model, NoiseAccumulation::kFrozen, Law(lc), Dob(oc), trig, delta[0]);
+  static_cast<void>(petc_dob.on_arrival(0, delta[0]));
+  PacketBuffer<S, 8> buffer;
+  static_cast<void>(buffer.accept(0, petc.packet()));
+  static_cast<void>(buffer.value(3));
 }
 
 }  // namespace
