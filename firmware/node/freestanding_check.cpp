@@ -121,6 +121,15 @@ void exercise_sync() {
   ControllerNode<NullBoard, DelayCompensatedLaw<S, 2, 1, Ref>, S, 2, 1> sp(
       3, ControllerMode::kOnArrival, DelayCompensatedLaw<S, 2, 1, Ref>{design.l, Matrix<S, 1, 1>{}, lo, hi, ref});
   sp.on_receive(now);
+}
+
+/// The send-on-delta receiver (dropout detector, held values) and its estimator.
+template <typename S>
+void exercise_sod() {
+  using namespace oneshot::node;
+  using V = oneshot::Vector<S, 1>;
+  V delta;
+  delta[0] = oneshot::ScalarTraits<S>::from_ratio(1, 100);
   // Receiver and estimator of send-on-delta nodes (two nodes, two states).
   using V2 = oneshot::Vector<S, 2>;
   using M2 = oneshot::Matrix<S, 2, 2>;
@@ -140,6 +149,14 @@ void exercise_sync() {
     const HeldMeasurement<S> m = rx.measurement(i, 1);
     if (m.present) static_cast<void>(est.correct(i, m.z, m.r_bar));
   }
+}
+
+/// NUMRE, the interlaced controller, the disturbance estimates and the packet buffer.
+template <typename S>
+void exercise_petc() {
+  using namespace oneshot::node;
+  oneshot::Vector<S, 1> delta;
+  delta[0] = oneshot::ScalarTraits<S>::from_ratio(1, 100);
   // PETC: NUMRE, interlaced law, both disturbance estimates, packet buffer.
   using Law = InterlacedController<S, 1, 2>;
   InterlacedConfig<S, 1, 2> lc{};
@@ -166,4 +183,8 @@ void oneshot_node_freestanding_check() {
   exercise<double>();
   exercise_sync<float>();
   exercise_sync<double>();
+  exercise_sod<float>();
+  exercise_sod<double>();
+  exercise_petc<float>();
+  exercise_petc<double>();
 }
