@@ -117,9 +117,14 @@ TEST(StrictJson, NonFiniteNumbersAndNullAreFoundByPath) {
   EXPECT_EQ(first_non_finite(j), "");
   j["list"] = {1.0, std::nan("")};
   EXPECT_EQ(first_non_finite(j), "list[1]");
+  EXPECT_EQ(first_non_finite_number(j), "list[1]");
+  EXPECT_NE(message_of([&] { dump_finite(j); }).find("field 'list[1]' is not a finite number"), std::string::npos);
+  // An explicit null is a result's own "not applicable" (an unbounded delta_t): found by the
+  // strict check the fuzz oracles use, written by dump_finite.
   j["list"] = {1.0, nullptr};
   EXPECT_EQ(first_non_finite(j), "list[1]");
-  EXPECT_NE(message_of([&] { dump_finite(j); }).find("field 'list[1]' is not a finite number"), std::string::npos);
+  EXPECT_EQ(first_non_finite_number(j), "");
+  EXPECT_NO_THROW(dump_finite(j));
 }
 
 TEST(ChildProcess, ArgumentsReachTheProgramUnchanged) {

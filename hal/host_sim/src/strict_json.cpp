@@ -34,22 +34,22 @@ std::string path_of(const std::vector<Level>& stack) {
   return p;
 }
 
-std::string non_finite_in(const json& j, const std::string& path) {
+std::string non_finite_in(const json& j, const std::string& path, bool null_is_bad) {
   const auto at = [&](const std::string& p) { return p.empty() ? std::string("(top level)") : p; };
   switch (j.type()) {
     case json::value_t::null:
-      return at(path);
+      return null_is_bad ? at(path) : std::string();
     case json::value_t::number_float:
       return std::isfinite(j.get<double>()) ? std::string() : at(path);
     case json::value_t::object:
       for (const auto& [k, v] : j.items()) {
-        const std::string r = non_finite_in(v, path.empty() ? k : path + "." + k);
+        const std::string r = non_finite_in(v, path.empty() ? k : path + "." + k, null_is_bad);
         if (!r.empty()) return r;
       }
       return {};
     case json::value_t::array:
       for (std::size_t i = 0; i < j.size(); ++i) {
-        const std::string r = non_finite_in(j[i], path + "[" + std::to_string(i) + "]");
+        const std::string r = non_finite_in(j[i], path + "[" + std::to_string(i) + "]", null_is_bad);
         if (!r.empty()) return r;
       }
       return {};
@@ -109,12 +109,14 @@ json parse_json_strict(const std::string& text) {
   return root;
 }
 
-std::string first_non_finite(const json& j) { return non_finite_in(j, ""); }
+std::string first_non_finite(const json& j) { return non_finite_in(j, "", true); }
+
+std::string first_non_finite_number(const json& j) { return non_finite_in(j, "", false); }
 
 std::string dump_finite(const json& j, int indent) {
-  const std::string where = first_non_finite(j);
+  const std::string where = first_non_finite_number(j);
   if (!where.empty()) {
-    throw JsonError("field '" + where + "' is not a finite number (NaN, infinite or missing): the computation diverged or "
+    throw JsonError("field '" + where + "' is not a finite number (NaN or infinite): the computation diverged or "
                     "the inputs are out of range; nothing written");
   }
   return j.dump(indent);

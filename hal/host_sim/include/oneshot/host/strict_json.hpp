@@ -26,7 +26,12 @@ nlohmann::json parse_json_strict(const std::string& text);
 /// The root itself is reported as "(top level)".
 std::string first_non_finite(const nlohmann::json& j);
 
-/// `j` dumped with `indent`; JsonError naming the field when it holds NaN, Inf or null.
+/// Key path of the first NaN or infinite number in `j` ("" when there is none); nulls pass.
+std::string first_non_finite_number(const nlohmann::json& j);
+
+/// `j` dumped with `indent`; JsonError naming the field when it holds a NaN or infinite
+/// number (nlohmann would write it as `null`). An explicit null that a result sets on purpose
+/// (an unbounded δt, a divergent MARE) is written as null, next to the reason the study gives.
 std::string dump_finite(const nlohmann::json& j, int indent = 2);
 
 }  // namespace oneshot::host
