@@ -179,7 +179,7 @@ void register_dropping_study(CLI::App& app) {
       std::vector<std::vector<double>> rows;
       for (std::size_t k = 0; k < m.trace.y.size(); ++k)
         rows.push_back({static_cast<double>(k), m.trace.y[k], m.trace.cx[k], m.trace.cxhat[k], m.trace.trace_p[k], m.trace.err[k]});
-      write_csv(o.out_dir + "/run_trace.csv", {"k", "y", "Cx", "Cxhat", "trace_p", "err"}, rows);
+      write_csv(o.out_dir + "/run_trace.csv", {"k", "y", "Cx", "Cxhat", "trace_p", "err"}, rows, NonFinite::kMissing);
       const nlohmann::json j = {{"experiment", "run"}, {"err", dropping::num(m.err)}, {"err_anchor", dropping::num(m.err_anchor)},
                                 {"trace_p", dropping::num(m.trace_p)}, {"trace_p_anchor", dropping::num(m.trace_p_anchor)},
                                 {"gamma", dropping::num(m.gamma)}, {"cost", dropping::num(m.cost)},

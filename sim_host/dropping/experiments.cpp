@@ -193,7 +193,7 @@ nlohmann::json run_closed_loop_experiment(const DroppingPlant& plant, const Stud
                         m.trace.cx[k], m.trace.cxhat[k], m.trace.trace_p[k], m.trace.err[k]});
     }
     sim::write_csv(path_in(opt.out_dir, "closed_loop_trace.csv"), {"scenario", "t_s", "y", "Cx", "Cxhat", "trace_p", "err"},
-                   rows);
+                   rows, sim::NonFinite::kMissing);
     if (opt.plots) {
       std::ostringstream g;
       g << "set terminal pngcairo size 1200," << 300 * lambdas.size() << " font 'Sans,10' noenhanced\n"
@@ -298,8 +298,8 @@ nlohmann::json closed_loop_outputs(const engine::SweepResults& r, const std::str
   sim::write_csv(path_in(out_dir, "closed_loop.csv"),
                  {"lambda", "approach", "err_median", "err_p10", "err_p90", "err_mean", "err_ci95", "trp_median", "trp_p10",
                   "trp_p90", "trp_mean", "trp_ci95"},
-                 csv);
-  engine::write_runs_csv(r, path_in(out_dir, "closed_loop_runs.csv"));
+                 csv, sim::NonFinite::kMissing);
+  engine::write_runs_csv(r, path_in(out_dir, "closed_loop_runs.csv"), sim::NonFinite::kMissing);
   if (plots) {
     std::ostringstream g;
     g << "set terminal pngcairo size 1200,500 font 'Sans,11' noenhanced\nset output 'closed_loop.png'\n"
@@ -407,8 +407,8 @@ nlohmann::json hold_outputs(const engine::SweepResults& r, const std::string& ou
   sim::write_csv(path_in(out_dir, "hold.csv"),
                  {"D", "T_hold", "err_median", "err_p10", "err_p90", "anchor_median", "anchor_p10", "anchor_p90",
                   "corrections"},
-                 csv);
-  engine::write_runs_csv(r, path_in(out_dir, "hold_runs.csv"));
+                 csv, sim::NonFinite::kMissing);
+  engine::write_runs_csv(r, path_in(out_dir, "hold_runs.csv"), sim::NonFinite::kMissing);
   if (plots) {
     std::ostringstream g;
     g << "set terminal pngcairo size 1000,550 font 'Sans,11' noenhanced\nset output 'hold.png'\n"

@@ -48,8 +48,11 @@ nlohmann::json run_mare_curve(const DroppingPlant& plant, const StudyOptions& op
   for (std::size_t i = 0; i < lambdas.size(); ++i) {
     const Point& p = pts[i];
     const double tr = p.o.converged ? p.o.trace : std::numeric_limits<double>::quiet_NaN();
-    csv.push_back({lambdas[i], p.o.converged ? 1.0 : 0.0, tr, static_cast<double>(p.o.iterations), p.k(0, 0), p.k(1, 0),
-                   p.k(2, 0), p.c.certified ? 1.0 : 0.0, (lambdas[i] - 0.5 * (b.lo + b.hi)) * tr});
+    // The CSV (and its plots) holds the converged points only; the JSON lists every point.
+    if (p.o.converged) {
+      csv.push_back({lambdas[i], 1.0, tr, static_cast<double>(p.o.iterations), p.k(0, 0), p.k(1, 0), p.k(2, 0),
+                     p.c.certified ? 1.0 : 0.0, (lambdas[i] - 0.5 * (b.lo + b.hi)) * tr});
+    }
     if (p.o.converged == p.c.certified) ++agree;
     rows.push_back({{"lambda", lambdas[i]},
                     {"converged", p.o.converged},

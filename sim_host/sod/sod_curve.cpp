@@ -205,7 +205,7 @@ nlohmann::json run_traces(const SodModel& model, const StudyOptions& opt, double
   }
   sim::make_directory(opt.out_dir);
   sim::write_csv(path_in(opt.out_dir, "e4_error.csv"),
-                 {"t_s", "sod_e1", "sod_e1_ci", "sod_e2", "sod_e2_ci", "msod_e1", "msod_e1_ci", "msod_e2", "msod_e2_ci"}, rows);
+                 {"t_s", "sod_e1", "sod_e1_ci", "sod_e2", "sod_e2_ci", "msod_e1", "msod_e1_ci", "msod_e2", "msod_e2_ci"}, rows, sim::NonFinite::kMissing);
   // One run (the first seed): y1, x1, both estimates, the instants of (2b) sends and of losses.
   RunTrace ta, tc;
   simulate_run(model, config(0), opt.seed, &ta);
@@ -219,7 +219,8 @@ nlohmann::json run_traces(const SodModel& model, const StudyOptions& opt, double
     run.push_back({tc.t_s[k], tc.x[0][k], tc.y[0][k], ta.x_hat[0][k], tc.x_hat[0][k], ts ? tc.y[0][k] : kNaN,
                    sent && tc.arrived[0][k] == 0 ? tc.y[0][k] : kNaN});
   }
-  sim::write_csv(path_in(opt.out_dir, "e4_run.csv"), {"t_s", "x1", "y1", "xhat1_sod", "xhat1_msod", "time_send_y1", "lost_y1"}, run);
+  // Send and loss markers are NaN where nothing happened (gnuplot draws no point there).
+  sim::write_csv(path_in(opt.out_dir, "e4_run.csv"), {"t_s", "x1", "y1", "xhat1_sod", "xhat1_msod", "time_send_y1", "lost_y1"}, run, sim::NonFinite::kMissing);
   nlohmann::json j = {{"experiment", "E4"}, {"loss", loss}, {"seeds", opt.seeds}, {"first_seed", opt.seed},
                       {"n_t", {config(1).n_t[0], config(1).n_t[1]}}, {"bin_s", static_cast<double>(per_bin) * T},
                       {"time_rule_sends_node1_first_seed", time_sends}, {"files", {"e4_error.csv", "e4_run.csv"}}};

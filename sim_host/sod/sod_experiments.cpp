@@ -163,7 +163,9 @@ nlohmann::json run_grid(const SodModel& model, const StudyOptions& opt, const st
   std::stable_sort(rows.begin(), rows.end(), [](const std::vector<double>& a, const std::vector<double>& b) { return a[1] < b[1]; });
   sim::make_directory(opt.out_dir);
   const std::string csv = (std::filesystem::path(opt.out_dir) / "e2_delta_t.csv").string();
-  sim::write_csv(csv, {"delta_y", "loss", "delta_t1_s", "delta_t2_s", "mean_gap1_s", "mean_gap2_s"}, rows);
+  // An unbounded δt* (brief §5: the constraint never binds) is written as gnuplot's missing value.
+  sim::write_csv(csv, {"delta_y", "loss", "delta_t1_s", "delta_t2_s", "mean_gap1_s", "mean_gap2_s"}, rows,
+                 sim::NonFinite::kMissing);
   j["files"] = {"e2_delta_t.csv"};
   if (opt.plots) {
     std::ostringstream g;

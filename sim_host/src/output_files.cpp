@@ -15,7 +15,7 @@
 namespace oneshot::sim {
 
 void write_csv(const std::string& path, const std::vector<std::string>& header,
-               const std::vector<std::vector<double>>& rows) {
+               const std::vector<std::vector<double>>& rows, NonFinite non_finite) {
   std::string out;
   for (std::size_t i = 0; i < header.size(); ++i) out += (i ? "," : "") + header[i];
   out += "\n";
@@ -23,6 +23,10 @@ void write_csv(const std::string& path, const std::vector<std::string>& header,
   for (std::size_t r = 0; r < rows.size(); ++r) {
     for (std::size_t i = 0; i < rows[r].size(); ++i) {
       if (!std::isfinite(rows[r][i])) {
+        if (non_finite == NonFinite::kMissing) {
+          out += (i ? ",nan" : "nan");
+          continue;
+        }
         throw std::runtime_error(path + ": row " + std::to_string(r + 1) + ", column '" +
                                  (i < header.size() ? header[i] : std::to_string(i + 1)) +
                                  "' is not a finite number: the run diverged or its inputs are out of range");

@@ -2,6 +2,9 @@
 /// @brief Scenario and trace files read strictly and boundedly; outputs never hold NaN/null.
 #include <gtest/gtest.h>
 
+#include <fstream>
+#include <sstream>
+
 #include <cmath>
 #include <filesystem>
 #include <functional>
@@ -100,6 +103,16 @@ TEST(OutputFiles, NonFiniteNumbersAreRefusedNotWrittenAsNullOrNan) {
   const std::string c = error_of([&] { write_csv((dir / "r.csv").string(), {"t", "x"}, {{0, 1}, {1, std::nan("")}}); });
   EXPECT_NE(c.find("row 2, column 'x' is not a finite number"), std::string::npos) << c;
   EXPECT_FALSE(fs::exists(dir));  // nothing written, not even the folder
+  // A divergence a study reports as its finding: written as gnuplot's missing value, on request only.
+  write_csv((dir / "d.csv").string(), {"t", "x"}, {{0, 1}, {1, std::numeric_limits<double>::infinity()}},
+            NonFinite::kMissing);
+  std::ifstream in(dir / "d.csv");
+  std::stringstream text;
+  text << in.rdbuf();
+  EXPECT_EQ(text.str(), "t,x\n0,1\n1,nan\n");
+  // An explicit null (an unbounded delta_t) is a result, written as such.
+  EXPECT_NO_THROW(write_json((dir / "n.json").string(), nlohmann::json{{"delta_t_s", nullptr}}));
+  fs::remove_all(dir);
 }
 
 TEST(OutputFiles, GnuplotLabelsAreQuotedAsData) {

@@ -101,7 +101,7 @@ nlohmann::json summary_json(const SweepResults& r, const SweepSummary& sm) {
   return j;
 }
 
-void write_runs_csv(const SweepResults& r, const std::string& path) {
+void write_runs_csv(const SweepResults& r, const std::string& path, sim::NonFinite non_finite) {
   std::vector<std::string> header = {"approach_index", "scenario_index", "seed"};
   header.insert(header.end(), r.spec.metrics.begin(), r.spec.metrics.end());
   std::vector<std::vector<double>> rows;
@@ -113,7 +113,7 @@ void write_runs_csv(const SweepResults& r, const std::string& path) {
         for (std::size_t m = 0; m < r.spec.metrics.size(); ++m) row.push_back(r.at(a, s, k, m));
         rows.push_back(row);
       }
-  sim::write_csv(path, header, rows);
+  sim::write_csv(path, header, rows, non_finite);
 }
 
 void write_summary_files(const SweepResults& r, const SweepSummary& sm, const std::string& dir, const std::string& prefix,

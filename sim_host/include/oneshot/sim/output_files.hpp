@@ -13,13 +13,21 @@
 
 namespace oneshot::sim {
 
-/// Writes a CSV: header line, then rows of numbers with 9 significant digits
-/// (std::runtime_error naming the row and column of a NaN or infinite value).
+/// What write_csv does with a NaN or infinite value.
+enum class NonFinite {
+  kRefuse,  ///< std::runtime_error naming the row and column (the default: a run diverged by mistake).
+  kMissing  ///< Written as `nan` (gnuplot: `set datafile missing 'nan'`), for studies where a divergence
+            ///< is the finding itself (a filter below the critical arrival rate) and is reported beside.
+};
+
+/// Writes a CSV: header line, then rows of numbers with 9 significant digits; NaN or infinite
+/// values as `non_finite` says.
 void write_csv(const std::string& path, const std::vector<std::string>& header,
-               const std::vector<std::vector<double>>& rows);
+               const std::vector<std::vector<double>>& rows,
+               NonFinite non_finite = NonFinite::kRefuse);
 
 /// Writes `j` pretty-printed to `path`, or to standard output when path is "-"
-/// (std::runtime_error naming the field when a number is NaN, infinite or null).
+/// (std::runtime_error naming the field when a number is NaN or infinite; an explicit null passes).
 void write_json(const std::string& path, const nlohmann::json& j);
 
 /// Writes `text` to `path`.
