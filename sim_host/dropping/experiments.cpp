@@ -249,7 +249,8 @@ nlohmann::json closed_loop_outputs(const engine::SweepResults& r, const std::str
       const engine::TailSummary tr = engine::tail_summary(ratio);
       const sim::Summary dd = sim::summarize(diff);
       ja["paired_err_ratio_to_buffered"] = tail_json(tr);
-      ja["paired_err_difference_to_buffered"] = {{"mean", dd.mean}, {"ci95", dd.ci95}};
+      // Null where the differences overflow (a diverging baseline): the median ratio beside it stays defined.
+      ja["paired_err_difference_to_buffered"] = {{"mean", num(dd.mean)}, {"ci95", num(dd.ci95)}};
       js["approaches"][r.spec.approaches[a]] = ja;
       const engine::TailSummary te = engine::tail_summary(e);
       const engine::TailSummary tp = engine::tail_summary(cell(r, a, s, r.metric("trace_p")));
