@@ -144,3 +144,20 @@ foreach(probe_n RANGE 2 16)
             -DOUT=$<TARGET_FILE:${image}>.stack.txt -P ${PROJECT_SOURCE_DIR}/cmake/oneshot_stack_bound.cmake
     COMMENT "size and stack bound of ${image}")
 endforeach()
+
+# The fixed-point job must link no soft-float routine at any optimisation level (its
+# constants are integer-exact): the fixed table image built at -Og, never part of ALL; a
+# test builds it and checks its symbols (tests/pil/og_no_floating_point.cmake).
+set(og_probe oneshot-og-probe-${ONESHOT_FIRMWARE_TARGET})
+add_executable(${og_probe} EXCLUDE_FROM_ALL firmware/app/mcu/main.cpp firmware/app/mcu/startup.cpp ${c_job_source})
+set_target_properties(${og_probe} PROPERTIES SUFFIX ".elf" C_STANDARD 99 C_STANDARD_REQUIRED ON C_EXTENSIONS OFF)
+add_dependencies(${og_probe} oneshot_generated)
+target_include_directories(${og_probe} PRIVATE
+  firmware/core/include firmware/app/include hal/include hal/mcu/include ${generated_dir} ${generated_dir}/oneshot_c)
+set(og_options ${fw_common_options})
+list(REMOVE_ITEM og_options ${ONESHOT_FIRMWARE_OPT} -Werror)
+target_compile_options(${og_probe} PRIVATE ${og_options} -Og)
+target_compile_definitions(${og_probe} PRIVATE ${soc_define}
+  ONESHOT_MCU_IRQ_COUNT=${irq_count} ONESHOT_MCU_ACTUATION_IRQ=8 ONESHOT_MCU_UART_IRQ=${uart_irq} ${extra_defines}
+  ONESHOT_FW_FIXED=1 ONESHOT_FW_DISC=0)
+oneshot_firmware_link(${og_probe})

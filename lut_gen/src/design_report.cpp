@@ -71,9 +71,7 @@ nlohmann::json design_json(const PlantDescription& plant, const DesignResult& d)
       dist["covariance_per_period"] = matrix_json(plant.disturbance_covariance_per_period);
     }
     if (plant.c_bar.rows != 0) dist["C_bar"] = matrix_json(plant.c_bar);
-    j["disturbance"] = dist;
-  } else {
-    j["disturbance"] = nullptr;
+    j["disturbance"] = dist;  // absent without disturbance inputs (outputs hold no null)
   }
   j["u_min"] = d.u_min;
   j["u_max"] = d.u_max;

@@ -1,7 +1,6 @@
 /// @file lut_gen_main.cpp
 /// @brief lut_gen: build-time generator of the table header and lut_report.json.
 #include <CLI/CLI.hpp>
-#include <fstream>
 #include <iostream>
 #include <memory>
 #include <nlohmann/json.hpp>
@@ -14,6 +13,8 @@
 #include "oneshot/design/plant_description.hpp"
 #include "oneshot/design/structure_analysis.hpp"
 #include "oneshot/design/table_builder.hpp"
+#include "oneshot/host/file_io.hpp"
+#include "oneshot/host/strict_json.hpp"
 
 namespace {
 
@@ -42,11 +43,8 @@ nlohmann::json table_json(const oneshot::design::TableData<S>& t, const oneshot:
   return j;
 }
 
-void write_file(const std::string& path, const std::string& text) {
-  std::ofstream out(path, std::ios::binary);
-  out << text;
-  if (!out) throw std::runtime_error(path + ": cannot write");
-}
+/// Atomic, checked write (temporary file, fsync, rename): the build never sees half a header.
+void write_file(const std::string& path, const std::string& text) { oneshot::host::write_file_atomic(path, text); }
 
 }  // namespace
 
@@ -136,7 +134,7 @@ int main(int argc, char** argv) {
     }
     report["formats"]["fixed"] = fixed;
     report["design"] = d::design_json(plant, design);
-    write_file(report_path, report.dump(2) + "\n");
+    write_file(report_path, oneshot::host::dump_finite(report) + "\n");
     std::cout << "lut_gen: " << plant.name << ": float table " << table_f.bytes() << " bytes (" << table_f.radix.size()
               << " levels, " << table_f.entry_time_us.size() << " entries x " << static_cast<int>(table_f.slots)
               << " slots), max abs error " << acc_f.max_abs_error;

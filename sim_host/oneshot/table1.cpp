@@ -5,7 +5,6 @@
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
-#include <fstream>
 #include <sstream>
 #include <stdexcept>
 
@@ -87,7 +86,6 @@ engine::SweepResults table1_sweep(const SimContext& ctx, const CommonOptions& op
 }
 
 nlohmann::json table1_outputs(const engine::SweepResults& results, const std::string& out_dir, bool plots) {
-  make_directory(out_dir);
   const engine::SweepSpec& spec = results.spec;
   const nlohmann::json& cfg = spec.config;
   const std::size_t na = spec.approaches.size();
@@ -185,10 +183,11 @@ nlohmann::json table1_outputs(const engine::SweepResults& results, const std::st
   j["markdown"] = md.str();
   j["markdown_per_scenario"] = per.str();
   {
-    std::ofstream out(path_in(out_dir, "table1.md"));
+    std::ostringstream out;
     out << "Table I: mean cost over " << ns << " scenarios, " << seeds << " seeds each ("
         << cfg.at("number_format").get<std::string>() << ", " << cfg.at("discretizer").get<std::string>() << ")\n\n"
         << md.str() << "\nPer scenario (mean over seeds):\n\n" << per.str();
+    write_text(path_in(out_dir, "table1.md"), out.str());  // atomic and checked; creates the folder
   }
   std::vector<std::vector<double>> raw;
   for (std::size_t a = 0; a < na; ++a)
@@ -200,7 +199,7 @@ nlohmann::json table1_outputs(const engine::SweepResults& results, const std::st
   write_csv(path_in(out_dir, "table1.csv"), {"approach_index", "cost_mean", "cost_ci95", "ratio_mean", "ratio_ci95"}, csv_rows);
   if (plots) {
     std::ostringstream xtics;
-    for (std::size_t a = 0; a < na; ++a) xtics << (a == 0 ? "" : ", ") << "'" << spec.approaches[a] << "' " << a;
+    for (std::size_t a = 0; a < na; ++a) xtics << (a == 0 ? "" : ", ") << gnuplot_quote(spec.approaches[a]) << " " << a;
     std::ostringstream g;
     g << "set terminal pngcairo size 1100,700 font 'Sans,11' noenhanced\n"
       << "set output 'table1.png'\nset datafile separator ','\nset grid ytics\nset style fill solid 0.6\n"
@@ -220,7 +219,7 @@ namespace oneshot::sim {
 
 nlohmann::json run_table1(const SimContext& ctx, const CommonOptions& opt, const std::vector<Scenario>& scenarios,
                           std::size_t seeds, const engine::Shard& shard, double* wall_time_s) {
-  make_directory(opt.out_dir);
+  // No folder before the first file: a run refused by its checks leaves nothing behind.
   const engine::SweepResults r = table1_sweep(ctx, opt, scenarios, seeds, shard, wall_time_s);
   if (!shard.whole()) {
     const nlohmann::json j = engine::shard_to_json(r);

@@ -1,6 +1,5 @@
 /// @file cli_design.cpp
 /// @brief `oneshot-sim design`.
-#include <fstream>
 #include <iostream>
 #include <memory>
 
@@ -8,6 +7,7 @@
 #include "oneshot/design/design_report.hpp"
 #include "oneshot/design/plant_description.hpp"
 #include "oneshot/sim/cli_commands.hpp"
+#include "oneshot/sim/output_files.hpp"
 
 namespace oneshot::sim {
 
@@ -24,17 +24,13 @@ void register_design_command(CLI::App& app) {
     const design::PlantDescription plant =
         opt->plant.empty() ? design::reference_plant() : design::load_plant_file(opt->plant);
     const design::DesignResult result = design::synthesize(plant);
-    const std::string text = design::design_json(plant, result).dump(2) + "\n";
+    const nlohmann::json j = design::design_json(plant, result);
     if (opt->json == "-") {
-      std::cout << text;
+      write_json("-", j);
       return;
     }
     design::print_design(std::cout, plant, result);
-    if (!opt->json.empty()) {
-      std::ofstream out(opt->json, std::ios::binary);
-      out << text;
-      if (!out) throw std::runtime_error(opt->json + ": cannot write");
-    }
+    if (!opt->json.empty()) write_json(opt->json, j);
   });
 }
 

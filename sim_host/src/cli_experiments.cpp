@@ -2,7 +2,9 @@
 /// @brief Subcommands noise, jitter, gain, table1, exectime, run, benchmark and report.
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
@@ -43,6 +45,44 @@ struct CliCommon {
   }
 };
 
+/// A finite number in [lo, hi] ((lo, hi] when lo_open): NaN, ±inf and text are refused by
+/// name (CLI11's Range lets NaN through, which silently meant a default elsewhere).
+CLI::Validator finite_in(double lo, double hi, bool lo_open = false) {
+  std::ostringstream d;
+  d << "FLOAT in " << (lo_open ? "(" : "[") << lo << ", " << hi << "]";
+  return CLI::Validator(
+      [=](std::string& text) -> std::string {
+        char* end = nullptr;
+        const double v = std::strtod(text.c_str(), &end);
+        if (text.empty() || end == text.c_str() || *end != '\0') return "'" + text + "' is not a number";
+        if (!std::isfinite(v)) return "must be a finite number, got '" + text + "'";
+        if (v < lo || v > hi || (lo_open && v == lo)) {
+          std::ostringstream o;
+          o << "must be in " << (lo_open ? "(" : "[") << lo << ", " << hi << "], got " << text;
+          return o.str();
+        }
+        return {};
+      },
+      d.str());
+}
+
+/// An unsigned decimal integer up to `max` (CLI11 reads "-1" into an unsigned as 2^64 - 1).
+CLI::Validator unsigned_up_to(std::uint64_t max, const std::string& why) {
+  return CLI::Validator(
+      [=](std::string& text) -> std::string {
+        const bool digits = !text.empty() && text.size() <= 19 &&
+                            std::all_of(text.begin(), text.end(), [](char ch) { return ch >= '0' && ch <= '9'; });
+        if (!digits || std::strtoull(text.c_str(), nullptr, 10) > max) {
+          return "must be an integer in [0, " + std::to_string(max) + "] (" + why + "), got '" + text + "'";
+        }
+        return {};
+      },
+      "INT in [0, " + std::to_string(max) + "]");
+}
+
+/// Largest seed: seeds are written to CSV and JSON as numbers, exact up to 2^53.
+constexpr std::uint64_t kMaxSeed = std::uint64_t{1} << 53;
+
 void add_common(CLI::App* cmd, CliCommon& c, const std::string& default_out) {
   c.opt.out_dir = default_out;
   if (c.noise.empty()) c.noise = "exact";
@@ -50,7 +90,9 @@ void add_common(CLI::App* cmd, CliCommon& c, const std::string& default_out) {
       ->check(CLI::ExistingFile);
   cmd->add_option("--out", c.opt.out_dir, "output folder for CSV files and plots")->capture_default_str();
   cmd->add_option("--json", c.json, "write the summary as JSON to PATH ('-' for standard output)");
-  cmd->add_option("--seed", c.opt.seed, "random seed (first seed of a sweep)")->capture_default_str();
+  cmd->add_option("--seed", c.opt.seed, "random seed (first seed of a sweep)")
+      ->check(unsigned_up_to(kMaxSeed, "written exactly as a JSON/CSV number"))
+      ->capture_default_str();
   cmd->add_option("--number-format", c.format, "number format of the control job")
       ->check(CLI::IsMember({"float", "double", "fixed"}))
       ->capture_default_str();
@@ -65,7 +107,9 @@ void add_common(CLI::App* cmd, CliCommon& c, const std::string& default_out) {
   cmd->add_option("--pwm-update", c.pwm, "when a new duty acts: immediately or at the next PWM period")
       ->check(CLI::IsMember({"immediate", "period"}))
       ->capture_default_str();
-  cmd->add_option("--threads", c.opt.threads, "worker threads for sweeps (0: every core)")->capture_default_str();
+  cmd->add_option("--threads", c.opt.threads, "worker threads for sweeps (0: every core)")
+      ->check(unsigned_up_to(1024, "threads per process"))
+      ->capture_default_str();
   cmd->add_flag("--no-plots", c.no_plots, "write CSV files only (no gnuplot)");
 }
 
@@ -98,7 +142,7 @@ void register_experiment_commands(CLI::App& app) {
     auto duration = std::make_shared<double>(5.0);
     CLI::App* cmd = app.add_subcommand("noise", "Experiment 1: noisy measured v1 beside the estimated states");
     add_common(cmd, *c, "out/noise");
-    cmd->add_option("--duration", *duration, "simulated seconds")->check(CLI::Range(0.1, 3600.0))->capture_default_str();
+    cmd->add_option("--duration", *duration, "simulated seconds")->check(finite_in(0.1, 3600.0))->capture_default_str();
     cmd->callback([c, duration]() {
       const auto ctx = SimContext::load(c->plant);
       emit(*c, run_noise_experiment(*ctx, c->resolve(), *duration));
@@ -110,7 +154,7 @@ void register_experiment_commands(CLI::App& app) {
     auto jitter = std::make_shared<std::int32_t>(20'000);
     CLI::App* cmd = app.add_subcommand("jitter", "Experiment 2: one-shot + half Kalman against standard controllers under jitter");
     add_common(cmd, *c, "out/jitter");
-    cmd->add_option("--duration", *duration, "simulated seconds")->check(CLI::Range(0.1, 3600.0))->capture_default_str();
+    cmd->add_option("--duration", *duration, "simulated seconds")->check(finite_in(0.1, 3600.0))->capture_default_str();
     cmd->add_option("--jitter-us", *jitter, "largest release delay of the job (us)")->check(CLI::Range(0, 10'000'000))->capture_default_str();
     cmd->callback([c, duration, jitter]() {
       const auto ctx = SimContext::load(c->plant);
@@ -123,8 +167,8 @@ void register_experiment_commands(CLI::App& app) {
     auto p0 = std::make_shared<double>(100.0);
     CLI::App* cmd = app.add_subcommand("gain", "Experiment 3: first Kalman gain element over time");
     add_common(cmd, *c, "out/gain");
-    cmd->add_option("--duration", *duration, "simulated seconds")->check(CLI::Range(0.1, 3600.0))->capture_default_str();
-    cmd->add_option("--p0-scale", *p0, "initial covariance as a multiple of the steady state")->check(CLI::PositiveNumber)->capture_default_str();
+    cmd->add_option("--duration", *duration, "simulated seconds")->check(finite_in(0.1, 3600.0))->capture_default_str();
+    cmd->add_option("--p0-scale", *p0, "initial covariance as a multiple of the steady state")->check(finite_in(0.0, 1e12, true))->capture_default_str();
     cmd->callback([c, duration, p0]() {
       const auto ctx = SimContext::load(c->plant);
       emit(*c, run_gain_experiment(*ctx, c->resolve(), *duration, *p0));
@@ -177,7 +221,7 @@ void register_experiment_commands(CLI::App& app) {
         ->capture_default_str();
     cmd->add_option("--approach", *approach, "approach A-E")->check(CLI::IsMember({"A", "B", "C", "D", "E", "a", "b", "c", "d", "e"}))->capture_default_str();
     cmd->add_option("--scenario", *scenario, "built-in scenario")->capture_default_str();
-    cmd->add_option("--duration", *duration, "simulated seconds")->check(CLI::Range(0.05, 3600.0))->capture_default_str();
+    cmd->add_option("--duration", *duration, "simulated seconds")->check(finite_in(0.05, 3600.0))->capture_default_str();
     cmd->add_flag("--table1", *table1, "run Table I (every approach and scenario) through the MCU");
     cmd->add_option("--seeds", *seeds, "seeds per scenario with --table1")->check(CLI::Range(2, 1000))->capture_default_str();
     cmd->add_option("--firmware-dir", *fw_dir, "build tree holding firmware-<target>/ (default: this build's)");
@@ -206,7 +250,7 @@ void register_experiment_commands(CLI::App& app) {
         Scenario sc = find_scenario(default_scenarios(), *scenario);
         sc.duration_s = *duration;
         j = run_pil_compare(*ctx, o, p, sc, parse_approach(*approach));
-        if (c->json != "-") std::cout << j.dump(2) << "\n";
+        if (c->json != "-") write_json("-", j);
       }
       if (!c->json.empty()) write_json(c->json, j);
     });
@@ -279,7 +323,8 @@ void register_experiment_commands(CLI::App& app) {
     cmd->add_option("--approach", *approach, "approach A-E")->check(CLI::IsMember({"A", "B", "C", "D", "E", "a", "b", "c", "d", "e"}))->capture_default_str();
     cmd->add_option("--scenario", *scenario, "scenario name (built-in or from --scenarios)")->capture_default_str();
     cmd->add_option("--scenarios", *file, "scenario file")->check(CLI::ExistingFile);
-    cmd->add_option("--duration", *duration, "override the scenario duration (s)")->check(CLI::Range(0.0, 3600.0));
+    CLI::Option* duration_opt = cmd->add_option("--duration", *duration, "override the scenario duration (s)")
+                                    ->check(finite_in(0.0, 3600.0, true));
     cmd->add_option("--jitter", *jitter_model, "override the jitter model: none, uniform or trace")->check(CLI::IsMember({"none", "uniform", "trace"}));
     cmd->add_option("--jitter-us", *jitter_us, "uniform jitter: largest release delay (us)")->check(CLI::Range(0, 10'000'000));
     cmd->add_option("--jitter-trace", *trace_file, "trace jitter: CSV 'release_us,exec_us'")->check(CLI::ExistingFile);
@@ -287,14 +332,21 @@ void register_experiment_commands(CLI::App& app) {
     cmd->callback([=]() {
       const auto ctx = SimContext::load(c->plant);
       Scenario sc = find_scenario(scenarios_from(*file), *scenario);
-      if (*duration > 0) sc.duration_s = *duration;
-      if (*jitter_model == "none") sc.jitter = JitterModel{};
-      if (*jitter_model == "uniform" || (jitter_model->empty() && *jitter_us >= 0)) {
+      if (duration_opt->count() > 0) sc.duration_s = *duration;
+      // --jitter-us implies the uniform model and --jitter-trace the trace model; an option
+      // that the chosen model would ignore is refused.
+      const bool has_us = *jitter_us >= 0;
+      const bool has_trace = !trace_file->empty();
+      const std::string model = !jitter_model->empty() ? *jitter_model : has_trace ? "trace" : has_us ? "uniform" : "";
+      if (has_trace && model != "trace") throw ScenarioError("--jitter-trace needs --jitter trace (got --jitter " + model + ")");
+      if (has_us && model != "uniform") throw ScenarioError("--jitter-us needs --jitter uniform (got --jitter " + model + ")");
+      if (model == "none") sc.jitter = JitterModel{};
+      if (model == "uniform") {
         sc.jitter.kind = JitterModel::Kind::kUniform;
-        if (*jitter_us >= 0) sc.jitter.release_max_us = *jitter_us;
+        if (has_us) sc.jitter.release_max_us = *jitter_us;
       }
-      if (*jitter_model == "trace") {
-        if (trace_file->empty()) throw ScenarioError("--jitter trace needs --jitter-trace FILE");
+      if (model == "trace") {
+        if (!has_trace) throw ScenarioError("--jitter trace needs --jitter-trace FILE");
         sc.jitter.kind = JitterModel::Kind::kTrace;
         sc.jitter.trace_path = *trace_file;
         sc.jitter.trace = load_jitter_trace(*trace_file);
@@ -307,11 +359,11 @@ void register_experiment_commands(CLI::App& app) {
     auto seconds = std::make_shared<double>(200.0);
     CLI::App* cmd = app.add_subcommand("benchmark", "Simulated seconds per wall second of the board emulation (one core)");
     add_common(cmd, *c, "out/benchmark");
-    cmd->add_option("--simulated-seconds", *seconds, "simulated time per measurement")->check(CLI::Range(1.0, 1e5))->capture_default_str();
+    cmd->add_option("--simulated-seconds", *seconds, "simulated time per measurement")->check(finite_in(1.0, 1e5))->capture_default_str();
     cmd->callback([c, seconds]() {
       const auto ctx = SimContext::load(c->plant);
       const nlohmann::json j = run_benchmark(*ctx, c->resolve(), *seconds);
-      if (c->json != "-") std::cout << j.dump(2) << "\n";
+      if (c->json != "-") write_json("-", j);
       if (!c->json.empty()) write_json(c->json, j);
     });
   }
@@ -322,17 +374,22 @@ void register_experiment_commands(CLI::App& app) {
     auto file = std::make_shared<std::string>();
     CLI::App* cmd = app.add_subcommand("report", "Run every experiment and write OUTDIR/report.md with tables and plots");
     add_common(cmd, *c, "out");
-    cmd->add_option("outdir", *outdir, "output folder")->capture_default_str();
+    CLI::Option* outdir_opt = cmd->add_option("outdir", *outdir, "output folder (the same as --out)")->capture_default_str();
     cmd->add_option("--seeds", *seeds, "seeds per Table I scenario")->check(CLI::Range(2, 100000))->capture_default_str();
     cmd->add_option("--scenarios", *file, "scenario file for Table I")->check(CLI::ExistingFile);
     auto no_mcu = std::make_shared<bool>(false);
     auto fw_dir = std::make_shared<std::string>();
     cmd->add_flag("--no-mcu", *no_mcu, "leave out the firmware section (instruction counts and PIL under QEMU)");
     cmd->add_option("--firmware-dir", *fw_dir, "build tree holding firmware-<target>/ (default: this build's)");
-    cmd->callback([c, seeds, outdir, file, no_mcu, fw_dir]() {
+    CLI::Option* out_opt = cmd->get_option("--out");
+    cmd->callback([c, seeds, outdir, file, no_mcu, fw_dir, outdir_opt, out_opt]() {
+      if (outdir_opt->count() > 0 && out_opt->count() > 0 && *outdir != c->opt.out_dir) {
+        throw std::invalid_argument("two output folders given ('" + *outdir + "' and --out '" + c->opt.out_dir +
+                                    "'): give one");
+      }
       const auto ctx = SimContext::load(c->plant);
       CommonOptions o = c->resolve();
-      o.out_dir = *outdir;
+      o.out_dir = outdir_opt->count() > 0 ? *outdir : c->opt.out_dir;
       ReportOptions r;
       r.scenarios = scenarios_from(*file);
       r.seeds = *seeds;

@@ -1,13 +1,13 @@
 /// @file cli_merge.cpp
 /// @brief `oneshot-sim merge`: joins the shard files of a sweep into its result.
-#include <filesystem>
-#include <fstream>
 #include <iostream>
 #include <memory>
 #include <sstream>
 
 #include "oneshot/engine/sweep.hpp"
 #include "oneshot/engine/sweep_registry.hpp"
+#include "oneshot/host/file_io.hpp"
+#include "oneshot/host/strict_json.hpp"
 #include "oneshot/sim/cli_commands.hpp"
 #include "oneshot/sim/output_files.hpp"
 
@@ -15,19 +15,17 @@ namespace oneshot::sim {
 namespace {
 
 /// Largest shard file read (bytes): a shard holds a few numbers per run.
-constexpr std::uintmax_t kMaxShardBytes = std::uintmax_t{1} << 30;
+constexpr std::size_t kMaxShardBytes = std::size_t{1} << 30;
 
 engine::SweepResults read_shard(const std::string& path) {
-  std::error_code ec;
-  if (!std::filesystem::is_regular_file(path, ec)) throw std::invalid_argument(path + ": not a regular file");
-  if (std::filesystem::file_size(path, ec) > kMaxShardBytes) throw std::invalid_argument(path + ": larger than 1 GiB");
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw std::invalid_argument(path + ": cannot read");
   nlohmann::json j;
   try {
-    in >> j;
-  } catch (const nlohmann::json::exception& e) {
-    throw std::invalid_argument(path + ": not valid JSON: " + e.what());
+    // Bounded read (a directory, device or oversized file is named as such); duplicate keys refused.
+    j = host::parse_json_strict(host::read_text_file(path, "shard file", kMaxShardBytes));
+  } catch (const host::FileError& e) {
+    throw std::invalid_argument(e.what());
+  } catch (const host::JsonError& e) {
+    throw std::invalid_argument(path + ": " + e.what());
   }
   try {
     return engine::shard_from_json(j);

@@ -14,9 +14,10 @@
 #include <iostream>
 #include <map>
 #include <sstream>
-#include <sys/wait.h>
 
 #include "oneshot/engine/engine_benchmark.hpp"
+#include "oneshot/host/child_process.hpp"
+#include "oneshot/host/file_io.hpp"
 #include "oneshot/sim/output_files.hpp"
 #include "oneshot/sim/parallel.hpp"
 #include "oneshot/sim/progress_bar.hpp"
@@ -69,7 +70,6 @@ RunOptions run_options(const CommonOptions& opt, Approach a) {
 }
 
 nlohmann::json run_noise_experiment(const SimContext& ctx, const CommonOptions& opt, double duration_s) {
-  make_directory(opt.out_dir);
   const Scenario sc = uniform_scenario("noise-demo", 20'000, 0.2, 1.0, duration_s);
   RunOptions ro = run_options(opt, Approach::kB);
   ro.record_jobs = true;
@@ -112,13 +112,13 @@ nlohmann::json run_noise_experiment(const SimContext& ctx, const CommonOptions& 
     std::ostringstream g;
     g << png_terminal() << "set output 'noise.png'\nset datafile separator ','\nset key outside right top\n"
       << "set multiplot layout " << std::min<std::size_t>(n, 2) << ",1 title 'Noise removal: one-shot controller with half Kalman filter (jitter 0-20 ms)'\n"
-      << "set grid\nset ylabel '" << state_label(ctx, 0) << " (V)'\n"
+      << "set grid\nset ylabel " << gnuplot_quote(state_label(ctx, 0) + " (V)") << "\n"
       << "plot 'noise_jobs.csv' using 1:2 skip 1 with points pt 7 ps 0.5 lc rgb '#999999' title 'measured (ADC)', "
       << "'noise_trace.csv' using 1:" << n + 2 << " skip 1 with lines dt 2 lw 1.5 lc rgb 'black' title 'set-point', "
       << "'noise_trace.csv' using 1:2 skip 1 with lines lw 2 lc rgb '#1f77b4' title 'true', "
       << "'noise_jobs.csv' using 3:4 skip 1 with steps lw 2 lc rgb '#d62728' title 'estimate'\n";
     if (n >= 2) {
-      g << "set xlabel 'time (s)'\nset ylabel '" << state_label(ctx, 1) << " (V)'\n"
+      g << "set xlabel 'time (s)'\nset ylabel " << gnuplot_quote(state_label(ctx, 1) + " (V)") << "\n"
         << "plot 'noise_trace.csv' using 1:3 skip 1 with lines lw 2 lc rgb '#1f77b4' title 'true', "
         << "'noise_jobs.csv' using 3:5 skip 1 with steps lw 2 lc rgb '#d62728' title 'estimate'\n";
     }
@@ -138,7 +138,6 @@ nlohmann::json run_noise_experiment(const SimContext& ctx, const CommonOptions& 
 
 nlohmann::json run_jitter_experiment(const SimContext& ctx, const CommonOptions& opt, double duration_s,
                                      std::int32_t jitter_us) {
-  make_directory(opt.out_dir);
   const Scenario sc = uniform_scenario("jitter-demo", jitter_us, 0.2, 1.0, duration_s);
   const std::array<Approach, 4> approaches = {Approach::kA, Approach::kB, Approach::kD, Approach::kE};
   std::vector<RunResult> results(approaches.size());
@@ -159,7 +158,7 @@ nlohmann::json run_jitter_experiment(const SimContext& ctx, const CommonOptions&
     std::ostringstream g;
     g << png_terminal() << "set output 'jitter.png'\nset datafile separator ','\nset key top left box opaque\nset grid\n"
       << "set title 'Response under jitter (release 0-" << jitter_us / 1000.0 << " ms): one-shot + half Kalman vs standard controllers'\n"
-      << "set xlabel 'time (s)'\nset ylabel '" << v << " (V)'\n"
+      << "set xlabel 'time (s)'\nset ylabel " << gnuplot_quote(v + " (V)") << "\n"
       << "plot 'jitter.csv' using 1:2 skip 1 with lines dt 2 lw 1.5 lc rgb 'black' title 'set-point', "
       << "'' using 1:3 skip 1 with lines lw 3 lc rgb '#bbbbbb' title 'A: standard + Kalman, no jitter', "
       << "'' using 1:4 skip 1 with lines lw 1.5 lc rgb '#d62728' title 'B: one-shot + half Kalman', "
@@ -176,7 +175,6 @@ nlohmann::json run_jitter_experiment(const SimContext& ctx, const CommonOptions&
 }
 
 nlohmann::json run_gain_experiment(const SimContext& ctx, const CommonOptions& opt, double duration_s, double p0_scale) {
-  make_directory(opt.out_dir);
   const Scenario sc = uniform_scenario("gain-demo", 20'000, 0.2, 1.0, duration_s);
   const std::array<Approach, 3> approaches = {Approach::kB, Approach::kC, Approach::kA};
   std::vector<RunResult> results(approaches.size());
@@ -259,37 +257,30 @@ const Variant& find_variant(const std::string& name) {
   throw std::invalid_argument("unknown variant '" + name + "'");
 }
 
-std::string run_capture(const std::string& command, int& exit_code) {
-  FILE* pipe = ::popen((command + " 2>&1").c_str(), "r");
-  if (pipe == nullptr) {
-    exit_code = -1;
-    return {};
-  }
+/// `path` for valgrind's --callgrind-out-file, where %p and %q{VAR} would be expanded.
+std::string valgrind_literal(const std::string& path) {
   std::string out;
-  std::array<char, 4096> buf{};
-  std::size_t n = 0;
-  while ((n = std::fread(buf.data(), 1, buf.size(), pipe)) > 0) out.append(buf.data(), n);
-  const int status = ::pclose(pipe);
-  exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  for (char c : path) out += c == '%' ? std::string("%%") : std::string(1, c);
   return out;
 }
 
 /// Instructions of one replay under callgrind, or −1 when valgrind is unavailable.
-double callgrind_instructions(const std::string& self, const CommonOptions& opt, const std::string& extra_args,
+double callgrind_instructions(const std::string& self, const CommonOptions& opt, const std::vector<std::string>& extra_args,
                               const std::string& variant) {
 #if defined(__SANITIZE_ADDRESS__)
   return -1;  // valgrind cannot run an AddressSanitizer binary
 #endif
-  int code = 0;
-  run_capture("valgrind --version", code);
-  if (code != 0) return -1;
+  if (host::find_program("valgrind").empty()) return -1;
+  make_directory(opt.out_dir);
   const std::string out_file = path_in(opt, "callgrind." + variant + ".out");
-  const std::string cmd = "valgrind --tool=callgrind --collect-atstart=no --toggle-collect=oneshot_exectime_replay "
-                          "--callgrind-out-file='" + out_file + "' '" + self + "' exectime-probe --variant " + variant +
-                          " " + extra_args;
-  const std::string output = run_capture(cmd, code);
-  if (code != 0) throw std::runtime_error("callgrind run failed:\n" + output);
-  std::ifstream in(out_file);
+  host::ProcessSpec spec;
+  spec.argv = {"valgrind", "--tool=callgrind", "--collect-atstart=no", "--toggle-collect=oneshot_exectime_replay",
+               "--callgrind-out-file=" + valgrind_literal(out_file), self, "exectime-probe", "--variant", variant};
+  spec.argv.insert(spec.argv.end(), extra_args.begin(), extra_args.end());
+  const host::CapturedRun run = host::run_captured(spec);
+  if (!run.status.success()) throw std::runtime_error("callgrind run failed (" + run.status.describe() + "):\n" + run.output);
+  const std::string text = host::read_text_file(out_file, "callgrind output", std::size_t{256} << 20);
+  std::istringstream in(text);
   std::string line;
   double total = -1;
   while (std::getline(in, line)) {
@@ -312,7 +303,6 @@ int run_exectime_probe(const SimContext& ctx, const CommonOptions& opt, const st
 }
 
 nlohmann::json run_exectime(const SimContext& ctx, const CommonOptions& opt, const std::string& self_path) {
-  make_directory(opt.out_dir);
   const std::vector<JobRecord> jobs = exectime_jobs(ctx, opt);
   const double jobs_per_4s = static_cast<double>(jobs.size());
   nlohmann::json j = common_json(ctx, opt);
@@ -322,9 +312,9 @@ nlohmann::json run_exectime(const SimContext& ctx, const CommonOptions& opt, con
   const auto measure = [&](NoiseModel noise) {
     CommonOptions o = opt;
     o.noise = noise;
-    std::string extra = std::string("--number-format ") + to_string(o.format) + " --noise-model " +
-                        (noise == NoiseModel::kExact ? "exact" : "constant") + " --seed " + std::to_string(o.seed);
-    if (!ctx.generated()) extra += " --plant '" + ctx.plant().source + "'";
+    std::vector<std::string> extra = {"--number-format", to_string(o.format), "--noise-model",
+                                      noise == NoiseModel::kExact ? "exact" : "constant", "--seed", std::to_string(o.seed)};
+    if (!ctx.generated()) extra.insert(extra.end(), {"--plant", ctx.plant().source});
     nlohmann::json variants;
     for (const Variant& v : kVariants) {
       RunOptions ro = run_options(o, v.approach);
@@ -352,7 +342,6 @@ nlohmann::json run_exectime(const SimContext& ctx, const CommonOptions& opt, con
         e["host_instructions_per_job"] = instructions / jobs_per_4s;
         e["host_instructions_per_4s"] = instructions;
       } else {
-        e["host_instructions_per_job"] = nullptr;
         e["note"] = "valgrind not available (not installed, or a sanitizer build): instruction counts skipped";
       }
       variants[v.name] = e;
@@ -370,7 +359,7 @@ nlohmann::json run_exectime(const SimContext& ctx, const CommonOptions& opt, con
     const auto& p = j["variants_by_noise_model"][primary_name][v.name];
     const auto& q = j["variants_by_noise_model"][other_name][v.name];
     const auto ins = [](const nlohmann::json& e) {
-      return e["host_instructions_per_job"].is_null() ? 0.0 : e["host_instructions_per_job"].get<double>();
+      return e.contains("host_instructions_per_job") ? e["host_instructions_per_job"].get<double>() : 0.0;
     };
     rows.push_back({static_cast<double>(rows.size()), p["host_us_per_4s"].get<double>(), ins(p),
                     q["host_us_per_4s"].get<double>(), ins(q)});
@@ -402,7 +391,6 @@ nlohmann::json run_exectime(const SimContext& ctx, const CommonOptions& opt, con
 
 nlohmann::json run_single(const SimContext& ctx, const CommonOptions& opt, const Scenario& scenario, Approach approach,
                           std::int32_t trace_step_us) {
-  make_directory(opt.out_dir);
   RunOptions ro = run_options(opt, approach);
   ro.record_jobs = true;
   ro.trace_step_us = trace_step_us;
@@ -439,9 +427,10 @@ nlohmann::json run_single(const SimContext& ctx, const CommonOptions& opt, const
     if (opt.plots) {
       std::ostringstream g;
       g << png_terminal() << "set output 'run.png'\nset datafile separator ','\nset key outside right top\nset grid\n"
-        << "set multiplot layout 2,1 title 'Run: approach " << info(approach).letter << " (" << info(approach).description
-        << "), scenario " << scenario.name << ", seed " << opt.seed << "'\n"
-        << "set ylabel '" << state_label(ctx, 0) << " (V)'\nplot 'run_trace.csv' using 1:" << n + 2
+        << "set multiplot layout 2,1 title "
+        << gnuplot_quote("Run: approach " + std::string(1, info(approach).letter) + " (" + info(approach).description +
+                         "), scenario " + scenario.name + ", seed " + std::to_string(opt.seed))
+        << "\nset ylabel " << gnuplot_quote(state_label(ctx, 0) + " (V)") << "\nplot 'run_trace.csv' using 1:" << n + 2
         << " skip 1 with lines dt 2 lc rgb 'black' title 'set-point', '' using 1:2 skip 1 with lines lw 2 lc rgb '#1f77b4' title 'true', "
         << "'run_jobs.csv' using 2:" << 5 + n << " skip 1 with steps lc rgb '#d62728' title 'estimate'\n"
         << "set xlabel 'time (s)'\nset ylabel 'u (V)'\nplot 'run_trace.csv' using 1:" << n + 3

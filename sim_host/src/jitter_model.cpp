@@ -5,8 +5,9 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
-#include <fstream>
 #include <sstream>
+
+#include "oneshot/host/file_io.hpp"
 
 namespace oneshot::sim {
 
@@ -65,14 +66,15 @@ namespace {
 std::int32_t get_us(const nlohmann::json& j, const char* key, const std::string& field, std::int32_t fallback) {
   const auto it = j.find(key);
   if (it == j.end()) return fallback;
-  if (!it->is_number_integer() || it->get<std::int64_t>() < 0 || it->get<std::int64_t>() > 60'000'000) {
+  if (!it->is_number_integer() || it->get<std::int64_t>() < 0 || it->get<std::int64_t>() > kMaxJobTimeUs) {
     throw ScenarioError("field '" + field + "." + key + "': must be an integer number of microseconds in [0, 6e7]");
   }
   return static_cast<std::int32_t>(it->get<std::int64_t>());
 }
 }  // namespace
 
-JitterModel parse_jitter(const nlohmann::json& j, const std::string& field, const std::string& base_dir) {
+JitterModel parse_jitter(const nlohmann::json& j, const std::string& field, const std::string& base_dir,
+                         const TraceLoader& load_trace) {
   if (!j.is_object()) throw ScenarioError("field '" + field + "': must be an object");
   for (const auto& item : j.items()) {
     static const char* const kKnown[] = {"model", "release_min_us", "release_max_us", "exec_min_us", "exec_max_us",
@@ -104,34 +106,68 @@ JitterModel parse_jitter(const nlohmann::json& j, const std::string& field, cons
     std::filesystem::path path = file->get<std::string>();
     if (path.is_relative() && !base_dir.empty()) path = std::filesystem::path(base_dir) / path;
     m.trace_path = path.string();
-    m.trace = load_jitter_trace(m.trace_path);
+    m.trace = load_trace ? load_trace(m.trace_path) : load_jitter_trace(m.trace_path);
   } else {
     throw ScenarioError("field '" + field + ".model': unknown model '" + kind + "' (none, uniform, trace)");
   }
   return m;
 }
 
-std::vector<JobTiming> load_jitter_trace(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) throw ScenarioError(path + ": cannot read the jitter trace");
+namespace {
+
+/// Spaces and tabs at both ends removed (and the CR of a CRLF line end).
+std::string trimmed(const std::string& line) {
+  const auto first = line.find_first_not_of(" \t\r");
+  if (first == std::string::npos) return {};
+  return line.substr(first, line.find_last_not_of(" \t\r") - first + 1);
+}
+
+/// A decimal integer in [0, kMaxJobTimeUs] filling all of `text` (after trimming), or −1.
+std::int64_t job_time(const std::string& text) {
+  const std::string t = trimmed(text);
+  if (t.empty() || t.size() > 9) return -1;
+  std::int64_t v = 0;
+  for (char ch : t) {
+    if (ch < '0' || ch > '9') return -1;
+    v = v * 10 + (ch - '0');
+  }
+  return v <= kMaxJobTimeUs ? v : -1;
+}
+
+}  // namespace
+
+std::vector<JobTiming> parse_jitter_trace(const std::string& text, const std::string& source) {
+  std::istringstream in(text);
   std::string line;
-  if (!std::getline(in, line) || line.rfind("release_us,exec_us", 0) != 0) {
-    throw ScenarioError(path + ": line 1: expected the header 'release_us,exec_us'");
+  if (!std::getline(in, line) || trimmed(line) != "release_us,exec_us") {
+    throw ScenarioError(source + ": line 1: expected the header 'release_us,exec_us'");
   }
   std::vector<JobTiming> out;
   for (int n = 2; std::getline(in, line); ++n) {
-    if (line.empty() || line[0] == '#') continue;
-    std::istringstream s(line);
-    long long r = -1;
-    long long e = -1;
-    char comma = 0;
-    if (!(s >> r >> comma >> e) || comma != ',' || r < 0 || e < 0 || r > 60'000'000 || e > 60'000'000) {
-      throw ScenarioError(path + ": line " + std::to_string(n) + ": expected two non-negative integers 'release_us,exec_us'");
+    const std::string t = trimmed(line);
+    if (t.empty() || t[0] == '#') continue;
+    const auto comma = t.find(',');
+    const std::int64_t r = comma == std::string::npos ? -1 : job_time(t.substr(0, comma));
+    const std::int64_t e = comma == std::string::npos ? -1 : job_time(t.substr(comma + 1));
+    if (r < 0 || e < 0) {
+      throw ScenarioError(source + ": line " + std::to_string(n) +
+                          ": expected 'release_us,exec_us': two integers in [0, 60000000] and nothing else, got '" +
+                          t.substr(0, 80) + "'");
     }
     out.push_back({static_cast<std::int32_t>(r), static_cast<std::int32_t>(e)});
   }
-  if (out.empty()) throw ScenarioError(path + ": the trace has no jobs");
+  if (out.empty()) throw ScenarioError(source + ": the trace has no jobs");
   return out;
+}
+
+std::vector<JobTiming> load_jitter_trace(const std::string& path) {
+  std::string text;
+  try {
+    text = host::read_text_file(path, "jitter trace");
+  } catch (const host::FileError& e) {
+    throw ScenarioError(e.what());
+  }
+  return parse_jitter_trace(text, path);
 }
 
 }  // namespace oneshot::sim

@@ -1,13 +1,19 @@
 /// @file main.cpp
 /// @brief oneshot-sim: the host simulator's command line.
 #include <CLI/CLI.hpp>
+#include <csignal>
 #include <exception>
 #include <iostream>
 #include <string>
 
+#include "oneshot/host/termination_cleanup.hpp"
 #include "oneshot/sim/cli_commands.hpp"
 
 int main(int argc, char** argv) {
+  // Interrupted runs end their child processes and remove temporary files; a child that
+  // died must give an error on write, not kill us with SIGPIPE.
+  oneshot::host::install_termination_handlers();
+  std::signal(SIGPIPE, SIG_IGN);
   CLI::App app{"oneshot-sim: discrete-event simulator of control loops on small MCUs and over networks.\n"
                "Studies: oneshot-sim <study> <experiment> (oneshot-sim <study> --help); the one-shot study's\n"
                "experiments are also top-level commands (design, noise, jitter, gain, table1, ...)"};
@@ -32,6 +38,11 @@ int main(int argc, char** argv) {
     return app.exit(e);
   } catch (const std::exception& e) {
     std::cerr << "oneshot-sim: error: " << e.what() << "\n";
+    return 1;
+  }
+  std::cout.flush();
+  if (!std::cout) {
+    std::cerr << "oneshot-sim: error: standard output: write failed\n";
     return 1;
   }
   return 0;

@@ -4,10 +4,10 @@
 #include <chrono>
 #include <cmath>
 #include <filesystem>
-#include <fstream>
 #include <iostream>
 #include <sstream>
 
+#include "oneshot/host/file_io.hpp"
 #include "oneshot/sim/experiments.hpp"
 #include "oneshot/sim/output_files.hpp"
 #include "oneshot/sim/pil_link.hpp"
@@ -60,8 +60,7 @@ Comparison compare(const RunResult& host, const RunResult& mcu) {
 
 /// Flash (text + rodata + initialised data) and RAM (data + bss) of an ELF image.
 std::pair<std::size_t, std::size_t> image_memory(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  const std::string d((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const std::string d = host::read_text_file(path, "firmware image", kMaxImageBytes);
   const auto u16 = [&](std::size_t o) {
     return static_cast<std::uint32_t>(static_cast<unsigned char>(d.at(o)) | static_cast<unsigned char>(d.at(o + 1)) << 8);
   };
@@ -101,7 +100,10 @@ nlohmann::json c_job_only_image(const PilOptions& base, const std::string& forma
   if (!std::filesystem::exists(image)) return nlohmann::json{{"image", image}, {"available", false}};
   const auto [flash, ram] = image_memory(image);
   nlohmann::json j{{"image", image}, {"flash_bytes", flash}, {"ram_static_bytes", ram}};
-  std::ifstream stack(image + ".stack.txt");
+  std::string stack_text;  // the build's stack bound, when it computed one
+  if (std::filesystem::is_regular_file(image + ".stack.txt"))
+    stack_text = host::read_text_file(image + ".stack.txt", "stack bound", 4096);
+  std::istringstream stack(stack_text);
   std::size_t bound = 0;
   if (stack >> bound) {
     j["stack_bound_bytes"] = bound;
@@ -298,7 +300,6 @@ nlohmann::json run_exectime_target(const SimContext& ctx, const CommonOptions& o
           if (opt.noise == NoiseModel::kExact) {
             j["variants"][name]["bit_identical_to_cpp_jobs"] = c_job_identical;
           } else {
-            j["variants"][name]["bit_identical_to_cpp_jobs"] = nullptr;
             j["variants"][name]["note"] = "B ran with the constant Q: use --noise-model exact to compare";
           }
           j["variants"][name]["jobs"] = jobs.size();

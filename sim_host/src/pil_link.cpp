@@ -5,17 +5,15 @@
 #include <cerrno>
 #include <fcntl.h>
 #include <chrono>
-#include <csignal>
 #include <cstring>
 #include <filesystem>
-#include <fstream>
 #include <poll.h>
-#include <spawn.h>
 #include <sstream>
-#include <sys/wait.h>
+#include <sys/mman.h>
 #include <unistd.h>
 
-extern char** environ;
+#include "oneshot/host/child_process.hpp"
+#include "oneshot/host/file_io.hpp"
 
 namespace oneshot::sim {
 
@@ -29,9 +27,12 @@ std::string firmware_image_path(const PilOptions& o) {
 }
 
 std::uint32_t elf_symbol_address(const std::string& path, const std::string& name) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw PilError(path + ": cannot read the firmware image");
-  const std::string data((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  std::string data;
+  try {
+    data = host::read_text_file(path, "firmware image", kMaxImageBytes);
+  } catch (const host::FileError& e) {
+    throw PilError(e.what());
+  }
   const auto u16 = [&](std::size_t off) {
     if (off + 2 > data.size()) throw PilError(path + ": truncated ELF");
     return static_cast<std::uint32_t>(static_cast<unsigned char>(data[off]) | static_cast<unsigned char>(data[off + 1]) << 8);
@@ -60,56 +61,89 @@ std::uint32_t elf_symbol_address(const std::string& path, const std::string& nam
   throw PilError(path + ": symbol '" + name + "' not found");
 }
 
+namespace {
+
+/// Descriptor number of the instruction-count file inside QEMU.
+constexpr int kCountsFdInQemu = 3;
+
+/// An anonymous in-memory file: no path, nothing left behind.
+int memory_file(const char* name) {
+  const int fd = ::memfd_create(name, MFD_CLOEXEC);
+  if (fd < 0) throw PilError(std::string("cannot create an in-memory file: ") + std::strerror(errno));
+  return fd;
+}
+
+/// Everything written to `fd` so far (from offset 0; at most 16 MiB).
+std::string contents(int fd) {
+  std::string out;
+  char buf[4096];
+  for (off_t at = 0; out.size() < (std::size_t{16} << 20);) {
+    const ssize_t n = ::pread(fd, buf, sizeof buf, at);
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) break;
+    out.append(buf, static_cast<std::size_t>(n));
+    at += n;
+  }
+  return out;
+}
+
+/// A value inside a QEMU option string, where ',' separates options and ',,' is a comma.
+std::string qemu_option_value(const std::string& v) {
+  std::string out;
+  for (char c : v) out += c == ',' ? std::string(",,") : std::string(1, c);
+  return out;
+}
+
+}  // namespace
+
 PilLink::PilLink(const PilOptions& options) : options_(options), image_(firmware_image_path(options)) {
   if (!fs::exists(image_)) {
     throw PilError(image_ + ": firmware image not found (build the host project with arm-none-eabi-gcc installed)");
   }
-  static int counter = 0;
-  workdir_ = (fs::temp_directory_path() / ("oneshot_pil_" + std::to_string(::getpid()) + "_" + std::to_string(counter++))).string();
-  fs::create_directories(workdir_);
   const std::string machine = options.target == "cortex-m4f" ? "mps2-an386" : "microbit";
-  std::vector<std::string> args = {"qemu-system-arm", "-M",      machine, "-kernel", image_, "-display", "none",
-                                   "-serial",         "stdio",  "-monitor", "none", "-icount", "shift=0,sleep=off"};
+  host::ProcessSpec spec;
+  spec.argv = {"qemu-system-arm", "-M",      machine, "-kernel", image_, "-display", "none",
+               "-serial",         "stdio",  "-monitor", "none", "-icount", "shift=0,sleep=off"};
+  stderr_fd_ = memory_file("qemu-stderr");
   if (options.count_instructions) {
+    counts_fd_ = memory_file("insn-window");
     const std::string plugin = options.plugin_path.empty() ? std::string(ONESHOT_DEFAULT_QEMU_PLUGIN) : options.plugin_path;
-    counts_path_ = (fs::path(workdir_) / "instructions.txt").string();
     std::ostringstream p;
-    p << plugin << ",begin=0x" << std::hex << elf_symbol_address(image_, "oneshot_job_begin") << ",end=0x"
-      << elf_symbol_address(image_, "oneshot_job_end") << ",out=" << counts_path_;
+    p << qemu_option_value(plugin) << ",begin=0x" << std::hex << elf_symbol_address(image_, "oneshot_job_begin")
+      << ",end=0x" << elf_symbol_address(image_, "oneshot_job_end") << std::dec
+      << ",out=/proc/self/fd/" << kCountsFdInQemu;
     if (!options.profile_dir.empty()) {
       fs::create_directories(options.profile_dir);
-      p << ",profile=" << (fs::absolute(options.profile_dir) / (fs::path(image_).stem().string() + ".profile")).string();
+      p << ",profile="
+        << qemu_option_value((fs::absolute(options.profile_dir) / (fs::path(image_).stem().string() + ".profile")).string());
     }
-    args.push_back("-plugin");
-    args.push_back(p.str());
+    spec.argv.push_back("-plugin");
+    spec.argv.push_back(p.str());
+    spec.extra_fds.emplace_back(counts_fd_, kCountsFdInQemu);
   }
-  int in_pipe[2];
-  int out_pipe[2];
-  if (::pipe(in_pipe) != 0 || ::pipe(out_pipe) != 0) throw PilError("cannot create pipes for QEMU");
-  posix_spawn_file_actions_t actions;
-  posix_spawn_file_actions_init(&actions);
-  posix_spawn_file_actions_adddup2(&actions, in_pipe[0], STDIN_FILENO);
-  posix_spawn_file_actions_adddup2(&actions, out_pipe[1], STDOUT_FILENO);
-  const std::string err_path = (fs::path(workdir_) / "qemu.stderr").string();
-  posix_spawn_file_actions_addopen(&actions, STDERR_FILENO, err_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-  posix_spawn_file_actions_addclose(&actions, in_pipe[1]);
-  posix_spawn_file_actions_addclose(&actions, out_pipe[0]);
-  std::vector<char*> argv;
-  for (std::string& a : args) argv.push_back(a.data());
-  argv.push_back(nullptr);
-  pid_t pid = 0;
-  const int rc = posix_spawnp(&pid, "qemu-system-arm", &actions, nullptr, argv.data(), environ);
-  posix_spawn_file_actions_destroy(&actions);
-  ::close(in_pipe[0]);
-  ::close(out_pipe[1]);
+  int in_pipe[2] = {-1, -1};
+  int out_pipe[2] = {-1, -1};
+  if (::pipe2(in_pipe, O_CLOEXEC) != 0 || ::pipe2(out_pipe, O_CLOEXEC) != 0) {
+    for (int fd : {in_pipe[0], in_pipe[1]})
+      if (fd >= 0) ::close(fd);
+    ::close(stderr_fd_);
+    if (counts_fd_ >= 0) ::close(counts_fd_);
+    throw PilError("cannot create pipes for QEMU");
+  }
+  spec.stdin_fd = in_pipe[0];
+  spec.stdout_fd = out_pipe[1];
+  spec.stderr_fd = stderr_fd_;
   to_qemu_ = in_pipe[1];
   from_qemu_ = out_pipe[0];
-  if (rc != 0) {
-    ::close(to_qemu_);
-    ::close(from_qemu_);
-    throw PilError("cannot start qemu-system-arm (apt-get install qemu-system-arm): " + std::string(std::strerror(rc)));
+  try {
+    qemu_ = std::make_unique<host::ChildProcess>(spec);
+  } catch (const host::ProcessError& e) {
+    ::close(in_pipe[0]);
+    ::close(out_pipe[1]);
+    throw PilError(std::string("cannot start QEMU (apt-get install qemu-system-arm): ") + e.what());
   }
-  pid_ = pid;
+  ::close(in_pipe[0]);
+  ::close(out_pipe[1]);
   pil::Frame hello;
   if (!read_frame(hello, 10000) || static_cast<std::uint8_t>(hello.type) != 0x81) fail("no hello from the firmware");
   info_ = parse_hello(hello);
@@ -136,20 +170,14 @@ int PilLink::stack_peak_bytes() { return parse_hello(request(pil::Type::kHello, 
 PilLink::~PilLink() {
   if (to_qemu_ >= 0) ::close(to_qemu_);
   if (from_qemu_ >= 0) ::close(from_qemu_);
-  if (pid_ > 0) {
-    ::kill(pid_, SIGTERM);
-    int status = 0;
-    ::waitpid(pid_, &status, 0);
-  }
-  std::error_code ec;
-  fs::remove_all(workdir_, ec);
+  if (qemu_) qemu_->terminate();  // SIGTERM lets the plugin write its profile; SIGKILL after 2 s
+  if (stderr_fd_ >= 0) ::close(stderr_fd_);
+  if (counts_fd_ >= 0) ::close(counts_fd_);
 }
 
 void PilLink::fail(const std::string& what) {
-  std::ifstream err((fs::path(workdir_) / "qemu.stderr").string());
-  std::ostringstream s;
-  s << err.rdbuf();
-  throw PilError("PIL (" + image_ + "): " + what + (s.str().empty() ? "" : "\nQEMU said: " + s.str()));
+  const std::string said = stderr_fd_ >= 0 ? contents(stderr_fd_) : std::string();
+  throw PilError("PIL (" + image_ + "): " + what + (said.empty() ? "" : "\nQEMU said: " + said));
 }
 
 void PilLink::write_bytes(const std::uint8_t* data, std::size_t n) {
@@ -186,7 +214,15 @@ bool PilLink::read_frame(pil::Frame& out, int timeout_ms) {
             if (r.bad()) break;
             file += static_cast<char>(c);
           }
-          fail(line == 0xFFFFFFFFU ? "firmware hard fault" : "firmware invariant failed at " + file + ":" + std::to_string(line));
+          if (line == pil::kFaultHard) fail("firmware hard fault");
+          if (line == pil::kFaultUnknownRequest) {
+            fail("the firmware does not know the request type (sequence " + std::to_string(out.seq) + ")");
+          }
+          if (line == pil::kFaultMalformedRequest) {
+            fail("the firmware refused a malformed request (sequence " + std::to_string(out.seq) +
+                 "): wrong payload length or value");
+          }
+          fail("firmware invariant failed at " + file + ":" + std::to_string(line));
         }
         // Keep the remaining bytes for the next read: the decoder holds any partial frame.
         for (ssize_t j = i + 1; j < n; ++j) {
@@ -251,7 +287,8 @@ pil::Frame PilLink::request(pil::Type type, const pil::Frame& payload) {
 
 std::vector<std::uint64_t> PilLink::instruction_counts() const {
   std::vector<std::uint64_t> counts;
-  std::ifstream in(counts_path_);
+  if (counts_fd_ < 0) return counts;
+  std::istringstream in(contents(counts_fd_));
   std::uint64_t v = 0;
   while (in >> v) counts.push_back(v);
   return counts;

@@ -5,10 +5,10 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
-#include <fstream>
 #include <iostream>
 #include <sstream>
 
+#include "oneshot/host/file_io.hpp"
 #include "oneshot/sim/experiments.hpp"
 #include "oneshot/sim/study_report.hpp"
 #include "oneshot/sim/output_files.hpp"
@@ -27,7 +27,6 @@ std::string fmt(const char* f, double v) {
 CommonOptions in_subdir(const CommonOptions& o, const std::string& sub) {
   CommonOptions r = o;
   r.out_dir = (std::filesystem::path(o.out_dir) / sub).string();
-  make_directory(r.out_dir);
   return r;
 }
 
@@ -63,13 +62,20 @@ nlohmann::json number_formats(const SimContext& ctx, const CommonOptions& o, con
 /// The generated table of the build (built-in plant only).
 nlohmann::json table_section(const SimContext& ctx, std::ostringstream& md) {
   md << "## 6. The Phi/Gamma/Q_d table\n\n";
-  std::ifstream in(ONESHOT_LUT_REPORT_PATH);
-  if (!ctx.generated() || !in) {
+  std::string text;
+  if (ctx.generated()) {
+    try {
+      text = host::read_text_file(ONESHOT_LUT_REPORT_PATH, "table report");
+    } catch (const host::FileError&) {
+      text.clear();  // a build without the generated table: reported below
+    }
+  }
+  if (text.empty()) {
     md << "The build-time table belongs to the built-in plant; see `lut_report.json` of a build with "
           "`-DONESHOT_PLANT=FILE`.\n\n";
     return nullptr;
   }
-  const nlohmann::json lut = nlohmann::json::parse(in);
+  const nlohmann::json lut = nlohmann::json::parse(text);
   const auto& f = lut["formats"];
   md << "| format | bytes | levels | entries | max abs error vs double generic |\n|---|---|---|---|---|\n"
      << "| float | " << f["float"]["bytes"] << " | " << f["float"]["levels"] << " | " << f["float"]["entries"] << " | "
@@ -191,7 +197,8 @@ void targets_section(const nlohmann::json& table1, const nlohmann::json& lut, co
 }  // namespace
 
 nlohmann::json run_report(const SimContext& ctx, const CommonOptions& o, const ReportOptions& r) {
-  make_directory(o.out_dir);
+  // Refuse bad scenarios before anything is run or written.
+  for (const Scenario& s : r.scenarios) validate_scenario(s, ctx.plant());
   const auto t0 = std::chrono::steady_clock::now();
   std::cerr << "report: noise\n";
   const nlohmann::json noise = run_noise_experiment(ctx, o, 5.0);
@@ -239,7 +246,7 @@ nlohmann::json run_report(const SimContext& ctx, const CommonOptions& o, const R
     for (const auto& [k, v] : variants.items()) {
       md << "| " << model << " | " << k << " | " << v["host_ns_per_job"].get<double>() << " | "
          << v["host_us_per_4s"].get<double>() << " | "
-         << (v["host_instructions_per_job"].is_null() ? std::string("n/a")
+         << (!v.contains("host_instructions_per_job") ? std::string("n/a")
                                                       : std::to_string(std::lround(v["host_instructions_per_job"].get<double>())))
          << " |\n";
     }
@@ -267,12 +274,14 @@ nlohmann::json run_report(const SimContext& ctx, const CommonOptions& o, const R
     studies[section.study] = std::move(res.json);
   }
 
-  nlohmann::json all = {{"noise", noise},      {"jitter", jitter}, {"gain", gain},     {"table1", table1},
-                        {"formats", formats},  {"table", lut},     {"mcu", mcu},       {"exectime", exectime},
-                        {"benchmark", bench},  {"targets", targets}, {"studies", studies}};
+  nlohmann::json all = {{"noise", noise},         {"jitter", jitter},     {"gain", gain},
+                        {"table1", table1},       {"formats", formats},   {"exectime", exectime},
+                        {"benchmark", bench},     {"targets", targets},   {"studies", studies}};
+  if (!lut.is_null()) all["table"] = lut;  // sections that did not run are left out, not null
+  if (!mcu.is_null()) all["mcu"] = mcu;
   all["wall_time_s"] = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   write_json((std::filesystem::path(o.out_dir) / "report.json").string(), all);
-  std::ofstream(std::filesystem::path(o.out_dir) / "report.md") << md.str();
+  write_text((std::filesystem::path(o.out_dir) / "report.md").string(), md.str());
   return all;
 }
 

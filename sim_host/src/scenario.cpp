@@ -5,8 +5,11 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
-#include <fstream>
+#include <map>
 #include <sstream>
+
+#include "oneshot/host/file_io.hpp"
+#include "oneshot/host/strict_json.hpp"
 
 namespace oneshot::sim {
 namespace {
@@ -66,21 +69,23 @@ Scenario find_scenario(const std::vector<Scenario>& scenarios, const std::string
   throw ScenarioError("unknown scenario '" + name + "' (available: " + names + ")");
 }
 
-std::vector<Scenario> load_scenarios(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) throw ScenarioError(path + ": cannot read the scenario file");
+std::vector<Scenario> parse_scenarios(const std::string& text, const std::string& source, const std::string& base,
+                                      const TraceLoader& load_trace) {
   nlohmann::json root;
   try {
-    in >> root;
-  } catch (const nlohmann::json::exception& e) {
-    throw ScenarioError(path + ": not valid JSON: " + e.what());
+    root = host::parse_json_strict(text);
+  } catch (const host::JsonError& e) {
+    throw ScenarioError(source + ": " + e.what());
   }
-  const std::string base = std::filesystem::path(path).parent_path().string();
   try {
     if (!root.is_object() || !root.contains("scenarios") || !root["scenarios"].is_array() || root["scenarios"].empty()) {
       throw ScenarioError("field 'scenarios': must be a non-empty array");
     }
+    for (const auto& item : root.items()) {
+      if (item.key() != "scenarios") throw ScenarioError("field '" + item.key() + "': unknown field");
+    }
     std::vector<Scenario> out;
+    std::map<std::string, std::size_t> names;
     for (std::size_t i = 0; i < root["scenarios"].size(); ++i) {
       const nlohmann::json& j = root["scenarios"][i];
       const std::string field = "scenarios[" + std::to_string(i) + "]";
@@ -92,24 +97,48 @@ std::vector<Scenario> load_scenarios(const std::string& path) {
       }
       Scenario s;
       const auto name = j.find("name");
-      if (name == j.end() || !name->is_string() || name->get<std::string>().empty()) {
-        throw ScenarioError("field '" + field + ".name': must be a non-empty string");
+      if (name == j.end() || !name->is_string() || name->get<std::string>().empty() || name->get<std::string>().size() > 100) {
+        throw ScenarioError("field '" + field + ".name': must be a string of 1 to 100 characters");
       }
       s.name = name->get<std::string>();
+      if (std::any_of(s.name.begin(), s.name.end(), [](char c) { return static_cast<unsigned char>(c) < 0x20 || c == 0x7F; })) {
+        throw ScenarioError("field '" + field + ".name': control characters (line breaks, tabs) are not allowed: the "
+                            "name appears in tables and plot titles");
+      }
+      const auto [seen, fresh] = names.emplace(s.name, i);
+      if (!fresh) {
+        throw ScenarioError("field '" + field + ".name': '" + s.name + "' is already the name of scenarios[" +
+                            std::to_string(seen->second) + "] (names select scenarios: they must be unique)");
+      }
       s.duration_s = number(j, "duration_s", field, 20.0, 0.05, 1e5);
       if (j.contains("setpoint")) {
         const nlohmann::json& sp = j["setpoint"];
         if (!sp.is_object()) throw ScenarioError("field '" + field + ".setpoint': must be an object");
+        for (const auto& item : sp.items()) {
+          if (item.key() != "amplitude_volts" && item.key() != "change_period_s") {
+            throw ScenarioError("field '" + field + ".setpoint." + item.key() + "': unknown field");
+          }
+        }
         s.amplitude_volts = number(sp, "amplitude_volts", field + ".setpoint", 0.2, 0.0, 1e3);
         s.change_period_s = number(sp, "change_period_s", field + ".setpoint", 1.0, 1e-3, 1e5);
       }
-      if (j.contains("jitter")) s.jitter = parse_jitter(j["jitter"], field + ".jitter", base);
+      if (j.contains("jitter")) s.jitter = parse_jitter(j["jitter"], field + ".jitter", base, load_trace);
       out.push_back(s);
     }
     return out;
   } catch (const ScenarioError& e) {
-    throw ScenarioError(path + ": " + e.what());
+    throw ScenarioError(source + ": " + e.what());
   }
+}
+
+std::vector<Scenario> load_scenarios(const std::string& path) {
+  std::string text;
+  try {
+    text = host::read_text_file(path, "scenario file");
+  } catch (const host::FileError& e) {
+    throw ScenarioError(e.what());
+  }
+  return parse_scenarios(text, path, std::filesystem::path(path).parent_path().string());
 }
 
 void validate_scenario(const Scenario& s, const design::PlantDescription& plant) {
@@ -125,6 +154,11 @@ void validate_scenario(const Scenario& s, const design::PlantDescription& plant)
     }
   }
   if (s.duration_s * 1e6 < plant.period_us) throw ScenarioError("scenario '" + s.name + "': shorter than one period");
+  if (s.duration_s / s.change_period_s > kMaxSetpointChanges) {
+    throw ScenarioError("scenario '" + s.name + "': " + std::to_string(s.duration_s / s.change_period_s) +
+                        " set-point changes in one run, more than the limit of 10^7 (a change period of " +
+                        std::to_string(s.change_period_s) + " s over " + std::to_string(s.duration_s) + " s)");
+  }
 }
 
 std::int32_t SetpointSchedule::code_at(std::int64_t t_ns) const {

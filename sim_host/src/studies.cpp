@@ -13,10 +13,10 @@ namespace oneshot::sim {
 
 void register_studies(CLI::App& app) {
   register_oneshot_study(app);  // sim_host/oneshot/: seed 000, the one-shot task model
-  // register_ncs_study(app);       sim_host/ncs/:      networked actuation sync (issue 12)
-  // register_dropping_study(app);  sim_host/dropping/: over-delay dropping Kalman (issue 13)
-  // register_sod_study(app);       sim_host/sod/:      send-on-delta estimation (issue 14)
-  // register_petc_study(app);      sim_host/petc/:     NUMRE periodic event-triggered control (issue 15)
+  register_ncs_study(app);       // sim_host/ncs/:      networked actuation sync (issue 12)
+  register_dropping_study(app);  // sim_host/dropping/: over-delay dropping Kalman (issue 13)
+  register_sod_study(app);       // sim_host/sod/:      send-on-delta estimation (issue 14)
+  register_petc_study(app);      // sim_host/petc/:     NUMRE periodic event-triggered control (issue 15)
 }
 
 }  // namespace oneshot::sim

@@ -117,6 +117,48 @@ TEST_P(PilLinkTest, ReportsItsStackPeakWithinTheReservation) {
   EXPECT_LT(peak, 4096);  // STACK_SIZE in firmware/app/mcu/oneshot_sections.ld
 }
 
+/// The firmware's answer to `request`: the PilError text, or "(ran)" when it was accepted.
+std::string refusal(PilLink& link, pil::Type type, const pil::Frame& request) {
+  try {
+    link.request(type, request);
+  } catch (const PilError& e) {
+    return e.what();
+  }
+  return "(ran)";
+}
+
+TEST_P(PilLinkTest, ATruncatedRequestIsRefusedNotRunOnZeros) {
+  PilLink link(options_for(GetParam()));
+  pil::Frame job;
+  pil::Writer w(job);
+  w.u(41'000, 4);  // the sample instant only: the next actuation, ADC and set-point codes are missing
+  EXPECT_NE(refusal(link, pil::Type::kSample, job).find("refused a malformed request"), std::string::npos);
+}
+
+TEST_P(PilLinkTest, AConfigWithAnUnknownApproachIsRefused) {
+  PilLink link(options_for(GetParam()));
+  pil::Frame cfg;
+  pil::Writer w(cfg);
+  w.u(7, 1);  // no approach H
+  w.u(1, 1);
+  w.u(2000, 2);
+  EXPECT_NE(refusal(link, pil::Type::kConfig, cfg).find("refused a malformed request"), std::string::npos);
+}
+
+TEST_P(PilLinkTest, TheGeneratedCJobIsRefusedByAnImageWithoutIt) {
+  // Approach 5 (the C99 job) exists on table images only; the generic image refuses it
+  // instead of running another approach in its place.
+  PilOptions o = options_for(GetParam());
+  o.discretizer = "generic";
+  PilLink link(o);
+  pil::Frame cfg;
+  pil::Writer w(cfg);
+  w.u(pil::kMaxApproach, 1);
+  w.u(1, 1);
+  w.u(2000, 2);
+  EXPECT_NE(refusal(link, pil::Type::kConfig, cfg).find("refused a malformed request"), std::string::npos);
+}
+
 INSTANTIATE_TEST_SUITE_P(Targets, PilLinkTest, ::testing::Values("cortex-m0", "cortex-m4f"),
                          [](const ::testing::TestParamInfo<std::string>& param_info) {
                            return std::string(param_info.param == "cortex-m0" ? "M0" : "M4F");

@@ -10,24 +10,16 @@
 #include <unistd.h>
 
 #include "support/run_command.hpp"
+#include "support/temp_files.hpp"
 
 namespace oneshot {
 namespace {
 
 std::string sim() { return ONESHOT_SIM_PATH; }
 
-std::string fresh_dir(const std::string& name) {
-  const auto d = std::filesystem::temp_directory_path() / ("oneshot_engine_cli_" + std::to_string(::getpid()) + "_" + name);
-  std::filesystem::remove_all(d);
-  return d.string();
-}
+std::string fresh_dir(const std::string& name) { return test::fresh_dir("oneshot_engine_cli", name); }
 
-std::string read(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
+std::string read(const std::string& path) { return test::read_file(path); }
 
 TEST(CliEngine, Table1IsTheSameOnOneAndTwoThreads) {
   const std::string a = fresh_dir("t1");

@@ -10,6 +10,7 @@
 
 #include "oneshot/app/control_task.hpp"
 #include "oneshot/app/pil_protocol.hpp"
+#include "oneshot/app/wait_until_set.hpp"
 #include "oneshot/assert_handler.hpp"
 #include "oneshot/complete_kalman.hpp"
 #include "oneshot/controller.hpp"
@@ -250,6 +251,13 @@ std::uint8_t g_approach = 1;
 volatile bool g_tick_done = false;
 mcu::RxRing g_rx;
 
+/// The core's interrupt mask and sleep, for app::wait_until_set.
+struct Cpu {
+  static void interrupts_off() { mcu::interrupts_off(); }
+  static void interrupts_on() { mcu::interrupts_on(); }
+  static void wait_for_interrupt() { mcu::wait_for_interrupt(); }
+};
+
 /// Next received byte; sleeps until the receive interrupt when there is none.
 std::uint8_t next_byte() {
   for (;;) {
@@ -307,38 +315,57 @@ void hello(pil::Frame& r) {
   w.u(oneshot_stack_peak_bytes(), 2);
 }
 
+/// Refuses a request whose payload does not decode (wrong length or value): a fault
+/// reply naming it, never a job run on zeros.
+void malformed(pil::Frame& r) {
+  r.type = pil::Type::kFault;
+  pil::Writer w(r);
+  w.u(pil::kFaultMalformedRequest, 4);
+}
+
+/// Waits for the actuation interrupt without sleeping through it: the flag is tested with
+/// interrupts masked, and WFI still wakes on the pending interrupt, which runs as soon as
+/// they are unmasked (a test then a WFI with interrupts on could miss the wake-up).
+void wait_for_tick() {
+  app::wait_until_set<Cpu>(g_tick_done);
+}
+
 void handle(const pil::Frame& q, pil::Frame& r) {
   r.seq = q.seq;
   r.type = static_cast<pil::Type>(static_cast<std::uint8_t>(q.type) | 0x80U);
   r.length = 0;
-  pil::Reader in(q);
   pil::Writer w(r);
   switch (q.type) {
     case pil::Type::kHello:
+      if (q.length != 0) return malformed(r);
       hello(r);
       return;
     case pil::Type::kConfig: {
-      const std::uint8_t approach = static_cast<std::uint8_t>(in.u(1));
-      const NoiseModel noise = in.u(1) != 0U ? NoiseModel::kExact : NoiseModel::kConstant;
-      std::int32_t codes[kM] = {};
-      for (std::size_t j = 0; j < kM; ++j) codes[j] = static_cast<std::int32_t>(in.u(2));
-      g_approach = approach <= 5 ? approach : 1;
-      g_half.configure(HalfEst(K::kDesign, g_disc, noise), codes);
-      g_complete.configure(CompleteEst(K::kDesign, g_disc, noise), codes);
-      g_standard.configure(StandardEst(K::kDesign, noise), codes);
-      g_deadbeat.configure(DeadbeatEst(K::kDesign), codes);
+      pil::ConfigRequest<kM> c;
+      if (!pil::decode(q, c)) return malformed(r);
+#ifndef ONESHOT_CJOB
+      if (c.approach == pil::kMaxApproach) return malformed(r);  // no generated C job in this image
+#endif
+      const NoiseModel noise = c.exact_noise ? NoiseModel::kExact : NoiseModel::kConstant;
+      g_approach = c.approach;
+      g_half.configure(HalfEst(K::kDesign, g_disc, noise), c.codes);
+      g_complete.configure(CompleteEst(K::kDesign, g_disc, noise), c.codes);
+      g_standard.configure(StandardEst(K::kDesign, noise), c.codes);
+      g_deadbeat.configure(DeadbeatEst(K::kDesign), c.codes);
 #ifdef ONESHOT_CJOB
-      g_cjob.configure(codes);
+      g_cjob.configure(c.codes);
 #endif
       clear_saturation_flag();
       w.u(g_approach, 1);
       return;
     }
     case pil::Type::kSample: {
-      g_pil.now_us = in.u(4);
-      g_pil.next_actuation_us = in.u(4);
-      for (std::size_t o = 0; o < kP; ++o) g_pil.adc[o] = in.s(2);
-      for (std::size_t o = 0; o < kP; ++o) g_pil.setpoint[o] = in.s(2);
+      pil::SampleRequest<kP> sample;
+      if (!pil::decode(q, sample)) return malformed(r);
+      g_pil.now_us = sample.now_us;
+      g_pil.next_actuation_us = sample.next_actuation_us;
+      for (std::size_t o = 0; o < kP; ++o) g_pil.adc[o] = sample.adc[o];
+      for (std::size_t o = 0; o < kP; ++o) g_pil.setpoint[o] = sample.setpoint[o];
       g_pil.writes = 0;
       const JobOutcome job = with_loop([](auto& loop) {
         oneshot_job_begin();
@@ -354,15 +381,18 @@ void handle(const pil::Frame& q, pil::Frame& r) {
       return;
     }
     case pil::Type::kTick: {
-      g_pil.now_us = in.u(4);
+      pil::TickRequest tick;
+      if (!pil::decode(q, tick)) return malformed(r);
+      g_pil.now_us = tick.now_us;
       g_pil.writes = 0;
       g_tick_done = false;
       soc::ActuationTimer::arm_once();
-      while (!g_tick_done) mcu::wait_for_interrupt();
+      wait_for_tick();
       write_pwm(w);
       return;
     }
     case pil::Type::kCalibrate:
+      if (q.length != 0) return malformed(r);
       oneshot_job_begin();
       oneshot_job_end();
       return;
@@ -372,7 +402,7 @@ void handle(const pil::Frame& q, pil::Frame& r) {
       return;
     default:
       r.type = pil::Type::kFault;
-      w.u(0xFFFFFFFEU, 4);  // unknown request
+      w.u(pil::kFaultUnknownRequest, 4);
       return;
   }
 }
@@ -399,7 +429,7 @@ extern "C" [[noreturn]] void oneshot_fault_handler() {
   pil::Frame f;
   f.type = pil::Type::kFault;
   pil::Writer w(f);
-  w.u(0xFFFFFFFFU, 4);  // hard fault
+  w.u(pil::kFaultHard, 4);
   send(f);
   for (;;) {
   }

@@ -4,10 +4,10 @@
 
 #include <cmath>
 #include <filesystem>
-#include <fstream>
 #include <sstream>
 
 #include "oneshot/engine/json_fields.hpp"
+#include "oneshot/host/file_io.hpp"
 
 namespace oneshot::engine {
 namespace {
@@ -37,6 +37,9 @@ Duration DelayModel::draw(RandomStream& rng, std::uint64_t index, bool& clamped)
     case Kind::kConstant:
       return constant;
     case Kind::kUniform:
+      if (resolution.count() > 1) {
+        return min + resolution * rng.uniform_int(0, (max - min).count() / resolution.count());
+      }
       return Duration{rng.uniform_int(min.count(), max.count())};
     case Kind::kPoissonPeriods:
       return shift + period * rng.poisson(mean_periods);
@@ -128,11 +131,13 @@ DelayModel parse_delay_model(const nlohmann::json& j, const std::string& field, 
     d.kind = DelayModel::Kind::kConstant;
     d.constant = us("delay_us", false, 0);
   } else if (model == "uniform") {
-    require_keys(j, field, {"model", "min_us", "max_us"});
+    require_keys(j, field, {"model", "min_us", "max_us", "resolution_us"});
     d.kind = DelayModel::Kind::kUniform;
     d.min = us("min_us", false, 0);
     d.max = us("max_us", false, 0);
     if (d.max < d.min) throw InputError("field '" + field + ".max_us': below min_us");
+    d.resolution = us("resolution_us", true, 0.001);
+    if (d.resolution.count() <= 0) throw InputError("field '" + field + ".resolution_us': must be positive");
   } else if (model == "poisson_periods") {
     require_keys(j, field, {"model", "mean_periods", "period_us", "offset_us"});
     d.kind = DelayModel::Kind::kPoissonPeriods;
@@ -147,14 +152,16 @@ DelayModel parse_delay_model(const nlohmann::json& j, const std::string& field, 
     if (path.is_relative() && !base_dir.empty()) path = std::filesystem::path(base_dir) / path;
     d.trace_path = path.string();
     std::error_code ec;
-    if (!std::filesystem::is_regular_file(path, ec) || std::filesystem::file_size(path, ec) > (std::uintmax_t{1} << 28)) {
-      throw InputError("field '" + field + ".file': " + d.trace_path + " is not a readable file under 256 MiB");
+    if (!std::filesystem::is_regular_file(path, ec)) {
+      throw InputError("field '" + field + ".file': " + d.trace_path + " is not a readable regular file");
     }
-    std::ifstream in(path, std::ios::binary);
-    std::ostringstream text;
-    text << in.rdbuf();
-    if (!in && !in.eof()) throw InputError("field '" + field + ".file': cannot read " + d.trace_path);
-    d.trace = parse_delay_trace(text.str(), d.trace_path);
+    std::string text;
+    try {
+      text = host::read_text_file(d.trace_path, "delay trace", std::size_t{1} << 28);  // bounded: 256 MiB
+    } catch (const host::FileError& e) {
+      throw InputError("field '" + field + ".file': " + e.what());
+    }
+    d.trace = parse_delay_trace(text, d.trace_path);
   } else if (model == "lognormal") {
     require_keys(j, field, {"model", "median_us", "sigma", "shift_us", "cap_us"});
     d.kind = DelayModel::Kind::kLognormal;

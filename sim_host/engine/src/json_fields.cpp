@@ -41,7 +41,8 @@ nlohmann::json parse_json_strict(const std::string& text, const std::string& sou
   nlohmann::json j;
   try {
     j = nlohmann::json::parse(text, check);
-  } catch (const nlohmann::json::parse_error& e) {
+  } catch (const nlohmann::json::exception& e) {
+    // parse_error, and out_of_range for a number beyond double (5001e308): both refused by name.
     throw InputError(source + ": not valid JSON: " + e.what());
   }
   if (!duplicate.empty()) throw InputError(source + ": duplicate key '" + duplicate + "'");

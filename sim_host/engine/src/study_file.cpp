@@ -4,11 +4,11 @@
 
 #include <cmath>
 #include <filesystem>
-#include <fstream>
 #include <set>
 #include <sstream>
 
 #include "oneshot/dimension_limits.hpp"
+#include "oneshot/host/file_io.hpp"
 #include "study_parse_detail.hpp"
 
 namespace oneshot::engine {
@@ -306,12 +306,13 @@ StudyFile parse_study(const std::string& text, const std::string& source, const 
 StudyFile load_study(const std::string& path, const StudySchema* schema) {
   std::error_code ec;
   if (!std::filesystem::is_regular_file(path, ec)) throw InputError(path + ": not a readable regular file");
-  if (std::filesystem::file_size(path, ec) > (std::uintmax_t{1} << 26)) throw InputError(path + ": larger than 64 MiB");
-  std::ifstream in(path, std::ios::binary);
-  std::ostringstream text;
-  text << in.rdbuf();
-  if (!in && !in.eof()) throw InputError(path + ": cannot read");
-  return parse_study(text.str(), path, schema, std::filesystem::path(path).parent_path().string());
+  std::string text;
+  try {
+    text = host::read_text_file(path, "study file", std::size_t{1} << 26);  // bounded: 64 MiB
+  } catch (const host::FileError& e) {
+    throw InputError(e.what());
+  }
+  return parse_study(text, path, schema, std::filesystem::path(path).parent_path().string());
 }
 
 }  // namespace oneshot::engine

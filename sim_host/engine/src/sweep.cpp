@@ -78,6 +78,18 @@ SweepSpec SweepSpec::from_json(const nlohmann::json& j) {
   if (s.approaches.empty() || s.scenarios.empty() || s.metrics.empty()) {
     throw std::invalid_argument("spec: approaches, scenarios and metrics must not be empty");
   }
+  // A shard file is read back from disk: its sweep must fit in memory (runs x metrics values)
+  // and its names must stay one CSV cell each.
+  constexpr double kMaxValues = 1e9;
+  if (static_cast<double>(s.approaches.size()) * static_cast<double>(s.scenarios.size()) * static_cast<double>(s.seeds) *
+          static_cast<double>(s.metrics.size()) > kMaxValues) {
+    throw std::invalid_argument("spec: more than 1e9 values (approaches x scenarios x seeds x metrics)");
+  }
+  for (const std::string& m : s.metrics) {
+    if (m.empty() || m.find_first_of(",\"\r\n") != std::string::npos) {
+      throw std::invalid_argument("spec.metrics: '" + m + "' is not a plain name (no comma, quote or line break)");
+    }
+  }
   return s;
 }
 

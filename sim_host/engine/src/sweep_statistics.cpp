@@ -101,7 +101,7 @@ nlohmann::json summary_json(const SweepResults& r, const SweepSummary& sm) {
   return j;
 }
 
-void write_runs_csv(const SweepResults& r, const std::string& path) {
+void write_runs_csv(const SweepResults& r, const std::string& path, sim::NonFinite non_finite) {
   std::vector<std::string> header = {"approach_index", "scenario_index", "seed"};
   header.insert(header.end(), r.spec.metrics.begin(), r.spec.metrics.end());
   std::vector<std::vector<double>> rows;
@@ -113,12 +113,11 @@ void write_runs_csv(const SweepResults& r, const std::string& path) {
         for (std::size_t m = 0; m < r.spec.metrics.size(); ++m) row.push_back(r.at(a, s, k, m));
         rows.push_back(row);
       }
-  sim::write_csv(path, header, rows);
+  sim::write_csv(path, header, rows, non_finite);
 }
 
 void write_summary_files(const SweepResults& r, const SweepSummary& sm, const std::string& dir, const std::string& prefix,
                          bool plots) {
-  sim::make_directory(dir);
   const auto in = [&](const std::string& name) { return (std::filesystem::path(dir) / name).string(); };
   write_runs_csv(r, in(prefix + "_runs.csv"));
   std::vector<std::vector<double>> rows;
@@ -127,20 +126,20 @@ void write_summary_files(const SweepResults& r, const SweepSummary& sm, const st
   }
   sim::write_csv(in(prefix + "_summary.csv"), {"approach_index", "mean", "ci95", "ratio_mean", "ratio_ci95"}, rows);
   if (!plots) return;
-  // Labels go to gnuplot as data-free tic labels with quotes removed (names are the study's).
+  // Names may come from a study or shard file: every label reaches gnuplot as a quoted
+  // string constant (sim::gnuplot_quote), never as script text.
   std::ostringstream tics;
   for (std::size_t a = 0; a < r.spec.approaches.size(); ++a) {
-    std::string name = r.spec.approaches[a];
-    for (char& c : name)
-      if (c == '\'' || c == '"' || c == '\\' || c == '\n') c = '_';
-    tics << (a ? ", " : "") << "'" << name << "' " << a;
+    tics << (a ? ", " : "") << sim::gnuplot_quote(r.spec.approaches[a]) << " " << a;
   }
   std::ostringstream g;
-  g << "set terminal pngcairo size 1100,700 font 'Sans,11' noenhanced\nset output '" << prefix << ".png'\n"
+  g << "set terminal pngcairo size 1100,700 font 'Sans,11' noenhanced\nset output " << sim::gnuplot_quote(prefix + ".png") << "\n"
     << "set datafile separator ','\nset grid ytics\nset style fill solid 0.6\nset boxwidth 0.6\nset key off\n"
     << "set xtics (" << tics.str() << ")\nset xrange [-0.6:" << static_cast<double>(r.spec.approaches.size()) - 0.4 << "]\nset yrange [0:*]\n"
-    << "set ylabel '" << r.spec.metrics[sm.metric] << " (mean over scenarios, 95 % CI over " << r.spec.seeds << " seeds)'\n"
-    << "plot '" << prefix << "_summary.csv' using 1:2 skip 1 with boxes lc rgb '#4c72b0', '' using 1:2:3 skip 1 with "
+    << "set ylabel "
+    << sim::gnuplot_quote(r.spec.metrics[sm.metric] + " (mean over scenarios, 95 % CI over " + std::to_string(r.spec.seeds) +
+                          " seeds)")
+    << "\nplot " << sim::gnuplot_quote(prefix + "_summary.csv") << " using 1:2 skip 1 with boxes lc rgb '#4c72b0', '' using 1:2:3 skip 1 with "
     << "yerrorbars pt 0 lw 2 lc rgb 'black'\n";
   sim::run_gnuplot(dir, prefix + ".gp", g.str());
 }

@@ -44,6 +44,26 @@ TEST(DelayModel, UniformPassesKolmogorovSmirnov) {
   }
 }
 
+TEST(DelayModel, UniformWithAResolutionDrawsWholeStepsOverTheRange) {
+  const DelayModel m = parse(R"({"model": "uniform", "min_us": 500, "max_us": 4000, "resolution_us": 1})");
+  RandomStream rng(5, "delay-test");
+  bool clamped = false;
+  bool hit_min = false;
+  bool hit_max = false;
+  for (std::size_t i = 0; i < kDraws; ++i) {
+    const std::int64_t ns = m.draw(rng, i, clamped).count();
+    ASSERT_EQ(ns % 1000, 0);
+    ASSERT_GE(ns, 500'000);
+    ASSERT_LE(ns, 4'000'000);
+    hit_min = hit_min || ns <= 501'000;
+    hit_max = hit_max || ns >= 3'999'000;
+  }
+  EXPECT_TRUE(hit_min && hit_max);
+  const double d = test::ks_statistic(draws_ms(m, 11), [](double x) { return std::clamp((x - 0.5) / 3.5, 0.0, 1.0); });
+  EXPECT_LT(d, test::ks_critical(kDraws));
+  EXPECT_THROW(parse(R"({"model": "uniform", "min_us": 5, "max_us": 40, "resolution_us": 0})"), InputError);
+}
+
 TEST(DelayModel, LognormalPassesKolmogorovSmirnov) {
   const DelayModel m = parse(R"({"model": "lognormal", "median_us": 2000, "sigma": 0.8, "shift_us": 500})");
   const double d = test::ks_statistic(draws_ms(m, 21), [](double x) {

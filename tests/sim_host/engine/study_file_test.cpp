@@ -101,6 +101,8 @@ TEST(StudyFile, MalformedFilesNameTheField) {
       {edited("\"links\": {\"sc\"", "\"links\": {\"ca\""), "link 'ca' runs on CAN bus"},
       {edited("\"sigma\": 0.6", "\"sigma\": \"wide\""), "scenarios[1].links.sc.delay.sigma"},
       {"{\"schema\": ", "not valid JSON"},
+      // Found by fuzz_study: a number beyond double escaped as nlohmann's out_of_range.
+      {edited("\"duration_s\": 20,", "\"duration_s\": 5001e308,"), "not valid JSON"},
       {"[]", "must be an object"},
       {std::string(40, '[') + std::string(40, ']'), "nested deeper than 32"},
   };

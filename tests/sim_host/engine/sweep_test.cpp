@@ -8,8 +8,10 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <sstream>
 
 #include "oneshot/engine/random_stream.hpp"
+#include "oneshot/host/child_process.hpp"
 #include "oneshot/engine/sweep.hpp"
 #include "oneshot/engine/sweep_statistics.hpp"
 
@@ -119,6 +121,45 @@ TEST(SweepStatistics, SummaryFilesHoldTheRunsAndTheIntervals) {
   char buf[64];
   std::snprintf(buf, sizeof buf, "0,%.9g,%.9g,", s.value[0].mean, s.value[0].ci95);
   EXPECT_EQ(first.rfind(buf, 0), 0U) << first;
+}
+
+TEST(SweepStatistics, NamesReachGnuplotAsQuotedStringsNotCommands) {
+  if (host::find_program("gnuplot").empty()) GTEST_SKIP() << "gnuplot not installed";
+  // Names come from study and shard files. gnuplot's command-running function is spelt in
+  // two pieces (tests/no_shell.cmake); gnuplot runs in `dir`, so ../pwnedN would land in root.
+  const std::string run = std::string("sys") + "tem";
+  SweepSpec sp = spec();
+  sp.approaches = {"it's", "x' . " + run + "('touch ../pwned1') . '", "`touch ../pwned2`"};
+  sp.metrics = {"cost' . " + run + "('touch ../pwned3') . '", "packets"};
+  const SweepResults r = run_sweep(sp, Shard{}, 1, toy, "t");
+  const SweepSummary s = summarize_metric(r, 0, 0);
+  const std::filesystem::path root = std::filesystem::temp_directory_path() / "oneshot_sweep_labels";
+  std::filesystem::remove_all(root);
+  const std::string dir = (root / "out").string();
+  write_summary_files(r, s, dir, "toy", true);
+  EXPECT_TRUE(std::filesystem::exists(dir + "/toy.png"));
+  for (const char* f : {"pwned1", "pwned2", "pwned3"}) EXPECT_FALSE(std::filesystem::exists(root / f)) << f;
+  std::ifstream in(dir + "/toy.gp");
+  std::stringstream gp;
+  gp << in.rdbuf();
+  EXPECT_NE(gp.str().find("'x'' . " + run + "(''touch ../pwned1'') . '''"), std::string::npos) << gp.str();
+}
+
+TEST(Sweep, ASpecReadBackFromAFileIsBounded) {
+  const nlohmann::json j = spec().to_json();
+  EXPECT_NO_THROW(SweepSpec::from_json(j));
+  // 1000 approaches x 1000 scenarios x 1e7 seeds x 2 metrics would not fit in memory.
+  nlohmann::json big = j;
+  big["approaches"] = std::vector<std::string>(1000, "a");
+  big["scenarios"] = std::vector<std::string>(1000, "s");
+  big["seeds"] = 10'000'000;
+  EXPECT_THROW(SweepSpec::from_json(big), std::invalid_argument);
+  // A metric name becomes a CSV column: no comma, quote or line break.
+  for (const char* bad : {"a,b", "a\nb", "a\"b", ""}) {
+    nlohmann::json m = j;
+    m["metrics"] = {"cost", bad};
+    EXPECT_THROW(SweepSpec::from_json(m), std::invalid_argument) << bad;
+  }
 }
 
 }  // namespace

@@ -194,8 +194,9 @@ struct ScalarTraits<Fixed<S, F>> {
   static constexpr int kTaylorDegree = detail::taylor_degree_for(kEpsilon);
   /// Additive identity.
   static constexpr T zero() { return T{}; }
-  /// 1 (saturates when the format cannot hold it).
-  static constexpr T one() { return from_double(1.0); }
+  /// 1 (saturates when the format cannot hold it). Integer arithmetic only: run-time
+  /// calls (at -Og nothing is folded) must not pull soft-float routines into an MCU image.
+  static constexpr T one() { return from_int(1); }
   /// v rounded into the format, saturated (constant data and host-side conversions).
   static constexpr T from_double(double v) {
     const double scaled = v * detail::pow2(F);
@@ -210,9 +211,38 @@ struct ScalarTraits<Fixed<S, F>> {
     }
     return T::from_raw(static_cast<S>(static_cast<std::int64_t>(r)));
   }
-  /// num/den rounded.
+  /// num/den rounded to nearest (ties away from zero, as from_double), saturated; exact
+  /// integer long division (no floating point, see one()). den = 0 saturates.
   static constexpr T from_ratio(std::int64_t num, std::int64_t den) {
-    return from_double(static_cast<double>(num) / static_cast<double>(den));
+    const bool negative = (num < 0) != (den < 0);
+    const auto magnitude = [](std::int64_t v) {
+      return v < 0 ? std::uint64_t{0} - static_cast<std::uint64_t>(v) : static_cast<std::uint64_t>(v);
+    };
+    const std::uint64_t n = magnitude(num);
+    const std::uint64_t d = magnitude(den);
+    // Any magnitude from 2^62 on saturates every storage: stop growing there.
+    constexpr std::uint64_t kHuge = std::uint64_t{1} << 62;
+    std::uint64_t q = d == 0 ? (n == 0 ? 0 : kHuge) : n / d;
+    std::uint64_t rem = d == 0 ? 0 : n % d;
+    bool round_up = false;
+    if constexpr (F >= 0) {
+      // q·2^F + rem/d, one fractional bit at a time (rem < d ≤ 2^63: 2·rem fits).
+      for (int i = 0; d != 0 && i < F && q < kHuge; ++i) {
+        rem *= 2;
+        q = 2 * q + (rem >= d ? 1 : 0);
+        if (rem >= d) rem -= d;
+      }
+      round_up = d != 0 && rem >= d - rem;  // rem/d ≥ 1/2
+    } else {
+      // round((q + rem/d) / 2^s): up when the dropped integer bits reach 2^(s−1).
+      constexpr int kShift = -F;
+      round_up = (q & ((std::uint64_t{1} << kShift) - 1)) >= (std::uint64_t{1} << (kShift - 1));
+      q >>= kShift;
+    }
+    if (round_up) ++q;
+    if (q > kHuge) q = kHuge;
+    const auto v = static_cast<std::int64_t>(q);
+    return T::from_raw(detail::saturate<S>(negative ? -v : v));
   }
   /// An integer, saturated.
   static constexpr T from_int(std::int32_t v) {

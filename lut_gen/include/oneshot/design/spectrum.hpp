@@ -49,7 +49,7 @@ ModeCheck detectable(const DenseMatrix& a, const DenseMatrix& c);
 /// (A, C) observable: every mode is.
 ModeCheck observable(const DenseMatrix& a, const DenseMatrix& c);
 
-/// Finite transmission zeros of the square system (A, B, C, D) (m = p): the finite
+/// Finite transmission zeros of the square plant (A, B, C, D) (m = p): the finite
 /// generalized eigenvalues of the Rosenbrock pencil [[A, B], [C, D]] − z [[I, 0], [0, 0]]
 /// (LAPACK dggev). std::invalid_argument when m ≠ p.
 std::vector<std::complex<double>> transmission_zeros(const DenseMatrix& a, const DenseMatrix& b,

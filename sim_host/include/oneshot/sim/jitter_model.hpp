@@ -8,6 +8,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <nlohmann/json.hpp>
 #include <stdexcept>
 #include <string>
@@ -49,10 +50,24 @@ struct JitterModel {
   std::string describe() const;
 };
 
-/// Parses {"model": "none"|"uniform"|"trace", ...}; `field` names it in errors.
-JitterModel parse_jitter(const nlohmann::json& j, const std::string& field, const std::string& base_dir);
+/// Loads the trace file a scenario names (load_jitter_trace unless a test or fuzzer gives another).
+using TraceLoader = std::function<std::vector<JobTiming>(const std::string& path)>;
 
-/// Reads a trace CSV with header "release_us,exec_us" (one job per line).
+/// Parses {"model": "none"|"uniform"|"trace", ...}; `field` names it in errors. A relative
+/// trace file is found from `base_dir` and read by `load_trace` (default: load_jitter_trace).
+JitterModel parse_jitter(const nlohmann::json& j, const std::string& field, const std::string& base_dir,
+                         const TraceLoader& load_trace = {});
+
+/// Largest release delay or execution time in a scenario or trace (µs): one minute.
+inline constexpr std::int64_t kMaxJobTimeUs = 60'000'000;
+
+/// Parses trace text: the header line "release_us,exec_us", then one job per line as two
+/// integers in [0, kMaxJobTimeUs] separated by a comma (spaces around them allowed; empty
+/// lines and lines starting with '#' skipped). Anything else on a line is refused with the
+/// line number; `source` names the text in errors (ScenarioError).
+std::vector<JobTiming> parse_jitter_trace(const std::string& text, const std::string& source);
+
+/// Reads and parses a trace CSV (bounded read; ScenarioError naming the file).
 std::vector<JobTiming> load_jitter_trace(const std::string& path);
 
 }  // namespace oneshot::sim

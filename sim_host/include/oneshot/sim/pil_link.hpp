@@ -11,6 +11,10 @@
 
 #include "oneshot/app/pil_protocol.hpp"
 
+namespace oneshot::host {
+class ChildProcess;
+}  // namespace oneshot::host
+
 namespace oneshot::sim {
 
 /// The link or the firmware failed (no QEMU, no image, timeout, firmware fault).
@@ -48,6 +52,9 @@ struct FirmwareInfo {
 /// Path of the image for `options` (firmware_dir/firmware-<target>/oneshot-<target>-<format>-<disc>.elf).
 std::string firmware_image_path(const PilOptions& options);
 
+/// Largest firmware image read (ELF with debug information): 64 MiB.
+inline constexpr std::size_t kMaxImageBytes = std::size_t{64} << 20;
+
 /// Address of symbol `name` in a 32-bit little-endian ELF file (PilError when absent).
 std::uint32_t elf_symbol_address(const std::string& elf_path, const std::string& name);
 
@@ -55,7 +62,10 @@ std::uint32_t elf_symbol_address(const std::string& elf_path, const std::string&
 /// (the firmware has run the job: the resend must not run it again).
 enum class LinkFault { kNone, kCorruptByte, kDropByte, kLoseReply };
 
-/// A running firmware image behind its UART.
+/// A running firmware image behind its UART. QEMU runs in its own process group, without a
+/// shell, and dies with the thread that created the link (PR_SET_PDEATHSIG) or with the
+/// termination handlers; its error output and the instruction counts go to in-memory
+/// files, so nothing is left on disk even when the harness is killed.
 class PilLink {
  public:
   /// Starts QEMU with the image of `options` and waits for its kHello.
@@ -86,9 +96,9 @@ class PilLink {
 
   PilOptions options_;
   std::string image_;
-  std::string workdir_;
-  std::string counts_path_;
-  int pid_ = -1;
+  std::unique_ptr<host::ChildProcess> qemu_;  // own process group, ended with us
+  int stderr_fd_ = -1;   // QEMU's standard error: an in-memory file (no temporary folder)
+  int counts_fd_ = -1;   // the plugin's instruction counts: an in-memory file
   int to_qemu_ = -1;
   int from_qemu_ = -1;
   static FirmwareInfo parse_hello(const app::pil::Frame& hello);

@@ -37,12 +37,22 @@ std::vector<Scenario> default_scenarios();
 /// The scenario called `name` in `scenarios` (ScenarioError listing the names otherwise).
 Scenario find_scenario(const std::vector<Scenario>& scenarios, const std::string& name);
 
-/// Reads {"scenarios": [{"name", "duration_s", "setpoint": {"amplitude_volts",
-/// "change_period_s"}, "jitter": {...}}, ...]} (ScenarioError naming the field).
+/// Parses {"scenarios": [{"name", "duration_s", "setpoint": {"amplitude_volts",
+/// "change_period_s"}, "jitter": {...}}, ...]} (ScenarioError naming the field): strict
+/// JSON (a key twice is refused), names unique, printable and at most 100 characters.
+/// `source` names the text in errors; trace files are found from `base_dir`.
+std::vector<Scenario> parse_scenarios(const std::string& text, const std::string& source, const std::string& base_dir,
+                                      const TraceLoader& load_trace = {});
+
+/// Reads (bounded) and parses a scenario file.
 std::vector<Scenario> load_scenarios(const std::string& path);
 
+/// Most set-point changes in one run (each is stored): 10^7.
+inline constexpr double kMaxSetpointChanges = 1e7;
+
 /// Checks a scenario against a plant: the job must finish within the period
-/// (release + exec < h), set-points within the ADC range (ScenarioError).
+/// (release + exec < h), set-points within the ADC range, at least one period long, at
+/// most kMaxSetpointChanges set-point changes (ScenarioError).
 void validate_scenario(const Scenario& s, const design::PlantDescription& plant);
 
 /// Set-point code schedule: (time, ADC code) pairs, first at t = 0.

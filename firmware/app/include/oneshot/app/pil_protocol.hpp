@@ -195,4 +195,84 @@ class Reader {
   bool bad_ = false;
 };
 
+/// First word of a kFault payload: what went wrong (otherwise the line of a failed invariant).
+inline constexpr std::uint32_t kFaultHard = 0xFFFFFFFFU;              ///< Hard fault.
+inline constexpr std::uint32_t kFaultUnknownRequest = 0xFFFFFFFEU;    ///< Request type not known.
+inline constexpr std::uint32_t kFaultMalformedRequest = 0xFFFFFFFDU;  ///< Wrong payload length or value.
+
+/// Largest approach id of kConfig: 0–4 are A–E, 5 the generated C99 job (B's job; an image
+/// without one refuses it).
+inline constexpr std::uint8_t kMaxApproach = 5;
+
+/// kConfig: approach (0–5), noise model (0 constant, 1 exact), initial PWM code per input.
+template <std::size_t M>
+struct ConfigRequest {
+  std::uint8_t approach = 0;       ///< Approach A–E as 0–4, the generated C job as 5.
+  bool exact_noise = false;        ///< Exact Q_d(τ) instead of the constant Q.
+  std::int32_t codes[M] = {};      ///< Initial PWM code of each input (0–65535).
+  /// Exact payload length: 1 + 1 + 2·M bytes.
+  static constexpr std::size_t kLength = 2 + 2 * M;
+};
+
+/// kSample: sample instant, next actuation instant, ADC and set-point codes per output.
+template <std::size_t P>
+struct SampleRequest {
+  std::uint32_t now_us = 0;             ///< Sample instant.
+  std::uint32_t next_actuation_us = 0;  ///< Next actuation instant.
+  std::int32_t adc[P] = {};             ///< ADC code of each output (signed 16-bit).
+  std::int32_t setpoint[P] = {};        ///< Set-point code of each output (signed 16-bit).
+  /// Exact payload length: 4 + 4 + 2·P + 2·P bytes.
+  static constexpr std::size_t kLength = 8 + 4 * P;
+};
+
+/// kTick: the actuation instant.
+struct TickRequest {
+  std::uint32_t now_us = 0;  ///< Actuation instant.
+  /// Exact payload length.
+  static constexpr std::size_t kLength = 4;
+};
+
+/// Decodes a kConfig payload; false (out untouched) unless the length is exact and the
+/// approach and noise model are known: a truncated request must not run on zeros.
+template <std::size_t M>
+constexpr bool decode(const Frame& f, ConfigRequest<M>& out) {
+  if (f.length != ConfigRequest<M>::kLength) return false;
+  Reader in(f);
+  ConfigRequest<M> r;
+  const std::uint32_t approach = in.u(1);
+  const std::uint32_t noise = in.u(1);
+  if (approach > kMaxApproach || noise > 1) return false;
+  r.approach = static_cast<std::uint8_t>(approach);
+  r.exact_noise = noise == 1;
+  for (std::size_t j = 0; j < M; ++j) r.codes[j] = static_cast<std::int32_t>(in.u(2));
+  if (in.bad()) return false;
+  out = r;
+  return true;
+}
+
+/// Decodes a kSample payload; false (out untouched) unless the length is exact.
+template <std::size_t P>
+constexpr bool decode(const Frame& f, SampleRequest<P>& out) {
+  if (f.length != SampleRequest<P>::kLength) return false;
+  Reader in(f);
+  SampleRequest<P> r;
+  r.now_us = in.u(4);
+  r.next_actuation_us = in.u(4);
+  for (std::size_t o = 0; o < P; ++o) r.adc[o] = in.s(2);
+  for (std::size_t o = 0; o < P; ++o) r.setpoint[o] = in.s(2);
+  if (in.bad()) return false;
+  out = r;
+  return true;
+}
+
+/// Decodes a kTick payload; false (out untouched) unless the length is exact.
+constexpr bool decode(const Frame& f, TickRequest& out) {
+  if (f.length != TickRequest::kLength) return false;
+  Reader in(f);
+  const std::uint32_t now = in.u(4);
+  if (in.bad()) return false;
+  out.now_us = now;
+  return true;
+}
+
 }  // namespace oneshot::app::pil

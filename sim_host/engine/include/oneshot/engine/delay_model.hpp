@@ -6,7 +6,8 @@
 /// 0; uniform, Poisson: 1; lognormal: normals of the polar method; Pareto: 1; trace: 0),
 /// and the models below (all delays are integer ns, drawn in double and rounded):
 ///     constant          d
-///     uniform           U{min, …, max}                       (integer ns, inclusive)
+///     uniform           U{min, …, max}                       (integer ns, inclusive; with a
+///                       resolution r: min + r·U{0, …, ⌊(max − min)/r⌋}, e.g. whole µs)
 ///     poisson_periods   offset + K·T,  K ~ Poisson(mean)       (the dropping brief: D whole periods)
 ///     trace             trace[n mod size] for the n-th message  (recorded delays, cycled)
 ///     lognormal         shift + median·exp(σ Z),  Z ~ N(0, 1)
@@ -33,6 +34,7 @@ struct DelayModel {
   Duration constant{0};          ///< Constant: the delay.
   Duration min{0};               ///< Uniform: smallest delay.
   Duration max{0};               ///< Uniform: largest delay.
+  Duration resolution{1};        ///< Uniform: delays are min + j·resolution (1 ns: every integer ns).
   double mean_periods = 0;       ///< Poisson: mean number of whole periods D.
   Duration period{0};            ///< Poisson: the period T.
   Duration shift{0};             ///< Poisson, lognormal, Pareto: added offset.

@@ -19,6 +19,7 @@
 #include <vector>
 
 #include "oneshot/engine/sweep.hpp"
+#include "oneshot/sim/output_files.hpp"
 #include "oneshot/sim/statistics.hpp"
 
 namespace oneshot::engine {
@@ -56,8 +57,10 @@ SweepSummary summarize_metric(const SweepResults& results, std::size_t metric, s
 /// ratios are null.
 nlohmann::json summary_json(const SweepResults& results, const SweepSummary& summary);
 
-/// Writes the raw runs as CSV: approach_index, scenario_index, seed, one column per metric.
-void write_runs_csv(const SweepResults& results, const std::string& path);
+/// Writes the raw runs as CSV: approach_index, scenario_index, seed, one column per metric;
+/// a NaN or infinite value is refused unless `non_finite` is kMissing (a divergence the study reports).
+void write_runs_csv(const SweepResults& results, const std::string& path,
+                    sim::NonFinite non_finite = sim::NonFinite::kRefuse);
 
 /// Writes DIR/PREFIX_runs.csv (raw runs), DIR/PREFIX_summary.csv (approach_index, mean,
 /// ci95, ratio_mean, ratio_ci95 of the summarized metric) and, with `plots`, DIR/PREFIX.png

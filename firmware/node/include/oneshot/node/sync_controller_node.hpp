@@ -1,0 +1,110 @@
+/// @file sync_controller_node.hpp
+/// @brief The controller of the actuation-synchronized loop: on each sample report it runs
+///        its estimator to the actuation instant t_k and sends u_k for period k.
+///
+///     x̂_k = estimator(τ_k, y_s,k, u applied at t_{k−1}),   u_k = u_ref,k − L (x̂_k − x_ref,k),
+/// clamped to the actuator's range (counted). The estimator is a plug-in (sync_estimators.hpp);
+/// the reference gives x_ref,k and u_ref,k for the instant the command targets. Reports
+/// that are not newer than the last one are counted and dropped.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+
+#include "oneshot/hal/network_contract.hpp"
+#include "oneshot/node/actuation_sync_messages.hpp"
+#include "oneshot/node/square_wave_reference.hpp"
+#include "oneshot/status.hpp"
+
+namespace oneshot::node {
+
+/// Counters of a synchronized controller.
+struct SyncControllerStatistics {
+  std::uint32_t received = 0;      ///< Reports decoded.
+  std::uint32_t stale = 0;         ///< Not newer than the last one (dropped).
+  std::uint32_t malformed = 0;     ///< Frames that did not decode.
+  std::uint32_t computations = 0;  ///< Estimator runs.
+  std::uint32_t faults = 0;        ///< Estimator runs whose status was not exact.
+  std::uint32_t saturated = 0;     ///< Commands clamped to the actuator's range.
+  std::uint32_t sends = 0;         ///< Commands sent.
+  std::uint32_t refused = 0;       ///< Sends the interface refused.
+};
+
+/// Controller of N states, P outputs, M inputs in scalar S on board `Board`.
+template <typename Board, typename Estimator, typename Reference, typename S, std::size_t N, std::size_t P,
+          std::size_t M>
+class SyncControllerNode {
+  static_assert(hal::kHasNetwork<Board>, "Board::Net must fulfil the network contract (network_contract.hpp)");
+
+ public:
+  using Report = SampleReport<S, P, M>;              ///< What it receives.
+  using Command = Message<VectorPayload<S, M>>;      ///< What it sends (seq = k).
+
+  /// Commands go to `actuator`; gain L, actuator range [u_min, u_max].
+  constexpr SyncControllerNode(std::uint8_t actuator, const Matrix<S, M, N>& l, const Vector<S, M>& u_min,
+                               const Vector<S, M>& u_max, const Estimator& estimator, const Reference& reference)
+      : actuator_(actuator), l_(l), u_min_(u_min), u_max_(u_max), estimator_(estimator), reference_(reference) {}
+
+  /// Frames waiting at the interface: each newer report gives one command.
+  void on_receive(McuInstant now) {
+    std::uint8_t bytes[kMaxMessageBytes];
+    std::uint8_t source = 0;
+    for (std::size_t n = Board::Net::receive(source, bytes, sizeof bytes); n != 0;
+         n = Board::Net::receive(source, bytes, sizeof bytes)) {
+      Report r;
+      if (!decode(bytes, n, r)) {
+        ++stats_.malformed;
+        continue;
+      }
+      ++stats_.received;
+      if (any_ && !seq_newer(r.k, last_k_)) {
+        ++stats_.stale;
+        continue;
+      }
+      any_ = true;
+      last_k_ = r.k;
+      compute(r, now);
+    }
+  }
+
+  /// The estimator (reset, covariance, …).
+  constexpr Estimator& estimator() { return estimator_; }
+  /// Period index of the last report used (valid after the first).
+  constexpr SequenceNumber last_k() const { return last_k_; }
+  /// The last command sent.
+  constexpr const Vector<S, M>& last_command() const { return u_; }
+  /// Counters.
+  constexpr const SyncControllerStatistics& statistics() const { return stats_; }
+
+ private:
+  void compute(const Report& r, McuInstant now) {
+    ++stats_.computations;
+    if (!is_exact(estimator_.update(r.tau_us, r.y, r.u_applied))) ++stats_.faults;
+    u_ = reference_.input(r.k) - l_ * (estimator_.estimate() - reference_.state(r.k));
+    if (saturate(u_, u_min_, u_max_)) ++stats_.saturated;
+    Command c;
+    c.seq = r.k;
+    c.stamp = now;
+    c.payload.value = u_;
+    std::uint8_t bytes[kMaxMessageBytes];
+    const std::size_t n = encode(c, bytes);
+    if (Board::Net::send(actuator_, bytes, n)) {
+      ++stats_.sends;
+    } else {
+      ++stats_.refused;
+    }
+  }
+
+  std::uint8_t actuator_;
+  Matrix<S, M, N> l_;
+  Vector<S, M> u_min_;
+  Vector<S, M> u_max_;
+  Estimator estimator_;
+  Reference reference_;
+  Vector<S, M> u_{};
+  SequenceNumber last_k_ = 0;
+  bool any_ = false;
+  SyncControllerStatistics stats_{};
+};
+
+}  // namespace oneshot::node

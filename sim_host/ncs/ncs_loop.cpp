@@ -1,0 +1,347 @@
+/// @file ncs_loop.cpp
+/// @brief One run of study `ncs` on the engine (see ncs_loop.hpp).
+#include "ncs_loop.hpp"
+
+#include <cmath>
+#include <functional>
+#include <memory>
+#include <stdexcept>
+
+#include "oneshot/engine/continuous_plant.hpp"
+#include "oneshot/engine/kernel.hpp"
+#include "oneshot/engine/network.hpp"
+#include "oneshot/host/host_network.hpp"
+#include "oneshot/node/actuator_node.hpp"
+#include "oneshot/node/controller_node.hpp"
+#include "oneshot/node/periodic_trigger.hpp"
+#include "oneshot/node/sampling_sync_laws.hpp"
+#include "oneshot/node/sensor_node.hpp"
+#include "oneshot/node/sync_actuator_node.hpp"
+#include "oneshot/node/sync_controller_node.hpp"
+#include "oneshot/node/sync_estimators.hpp"
+#include "oneshot/node/sync_sensor_node.hpp"
+#include "oneshot/plant_structure.hpp"
+
+namespace oneshot::ncs {
+namespace {
+
+using Board = host::HostNetwork;
+using Structure = DenseStructure<kN, kM, kP>;
+using Ref = node::SquareWaveReference<double, kN, kM>;
+using Plant = engine::ContinuousPlant<kN, kM, kP, 1>;
+using engine::Duration;
+using engine::EventClass;
+using engine::HandlerId;
+using engine::SimTime;
+using InputVec = Vector<double, kM>;
+using OutputVec = Vector<double, kP>;
+
+constexpr std::uint8_t kSensor = 1;
+constexpr std::uint8_t kController = 2;
+constexpr std::uint8_t kActuator = 3;
+
+/// What every loop shares: kernel, plant, network, set-point, noise and timing streams.
+class Harness {
+ public:
+  Harness(const Context& ctx, Approach a, const Scenario& sc, std::uint64_t seed, const RunOptions& opt)
+      : ctx_(ctx),
+        approach_(a),
+        sc_(sc),
+        design_(ctx.controller_design(sc.noise_scale)),
+        disc_(ctx.discretizer_model(sc.noise_scale)),
+        kernel_(seed),
+        plant_(plant_config(ctx, sc, noisy(a, opt)), kernel_.stream("process")),
+        net_(kernel_),
+        measurement_(kernel_.stream("measurement")),
+        compute_(kernel_.stream("compute")),
+        ref_(reference(ctx, sc)),
+        noisy_(noisy(a, opt)),
+        h_(engine::from_us(ctx.period_us())),
+        end_(engine::from_seconds(sc.duration_s, "ncs scenario duration")) {
+    if (!(sc.max_delay_ms * 1000 >= static_cast<double>(ctx.timing().leg_min_us))) {
+      throw std::invalid_argument("ncs scenario " + sc.name + ": d must be at least 0.5 ms");
+    }
+    // R = chol(s·R_n): y = C x + chol·n per sample.
+    const double r00 = design_.r(0, 0);
+    r_chol_[0] = std::sqrt(r00);
+    r_chol_[1] = r00 > 0 ? design_.r(1, 0) / r_chol_[0] : 0;
+    r_chol_[2] = std::sqrt(std::fmax(0.0, design_.r(1, 1) - r_chol_[1] * r_chol_[1]));
+    for (std::size_t j = 0; j < kM; ++j) {
+      u_min_[j] = ctx.design().u_min[j];
+      u_max_[j] = ctx.design().u_max[j];
+    }
+    const Vector<double, kN> x0 = ref_.state(0);
+    plant_.set_state(x0);
+    plant_.set_reference(x0, ref_.input(0));
+    if (opt.trace_step_s > 0) plant_.record_trace(engine::from_seconds(opt.trace_step_s, "trace step"), kernel_.stream("trace"));
+    // Set-point switches on the kh grid (before anything else at that instant but the plant).
+    const HandlerId sw = kernel_.add_handler("setpoint", [this](std::uint64_t k) {
+      plant_.advance_to(kernel_.now());
+      plant_.set_reference(ref_.state(static_cast<node::SequenceNumber>(k)), ref_.input(static_cast<node::SequenceNumber>(k)));
+    });
+    const std::uint64_t half = half_wave_periods(ctx, sc);
+    for (std::uint64_t k = half; SimTime{h_ * static_cast<std::int64_t>(k)} < end_; k += half) {
+      kernel_.schedule(SimTime{h_ * static_cast<std::int64_t>(k)}, EventClass::kEnvironment, sw, k);
+    }
+    const HandlerId end = kernel_.add_handler("end", [this](std::uint64_t) { plant_.advance_to(kernel_.now()); });
+    kernel_.schedule(end_, EventClass::kEnd, end);
+  }
+
+  static bool noisy(Approach a, const RunOptions& opt) { return !opt.noise_free && a != Approach::kI; }
+
+  static engine::ContinuousPlantConfig<kN, kM, kP, 1> plant_config(const Context& ctx, const Scenario& sc, bool noisy) {
+    engine::ContinuousPlantConfig<kN, kM, kP, 1> c;
+    const design::PlantDescription& p = ctx.plant();
+    for (std::size_t i = 0; i < kN; ++i) {
+      for (std::size_t j = 0; j < kN; ++j) {
+        c.a(i, j) = p.a(i, j);
+        c.qc(i, j) = ctx.design().qc(i, j) * sc.noise_scale;
+        c.q1c(i, j) = p.q1c(i, j);
+      }
+      for (std::size_t j = 0; j < kM; ++j) c.b(i, j) = p.b(i, j);
+    }
+    for (std::size_t i = 0; i < kP; ++i)
+      for (std::size_t j = 0; j < kN; ++j) c.c(i, j) = p.c(i, j);
+    c.q2c(0, 0) = p.q2c(0, 0);
+    c.process_noise = noisy;
+    return c;
+  }
+
+  static std::uint64_t half_wave_periods(const Context& ctx, const Scenario& sc) {
+    const double half = sc.period_s * 0.5e6 / ctx.period_us();
+    const auto n = static_cast<std::uint64_t>(std::llround(half));
+    if (n == 0 || std::fabs(half - static_cast<double>(n)) > 1e-9) {
+      throw std::invalid_argument("ncs scenario " + sc.name + ": T_r/2 must be a whole number of periods h");
+    }
+    return n;
+  }
+
+  static Ref reference(const Context& ctx, const Scenario& sc) {
+    const std::size_t out = ctx.design().tracked_outputs.empty() ? 0 : ctx.design().tracked_outputs[0];
+    Vector<double, kN> nx;
+    Vector<double, kM> nu;
+    for (std::size_t i = 0; i < kN; ++i) nx[i] = ctx.design().nx(i, out);
+    for (std::size_t j = 0; j < kM; ++j) nu[j] = ctx.design().nu(j, out);
+    return Ref(sc.amplitude_volts, static_cast<std::uint32_t>(half_wave_periods(ctx, sc)), nx, nu);
+  }
+
+  /// A network leg: U[0.5, d] ms in whole µs (FIFO), or none for the delay-free loops.
+  engine::LinkConfig leg(const char* name) const {
+    engine::LinkConfig c;
+    c.name = name;
+    c.fifo = true;
+    if (delay_free(approach_)) return c;  // constant 0
+    c.delay.kind = engine::DelayModel::Kind::kUniform;
+    c.delay.min = engine::from_us(ctx_.timing().leg_min_us);
+    c.delay.max = engine::from_us(std::llround(sc_.max_delay_ms * 1000));
+    c.delay.resolution = engine::from_us(1);
+    return c;
+  }
+
+  /// τ_c of the next computation (whole µs), 0 for the delay-free loops.
+  Duration compute_time() {
+    if (delay_free(approach_)) return Duration{0};
+    return engine::from_us(compute_.uniform_int(ctx_.timing().compute_min_us, ctx_.timing().compute_max_us));
+  }
+
+  /// The plant at now and a sample y = C x + v.
+  OutputVec sample() {
+    plant_.advance_to(kernel_.now());
+    OutputVec y = plant_.output();
+    if (noisy_) {
+      const double n0 = measurement_.normal();
+      const double n1 = measurement_.normal();
+      y[0] += r_chol_[0] * n0;
+      y[1] += r_chol_[1] * n0 + r_chol_[2] * n1;
+    }
+    const double t = engine::to_seconds(kernel_.now());
+    const OutputVec clean = plant_.output();
+    result_.samples.push_back(Point{t, {y[0], y[1]}});
+    result_.sample_truth.push_back(Point{t, {clean[0], clean[1]}});
+    return y;
+  }
+
+  void apply(const InputVec& u) {
+    plant_.advance_to(kernel_.now());
+    plant_.set_input(u);
+    ++result_.commands;
+  }
+
+  void estimate(node::SequenceNumber k, const Vector<double, kN>& x) {
+    result_.estimates.push_back(Point{static_cast<double>(k) * engine::to_seconds(h_), {x[0], x[1]}});
+  }
+
+  /// Runs the kernel to the end and collects the cost and trace.
+  RunResult finish() {
+    kernel_.run_until(end_);
+    result_.cost = plant_.cost().total();
+    for (const auto& s : plant_.trace()) {
+      const double t = engine::to_seconds(s.t);
+      result_.truth.push_back(Point{t, {s.x[0], s.x[1]}});
+      result_.setpoint.push_back(Point{t, {s.r[0], s.u[0]}});
+    }
+    return std::move(result_);
+  }
+
+  const Context& ctx_;
+  Approach approach_;
+  const Scenario& sc_;
+  Design design_;
+  Disc disc_;
+  engine::Kernel kernel_;
+  Plant plant_;
+  engine::Network net_;
+  engine::RandomStream measurement_;
+  engine::RandomStream compute_;
+  Ref ref_;
+  bool noisy_;
+  Duration h_;
+  SimTime end_;
+  double r_chol_[3] = {};
+  InputVec u_min_;
+  InputVec u_max_;
+  RunResult result_;
+};
+
+/// The actuation-synchronized loop with estimator `est` (brief §1).
+template <typename Estimator>
+RunResult run_synchronized(Harness& hs, Estimator est, std::int32_t late_us) {
+  Matrix<double, kM, kN> l = hs.design_.l;
+  node::SyncActuatorNode<Board, double, kM> act(kSensor, InputVec{});
+  node::SyncSensorNode<Board, double, kP, kM> sensor(kController, late_us);
+  node::SyncControllerNode<Board, Estimator, Ref, double, kN, kP, kM> ctrl(kActuator, l, hs.u_min_, hs.u_max_, est,
+                                                                          hs.ref_);
+  engine::Network& net = hs.net_;
+  engine::Kernel& k = hs.kernel_;
+  const HandlerId sample_h = k.add_handler("sample", [&](std::uint64_t) {
+    const OutputVec y = hs.sample();
+    net.run_node(kSensor, [&]() { sensor.on_sample(net.node_clock(kSensor), y); });
+  });
+  const HandlerId compute_h = k.add_handler("compute", [&](std::uint64_t) {
+    net.run_node(kController, [&]() { ctrl.on_receive(net.node_clock(kController)); });
+    hs.estimate(ctrl.last_k(), ctrl.estimator().estimate());
+  });
+  net.add_node(kSensor, "sensor", Duration{0}, [&]() {
+    const McuInstant now = net.node_clock(kSensor);
+    McuInstant at;
+    if (!sensor.on_receive(now, at)) return;
+    const std::int64_t wait_us = at - now;
+    if (wait_us <= 0) {
+      const OutputVec y = hs.sample();
+      sensor.on_sample(now, y);  // inside the sensor's run_node: routed afterwards
+    } else {
+      k.schedule_in(engine::from_us(wait_us), EventClass::kSample, sample_h);
+    }
+  });
+  net.add_node(kController, "controller", Duration{0},
+               [&]() { k.schedule_in(hs.compute_time(), EventClass::kCompute, compute_h); });
+  net.add_node(kActuator, "actuator", Duration{0}, [&]() { act.on_receive(); });
+  net.route(kActuator, kSensor, net.add_link(hs.leg("as")));
+  net.route(kSensor, kController, net.add_link(hs.leg("sc")));
+  net.route(kController, kActuator, net.add_link(hs.leg("ca")));
+  auto timer_h = std::make_shared<HandlerId>(0);
+  *timer_h = k.add_handler("actuation", [&, timer_h](std::uint64_t n) {
+    net.run_node(kActuator, [&]() {
+      const McuInstant next = net.node_clock(kActuator).plus(hs.ctx_.period_us());
+      if (n == 0) {
+        act.start(next);
+      } else {
+        act.on_timer(static_cast<node::SequenceNumber>(n), next);
+      }
+      InputVec u;
+      if (act.take_output(u)) hs.apply(u);
+    });
+    const SimTime t_next = k.now() + hs.h_;
+    if (t_next < hs.end_) k.schedule(t_next, EventClass::kActuation, *timer_h, n + 1);
+  });
+  k.schedule(SimTime{0}, EventClass::kActuation, *timer_h, 0);
+  RunResult r = hs.finish();
+  r.late = act.statistics().late;
+  r.saturated = ctrl.statistics().saturated;
+  r.faults = ctrl.statistics().faults;
+  return r;
+}
+
+/// The sampling-synchronized baseline with law `law`; `saturated(law)` reads its count.
+template <typename Law, typename Saturated>
+RunResult run_sampling(Harness& hs, Law law, Saturated saturated) {
+  node::SensorNode<Board, node::PeriodicTrigger<double, kP>, double, kP> sensor(kController,
+                                                                               node::PeriodicTrigger<double, kP>(1));
+  node::ControllerNode<Board, Law, double, kP, kM> ctrl(kActuator, node::ControllerMode::kOnArrival, law);
+  node::ActuatorNode<Board, double, kM> act(node::ActuatorMode::kOnArrival, InputVec{});
+  engine::Network& net = hs.net_;
+  engine::Kernel& k = hs.kernel_;
+  const HandlerId compute_h = k.add_handler("compute", [&](std::uint64_t) {
+    net.run_node(kController, [&]() { ctrl.on_receive(net.node_clock(kController)); });
+  });
+  net.add_node(kSensor, "sensor", Duration{0}, nullptr);
+  net.add_node(kController, "controller", Duration{0},
+               [&]() { k.schedule_in(hs.compute_time(), EventClass::kCompute, compute_h); });
+  net.add_node(kActuator, "actuator", Duration{0}, [&]() {
+    act.on_receive();
+    InputVec u;
+    if (act.take_output(u)) hs.apply(u);
+  });
+  net.route(kSensor, kController, net.add_link(hs.leg("sc")));
+  net.route(kController, kActuator, net.add_link(hs.leg("ca")));
+  auto timer_h = std::make_shared<HandlerId>(0);
+  *timer_h = k.add_handler("sample", [&, timer_h](std::uint64_t n) {
+    const OutputVec y = hs.sample();
+    net.run_node(kSensor, [&]() { sensor.on_sample(static_cast<node::SequenceNumber>(n), net.node_clock(kSensor), y); });
+    const SimTime t_next = k.now() + hs.h_;
+    if (t_next < hs.end_) k.schedule(t_next, EventClass::kSample, *timer_h, n + 1);
+  });
+  k.schedule(SimTime{0}, EventClass::kSample, *timer_h, 0);
+  RunResult r = hs.finish();
+  r.saturated = saturated(ctrl.law());
+  return r;
+}
+
+}  // namespace
+
+RunResult run(const Context& ctx, Approach a, const Scenario& sc, std::uint64_t seed, const RunOptions& options) {
+  Harness hs(ctx, a, sc, seed, options);
+  const Vector<double, kN> x0 = hs.ref_.state(0);
+  using HalfEst = node::HalfKalmanEstimator<Fmt, Structure, Disc>;
+  using Pred = node::SampledStatePredictor<Fmt, Structure, Disc>;
+  const auto half = [&](NoiseModel noise) {
+    HalfEst e(hs.design_, hs.disc_, noise);
+    e.reset(x0, hs.design_.p0, InputVec{});
+    return e;
+  };
+  using Feedback = node::StateFeedbackLaw<double, kN, kM, Ref>;
+  using Kalman = node::PeriodicKalmanLaw<Fmt, Structure, Ref>;
+  using Compensated = node::DelayCompensatedLaw<double, kN, kM, Ref>;
+  switch (a) {
+    case Approach::kA:
+      return run_synchronized(hs, Pred(hs.disc_), 0);
+    case Approach::kAK:
+      return run_synchronized(hs, half(NoiseModel::kConstant), 0);
+    case Approach::kAKx:
+      return run_synchronized(hs, half(NoiseModel::kExact), 0);
+    case Approach::kAKl:
+      return run_synchronized(hs, half(NoiseModel::kConstant), ctx.worst_chain_us(sc));
+    case Approach::kI:
+    case Approach::kS:
+      return run_sampling(hs, Feedback{hs.design_.l, hs.u_min_, hs.u_max_, hs.ref_},
+                          [](const Feedback& f) { return f.saturated; });
+    case Approach::kSK:
+    case Approach::kIK: {
+      Kalman law(hs.design_, NoiseModel::kConstant, hs.u_min_, hs.u_max_, hs.ref_);
+      law.filter().reset(x0, hs.design_.p0, InputVec{});
+      return run_sampling(hs, law, [](Kalman& f) { return f.saturated(); });
+    }
+    case Approach::kSPlus: {
+      const auto g = delay_compensated_gain(ctx, ctx.mean_tau_io_us(sc));
+      Matrix<double, kM, kN> lx;
+      Matrix<double, kM, kM> lu;
+      for (std::size_t j = 0; j < kN; ++j) lx(0, j) = g[j];
+      lu(0, 0) = g[kN];
+      Compensated law{lx, lu, hs.u_min_, hs.u_max_, hs.ref_};
+      return run_sampling(hs, law, [](const Compensated& f) { return f.saturated; });
+    }
+  }
+  throw std::logic_error("ncs: unknown approach");
+}
+
+}  // namespace oneshot::ncs

@@ -1,0 +1,51 @@
+/// @file ncs_loop.hpp
+/// @brief One run of study `ncs`: an approach on a scenario with a seed, on the engine.
+///
+/// Three firmware nodes (firmware/node/) on the engine's network, around the continuous
+/// plant of the plant file (exact propagation and cost). Actuation-synchronized loops (A,
+/// AK, AKx, AKl): the actuator's timer at t_k = kh applies command k and sends msg 1 over
+/// link "as"; the sensor samples on arrival (AKl: at t_k − D) and reports over "sc"; the
+/// controller computes τ_c later and sends over "ca". Baseline loops (I, S, SK, S+, IK):
+/// the sensor samples at kh, the controller computes τ_c after arrival, the actuator applies
+/// on arrival. Links: uniform delays U[0.5, d] ms in whole µs; τ_c ~ U[1, 5] ms (stream
+/// "compute"); I and IK have none. Streams per source (common random numbers): process,
+/// measurement, compute, link/<as|sc|ca>/delay.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "ncs_model.hpp"
+
+namespace oneshot::ncs {
+
+/// Options of a run.
+struct RunOptions {
+  bool noise_free = false;  ///< No process or measurement noise (delays stay).
+  double trace_step_s = 0;  ///< > 0: record the true state every step (bridged, never changes the run).
+};
+
+/// One row of a recorded sample or estimate.
+struct Point {
+  double t_s = 0;    ///< Time (s).
+  double v[2] = {};  ///< Values (y1, y2 or x̂1, x̂2).
+};
+
+/// What a run returns.
+struct RunResult {
+  double cost = 0;             ///< J over the run.
+  std::uint32_t late = 0;      ///< Periods whose command was late (actuation-synchronized).
+  std::uint32_t saturated = 0; ///< Commands clamped to the actuator's range.
+  std::uint32_t faults = 0;    ///< Estimator runs whose status was not exact.
+  std::uint32_t commands = 0;  ///< Commands applied.
+  std::vector<Point> truth;      ///< True state every trace step (x1, x2).
+  std::vector<Point> samples;    ///< Samples y at their instants.
+  std::vector<Point> sample_truth;  ///< C x at the same instants (noise-free output).
+  std::vector<Point> estimates;  ///< Controller's x̂ at the instant it targets (t_k, or kh).
+  std::vector<Point> setpoint;   ///< x_ref,1 and u at each trace step.
+};
+
+/// Runs approach `a` on `scenario` with `seed`.
+RunResult run(const Context& ctx, Approach a, const Scenario& scenario, std::uint64_t seed, const RunOptions& options);
+
+}  // namespace oneshot::ncs

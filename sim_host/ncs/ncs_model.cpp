@@ -1,0 +1,244 @@
+/// @file ncs_model.cpp
+/// @brief Plant, design, approaches, scenarios and the S+ design of study `ncs`.
+#include "ncs_model.hpp"
+
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <set>
+#include <sstream>
+#include <stdexcept>
+
+#include "oneshot/design/dare.hpp"
+#include "oneshot/design/dense_ops.hpp"
+#include "oneshot/design/fixed_size.hpp"
+#include "oneshot/engine/json_fields.hpp"
+
+#ifndef ONESHOT_NCS_PLANT_FILE
+#error "ONESHOT_NCS_PLANT_FILE must name lut_gen/plants/networked_board.json"
+#endif
+
+namespace oneshot::ncs {
+
+const char* name(Approach a) {
+  switch (a) {
+    case Approach::kI: return "I";
+    case Approach::kS: return "S";
+    case Approach::kA: return "A";
+    case Approach::kAK: return "AK";
+    case Approach::kAKx: return "AKx";
+    case Approach::kAKl: return "AKl";
+    case Approach::kSK: return "SK";
+    case Approach::kSPlus: return "S+";
+    case Approach::kIK: return "IK";
+  }
+  return "?";
+}
+
+const char* description(Approach a) {
+  switch (a) {
+    case Approach::kI: return "sampling-synchronized, ideal (no delay, no noise)";
+    case Approach::kS: return "sampling-synchronized, delays and noise, no filter";
+    case Approach::kA: return "actuation-synchronized, no filter (eq. 10)";
+    case Approach::kAK: return "actuation-synchronized, half Kalman, constant Q";
+    case Approach::kAKx: return "actuation-synchronized, half Kalman, exact Q_d";
+    case Approach::kAKl: return "AK with late sampling at t_k - D";
+    case Approach::kSK: return "sampling-synchronized, periodic Kalman";
+    case Approach::kSPlus: return "sampling-synchronized, LQR on eq. 8 for the mean delay";
+    case Approach::kIK: return "no delay, noise, periodic Kalman";
+  }
+  return "?";
+}
+
+Approach parse_approach(const std::string& text) {
+  for (Approach a : kAllApproaches)
+    if (text == name(a)) return a;
+  throw std::invalid_argument("ncs: unknown approach '" + text + "' (I, S, A, AK, AKx, AKl, SK, S+, IK)");
+}
+
+bool actuation_synchronized(Approach a) {
+  return a == Approach::kA || a == Approach::kAK || a == Approach::kAKx || a == Approach::kAKl;
+}
+
+bool delay_free(Approach a) { return a == Approach::kI || a == Approach::kIK; }
+
+std::vector<Scenario> default_scenarios() {
+  // Brief §3: (A_r V, T_r s, d ms, s).
+  const double rows[10][4] = {{0.2, 2, 4, 1},  {0.2, 2, 14, 1}, {0.5, 4, 8, 1},   {0.5, 2, 14, 4}, {1, 4, 4, 4},
+                              {1, 2, 8, 1},    {0.2, 4, 8, 16}, {0.5, 4, 14, 16}, {1, 2, 14, 16},  {0.2, 2, 8, 4}};
+  std::vector<Scenario> out;
+  for (const auto& r : rows) {
+    Scenario s;
+    char buf[64];
+    std::snprintf(buf, sizeof buf, "a%g-T%g-d%g-s%g", r[0], r[1], r[2], r[3]);
+    s.name = buf;
+    s.amplitude_volts = r[0];
+    s.period_s = r[1];
+    s.max_delay_ms = r[2];
+    s.noise_scale = r[3];
+    out.push_back(s);
+  }
+  return out;
+}
+
+std::vector<Scenario> parse_scenarios(const std::string& text, const std::string& source) {
+  using engine::InputError;
+  const nlohmann::json j = engine::parse_json_strict(text, source);
+  std::vector<Scenario> out;
+  try {
+    engine::require_keys(j, "file", {"description", "scenarios"});
+    const nlohmann::json& list = engine::member(j, "file", "scenarios");
+    if (!list.is_array() || list.empty()) throw InputError("field 'scenarios': must be a non-empty array");
+    std::set<std::string> names;
+    for (std::size_t i = 0; i < list.size(); ++i) {
+      const std::string where = "scenarios[" + std::to_string(i) + "]";
+      const nlohmann::json& e = list[i];
+      engine::require_keys(e, where, {"name", "amplitude_volts", "period_s", "max_delay_ms", "noise_scale", "duration_s"});
+      Scenario s;
+      s.name = engine::string_of(e, where, "name");
+      if (s.name.empty() || !names.insert(s.name).second) throw InputError("field '" + where + ".name': empty or repeated");
+      s.amplitude_volts = engine::number_in(e, where, "amplitude_volts", 0, 100);
+      s.period_s = engine::number_in(e, where, "period_s", 1e-3, 1e6);
+      s.max_delay_ms = engine::number_in(e, where, "max_delay_ms", 0.5, 1e6);
+      s.noise_scale = engine::number_in(e, where, "noise_scale", 0, 1e6);
+      s.duration_s = engine::number_in(e, where, "duration_s", 1e-3, 1e6, true, 20);
+      out.push_back(s);
+    }
+  } catch (const InputError& e) {
+    throw InputError(source + ": " + e.what());
+  }
+  return out;
+}
+
+std::vector<Scenario> load_scenarios(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw engine::InputError(path + ": cannot read the scenario file");
+  std::ostringstream text;
+  text << in.rdbuf();
+  return parse_scenarios(text.str(), path);
+}
+
+std::string describe(const Scenario& s) {
+  char buf[128];
+  std::snprintf(buf, sizeof buf, "A_r %g V, T_r %g s, d %g ms, s %g, %g s", s.amplitude_volts, s.period_s,
+                s.max_delay_ms, s.noise_scale, s.duration_s);
+  return buf;
+}
+
+std::shared_ptr<const Context> Context::load(const std::string& plant_path) {
+  auto ctx = std::make_shared<Context>();
+  ctx->plant_ = design::load_plant_file(plant_path.empty() ? std::string(ONESHOT_NCS_PLANT_FILE) : plant_path);
+  const design::PlantDescription& p = ctx->plant_;
+  if (!p.continuous() || p.a.rows != kN || p.b.cols != kM || p.c.rows != kP || !p.b_w.values.empty()) {
+    throw std::invalid_argument(p.source + ": study 'ncs' needs a continuous plant with n = 2, m = 1, p = 2 and no B_w");
+  }
+  for (std::size_t i = 0; i < kP; ++i)
+    for (std::size_t j = 0; j < kN; ++j)
+      if (p.c(i, j) != (i == j ? 1.0 : 0.0)) throw std::invalid_argument(p.source + ": study 'ncs' needs C = I (eq. 10)");
+  ctx->design_ = design::synthesize(p);
+  if (!ctx->design_.tracking) {
+    throw std::invalid_argument(p.source + ": no set-point feed-forward: " + ctx->design_.tracking_unavailable_reason);
+  }
+  if (ctx->design_.u_min.size() != kM) throw std::invalid_argument(p.source + ": study 'ncs' needs an actuator range");
+  (void)ctx->controller_design(1.0);  // refuses plants without a board or LQR gain, naming why
+  return ctx;
+}
+
+Design Context::controller_design(double s) const {
+  Design d = design::controller_design<double, kN, kM, kP>(plant_, design_);
+  d.q_constant = d.q_constant * s;
+  d.r = d.r * s;
+  d.p0 = d.r * 10.0;  // brief §3: P⁻ = 10·R
+  return d;
+}
+
+Disc::Model Context::discretizer_model(double s) const {
+  Disc::Model m = design::continuous_model_per_us<double, kN, kM>(plant_, design_);
+  m.qc_per_us = m.qc_per_us * s;
+  return m;
+}
+
+std::int32_t Context::worst_chain_us(const Scenario& s) const {
+  return static_cast<std::int32_t>(std::llround(2 * s.max_delay_ms * 1000) + timing_.compute_max_us);
+}
+
+double Context::mean_tau_io_us(const Scenario& s) const {
+  const double leg = 0.5 * (static_cast<double>(timing_.leg_min_us) + s.max_delay_ms * 1000);
+  return 2 * leg + 0.5 * static_cast<double>(timing_.compute_min_us + timing_.compute_max_us);
+}
+
+namespace {
+
+/// Van Loan over Δ for F = [[A, B], [0, 0]], W = blkdiag(Q1c, Q2c): Φ(Δ), Γ(Δ) and the
+/// Gramian G(Δ) with ∫₀^Δ [x; u]ᵀ W [x; u] = [x; u]ᵀ G [x; u] (x(0) = x, u held).
+struct Segment {
+  design::DenseMatrix phi, gamma, g;
+};
+
+Segment segment(const design::PlantDescription& p, double delta_s) {
+  const std::size_t k = kN + kM;
+  design::DenseMatrix f = design::DenseMatrix::zeros(k, k);
+  design::set_block(f, 0, 0, p.a);
+  design::set_block(f, 0, kN, p.b);
+  design::DenseMatrix w = design::DenseMatrix::zeros(k, k);
+  design::set_block(w, 0, 0, p.q1c);
+  design::set_block(w, kN, kN, p.q2c);
+  design::DenseMatrix v = design::DenseMatrix::zeros(2 * k, 2 * k);
+  design::set_block(v, 0, 0, -design::transpose(f) * delta_s);
+  design::set_block(v, 0, k, w * delta_s);
+  design::set_block(v, k, k, f * delta_s);
+  const design::DenseMatrix e = design::expm(v, "S+ cost segment");
+  const design::DenseMatrix e22 = design::block(e, k, k, k, k);
+  Segment s;
+  s.phi = design::block(e22, 0, 0, kN, kN);
+  s.gamma = design::block(e22, 0, kN, kN, kM);
+  s.g = design::transpose(e22) * design::block(e, 0, k, k, k);
+  design::symmetrize(s.g);
+  return s;
+}
+
+}  // namespace
+
+std::array<double, kN + kM> delay_compensated_gain(const Context& ctx, double tau_us) {
+  const design::PlantDescription& p = ctx.plant();
+  const double h = static_cast<double>(p.period_us) * 1e-6;
+  const double tau = tau_us * 1e-6;
+  if (!(tau >= 0 && tau < h)) throw std::invalid_argument("S+: the mean delay must lie in [0, h)");
+  const Segment s1 = segment(p, tau);
+  const Segment s2 = segment(p, h - tau);
+  const Segment sh = segment(p, h);
+  // w = [x; u_{k−1}; u_k]: [0, τ) holds u_{k−1} from x, [τ, h) holds u_k from x(τ).
+  const std::size_t nw = kN + 2 * kM;
+  design::DenseMatrix m1 = design::DenseMatrix::zeros(kN + kM, nw);
+  for (std::size_t i = 0; i < kN + kM; ++i) m1(i, i) = 1;
+  design::DenseMatrix m2 = design::DenseMatrix::zeros(kN + kM, nw);
+  design::set_block(m2, 0, 0, s1.phi);
+  design::set_block(m2, 0, kN, s1.gamma);
+  for (std::size_t i = 0; i < kM; ++i) m2(kN + i, kN + kM + i) = 1;
+  design::DenseMatrix qw = design::transpose(m1) * s1.g * m1 + design::transpose(m2) * s2.g * m2;
+  design::symmetrize(qw);
+  const std::size_t nx = kN + kM;
+  // ξ_{k+1} = [[Φ(h), Φ(h−τ)Γ(τ)], [0, 0]] ξ_k + [Γ(h−τ); I] u_k   (eq. 8 corrected)
+  design::DenseMatrix a = design::DenseMatrix::zeros(nx, nx);
+  design::set_block(a, 0, 0, sh.phi);
+  design::set_block(a, 0, kN, s2.phi * s1.gamma);
+  design::DenseMatrix b = design::DenseMatrix::zeros(nx, kM);
+  design::set_block(b, 0, 0, s2.gamma);
+  for (std::size_t i = 0; i < kM; ++i) b(kN + i, i) = 1;
+  const design::DareSolution sol =
+      design::solve_dare(a, b, design::block(qw, 0, 0, nx, nx), design::block(qw, nx, nx, kM, kM),
+                         design::block(qw, 0, nx, nx, kM));
+  if (sol.status != design::DareStatus::kOk) {
+    throw std::runtime_error(std::string("S+: the Riccati equation of eq. 8 failed: ") + design::to_string(sol.status));
+  }
+  // L = (R + BᵀXB)⁻¹ (BᵀXA + Sᵀ)
+  const design::DenseMatrix bt = design::transpose(b);
+  const design::SolveResult l = design::solve(design::block(qw, nx, nx, kM, kM) + bt * sol.x * b,
+                                              bt * sol.x * a + design::transpose(design::block(qw, 0, nx, nx, kM)));
+  if (!l.ok) throw std::runtime_error("S+: singular gain equation");
+  std::array<double, kN + kM> out{};
+  for (std::size_t j = 0; j < nx; ++j) out[j] = l.x(0, j);
+  return out;
+}
+
+}  // namespace oneshot::ncs

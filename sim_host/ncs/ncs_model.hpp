@@ -1,0 +1,105 @@
+/// @file ncs_model.hpp
+/// @brief Study `ncs` (networked-actuation brief): the plant and design, the approaches,
+///        the ten scenarios, and the S+ design on eq. 8.
+#pragma once
+
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "oneshot/controller_design.hpp"
+#include "oneshot/design/controller_synthesis.hpp"
+#include "oneshot/design/plant_description.hpp"
+#include "oneshot/generic_discretizer.hpp"
+#include "oneshot/number_format.hpp"
+
+namespace oneshot::ncs {
+
+inline constexpr std::size_t kN = 2;  ///< States v1, v2.
+inline constexpr std::size_t kM = 1;  ///< One input.
+inline constexpr std::size_t kP = 2;  ///< Both states measured (C = I).
+using Fmt = UniformFormat<double>;
+using Design = ControllerDesign<Fmt, kN, kM, kP>;
+using Disc = GenericDiscretizer<Fmt, kN, kM>;
+
+/// The approaches of brief §5, in table order (I first: the reference of every ratio).
+enum class Approach : std::uint8_t { kI, kS, kA, kAK, kAKx, kAKl, kSK, kSPlus, kIK };
+inline constexpr std::array<Approach, 9> kAllApproaches = {Approach::kI,   Approach::kS,   Approach::kA,
+                                                           Approach::kAK,  Approach::kAKx, Approach::kAKl,
+                                                           Approach::kSK,  Approach::kSPlus, Approach::kIK};
+/// Short name ("I", "S", "A", "AK", "AKx", "AKl", "SK", "S+", "IK").
+const char* name(Approach a);
+/// One-line description.
+const char* description(Approach a);
+/// Approach from its name; std::invalid_argument listing the names otherwise.
+Approach parse_approach(const std::string& text);
+/// True for the actuation-synchronized loops (A, AK, AKx, AKl).
+bool actuation_synchronized(Approach a);
+/// True for the ideal loops without delays (I, IK).
+bool delay_free(Approach a);
+
+/// One scenario (brief §3): square wave ±A_r of period T_r, network legs U[0.5, d] ms,
+/// noise scale s.
+struct Scenario {
+  std::string name;              ///< e.g. "a0.2-T2-d4-s1".
+  double amplitude_volts = 0;    ///< A_r.
+  double period_s = 0;           ///< T_r.
+  double max_delay_ms = 0;       ///< d.
+  double noise_scale = 1;        ///< s.
+  double duration_s = 20;        ///< Run length.
+};
+/// The ten scenarios of brief §3.
+std::vector<Scenario> default_scenarios();
+/// Scenarios from the text of a scenario file {"description", "scenarios": [{"name",
+/// "amplitude_volts", "period_s", "max_delay_ms", "noise_scale", "duration_s"}]}, every
+/// field checked (engine::InputError naming it); `source` names the file in errors.
+std::vector<Scenario> parse_scenarios(const std::string& text, const std::string& source);
+/// Scenarios from a file (sim_host/ncs/scenarios.json holds the defaults).
+std::vector<Scenario> load_scenarios(const std::string& path);
+/// Every scenario's fields as text ("A_r 0.2 V, T_r 2 s, d 4 ms, s 1").
+std::string describe(const Scenario& s);
+
+/// Network and computation timing of the study (µs).
+struct Timing {
+  std::int64_t leg_min_us = 500;      ///< Smallest network-leg delay.
+  std::int64_t compute_min_us = 1000; ///< τ_c ~ U[1, 5] ms.
+  std::int64_t compute_max_us = 5000;
+};
+
+/// The plant, its design, and the per-scenario pieces the controllers need.
+class Context {
+ public:
+  /// Loads the plant file (empty: the built-in default lut_gen/plants/networked_board.json)
+  /// and runs the design step; std::invalid_argument when the plant is not 2 states,
+  /// 1 input, 2 outputs with a board, or has no LQR gain or feed-forward.
+  static std::shared_ptr<const Context> load(const std::string& plant_path);
+
+  const design::PlantDescription& plant() const { return plant_; }  ///< The plant file.
+  const design::DesignResult& design() const { return design_; }    ///< The design step's result.
+  std::int32_t period_us() const { return plant_.period_us; }       ///< h.
+  const Timing& timing() const { return timing_; }                  ///< Delay/computation ranges.
+
+  /// The controller design at noise scale s: R = s·R_n, Q = s·Q_n (constant), P0 = 10·R.
+  Design controller_design(double noise_scale) const;
+  /// The continuous model (per µs) at noise scale s (Q_c scaled), for the discretizer.
+  Disc::Model discretizer_model(double noise_scale) const;
+  /// Worst τ_sc + τ_c + τ_ca of a scenario (µs): D of late sampling.
+  std::int32_t worst_chain_us(const Scenario& s) const;
+  /// Mean τ_io = τ_sc + τ_c + τ_ca of a scenario (µs).
+  double mean_tau_io_us(const Scenario& s) const;
+
+ private:
+  design::PlantDescription plant_;
+  design::DesignResult design_;
+  Timing timing_;
+};
+
+/// The S+ gain: LQR on eq. 8 with a constant τ (µs) on ξ = [x_k; u_{k−1}], the continuous
+/// cost sampled exactly over the period with the input switching at τ;
+/// u_k = −[L_x, L_u] ξ. Returns the 1×3 gain.
+std::array<double, kN + kM> delay_compensated_gain(const Context& ctx, double tau_us);
+
+}  // namespace oneshot::ncs

@@ -1,0 +1,216 @@
+/// @file ncs_table.cpp
+/// @brief E4: every approach on the ten scenarios, the same draws for every approach
+///        (common random numbers), summarized by the engine's sweep statistics.
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <sstream>
+#include <stdexcept>
+
+#include "ncs_experiments.hpp"
+#include "ncs_loop.hpp"
+#include "oneshot/engine/sweep_statistics.hpp"
+#include "oneshot/sim/output_files.hpp"
+
+namespace oneshot::ncs {
+namespace {
+
+std::string path_in(const std::string& dir, const std::string& name) { return (std::filesystem::path(dir) / name).string(); }
+
+Scenario scenario_from(const nlohmann::json& j) {
+  Scenario s;
+  s.name = j.at("name").get<std::string>();
+  s.amplitude_volts = j.at("amplitude_volts").get<double>();
+  s.period_s = j.at("period_s").get<double>();
+  s.max_delay_ms = j.at("max_delay_ms").get<double>();
+  s.noise_scale = j.at("noise_scale").get<double>();
+  s.duration_s = j.at("duration_s").get<double>();
+  return s;
+}
+
+}  // namespace
+
+engine::SweepResults table_sweep(const Context& ctx, const TableOptions& opt, const engine::Shard& shard) {
+  if (opt.seeds < 2) throw std::invalid_argument("ncs table needs at least 2 seeds for confidence intervals");
+  if (opt.approaches.empty() || opt.approaches.front() != Approach::kI) {
+    throw std::invalid_argument("ncs table: the approaches must start with I (the reference of every ratio)");
+  }
+  std::vector<Scenario> scenarios = opt.scenarios;
+  if (scenarios.empty()) {
+    scenarios = default_scenarios();
+    for (Scenario& s : scenarios) s.duration_s = opt.duration_s;
+  }
+  engine::SweepSpec spec;
+  spec.study = "ncs";
+  spec.experiment = "table";
+  for (Approach a : opt.approaches) spec.approaches.emplace_back(name(a));
+  nlohmann::json sc = nlohmann::json::array();
+  for (const Scenario& s : scenarios) {
+    spec.scenarios.push_back(s.name);
+    sc.push_back({{"name", s.name}, {"amplitude_volts", s.amplitude_volts}, {"period_s", s.period_s},
+                  {"max_delay_ms", s.max_delay_ms}, {"noise_scale", s.noise_scale}, {"duration_s", s.duration_s},
+                  {"s_plus_mean_tau_io_us", ctx.mean_tau_io_us(s)}, {"late_sampling_D_us", ctx.worst_chain_us(s)}});
+  }
+  spec.first_seed = opt.first_seed;
+  spec.seeds = opt.seeds;
+  spec.metrics = {"cost", "late", "saturated", "faults"};
+  spec.config = {{"plant", ctx.plant().name},
+                 {"plant_source", ctx.plant().source},
+                 {"noise_free", opt.noise_free},
+                 {"leg_delay_min_us", ctx.timing().leg_min_us},
+                 {"compute_us", {ctx.timing().compute_min_us, ctx.timing().compute_max_us}},
+                 {"scenarios", sc}};
+  const std::vector<Approach> approaches = opt.approaches;
+  RunOptions ro;
+  ro.noise_free = opt.noise_free;
+  return engine::run_sweep(
+      spec, shard, opt.threads,
+      [&](std::size_t a, std::size_t s, std::uint64_t seed) {
+        const RunResult r = run(ctx, approaches[a], scenarios[s], seed, ro);
+        return std::vector<double>{r.cost, static_cast<double>(r.late), static_cast<double>(r.saturated),
+                                   static_cast<double>(r.faults)};
+      },
+      opt.noise_free ? "ncs table (noise-free)" : "ncs table");
+}
+
+nlohmann::json table_outputs(const engine::SweepResults& results, const std::string& out_dir, bool plots) {
+  sim::make_directory(out_dir);
+  const engine::SweepSpec& spec = results.spec;
+  const std::size_t na = spec.approaches.size();
+  const std::size_t ns = spec.scenarios.size();
+  const std::size_t seeds = spec.seeds;
+  const std::size_t cost = results.metric("cost");
+  const engine::SweepSummary sm = engine::summarize_metric(results, cost, 0);
+  const bool noise_free = spec.config.at("noise_free").get<bool>();
+  std::vector<Scenario> scenarios;
+  for (const auto& s : spec.config.at("scenarios")) scenarios.push_back(scenario_from(s));
+
+  nlohmann::json j;
+  j["study"] = "ncs";
+  j["experiment"] = noise_free ? "table --noise-free" : "table";
+  j["plant"] = spec.config.at("plant");
+  j["noise_free"] = noise_free;
+  j["first_seed"] = spec.first_seed;
+  j["seeds"] = seeds;
+  j["scenarios"] = spec.config.at("scenarios");
+  j["runs"] = spec.runs();
+  std::ostringstream md;
+  md << "| approach | description | mean cost J | 95 % CI | ratio to I (95 % CI) | scenario-weighted ratio (95 % CI) | late | saturated |\n"
+        "|---|---|---|---|---|---|---|---|\n";
+  std::vector<std::pair<double, std::string>> order;
+  for (std::size_t a = 0; a < na; ++a) {
+    double late = 0;
+    double sat = 0;
+    double faults = 0;
+    for (std::size_t s = 0; s < ns; ++s) {
+      for (std::size_t k = 0; k < seeds; ++k) {
+        late += results.at(a, s, k, results.metric("late"));
+        sat += results.at(a, s, k, results.metric("saturated"));
+        faults += results.at(a, s, k, results.metric("faults"));
+      }
+    }
+    const std::string& nm = spec.approaches[a];
+    const Approach ap = parse_approach(nm);
+    j["approaches"][nm] = {{"description", description(ap)},
+                           {"cost_mean", sm.value[a].mean},
+                           {"cost_ci95", sm.value[a].ci95},
+                           {"ratio_to_I", sm.ratio_of_means[a]},
+                           {"ratio_mean", sm.ratio[a].mean},
+                           {"ratio_ci95", sm.ratio[a].ci95},
+                           {"ratio_scenario_weighted", sm.ratio_weighted[a].mean},
+                           {"ratio_scenario_weighted_ci95", sm.ratio_weighted[a].ci95},
+                           {"late_commands", late},
+                           {"saturated_commands", sat},
+                           {"estimator_faults", faults}};
+    char line[400];
+    std::snprintf(line, sizeof line, "| %s | %s | %.6f | ± %.6f | %.4f ± %.4f | %.4f ± %.4f | %.0f | %.0f |\n", nm.c_str(),
+                  description(ap), sm.value[a].mean, sm.value[a].ci95, sm.ratio_of_means[a], sm.ratio[a].ci95,
+                  sm.ratio_weighted[a].mean, sm.ratio_weighted[a].ci95, late, sat);
+    md << line;
+    order.emplace_back(sm.value[a].mean, nm);
+  }
+  std::stable_sort(order.begin(), order.end());
+  std::string order_text;
+  for (const auto& o : order) {
+    j["order_by_mean_cost"].push_back(o.second);
+    order_text += (order_text.empty() ? "" : " < ") + o.second;
+  }
+  j["order_text"] = order_text;
+  for (const auto& p : sm.paired) {
+    j["paired_differences"][spec.approaches[p.a] + "-" + spec.approaches[p.b]] = {{"mean", p.diff.mean},
+                                                                                 {"ci95", p.diff.ci95}};
+  }
+  // Per scenario: mean cost and ratio to I.
+  std::ostringstream per;
+  per << "| scenario | I";
+  for (std::size_t a = 1; a < na; ++a) per << " | " << spec.approaches[a] << "/I";
+  per << " |\n|---|";
+  for (std::size_t a = 0; a < na; ++a) per << "---|";
+  per << "\n";
+  for (std::size_t s = 0; s < ns; ++s) {
+    nlohmann::json e = {{"name", spec.scenarios[s]}};
+    char line[64];
+    std::snprintf(line, sizeof line, "| %s | %.5f |", spec.scenarios[s].c_str(), sm.per_scenario[0][s].mean);
+    per << line;
+    for (std::size_t a = 0; a < na; ++a) {
+      e["cost_mean"][spec.approaches[a]] = sm.per_scenario[a][s].mean;
+      e["cost_ci95"][spec.approaches[a]] = sm.per_scenario[a][s].ci95;
+      e["ratio_to_I"][spec.approaches[a]] = sm.per_scenario_ratio[a][s].mean;
+      e["ratio_to_I_ci95"][spec.approaches[a]] = sm.per_scenario_ratio[a][s].ci95;
+      if (a > 0) {
+        std::snprintf(line, sizeof line, " %.4f |", sm.per_scenario_ratio[a][s].mean);
+        per << line;
+      }
+    }
+    per << "\n";
+    j["per_scenario"].push_back(e);
+  }
+  // Noise-free invariants: A = I run by run; S against the delay level d.
+  const auto index_of = [&](const char* nm) -> std::ptrdiff_t {
+    const auto it = std::find(spec.approaches.begin(), spec.approaches.end(), nm);
+    return it == spec.approaches.end() ? -1 : it - spec.approaches.begin();
+  };
+  const std::ptrdiff_t ia = index_of("A");
+  const std::ptrdiff_t is = index_of("S");
+  if (ia > 0) {
+    double worst = 0;
+    for (std::size_t s = 0; s < ns; ++s)
+      for (std::size_t k = 0; k < seeds; ++k)
+        worst = std::fmax(worst, std::fabs(results.at(static_cast<std::size_t>(ia), s, k, cost) / results.at(0, s, k, cost) - 1));
+    j["A_vs_I_max_abs_ratio_minus_1"] = worst;
+  }
+  if (is > 0) {
+    std::map<double, std::pair<double, int>> by_d;
+    for (std::size_t s = 0; s < ns; ++s) {
+      auto& acc = by_d[scenarios[s].max_delay_ms];
+      acc.first += sm.per_scenario_ratio[static_cast<std::size_t>(is)][s].mean;
+      acc.second += 1;
+    }
+    double prev = 0;
+    bool increasing = true;
+    for (const auto& [d, acc] : by_d) {
+      const double r = acc.first / acc.second;
+      char key[32];
+      std::snprintf(key, sizeof key, "%g", d);
+      j["S_ratio_to_I_by_delay_ms"][key] = r;
+      increasing = increasing && r > prev;
+      prev = r;
+    }
+    j["S_ratio_increases_with_delay"] = increasing;
+  }
+  j["markdown"] = md.str();
+  j["markdown_per_scenario"] = per.str();
+  {
+    std::ofstream out(path_in(out_dir, "table.md"));
+    out << "Study ncs, " << (noise_free ? "noise-free, " : "") << ns << " scenarios x " << seeds << " seeds\n\n"
+        << md.str() << "\nOrder by mean cost: " << order_text << "\n\nPer scenario (mean over seeds):\n\n" << per.str();
+  }
+  engine::write_summary_files(results, sm, out_dir, "table", plots);
+  j["files"] = {"table.md", "table_runs.csv", "table_summary.csv", "table.png"};
+  return j;
+}
+
+}  // namespace oneshot::ncs

@@ -1,0 +1,209 @@
+/// @file fuzz_study.cpp
+/// @brief libFuzzer harness of the study-file parser: engine::parse_study(text, source, schema, base_dir).
+///
+/// Each input is parsed twice: without a schema (any approach kind, any finite parameter)
+/// and with a small schema of this harness (study "fuzz": kinds, ranges, an integer and a
+/// required parameter). Delay traces named in the input are read relative to a folder the
+/// harness fills with one valid trace ("delays.csv").
+///
+/// Oracle for an accepted study: every number is finite and inside its documented range;
+/// names of nodes, links, buses, approaches and scenarios are unique and node addresses
+/// too; every link joins two declared nodes; covariance and weight matrices are symmetric
+/// positive semidefinite (checked with Eigen's eigenvalues, independently of the parser);
+/// every link of every scenario has a configuration whose delay draws are whole, finite,
+/// between the model's lower bound and its cap, whose loss rate is a probability and whose
+/// description holds no "nan" or "inf"; the CAN response-time analysis of each bus's
+/// background traffic ends with finite figures; with the schema, approach kinds are known
+/// and parameters respect their range and integrality.
+#include <Eigen/Dense>
+#include <cmath>
+#include <cstdint>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <set>
+#include <string>
+
+#include "fuzz_oracle.hpp"
+#include "oneshot/engine/can_analysis.hpp"
+#include "oneshot/engine/random_stream.hpp"
+#include "oneshot/engine/study_file.hpp"
+
+namespace e = oneshot::engine;
+using oneshot::fuzz::require;
+
+namespace {
+
+std::string g_base_dir;
+
+bool finite_matrix(const oneshot::design::DenseMatrix& m) {
+  for (double v : m.values)
+    if (!std::isfinite(v)) return false;
+  return m.values.size() == m.rows * m.cols;
+}
+
+/// Symmetric positive semidefinite within a relative tolerance (or absent).
+void require_psd(const oneshot::design::DenseMatrix& m, const std::string& what) {
+  if (m.rows == 0) return;
+  require(m.rows == m.cols && finite_matrix(m), what + ": not a finite square matrix");
+  Eigen::MatrixXd x(static_cast<Eigen::Index>(m.rows), static_cast<Eigen::Index>(m.cols));
+  double scale = 0;
+  for (std::size_t i = 0; i < m.rows; ++i)
+    for (std::size_t j = 0; j < m.cols; ++j) {
+      x(static_cast<Eigen::Index>(i), static_cast<Eigen::Index>(j)) = m(i, j);
+      scale = std::fmax(scale, std::fabs(m(i, j)));
+    }
+  if (scale == 0) return;
+  const Eigen::MatrixXd unit = x / scale;  // no overflow in the eigen-solver
+  require((unit - unit.transpose()).cwiseAbs().maxCoeff() <= 1e-9, what + ": accepted, not symmetric");
+  const double lowest = Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(unit, Eigen::EigenvaluesOnly).eigenvalues().minCoeff();
+  require(lowest >= -1e-6, what + ": accepted, not positive semidefinite (eigenvalue " + std::to_string(lowest * scale) + ")");
+}
+
+void check_plant(const e::PlantSpec& p) {
+  if (p.kind == e::PlantSpec::Kind::kContinuous) {
+    const e::ContinuousModel& m = p.continuous;
+    require(finite_matrix(m.a) && finite_matrix(m.b) && finite_matrix(m.c) && finite_matrix(m.bw), "plant: non-finite matrix");
+    require(m.a.rows == m.a.cols && m.b.rows == m.a.rows && m.c.cols == m.a.rows, "plant: inconsistent shapes");
+    require_psd(m.qc, "plant.continuous.Q_c");
+    require_psd(m.q1c, "plant.continuous.Q1c");
+    require_psd(m.q2c, "plant.continuous.Q2c");
+  } else if (p.kind == e::PlantSpec::Kind::kDiscrete) {
+    const e::DiscreteModel& m = p.discrete;
+    require(finite_matrix(m.phi) && finite_matrix(m.gamma) && finite_matrix(m.c) && finite_matrix(m.gamma_w),
+            "plant: non-finite matrix");
+    require(m.phi.rows == m.phi.cols && m.gamma.rows == m.phi.rows && m.c.cols == m.phi.rows, "plant: inconsistent shapes");
+    require(m.period.count() > 0, "plant: non-positive period");
+    require_psd(m.q, "plant.discrete.Q");
+    require_psd(m.q1, "plant.discrete.Q1");
+    require_psd(m.q2, "plant.discrete.Q2");
+  } else {
+    require(!p.file.empty(), "plant: empty file name");
+  }
+}
+
+void check_link(const e::LinkConfig& c, const std::string& what) {
+  const std::string d = c.delay.describe() + " " + c.loss.describe();
+  require(d.find("nan") == std::string::npos && d.find("inf") == std::string::npos, what + ": describe() " + d);
+  const double rate = c.loss.loss_rate();
+  require(std::isfinite(rate) && rate >= 0 && rate <= 1, what + ": loss rate " + std::to_string(rate));
+  const e::Duration low = c.delay.lower_bound();
+  require(low.count() >= 0, what + ": negative lower bound");
+  e::RandomStream rng(1, "fuzz");
+  for (std::uint64_t k = 0; k < 16; ++k) {
+    bool clamped = false;
+    const e::Duration x = c.delay.draw(rng, k, clamped);
+    require(x >= low, what + ": delay draw below the lower bound");
+    require(x.count() >= 0, what + ": negative delay drawn");
+    const bool heavy = c.delay.kind == e::DelayModel::Kind::kLognormal || c.delay.kind == e::DelayModel::Kind::kPareto;
+    if (heavy) require(x <= c.delay.cap, what + ": delay draw above the cap");
+  }
+}
+
+void check_params(const std::map<std::string, double>& params, const std::vector<e::ParamSpec>* specs,
+                  const std::string& what) {
+  for (const auto& [name, v] : params) require(std::isfinite(v), what + "." + name + ": not finite");
+  if (specs == nullptr) return;
+  for (const e::ParamSpec& s : *specs) {
+    const auto it = params.find(s.name);
+    require(it != params.end(), what + ": parameter " + s.name + " missing after defaults");
+    require(it->second >= s.min && it->second <= s.max, what + "." + s.name + ": out of range");
+    if (s.integer) require(it->second == std::floor(it->second), what + "." + s.name + ": not an integer");
+  }
+  for (const auto& [name, v] : params) {
+    bool known = false;
+    for (const e::ParamSpec& s : *specs) known = known || s.name == name;
+    require(known, what + ": unknown parameter " + name + " accepted");
+  }
+}
+
+template <typename T, typename F>
+void require_unique(const std::vector<T>& items, F name, const std::string& what) {
+  std::set<std::string> seen;
+  for (const T& x : items) require(seen.insert(name(x)).second, what + ": duplicate name accepted: " + name(x));
+}
+
+void check_study(const e::StudyFile& s, const e::StudySchema* schema) {
+  require(std::isfinite(s.duration_s) && s.duration_s > 0 && s.duration_s <= 1e6, "duration_s out of range");
+  require(s.seeds >= 2 && s.seeds <= 10'000'000, "seed count out of range");
+  check_plant(s.plant);
+  require_unique(s.nodes, [](const e::NodeSpec& n) { return n.name; }, "nodes");
+  std::set<int> addresses;
+  for (const e::NodeSpec& n : s.nodes) {
+    require(addresses.insert(n.address).second, "node address used twice");
+    require(n.mode == "arrival" || n.period.count() > 0, "timer node without a period");
+    if (n.trigger) {
+      for (double d : n.trigger->delta) require(std::isfinite(d) && d >= 0, "trigger delta");
+      require(std::isfinite(n.trigger->sigma) && std::isfinite(n.trigger->mtm_delta), "MTM parameters");
+    }
+  }
+  require_unique(s.links, [](const e::LinkSpec& l) { return l.name; }, "links");
+  require_unique(s.buses, [](const e::BusSpec& b) { return b.config.name; }, "buses");
+  require_unique(s.approaches, [](const e::ApproachSpec& a) { return a.name; }, "approaches");
+  require_unique(s.scenarios, [](const e::ScenarioSpec& x) { return x.name; }, "scenarios");
+  for (const e::LinkSpec& l : s.links) {
+    s.node(l.from);  // throws when the parser let an unknown node through (crash: a finding)
+    s.node(l.to);
+    require(l.from != l.to, "link from a node to itself");
+    if (l.bus.empty()) check_link(s.link_config(l.name), "links." + l.name);
+  }
+  for (const e::ScenarioSpec& x : s.scenarios) {
+    if (x.duration_s) require(std::isfinite(*x.duration_s) && *x.duration_s > 0, "scenario duration");
+    check_params(x.params, schema != nullptr ? &schema->scenario_params : nullptr, "scenarios." + x.name);
+    for (const e::LinkSpec& l : s.links)
+      if (l.bus.empty()) check_link(s.link_config(l.name, &x), "scenarios." + x.name + ".links." + l.name);
+  }
+  for (const e::ApproachSpec& a : s.approaches) {
+    check_params(a.params, schema != nullptr ? &schema->approach_params : nullptr, "approaches." + a.name);
+    if (schema != nullptr) {
+      bool known = false;
+      for (const std::string& k : schema->approach_kinds) known = known || k == a.kind;
+      require(known, "unknown approach kind accepted: " + a.kind);
+    }
+  }
+  for (const e::BusSpec& b : s.buses) {
+    if (b.background.empty() || b.background.size() > 64) continue;
+    const std::vector<e::CanStreamBound> r = e::can_response_times(b.background, b.config);
+    require(r.size() == b.background.size(), "CAN analysis: one bound per stream");
+    for (const e::CanStreamBound& x : r) {
+      require(x.transmission.count() > 0, "CAN analysis: transmission time");
+      if (x.bounded) require(x.response >= x.transmission && x.response.count() > 0, "CAN analysis: response time");
+      require(!x.schedulable || x.bounded, "CAN analysis: schedulable without a bound");
+    }
+  }
+}
+
+void remove_base_dir() {
+  std::error_code ec;
+  std::filesystem::remove_all(g_base_dir, ec);
+}
+
+}  // namespace
+
+extern "C" int LLVMFuzzerInitialize(int*, char***) {
+  char dir[] = "/tmp/oneshot-fuzz-study-XXXXXX";
+  if (::mkdtemp(dir) == nullptr) std::abort();
+  g_base_dir = dir;
+  std::ofstream(g_base_dir + "/delays.csv") << "delay_us\n500\n# a comment\n1500\n\n250\n";
+  std::atexit(remove_base_dir);
+  return 0;
+}
+
+extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
+  const std::string text(reinterpret_cast<const char*>(data), size);
+  static const e::StudySchema schema = {
+      "fuzz",
+      {"ideal", "kalman"},
+      {{"gain", 0, 10, false, false, 1}, {"horizon", 1, 100, true, false, 10}},
+      {{"amplitude", 0, 5, false, true, 0}, {"steps", 0, 1000, true, false, 0}}};
+  for (const e::StudySchema* sc : {static_cast<const e::StudySchema*>(nullptr), &schema}) {
+    e::StudyFile s;
+    try {
+      s = e::parse_study(text, "fuzz", sc, g_base_dir);
+    } catch (const e::InputError&) {
+      continue;  // refused with a message: fine
+    }
+    check_study(s, sc);
+  }
+  return 0;
+}
