@@ -28,9 +28,9 @@
 namespace oneshot::sim {
 
 /// Runs `sc` with `seed` on the board plant around `driver` (see the file comment).
-template <std::size_t N, std::size_t M, std::size_t P, app::TaskModel kModel, typename Driver>
+template <std::size_t N, std::size_t M, std::size_t P, app::TaskModel kModel>
 RunResult run_board_loop(const SimContext& ctx, const Scenario& sc, std::uint64_t seed, const RunOptions& opt,
-                         Driver& driver) {
+                         BoardDriver<N, M>& driver) {
   using engine::Duration;
   using engine::EventClass;
   using engine::SimTime;

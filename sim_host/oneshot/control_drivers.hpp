@@ -2,9 +2,9 @@
 /// @brief The seed-000 control task as the board loop drives it: in-process through the
 ///        host port (LocalDriver), or in the emulated MCU behind the PIL link (RemoteDriver).
 ///
-/// A driver offers reset(initial codes, P0 scale), actuation(board) for the timer
-/// interrupt, job(board) for one control job, statistics() and saturated(); the board loop
-/// (board_loop.hpp) calls them from its engine events.
+/// Both implement BoardDriver: reset(initial codes, P0 scale), actuation(board) for the
+/// timer interrupt, job(board) for one control job, statistics() and saturated(); the
+/// board loop (board_loop.hpp) calls them from its engine events.
 #pragma once
 
 #include <cstddef>
@@ -40,16 +40,38 @@ struct JobReport {
   double u_applied = 0;
 };
 
+/// What the board loop drives, for N states and M inputs.
+///
+/// Virtual on purpose: this is the host harness around the job, not the control path (the
+/// job itself stays the statically typed Controller). One board loop per (n, m, p, task
+/// model) instead of one per estimator × discretizer × number format keeps the simulator's
+/// build time bounded.
+template <std::size_t N, std::size_t M>
+class BoardDriver {
+ public:
+  virtual ~BoardDriver() = default;
+  /// Starts a run: the PWM codes in force at power-on and the factor on P0.
+  virtual void reset(const std::int32_t (&codes)[M], double p0_scale) = 0;
+  /// The timer interrupt at an actuation instant.
+  virtual void actuation(host::HostBoardState& board) = 0;
+  /// One control job on the board's current ADC codes.
+  virtual JobReport<N> job(host::HostBoardState& board) = 0;
+  /// Jobs, overruns and faults so far.
+  virtual const app::TaskStatistics& statistics() const = 0;
+  /// True once any value saturated.
+  virtual bool saturated() const = 0;
+};
+
 /// The firmware's control task run in-process through the host port.
 template <typename Ctrl, app::TaskModel kModel>
-class LocalDriver {
+class LocalDriver final : public BoardDriver<Ctrl::kN, Ctrl::kM> {
  public:
   static constexpr std::size_t kN = Ctrl::kN;
+  static constexpr std::size_t kM = Ctrl::kM;
   explicit LocalDriver(Ctrl& ctrl) : ctrl_(&ctrl), task_(ctrl) {}
-  template <std::size_t M>
-  void reset(const std::int32_t (&codes)[M], double p0_scale) {
+  void reset(const std::int32_t (&codes)[kM], double p0_scale) override {
     typename Ctrl::InputVec u0;
-    for (std::size_t j = 0; j < M; ++j) u0[j] = input_of_code(ctrl_->design().actuator, j, codes[j]);
+    for (std::size_t j = 0; j < kM; ++j) u0[j] = input_of_code(ctrl_->design().actuator, j, codes[j]);
     // P0 scaled entry by entry in double (a fixed covariance format cannot hold the factor).
     auto p0 = ctrl_->design().p0;
     using CovScalar = typename Ctrl::CovScalar;
@@ -60,8 +82,8 @@ class LocalDriver {
     ctrl_->estimator().reset(typename Ctrl::StateVec{}, p0, u0);
     task_.reset();
   }
-  void actuation(host::HostBoardState&) { task_.on_actuation_interrupt(); }
-  JobReport<kN> job(host::HostBoardState&) {
+  void actuation(host::HostBoardState&) override { task_.on_actuation_interrupt(); }
+  JobReport<kN> job(host::HostBoardState&) override {
     task_.run_job();
     JobReport<kN> r;
     r.tau_us = task_.statistics().last_tau_us;
@@ -70,8 +92,8 @@ class LocalDriver {
     r.u_applied = to_double(ctrl_->applied_input()[0]);
     return r;
   }
-  const app::TaskStatistics& statistics() const { return task_.statistics(); }
-  bool saturated() const { return saturation_flag(); }
+  const app::TaskStatistics& statistics() const override { return task_.statistics(); }
+  bool saturated() const override { return saturation_flag(); }
 
  private:
   Ctrl* ctrl_;
@@ -94,10 +116,10 @@ double decode_raw(std::uint32_t raw) {
 
 /// The firmware's control task run in QEMU, behind the PIL link.
 template <typename Fmt, std::size_t N, std::size_t M, std::size_t P, app::TaskModel kModel>
-class RemoteDriver {
+class RemoteDriver final : public BoardDriver<N, M> {
  public:
   RemoteDriver(PilLink& link, Approach approach, NoiseModel noise) : link_(&link), approach_(approach), noise_(noise) {}
-  void reset(const std::int32_t (&codes)[M], double p0_scale) {
+  void reset(const std::int32_t (&codes)[M], double p0_scale) override {
     if (p0_scale != 1.0) throw std::invalid_argument("PIL runs start from the design's initial covariance (p0 scale 1)");
     app::pil::Frame f;
     app::pil::Writer w(f);
@@ -108,7 +130,7 @@ class RemoteDriver {
     stats_ = app::TaskStatistics{};
     saturated_ = false;
   }
-  void actuation(host::HostBoardState& b) {
+  void actuation(host::HostBoardState& b) override {
     app::pil::Frame f;
     app::pil::Writer w(f);
     w.u(static_cast<std::uint32_t>(b.now_us), 4);  // the MCU's 32-bit timer: wraps, wrap-safe there
@@ -117,7 +139,7 @@ class RemoteDriver {
     const std::size_t writes = read_writes(in, b);
     if (kModel == app::TaskModel::kOneShot && writes == 0 && stats_.jobs > 0) ++stats_.overruns;
   }
-  JobReport<N> job(host::HostBoardState& b) {
+  JobReport<N> job(host::HostBoardState& b) override {
     const std::uint64_t t_apply = kModel == app::TaskModel::kOneShot ? b.next_actuation_us : b.now_us;
     app::pil::Frame f;
     app::pil::Writer w(f);
@@ -144,8 +166,8 @@ class RemoteDriver {
     if (!is_exact(status)) ++stats_.faults;
     return rep;
   }
-  const app::TaskStatistics& statistics() const { return stats_; }
-  bool saturated() const { return saturated_; }
+  const app::TaskStatistics& statistics() const override { return stats_; }
+  bool saturated() const override { return saturated_; }
 
  private:
   static std::size_t read_writes(app::pil::Reader& in, host::HostBoardState& b) {
