@@ -13,19 +13,15 @@
 #include "oneshot/host/child_process.hpp"
 #include "oneshot/host/file_io.hpp"
 #include "oneshot/host/strict_json.hpp"
+#include "support/temp_files.hpp"
 
 namespace oneshot::host {
 namespace {
 
 namespace fs = std::filesystem;
 
-/// A fresh, empty folder for one test.
-std::string fresh_dir(const std::string& name) {
-  const fs::path d = fs::temp_directory_path() / ("oneshot_host_io_" + std::to_string(::getpid())) / name;
-  fs::remove_all(d);
-  fs::create_directories(d);
-  return d.string();
-}
+/// A fresh empty folder `name` (any characters) for one test.
+std::string fresh_dir(const std::string& name) { return test::made_dir("oneshot_host_io", name); }
 
 std::string message_of(const std::function<void()>& f) {
   try {

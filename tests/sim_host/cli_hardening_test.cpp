@@ -12,6 +12,7 @@
 
 #include "oneshot/host/child_process.hpp"
 #include "support/run_command.hpp"
+#include "support/temp_files.hpp"
 #include "support/test_plants.hpp"
 
 namespace oneshot {
@@ -23,19 +24,7 @@ using test::run_command;
 std::string sim() { return ONESHOT_SIM_PATH; }
 
 /// A fresh empty folder `name` (any characters) for one test.
-std::string fresh_dir(const std::string& name) {
-  const fs::path d = fs::temp_directory_path() / ("oneshot_hard_" + std::to_string(::getpid())) / name;
-  fs::remove_all(d);
-  fs::create_directories(d);
-  return d.string();
-}
-
-std::string read(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
+std::string fresh_dir(const std::string& name) { return test::made_dir("oneshot_hard", name); }
 
 /// A scenario file whose only scenario is called `name` (1 s, default jitter).
 std::string scenario_named(const std::string& file, const std::string& name) {
@@ -56,7 +45,7 @@ TEST(CliHardening, AScenarioNameIsDataInTheGnuplotScript) {
   ASSERT_EQ(r.exit_code, 0) << r.output;
   EXPECT_TRUE(fs::exists(dir + "/out/run.png"));
   for (const char* f : {"/pwned1", "/pwned2", "/pwned3"}) EXPECT_FALSE(fs::exists(dir + f)) << f;
-  EXPECT_NE(read(dir + "/out/run.gp").find("x'' . " + run + "(''touch ../pwned1'')"), std::string::npos);  // a label
+  EXPECT_NE(test::read_file(dir + "/out/run.gp").find("x'' . " + run + "(''touch ../pwned1'')"), std::string::npos);  // a label
 }
 
 TEST(CliHardening, AnOutputFolderWithAnApostropheOrShellSyntaxPlots) {
@@ -214,7 +203,7 @@ TEST(CliHardening, AFullDiskAtTheLastFlushIsAnErrorAndLeavesNoPartialFile) {
   EXPECT_EQ(files, 0U) << "neither a truncated file nor a temporary one may stay";
   // The same run without the limit writes the file.
   ASSERT_EQ(run_command(run).exit_code, 0);
-  EXPECT_GT(read(dir + "/o/run_jobs.csv").size(), 300U);
+  EXPECT_GT(test::read_file(dir + "/o/run_jobs.csv").size(), 300U);
 }
 
 TEST(CliHardening, ANonFiniteResultIsAnErrorNotNull) {
@@ -258,7 +247,7 @@ TEST(CliHardening, AShardFileIsReadStrictlyAndBounded) {
                                  "--out", dir});
   ASSERT_EQ(made.exit_code, 0) << made.output;
   const std::string shard = dir + "/table1.shard-0-of-2.json";
-  std::string text = read(shard);
+  std::string text = test::read_file(shard);
   ASSERT_EQ(text.rfind("{", 0), 0U);
   text.insert(1, "\"format\": \"x\",");
   const std::string twice = test::write_temp_file("hard_shard_twice.json", text);

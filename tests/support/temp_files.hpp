@@ -17,6 +17,13 @@ inline std::string fresh_dir(const std::string& prefix, const std::string& name)
   return d.string();
 }
 
+/// fresh_dir(prefix, name), created empty.
+inline std::string made_dir(const std::string& prefix, const std::string& name) {
+  const std::string d = fresh_dir(prefix, name);
+  std::filesystem::create_directories(d);
+  return d;
+}
+
 /// The whole file, bytes as stored ("" when it cannot be opened).
 inline std::string read_file(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
