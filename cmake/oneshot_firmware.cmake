@@ -127,6 +127,24 @@ target_compile_definitions(oneshot-heap-probe-${ONESHOT_FIRMWARE_TARGET} PRIVATE
   ONESHOT_MCU_IRQ_COUNT=${irq_count} ONESHOT_MCU_ACTUATION_IRQ=8 ONESHOT_MCU_UART_IRQ=${uart_irq})
 oneshot_firmware_link(oneshot-heap-probe-${ONESHOT_FIRMWARE_TARGET})
 
+# Size probes: one control job (half Kalman, generic float discretizer) for a synthetic dense
+# n-state plant, n = ONESHOT_PROBE_N; not part of ALL. <image>.stack.txt bounds its stack.
+foreach(probe_n RANGE 2 16)
+  set(image oneshot-${ONESHOT_FIRMWARE_TARGET}-size-probe-n${probe_n})
+  add_executable(${image} EXCLUDE_FROM_ALL firmware/app/mcu/size_probe.cpp firmware/app/mcu/startup.cpp)
+  set_target_properties(${image} PROPERTIES SUFFIX ".elf")
+  target_include_directories(${image} PRIVATE firmware/core/include)
+  target_compile_options(${image} PRIVATE ${fw_common_options})
+  target_compile_definitions(${image} PRIVATE ${soc_define} ONESHOT_MCU_IRQ_COUNT=${irq_count}
+    ONESHOT_MCU_ACTUATION_IRQ=8 ONESHOT_MCU_UART_IRQ=${uart_irq} ${extra_defines} ONESHOT_PROBE_N=${probe_n})
+  oneshot_firmware_link(${image})
+  add_custom_command(TARGET ${image} POST_BUILD
+    COMMAND arm-none-eabi-size $<TARGET_FILE:${image}>
+    COMMAND ${CMAKE_COMMAND} -DDIR=${CMAKE_CURRENT_BINARY_DIR}/CMakeFiles/${image}.dir
+            -DOUT=$<TARGET_FILE:${image}>.stack.txt -P ${PROJECT_SOURCE_DIR}/cmake/oneshot_stack_bound.cmake
+    COMMENT "size and stack bound of ${image}")
+endforeach()
+
 # The fixed-point job must link no soft-float routine at any optimisation level (its
 # constants are integer-exact): the fixed table image built at -Og, never part of ALL; a
 # test builds it and checks its symbols (tests/pil/og_no_floating_point.cmake).

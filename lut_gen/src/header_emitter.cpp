@@ -66,11 +66,14 @@ DenseMatrix per_us(DenseMatrix m, double extra = 1.0) {
 /// The table layout shared by every number format: level radices, slot maps, entry times.
 template <typename Storage>
 void emit_layout(std::ostringstream& o, const TableData<Storage>& t) {
+  const char* slot_t = t.narrow_slots() ? "std::int8_t" : "std::int16_t";
   o << "  static constexpr std::uint16_t kRadix[] = {" << int_list(t.radix) << "};\n"
     << "  static constexpr std::uint16_t kLevelOffset[] = {" << int_list(t.level_offset) << "};\n"
-    << "  static constexpr std::int8_t kPhiSlot[] = {" << int_list(t.phi_slot) << "};\n"
-    << "  static constexpr std::int8_t kGammaSlot[] = {" << int_list(t.gamma_slot) << "};\n"
-    << "  static constexpr std::int8_t kQdSlot[] = {" << int_list(t.qd_slot) << "};\n"
+    << "  static constexpr " << slot_t << " kPhiSlot[] = {" << int_list(t.phi_slot) << "};\n"
+    << "  static constexpr " << slot_t << " kGammaSlot[] = {" << int_list(t.gamma_slot) << "};\n"
+    << "  static constexpr " << slot_t << " kQdSlot[] = {" << int_list(t.qd_slot) << "};\n"
+    << "  static constexpr " << (t.narrow_slots() ? "std::uint8_t" : "std::uint16_t") << " kResidualOffset[] = {"
+    << int_list(t.residual_offset) << "};\n"
     << "  /// Entry times (us): " << int_list(t.entry_time_us) << ".\n";
 }
 
@@ -91,11 +94,11 @@ void emit_constants(std::ostringstream& o, const char* scalar, const PlantDescri
   o << "  static constexpr " << scalar << " kValues[] = {\n      " << value_list(t.values, t.slots) << "};\n"
     << "  static constexpr std::uint8_t kResidualLow[] = {" << int_list(t.residual_low) << "};\n"
     << "  static constexpr std::uint8_t kResidualHigh[] = {" << int_list(t.residual_high) << "};\n"
-    << "  static constexpr std::uint8_t kResidualOffset[] = {" << int_list(t.residual_offset) << "};\n"
     << "  static constexpr " << scalar << " kResidualCoefficients[] = {" << value_list(t.residual_coefficients, 0)
     << "};\n"
     << "  /// The look-up table (" << t.bytes() << " bytes).\n"
-    << "  static constexpr ::oneshot::TableView<" << scalar << "> kTable{" << t.granularity_us << ", " << t.range_us
+    << "  static constexpr ::oneshot::TableView<" << scalar << ", " << (t.narrow_slots() ? "std::int8_t" : "std::int16_t")
+    << "> kTable{" << t.granularity_us << ", " << t.range_us
     << ", " << t.radix.size() << ", kRadix, kLevelOffset, " << t.entry_time_us.size() << ", "
     << static_cast<int>(t.slots) << ", " << static_cast<int>(t.transition_slots)
     << ", kPhiSlot, kGammaSlot, kQdSlot, kValues, kResidualLow, kResidualHigh, kResidualOffset, "
@@ -191,11 +194,11 @@ void emit_fixed(std::ostringstream& o, const PlantDescription& plant, const Desi
     << "  static constexpr std::int8_t kValueFrac[] = {" << int_list(t.value_frac) << "};\n"
     << "  static constexpr std::uint8_t kResidualLow[] = {" << int_list(t.residual_low) << "};\n"
     << "  static constexpr std::uint8_t kResidualHigh[] = {" << int_list(t.residual_high) << "};\n"
-    << "  static constexpr std::uint8_t kResidualOffset[] = {" << int_list(t.residual_offset) << "};\n"
     << "  static constexpr ::oneshot::Mantissa32 kResidualCoefficients[] = {" << join(coeffs, 0) << "};\n"
     << "  static constexpr std::int8_t kResidualFrac[] = {" << int_list(t.residual_frac) << "};\n"
     << "  /// The look-up table (" << t.bytes() << " bytes, 16-bit mantissas with a scale per slot).\n"
-    << "  static constexpr ::oneshot::TableView<::oneshot::BlockFixedStorage> kTable{" << t.granularity_us << ", "
+    << "  static constexpr ::oneshot::TableView<::oneshot::BlockFixedStorage, "
+    << (t.narrow_slots() ? "std::int8_t" : "std::int16_t") << "> kTable{" << t.granularity_us << ", "
     << t.range_us << ", " << t.radix.size() << ", kRadix, kLevelOffset, " << t.entry_time_us.size() << ", "
     << static_cast<int>(t.slots) << ", " << static_cast<int>(t.transition_slots)
     << ", kPhiSlot, kGammaSlot, kQdSlot, kValues, kResidualLow, kResidualHigh, kResidualOffset, "

@@ -2,7 +2,9 @@
 /// @brief Graph analysis of the plant (see structure_analysis.hpp).
 #include "oneshot/design/structure_analysis.hpp"
 
+#include <algorithm>
 #include <cstdio>
+#include <string>
 #include <vector>
 
 namespace oneshot::design {
@@ -36,29 +38,35 @@ BoolMatrix transposed(const BoolMatrix& a) {
 }
 
 PatternMask from_nonzero(const BoolMatrix& nz, std::size_t rows, std::size_t cols) {
-  PatternMask p{rows, cols, 0, 0};
+  PatternMask p{rows, cols, {}, {}};
   for (std::size_t i = 0; i < rows; ++i)
     for (std::size_t j = 0; j < cols; ++j)
-      if (!nz[i][j]) p.zero |= std::uint64_t{1} << (i * cols + j);
+      if (!nz[i][j]) p.set_zero(i, j);
   return p;
 }
 
 }  // namespace
 
 std::string PatternMask::cpp_type() const {
-  char buf[160];
-  std::snprintf(buf, sizeof buf, "::oneshot::Pattern<%zu, %zu, 0x%llxULL, 0x%llxULL>", rows, cols,
-                static_cast<unsigned long long>(zero), static_cast<unsigned long long>(one));
-  return buf;
+  if (rows * cols > 256) throw DesignError("pattern of " + std::to_string(rows) + "x" + std::to_string(cols) +
+                                           " entries exceeds kMaxPatternEntries (256)");
+  const std::size_t words = std::max<std::size_t>(1, (rows * cols + 63) / 64);
+  std::string out = "::oneshot::Pattern<" + std::to_string(rows) + ", " + std::to_string(cols);
+  for (std::size_t w = 0; w < words; ++w) {
+    char buf[64];
+    std::snprintf(buf, sizeof buf, ", 0x%llxULL, 0x%llxULL", static_cast<unsigned long long>(zero[w]),
+                  static_cast<unsigned long long>(one[w]));
+    out += buf;
+  }
+  return out + ">";
 }
 
 PatternMask constant_pattern(const DenseMatrix& m) {
-  PatternMask p{m.rows, m.cols, 0, 0};
+  PatternMask p{m.rows, m.cols, {}, {}};
   for (std::size_t i = 0; i < m.rows; ++i)
     for (std::size_t j = 0; j < m.cols; ++j) {
-      const std::uint64_t bit = std::uint64_t{1} << (i * m.cols + j);
-      if (m(i, j) == 0.0) p.zero |= bit;
-      if (m(i, j) == 1.0) p.one |= bit;
+      if (m(i, j) == 0.0) p.set_zero(i, j);
+      if (m(i, j) == 1.0) p.set_one(i, j);
     }
   return p;
 }
@@ -81,7 +89,7 @@ PlantPatterns analyse_structure(const PlantDescription& plant, const DesignResul
   PlantPatterns p;
   p.phi = from_nonzero(phi_nz, n, n);
   for (std::size_t i = 0; i < n; ++i)
-    if (!reach[i][i]) p.phi.one |= std::uint64_t{1} << (i * n + i);
+    if (!reach[i][i]) p.phi.set_one(i, i);
   p.gamma = from_nonzero(bool_product(phi_nz, nonzero(plant.b)), n, m);
   p.qd = from_nonzero(bool_product(bool_product(phi_nz, nonzero(design.qc)), transposed(phi_nz)), n, n);
   p.constant_q = constant_pattern(design.q_constant);

@@ -238,26 +238,26 @@ TableData<S> build_fixed(const PlantDescription& plant, const DesignResult& desi
   bool in_transition = true;
   for (const Candidate& c : cands) {
     if (c.kind == Candidate::Kind::kQd && in_transition) {
-      t.transition_slots = static_cast<std::uint8_t>(slots.size());
+      t.transition_slots = static_cast<std::uint16_t>(slots.size());
       in_transition = false;
     }
     const RoundedSlot<S> rs = round_slot<S>(c.grid, c.coeffs);
     std::size_t index = 0;
     while (index < slots.size() && !same(slots[index], rs)) ++index;
     if (index == slots.size()) slots.push_back(rs);
-    if (slots.size() > 127) throw DesignError("table: more than 127 free entries");
-    const auto code = static_cast<std::int8_t>(index);
+    if (slots.size() > max_table_slots(N, M)) throw DesignError("table: more free entries than max_table_slots");
+    const auto code = static_cast<std::int16_t>(index);
     if (c.kind == Candidate::Kind::kPhi) t.phi_slot[c.i * N + c.j] = code;
     if (c.kind == Candidate::Kind::kGamma) t.gamma_slot[c.i * M + c.j] = code;
     if (c.kind == Candidate::Kind::kQd) t.qd_slot[c.i * N + c.j] = t.qd_slot[c.j * N + c.i] = code;
   }
-  if (in_transition) t.transition_slots = static_cast<std::uint8_t>(slots.size());
-  t.slots = static_cast<std::uint8_t>(slots.size());
+  if (in_transition) t.transition_slots = static_cast<std::uint16_t>(slots.size());
+  t.slots = static_cast<std::uint16_t>(slots.size());
   constexpr bool kBlock = std::is_same_v<S, BlockFixedStorage>;
   for (const RoundedSlot<S>& rs : slots) {
     t.residual_low.push_back(rs.low);
     t.residual_high.push_back(rs.high);
-    t.residual_offset.push_back(static_cast<std::uint8_t>(t.residual_coefficients.size()));
+    t.residual_offset.push_back(static_cast<std::uint16_t>(t.residual_coefficients.size()));
     t.residual_coefficients.insert(t.residual_coefficients.end(), rs.coeffs.begin(), rs.coeffs.end());
     if constexpr (kBlock) {
       t.value_frac.push_back(rs.value_frac);
@@ -266,13 +266,28 @@ TableData<S> build_fixed(const PlantDescription& plant, const DesignResult& desi
     t.quantization_abs = std::max(t.quantization_abs, rs.error_abs);
     t.quantization_rel = std::max(t.quantization_rel, rs.error_rel);
   }
-  if (t.residual_coefficients.size() > 255) throw DesignError("table: more than 255 residual coefficients");
+  // 8-bit tables (SlotIdFor) index coefficients in 8 bits, 16-bit tables in 16.
+  const std::size_t max_coefficients = t.narrow_slots() ? 255 : 65535;
+  if (t.residual_coefficients.size() > max_coefficients) {
+    throw DesignError("table: " + std::to_string(t.residual_coefficients.size()) + " residual coefficients exceed the " +
+                      std::to_string(max_coefficients) + " a " + (t.narrow_slots() ? "8" : "16") +
+                      "-bit-indexed table addresses");
+  }
+  if (t.narrow_slots()) {
+    const auto narrow = [](const std::vector<std::int16_t>& v) { return std::vector<std::int8_t>(v.begin(), v.end()); };
+    t.phi_slot8 = narrow(t.phi_slot);
+    t.gamma_slot8 = narrow(t.gamma_slot);
+    t.qd_slot8 = narrow(t.qd_slot);
+    for (std::uint16_t o : t.residual_offset) t.residual_offset8.push_back(static_cast<std::uint8_t>(o));
+  }
+  const std::size_t slot_id_bytes = t.narrow_slots() ? 1 : 2;
   using Value = typename TableData<S>::Value;
   using Coefficient = typename TableData<S>::Coefficient;
 
   // Layout: fewest levels that fit table.max_bytes, then fewest bytes.
-  const std::size_t fixed_bytes = sizeof(Coefficient) * t.residual_coefficients.size() + 2 * N * N + N * M +
-                                  3U * t.slots + (kBlock ? 2U * t.slots : 0U);
+  const std::size_t fixed_bytes = sizeof(Coefficient) * t.residual_coefficients.size() +
+                                  slot_id_bytes * (2 * N * N + N * M) + (2U + slot_id_bytes) * t.slots +
+                                  (kBlock ? 2U * t.slots : 0U);
   const auto cost = [&](std::size_t entries, std::size_t levels) {
     return fixed_bytes + sizeof(Value) * entries * t.slots + 4 * levels;
   };

@@ -64,7 +64,7 @@ RunResult run_board_loop(const SimContext& ctx, const Scenario& sc, std::uint64_
   host::HostBoardState hb;
   hb.adc_codes.assign(P, 0);
   hb.setpoint_context = &schedule;
-  hb.setpoint_at = [](const void* c, std::size_t, std::uint32_t at_us) {
+  hb.setpoint_at = [](const void* c, std::size_t, std::uint64_t at_us) {
     return static_cast<const SetpointSchedule*>(c)->code_at(static_cast<std::int64_t>(at_us) * 1000);
   };
   const host::ScopedHostBoard scope(hb);
@@ -73,7 +73,7 @@ RunResult run_board_loop(const SimContext& ctx, const Scenario& sc, std::uint64_
   const Duration h = engine::from_us(plant.period_us);
   const auto periods = static_cast<std::int64_t>(std::floor(sc.duration_s * 1e9 / static_cast<double>(h.count())));
   const SimTime end{periods * h.count()};
-  const auto us_of = [](SimTime t) { return static_cast<std::uint32_t>(t.count() / 1000); };
+  const auto us_of = [](SimTime t) { return static_cast<std::uint64_t>(t.count() / 1000); };  // 64-bit: no wrap
   const auto apply_writes = [&]() {
     for (const host::PwmWrite& w : hb.pwm_writes) board.set_duty(w.channel, w.code);
     hb.pwm_writes.clear();

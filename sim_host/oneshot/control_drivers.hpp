@@ -133,18 +133,18 @@ class RemoteDriver final : public BoardDriver<N, M> {
   void actuation(host::HostBoardState& b) override {
     app::pil::Frame f;
     app::pil::Writer w(f);
-    w.u(b.now_us, 4);
+    w.u(static_cast<std::uint32_t>(b.now_us), 4);  // the MCU's 32-bit timer: wraps, wrap-safe there
     const app::pil::Frame r = link_->request(app::pil::Type::kTick, f);
     app::pil::Reader in(r);
     const std::size_t writes = read_writes(in, b);
     if (kModel == app::TaskModel::kOneShot && writes == 0 && stats_.jobs > 0) ++stats_.overruns;
   }
   JobReport<N> job(host::HostBoardState& b) override {
-    const std::uint32_t t_apply = kModel == app::TaskModel::kOneShot ? b.next_actuation_us : b.now_us;
+    const std::uint64_t t_apply = kModel == app::TaskModel::kOneShot ? b.next_actuation_us : b.now_us;
     app::pil::Frame f;
     app::pil::Writer w(f);
-    w.u(b.now_us, 4);
-    w.u(b.next_actuation_us, 4);
+    w.u(static_cast<std::uint32_t>(b.now_us), 4);  // the MCU's 32-bit timer: wraps, wrap-safe there
+    w.u(static_cast<std::uint32_t>(b.next_actuation_us), 4);
     for (std::size_t o = 0; o < P; ++o) w.s(b.adc_codes[o], 2);
     for (std::size_t o = 0; o < P; ++o) w.s(b.setpoint_at(b.setpoint_context, o, t_apply), 2);
     const app::pil::Frame r = link_->request(app::pil::Type::kSample, f);

@@ -36,8 +36,8 @@ static_assert(Structure::kOutputs == 1 && kM == 1, "the reference covers the sin
 
 template <typename View>
 struct StorageOf;
-template <typename S>
-struct StorageOf<TableView<S>> {
+template <typename S, typename SlotId>
+struct StorageOf<TableView<S, SlotId>> {
   using type = S;
 };
 

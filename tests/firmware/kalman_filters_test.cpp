@@ -230,6 +230,44 @@ TEST(KalmanFilters, NearestPolicyFilterEqualsTheExactFilterOnRoundedTau) {
   }
 }
 
+TEST(KalmanFilters, NearestPolicyRoundsNegativeOffGridTauLikeTheExactFilterOnRoundedTau) {
+  // GIVEN filters over the nearest-grid-point table and over the exact table
+  using K = PlantConstants<double>;
+  using Exact = TableDiscretizer<K::Format, PlantStructure, double>;
+  using Nearest = TableDiscretizer<K::Format, PlantStructure, double, OutOfRange::kExtend, SubGrid::kNearest>;
+  const Exact exact(K::kTable);
+  const Nearest nearest(K::kTable);
+  const std::int32_t g = K::kTable.granularity_us;
+  HalfKalman<K::Format, PlantStructure, Nearest> half_n(K::kDesign, nearest, NoiseModel::kExact);
+  HalfKalman<K::Format, PlantStructure, Exact> half_e(K::kDesign, exact, NoiseModel::kExact);
+  CompleteKalman<K::Format, PlantStructure, Nearest> comp_n(K::kDesign, nearest, NoiseModel::kExact);
+  CompleteKalman<K::Format, PlantStructure, Exact> comp_e(K::kDesign, exact, NoiseModel::kExact);
+  std::mt19937_64 rng(12);
+  // τ < 0 (sample after the actuation: a scheduling fault), off the grid
+  std::uniform_int_distribution<std::int32_t> tau(-5 * g - g / 2, -1);
+  std::normal_distribution<double> y(0.0, 0.1);
+  for (int k = 0; k < 500; ++k) {
+    // WHEN the nearest filters get raw negative τ and the exact ones τ rounded away from zero
+    const std::int32_t t = tau(rng);
+    const std::int32_t rounded = -(((-t) + g / 2) / g) * g;
+    Vector<double, 1> yk;
+    yk[0] = y(rng);
+    // THEN no invariant fires, the statuses agree and the estimates are the same bits
+    ASSERT_EQ(half_n.update(t, yk), half_e.update(rounded, yk)) << "job " << k;
+    ASSERT_EQ(comp_n.update(t, yk), comp_e.update(rounded, yk)) << "job " << k;
+    for (std::size_t i = 0; i < 2; ++i) {
+      ASSERT_EQ(half_n.prediction()[i], half_e.prediction()[i]) << "job " << k;
+      ASSERT_EQ(comp_n.prediction()[i], comp_e.prediction()[i]) << "job " << k;
+    }
+    Vector<double, 1> u;
+    u[0] = y(rng);
+    half_n.set_applied_input(u);
+    half_e.set_applied_input(u);
+    comp_n.set_applied_input(u);
+    comp_e.set_applied_input(u);
+  }
+}
+
 TEST(KalmanFilters, JosephAndSymmetricFormsAgree) {
   using K = PlantConstants<double>;
   const TableDiscretizer<K::Format, PlantStructure, double> table(K::kTable);

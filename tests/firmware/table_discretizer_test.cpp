@@ -164,13 +164,17 @@ TEST(TableDiscretizer, NearestPolicyRoundsTauToTheGridAndIsExactThere) {
   const TableDiscretizer<F64, PlantStructure, double, OutOfRange::kExtend, SubGrid::kNearest> nearest(K::kTable);
   const TableDiscretizer<F64, PlantStructure, double> exact(K::kTable);
   const std::int32_t g = K::kTable.granularity_us;
-  // WHEN τ is quantized THEN it lands on the nearest multiple of g (ties up), negatives unchanged
+  // WHEN τ is quantized THEN it lands on the nearest multiple of g (ties away from zero), negatives too
   EXPECT_EQ(nearest.quantize(0), 0);
   EXPECT_EQ(nearest.quantize(g / 2 - 1), 0);
   EXPECT_EQ(nearest.quantize(g / 2), g);
   EXPECT_EQ(nearest.quantize(3 * g + g / 2 - 1), 3 * g);
   EXPECT_EQ(nearest.quantize(3 * g + g / 2 + 1), 4 * g);
-  EXPECT_EQ(nearest.quantize(-17), -17);
+  EXPECT_EQ(nearest.quantize(-17), 0);
+  EXPECT_EQ(nearest.quantize(-(g / 2) + 1), 0);
+  EXPECT_EQ(nearest.quantize(-(g / 2)), -g);
+  EXPECT_EQ(nearest.quantize(-3 * g - g / 2 + 1), -3 * g);
+  EXPECT_EQ(nearest.quantize(-3 * g - g / 2), -4 * g);
   EXPECT_EQ(exact.quantize(3 * g + 123), 3 * g + 123);
   // AND on the grid (also beyond the range) both policies give the same triple bit for bit
   for (std::int32_t k = 0; k <= 2 * K::kTable.range_us / g; ++k) {

@@ -75,8 +75,8 @@ static_assert(kP <= mcu::kMaxChannels && kM <= mcu::kMaxChannels, "too many chan
 
 template <typename View>
 struct StorageOf;
-template <typename S>
-struct StorageOf<TableView<S>> {
+template <typename S, typename SlotId>
+struct StorageOf<TableView<S, SlotId>> {
   using type = S;
 };
 
@@ -168,19 +168,31 @@ struct CJobLoop {
     volatile bool ready = false;
     app::TaskStatistics stats{};
     Status run_job() {
-      const std::uint32_t t_sample = PilBoard::Clock::now_us();
-      const std::uint32_t t_apply = PilBoard::Timer::next_actuation_us();
-      const auto tau_us = static_cast<std::int32_t>(t_apply - t_sample);
+      const auto time = PilBoard::Time::snapshot();
+      const auto t_apply = time.next_actuation;
+      DurationUs tau_us = 0;
+      Status status = checked_duration(time.now, t_apply, -kMaxTauUs, kMaxTauUs, tau_us);
+      if (status != Status::kOk) tau_us = (t_apply - time.now) > 0 ? kMaxTauUs : -kMaxTauUs;
       const auto adc = static_cast<std::uint16_t>(PilBoard::Adc::sample(0));
       const auto sp = static_cast<std::uint16_t>(PilBoard::Setpoint::setpoint_code(0, t_apply));
+#if ONESHOT_FW_FIXED
+      const std::uint8_t saturated_before = self->state.saturated;
+      self->state.saturated = 0U;
+#endif
       prepared = ONESHOT_CJOB(run)(&self->state, tau_us, adc, sp);
       ready = true;
       ++stats.jobs;
       stats.last_tau_us = tau_us;
-      stats.last_status = static_cast<Status>(self->state.status);
+      status = worst_of(status, static_cast<Status>(self->state.status));
 #if ONESHOT_FW_FIXED
-      if (self->state.saturated != 0U) detail::g_saturated = true;  // the reply's flag, as for the C++ job
+      // As ControlTask: this job's saturation is its status, the sticky flags keep their meaning.
+      if (self->state.saturated != 0U) {
+        status = worst_of(status, Status::kOverflow);
+        detail::g_saturated = true;  // the reply's flag, as for the C++ job
+      }
+      if (saturated_before != 0U) self->state.saturated = 1U;
 #endif
+      stats.last_status = status;
       if (!is_exact(stats.last_status)) ++stats.faults;
       return stats.last_status;
     }

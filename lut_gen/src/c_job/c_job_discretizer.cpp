@@ -106,7 +106,7 @@ void VariantEmitter::emit_triple(CodeWriter& w) const {
   w.close("} " + triple_type() + ";");
 }
 
-void VariantEmitter::emit_pick(CodeWriter& w, const std::string& dest, Qty q, std::int8_t slot,
+void VariantEmitter::emit_pick(CodeWriter& w, const std::string& dest, Qty q, std::int16_t slot,
                                const std::string& raw_prefix, bool residual) const {
   if (slot == kSlotZero) {
     w.line(dest + " = " + ar().zero(q) + ";");

@@ -247,8 +247,8 @@ void VariantEmitter::emit_run(CodeWriter& w) {
   w.middle("} else if (tau_us < " + int_literal(-bound, 32) + ") {").line("tau_us = " + int_literal(-bound, 32) + ";");
   w.close();
   if (!spec_.exact_subgrid) {
-    w.line("/* SubGrid::kNearest: tau rounded to the grid once, so that h - tau stays on it. (The C++");
-    w.line("   core leaves tau < 0 unrounded and rejects it off the grid; here it is rounded too.) */");
+    w.line("/* SubGrid::kNearest: tau rounded to the grid once, ties away from zero on both sides of 0,");
+    w.line("   so that h - tau stays on it (TableDiscretizer::quantize). */");
     w.open("if (tau_us > 0) {")
         .line("tau_us = " +
               divide_by_constant("tau_us + " + int_literal(g / 2, 32), static_cast<std::uint32_t>(g),
@@ -266,9 +266,9 @@ void VariantEmitter::emit_run(CodeWriter& w) {
   w.line("status = " + fn("discretize") + "(" + h + " - tau_us, &d" + sat_arg() + ");");
   w.line(fn("predict") + "(s, &d" + sat_arg() + ");");
   w.line("next = " + fn("correct") + "(s, y" + sat_arg() + ");");
-  w.line("status = status == ONESHOT_JOB_STATUS_OK ? next : status;");
+  w.line("status = next > status ? next : status; /* worst_of: the codes rise with severity */");
   w.line("next = " + fn("discretize") + "(tau_us, &d" + sat_arg() + ");");
-  w.line("status = status == ONESHOT_JOB_STATUS_OK ? next : status;");
+  w.line("status = next > status ? next : status;");
   w.line(fn("predict") + "(s, &d" + sat_arg() + ");");
   w.line("/* Control law u = N_u r - L (x - N_x r), actuator codes, and the input they realise. */");
   w.open("{");

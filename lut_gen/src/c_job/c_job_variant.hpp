@@ -26,7 +26,7 @@ struct TableText {
   std::vector<std::uint16_t> level_offset;  ///< First entry of each level.
   std::size_t entries = 0;                  ///< Stored entries.
   std::size_t slots = 0;                    ///< Free values per entry.
-  std::vector<std::int8_t> phi_slot, gamma_slot, qd_slot;  ///< Slot maps (kSlotZero/kSlotOne/slot).
+  std::vector<std::int16_t> phi_slot, gamma_slot, qd_slot;  ///< Slot maps (kSlotZero/kSlotOne/slot).
   std::string value_ctype;                  ///< C type of a stored value.
   std::vector<std::string> values;          ///< entries × slots literals, entry-major.
   std::vector<int> value_frac;              ///< Fixed: scale of each slot's values.
@@ -83,7 +83,7 @@ class VariantEmitter {
   // Pieces of the discretizer (c_job_discretizer.cpp).
   void emit_table(CodeWriter& w) const;
   void emit_triple(CodeWriter& w) const;
-  void emit_pick(CodeWriter& w, const std::string& dest, Qty q, std::int8_t slot, const std::string& raw_prefix,
+  void emit_pick(CodeWriter& w, const std::string& dest, Qty q, std::int16_t slot, const std::string& raw_prefix,
                  bool residual) const;
   void emit_load(CodeWriter& w) const;
   void emit_residual(CodeWriter& w) const;

@@ -8,17 +8,19 @@
 ///   P⁻_s,k+1 = Φ(a+b) P_s,k Φ(a+b)ᵀ + Φ(b) Q Φ(b)ᵀ + Q      (constant Q)
 ///            = Φ(a+b) P_s,k Φ(a+b)ᵀ + Q_d(a+b)              (exact Q_d)
 ///   correct with y, then x̂_{k+1} = Φ(τ_{k+1}) x̂_s,k+1 + Γ(τ_{k+1}) u_k.
-/// Φ is evaluated at three arguments per job (a+b up to 2h, b, τ_{k+1}); Γ(a) is the
-/// Γ(τ_k) of the previous job's actuation prediction. The reset state is an estimate at
-/// an actuation instant (a = 0, as for the half filter), so the first job adds no
-/// constant Q for interval a: both filters then produce the same estimates.
+/// Built on KalmanEstimator: the prediction is predict_across() over an input history
+/// holding u_{k−1} from the sample and u_k from t_k; Γ(a) is the Γ(τ_k) of the previous
+/// job's actuation prediction. Φ is evaluated at three arguments per job (a+b up to 2h,
+/// b, τ_{k+1}). The reset state is an estimate at an actuation instant (a = 0, as for the
+/// half filter), so the first job adds no constant Q for interval a: both filters then
+/// produce the same estimates.
 #pragma once
 
 #include <cstddef>
 #include <cstdint>
 
-#include "oneshot/kalman_correction.hpp"
-#include "oneshot/one_shot_predictor.hpp"
+#include "oneshot/kalman_estimator.hpp"
+#include "oneshot/time_us.hpp"
 
 namespace oneshot {
 
@@ -31,11 +33,12 @@ class CompleteKalman {
   static constexpr std::size_t kM = Structure::kInputs;
   static constexpr std::size_t kP = Structure::kOutputs;
   using Design = ControllerDesign<Fmt, kN, kM, kP>;
-  using StateVec = Vector<typename Fmt::State, kN>;
-  using OutputVec = Vector<typename Fmt::State, kP>;
-  using InputVec = Vector<typename Fmt::Input, kM>;
-  using Cov = Matrix<typename Fmt::Covariance, kN, kN>;
-  using Gain = Matrix<typename Fmt::KalmanGain, kN, kP>;
+  using Core = KalmanEstimator<Fmt, Structure, kForm>;  ///< The estimator it runs on.
+  using StateVec = typename Core::StateVec;
+  using OutputVec = typename Core::OutputVec;
+  using InputVec = typename Core::InputVec;
+  using Cov = typename Core::Cov;
+  using Gain = typename Core::Gain;
 
   /// Filter over `design` and `disc` (both must outlive it).
   constexpr CompleteKalman(const Design& design, const Disc& disc, NoiseModel noise)
@@ -44,90 +47,61 @@ class CompleteKalman {
   }
 
   /// Estimate x0 with covariance p0 at an actuation instant, input u0 applied there
-  /// (treated as a sample with τ = 0).
+  /// (treated as a sample with τ = 0: a zero-length segment of u0, then u0).
   constexpr void reset(const StateVec& x0, const Cov& p0, const InputVec& u0) {
-    xs_ = x0;
+    core_.reset(x0, p0);
     x_ = x0;
-    p_ = p0;
-    u_before_ = u0;
-    u_ = u0;
-    gamma_a_ = Matrix<typename Fmt::InputGain, kN, kM>{};
+    inputs_.reset(u0);
+    (void)inputs_.push(0, u0);
+    gamma_a_ = typename Core::InputGain{};
     tau_prev_us_ = 0;
     first_job_ = true;
-    k_ = Gain{};
   }
 
-  /// Job with sample y taken tau_us before the next actuation instant.
+  /// Job with sample y taken tau_us before the next actuation instant (bounded to
+  /// ±kMaxTauUs first: kClamped beyond).
   constexpr Status update(std::int32_t tau_us, const OutputVec& y) {
+    Status status = bound_tau(tau_us);
     tau_us = disc_->quantize(tau_us);  // the discretizer's sub-grid policy
-    using PhiP = typename Structure::PhiPattern;
-    using GammaP = typename Structure::GammaPattern;
-    using CovT = typename Fmt::Covariance;
     const std::int32_t b_us = design_->period_us - tau_us;
-    typename Disc::Triple sum{NoInit{}};
-    typename Disc::Triple b{NoInit{}};
-    Status status = disc_->discretize(b_us + tau_prev_us_, sum, qd_needed(noise_));
-    status = first_failure(status, disc_->discretize(b_us, b, WithQd::kNo));
-    // x̂⁻ = Φ(a+b) x̂_s + Φ(b)(Γ(a) u_{k−1}) + Γ(b) u_k.
-    const Vector<typename Fmt::State, kN> gu =
-        product<typename Fmt::State, GammaP, Dense<kM, 1>>(gamma_a_, u_before_);
-    const Vector<typename Fmt::State, kN> carried =
-        affine<typename Fmt::State, PhiP, GammaP>(b.phi, gu, b.gamma, u_);
-    for (std::size_t i = 0; i < kN; ++i) {
-      Accumulator<typename Fmt::State> acc;
-      for (std::size_t j = 0; j < kN; ++j)
-        detail::accumulate_term(acc, PhiP::is_zero(i, j), PhiP::is_one(i, j), sum.phi(i, j), false,
-                                false, xs_[j]);
-      acc.add(carried[i]);
-      x_[i] = acc.value();
-    }
-    if (noise_ == NoiseModel::kExact) {
-      p_ = congruence_add<CovT, PhiP, typename Structure::QdPattern>(sum.phi, p_, sum.qd);
-    } else {
-      using QP = typename Structure::ConstantQPattern;
-      if (first_job_) {
-        p_ = congruence_add<CovT, PhiP, QP>(sum.phi, p_, design_->q_constant);
-      } else {
-        const Cov q_b = congruence_add<CovT, PhiP, QP>(b.phi, design_->q_constant, design_->q_constant);
-        p_ = congruence_add<CovT, PhiP, Dense<kN, kN>>(sum.phi, p_, q_b);
-      }
-    }
-    status = first_failure(status, correct<Fmt, Structure, kForm>(x_, p_, y, design_->c, design_->r, k_));
-    xs_ = x_;
+    if (inputs_.size() == 1) (void)inputs_.push(tau_prev_us_, inputs_.latest());  // no new input at t_k
+    status = worst_of(status, core_.predict_across(*disc_, b_us + tau_prev_us_, inputs_, noise_,
+                                                   design_->q_constant, &gamma_a_, !first_job_));
+    status = worst_of(status, core_.correct_all(y, design_->c, design_->r));
     typename Disc::Triple c{NoInit{}};
-    status = first_failure(status, disc_->discretize(tau_us, c, WithQd::kNo));
-    x_ = predict_state<Fmt, Structure>(c, xs_, u_);
+    status = worst_of(status, disc_->discretize(tau_us, c, WithQd::kNo));
+    x_ = predict_state<Fmt, Structure>(c, core_.state(), inputs_.latest());
     gamma_a_ = c.gamma;
     tau_prev_us_ = tau_us < 0 ? 0 : tau_us;
+    inputs_.reset(inputs_.latest());  // u_k is active at the sample
     first_job_ = false;
     return status;
   }
 
   /// The input applied at the actuation instant the last update predicted to.
   constexpr void set_applied_input(const InputVec& u) {
-    u_before_ = u_;
-    u_ = u;
+    if (inputs_.size() > 1) inputs_.reset(inputs_.latest());  // a second call: the previous input came before
+    (void)inputs_.push(tau_prev_us_, u);  // cannot fail: one change after a reset
   }
   /// x̂_k: the estimate at the next actuation instant.
   constexpr const StateVec& prediction() const { return x_; }
   /// P_s,k: the corrected covariance at the last sample.
-  constexpr const Cov& covariance() const { return p_; }
+  constexpr const Cov& covariance() const { return core_.covariance(); }
   /// The gain of the last correction.
-  constexpr const Gain& gain() const { return k_; }
+  constexpr const Gain& gain() const { return core_.gain(); }
+  /// The estimator underneath (at the last sample).
+  constexpr const Core& core() const { return core_; }
 
  private:
   const Design* design_;
   const Disc* disc_;
   NoiseModel noise_;
-  StateVec xs_{};   // x̂_s,k at the last sample
-  StateVec x_{};    // prediction to the next actuation
-  Cov p_{};         // P_s,k
-  InputVec u_before_{};  // u_{k−1}
-  InputVec u_{};         // u_k
-  Matrix<typename Fmt::InputGain, kN, kM> gamma_a_{};  // Γ(τ_k)
+  Core core_{};
+  StateVec x_{};                                 // prediction to the next actuation
+  InputHistory<typename Fmt::Input, kM, 2> inputs_{};  // u_{k−1} from the sample, u_k from t_k
+  typename Core::InputGain gamma_a_{};           // Γ(τ_k)
   std::int32_t tau_prev_us_ = 0;
   bool first_job_ = true;
-  Gain k_{};
 };
 
 }  // namespace oneshot

@@ -108,6 +108,8 @@ constexpr std::int64_t wide_product(A a, B b) {
 inline bool saturation_flag() { return detail::g_saturated; }
 /// Clears the sticky saturation flag.
 inline void clear_saturation_flag() { detail::g_saturated = false; }
+/// Sets the sticky saturation flag (restores it around a scoped check).
+inline void raise_saturation_flag() { detail::g_saturated = true; }
 
 /// value = raw · 2^−kFrac, stored in Storage (int16_t or int32_t).
 template <typename Storage, int kFracBits>

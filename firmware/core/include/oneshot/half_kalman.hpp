@@ -4,17 +4,18 @@
 /// Job k samples y at t_s,k = t_k − τ_k, between actuations t_{k−1} and t_k; the state
 /// kept between jobs is the prediction at the last actuation instant. update(τ_k, y):
 ///   x̂⁻_s,k = Φ(h−τ_k) x̂⁻_{k−1} + Γ(h−τ_k) u_{k−1},  P⁻_s,k = Φ P⁻_{k−1} Φᵀ + Q
-///   correct with y (kalman_correction.hpp)
+///   correct with y (kalman_estimator.hpp)
 ///   x̂⁻_k   = Φ(τ_k) x̂_s,k + Γ(τ_k) u_{k−1},        P⁻_k = Φ P_s,k Φᵀ + Q
 /// and u_k = −L x̂⁻_k is applied at t_k (set_applied_input()). Only predictions to the
-/// actuation instant are stored, so Φ is needed at two arguments per job.
+/// actuation instant are stored, so Φ is needed at two arguments per job. Built on
+/// KalmanEstimator: two predict(Δt) and one correction of every output.
 #pragma once
 
 #include <cstddef>
 #include <cstdint>
 
-#include "oneshot/kalman_correction.hpp"
-#include "oneshot/one_shot_predictor.hpp"
+#include "oneshot/kalman_estimator.hpp"
+#include "oneshot/time_us.hpp"
 
 namespace oneshot {
 
@@ -27,11 +28,12 @@ class HalfKalman {
   static constexpr std::size_t kM = Structure::kInputs;
   static constexpr std::size_t kP = Structure::kOutputs;
   using Design = ControllerDesign<Fmt, kN, kM, kP>;
-  using StateVec = Vector<typename Fmt::State, kN>;
-  using OutputVec = Vector<typename Fmt::State, kP>;
-  using InputVec = Vector<typename Fmt::Input, kM>;
-  using Cov = Matrix<typename Fmt::Covariance, kN, kN>;
-  using Gain = Matrix<typename Fmt::KalmanGain, kN, kP>;
+  using Core = KalmanEstimator<Fmt, Structure, kForm>;  ///< The estimator it runs on.
+  using StateVec = typename Core::StateVec;
+  using OutputVec = typename Core::OutputVec;
+  using InputVec = typename Core::InputVec;
+  using Cov = typename Core::Cov;
+  using Gain = typename Core::Gain;
 
   /// Filter over `design` and `disc` (both must outlive it).
   constexpr HalfKalman(const Design& design, const Disc& disc, NoiseModel noise)
@@ -41,45 +43,38 @@ class HalfKalman {
 
   /// Estimate x0 with covariance p0 at an actuation instant, input u0 applied there.
   constexpr void reset(const StateVec& x0, const Cov& p0, const InputVec& u0) {
-    x_ = x0;
-    p_ = p0;
+    core_.reset(x0, p0);
     u_ = u0;
-    k_ = Gain{};
   }
 
-  /// Job with sample y taken tau_us before the next actuation instant.
+  /// Job with sample y taken tau_us before the next actuation instant (bounded to
+  /// ±kMaxTauUs first: kClamped beyond).
   constexpr Status update(std::int32_t tau_us, const OutputVec& y) {
+    Status status = bound_tau(tau_us);
     tau_us = disc_->quantize(tau_us);  // the discretizer's sub-grid policy
-    const WithQd with_qd = qd_needed(noise_);
-    typename Disc::Triple d{NoInit{}};
-    Status status = disc_->discretize(design_->period_us - tau_us, d, with_qd);
-    x_ = predict_state<Fmt, Structure>(d, x_, u_);
-    p_ = predict_covariance<Fmt, Structure>(d, p_, noise_, design_->q_constant);
-    const Status sc = correct<Fmt, Structure, kForm>(x_, p_, y, design_->c, design_->r, k_);
-    status = first_failure(status, sc);
-    status = first_failure(status, disc_->discretize(tau_us, d, with_qd));
-    x_ = predict_state<Fmt, Structure>(d, x_, u_);
-    p_ = predict_covariance<Fmt, Structure>(d, p_, noise_, design_->q_constant);
+    status = worst_of(status, core_.predict(*disc_, design_->period_us - tau_us, u_, noise_, design_->q_constant));
+    status = worst_of(status, core_.correct_all(y, design_->c, design_->r));
+    status = worst_of(status, core_.predict(*disc_, tau_us, u_, noise_, design_->q_constant));
     return status;
   }
 
   /// The input applied at the actuation instant the last update predicted to.
   constexpr void set_applied_input(const InputVec& u) { u_ = u; }
   /// x̂⁻_k: the estimate at the next actuation instant.
-  constexpr const StateVec& prediction() const { return x_; }
+  constexpr const StateVec& prediction() const { return core_.state(); }
   /// P⁻_k.
-  constexpr const Cov& covariance() const { return p_; }
+  constexpr const Cov& covariance() const { return core_.covariance(); }
   /// The gain of the last correction.
-  constexpr const Gain& gain() const { return k_; }
+  constexpr const Gain& gain() const { return core_.gain(); }
+  /// The estimator underneath (at the next actuation instant).
+  constexpr const Core& core() const { return core_; }
 
  private:
   const Design* design_;
   const Disc* disc_;
   NoiseModel noise_;
-  StateVec x_{};
-  Cov p_{};
+  Core core_{};
   InputVec u_{};
-  Gain k_{};
 };
 
 }  // namespace oneshot

@@ -6,13 +6,13 @@
 ///   x̂⁻ = Φ(h) x̂ + Γ(h) u,  P⁻ = Φ(h) P Φ(h)ᵀ + Q   (skipped at the first sample)
 ///   correct with y;  u = −L x̂ is applied as soon as the job finishes.
 /// Under scheduling jitter both assumptions break, which is what approach D measures.
+/// Built on KalmanEstimator: one step of the discrete model, one correction.
 #pragma once
 
 #include <cstddef>
 #include <cstdint>
 
-#include "oneshot/kalman_correction.hpp"
-#include "oneshot/one_shot_predictor.hpp"
+#include "oneshot/kalman_estimator.hpp"
 
 namespace oneshot {
 
@@ -24,11 +24,12 @@ class StandardKalman {
   static constexpr std::size_t kM = Structure::kInputs;
   static constexpr std::size_t kP = Structure::kOutputs;
   using Design = ControllerDesign<Fmt, kN, kM, kP>;
-  using StateVec = Vector<typename Fmt::State, kN>;
-  using OutputVec = Vector<typename Fmt::State, kP>;
-  using InputVec = Vector<typename Fmt::Input, kM>;
-  using Cov = Matrix<typename Fmt::Covariance, kN, kN>;
-  using Gain = Matrix<typename Fmt::KalmanGain, kN, kP>;
+  using Core = KalmanEstimator<Fmt, Structure, kForm>;  ///< The estimator it runs on.
+  using StateVec = typename Core::StateVec;
+  using OutputVec = typename Core::OutputVec;
+  using InputVec = typename Core::InputVec;
+  using Cov = typename Core::Cov;
+  using Gain = typename Core::Gain;
 
   /// Filter over `design` (must outlive it).
   constexpr StandardKalman(const Design& design, NoiseModel noise) : design_(&design), noise_(noise) {
@@ -37,11 +38,9 @@ class StandardKalman {
 
   /// Estimate x0 with covariance p0 at the first sampling instant.
   constexpr void reset(const StateVec& x0, const Cov& p0, const InputVec& u0) {
-    x_ = x0;
-    p_ = p0;
+    core_.reset(x0, p0);
     u_ = u0;
     first_ = true;
-    k_ = Gain{};
   }
 
   /// Job with sample y; the sampling delay argument is ignored (assumed zero).
@@ -51,30 +50,29 @@ class StandardKalman {
       d.phi = design_->phi_h;
       d.gamma = design_->gamma_h;
       d.qd = design_->qd_h;
-      x_ = predict_state<Fmt, Structure>(d, x_, u_);
-      p_ = predict_covariance<Fmt, Structure>(d, p_, noise_, design_->q_constant);
+      core_.predict(d, u_, noise_, design_->q_constant);
     }
     first_ = false;
-    return correct<Fmt, Structure, kForm>(x_, p_, y, design_->c, design_->r, k_);
+    return core_.correct_all(y, design_->c, design_->r);
   }
 
   /// The input applied after this job.
   constexpr void set_applied_input(const InputVec& u) { u_ = u; }
   /// x̂ at the last sample (used as if it were the actuation instant).
-  constexpr const StateVec& prediction() const { return x_; }
+  constexpr const StateVec& prediction() const { return core_.state(); }
   /// P after the last correction.
-  constexpr const Cov& covariance() const { return p_; }
+  constexpr const Cov& covariance() const { return core_.covariance(); }
   /// The gain of the last correction.
-  constexpr const Gain& gain() const { return k_; }
+  constexpr const Gain& gain() const { return core_.gain(); }
+  /// The estimator underneath (at the last sample).
+  constexpr const Core& core() const { return core_; }
 
  private:
   const Design* design_;
   NoiseModel noise_;
-  StateVec x_{};
-  Cov p_{};
+  Core core_{};
   InputVec u_{};
   bool first_ = true;
-  Gain k_{};
 };
 
 }  // namespace oneshot

@@ -1,5 +1,11 @@
 /// @file status.hpp
-/// @brief Result codes of fallible core maths (no exceptions in the core).
+/// @brief Result codes of fallible core maths (no exceptions in the core), ordered by severity.
+///
+/// The numeric values are part of the PIL protocol and the C job and never change; the
+/// order of severity is severity() (exact < approximate < a step skipped < no result):
+///   kOk < kExtended < kClamped < kOverflow < kNotConverged < kSingular < kOutOfRange.
+/// A sequence of operations reports worst_of() its statuses, so no failure ever hides
+/// behind a milder one (a kSingular correction after a kExtended prediction is kSingular).
 #pragma once
 
 #include <cstdint>
@@ -17,13 +23,30 @@ enum class Status : std::uint8_t {
   kNotConverged,      ///< An iterative routine hit its iteration bound.
 };
 
+/// Rank of s, 0 for kOk: approximate results (clamped, saturated, not converged) rank
+/// below a skipped step (singular), which ranks below no result at all (out of range).
+constexpr std::uint8_t severity(Status s) {
+  switch (s) {
+    case Status::kOk: return 0;
+    case Status::kExtended: return 1;
+    case Status::kClamped: return 2;
+    case Status::kOverflow: return 3;
+    case Status::kNotConverged: return 4;
+    case Status::kSingular: return 5;
+    case Status::kOutOfRange: return 6;
+  }
+  return 7;  // not a Status value: worse than any
+}
+
+/// The more severe of a and b (a on ties): the status of a and b done in sequence.
+constexpr Status worst_of(Status a, Status b) { return severity(b) > severity(a) ? b : a; }
+
 /// True when the result can be used as is (exact or exactly extended).
 constexpr bool is_exact(Status s) { return s == Status::kOk || s == Status::kExtended; }
 
-/// Keeps the first non-ok status of a sequence of operations.
-constexpr Status first_failure(Status current, Status next) {
-  return current == Status::kOk ? next : current;
-}
+/// Status of a sequence so far combined with the next operation's: the worst of both
+/// (kept under its historical name; it no longer returns a milder earlier status).
+constexpr Status first_failure(Status current, Status next) { return worst_of(current, next); }
 
 /// Short name for logs and error messages (host side).
 constexpr const char* to_string(Status s) {

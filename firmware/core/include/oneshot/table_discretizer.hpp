@@ -46,10 +46,12 @@ class TableDiscretizer {
   /// Compositions of the full range allowed beyond the table (kExtend).
   static constexpr std::int32_t kMaxExtensions = 3;
   using Triple = Discretization<Fmt, kN, kM>;  ///< What discretize() produces.
+  using SlotId = SlotIdFor<kN, kM>;            ///< Slot id width of this plant's tables.
+  using View = TableView<Storage, SlotId>;     ///< The table type it reads.
 
   /// Uses `view` (its arrays must outlive the discretizer). Every structural entry the
   /// patterns claim must be one in the table's slot maps (checked).
-  constexpr explicit TableDiscretizer(const TableView<Storage>& view)
+  constexpr explicit TableDiscretizer(const View& view)
       : view_(view), fraction_scale_(ScalarTraits<typename Fmt::Fraction>::fraction_scale(view.granularity_us)) {
     ONESHOT_ASSERT(view.levels >= 1 && view.granularity_us > 0 && view.range_us > 0);
     ONESHOT_ASSERT(view.range_us % view.granularity_us == 0);
@@ -57,7 +59,7 @@ class TableDiscretizer {
   }
 
   /// True when the slot maps of `view` agree with Structure (usable in static_assert).
-  static constexpr bool maps_match_structure(const TableView<Storage>& view) {
+  static constexpr bool maps_match_structure(const View& view) {
     using PhiP = typename Structure::PhiPattern;
     using GammaP = typename Structure::GammaPattern;
     using QdP = typename Structure::QdPattern;
@@ -72,12 +74,15 @@ class TableDiscretizer {
     return true;
   }
 
-  /// The τ the filters use: unchanged (kExact), or rounded to the nearest grid point
-  /// (kNearest; the filters round once, so that h − τ stays on the grid with τ).
+  /// The τ the filters use: unchanged (kExact), or rounded to the nearest grid point,
+  /// ties away from zero, on both sides of 0 (kNearest; the filters round once, so that
+  /// h − τ stays on the grid with τ, negative τ included; the generated C job rounds the
+  /// same way). τ must lie within ±kMaxTauUs (the filters bound it first): no overflow.
   constexpr std::int32_t quantize(std::int32_t tau_us) const {
     if constexpr (kSubGrid == SubGrid::kNearest) {
       const std::int32_t g = view_.granularity_us;
-      return tau_us <= 0 ? tau_us : ((tau_us + g / 2) / g) * g;
+      if (tau_us >= 0) return ((tau_us + g / 2) / g) * g;
+      return -(((-tau_us) + g / 2) / g) * g;
     } else {
       return tau_us;
     }
@@ -120,16 +125,15 @@ class TableDiscretizer {
   }
 
   /// The table in use.
-  constexpr const TableView<Storage>& view() const { return view_; }
+  constexpr const View& view() const { return view_; }
 
  private:
   template <typename P>
-  static constexpr bool slot_matches(std::int8_t slot, std::size_t i, std::size_t j,
-                                     std::uint8_t slots) {
+  static constexpr bool slot_matches(SlotId slot, std::size_t i, std::size_t j, std::uint16_t slots) {
     if (P::is_zero(i, j)) return slot == kSlotZero;
     if (P::is_one(i, j)) return slot == kSlotOne;
     // A free pattern entry claims nothing: the table may still know it is 0 or 1.
-    return slot == kSlotZero || slot == kSlotOne || (slot >= 0 && slot < static_cast<std::int8_t>(slots));
+    return slot == kSlotZero || slot == kSlotOne || (slot >= 0 && static_cast<int>(slot) < static_cast<int>(slots));
   }
 
   /// d = the triple for 0 ≤ τ ≤ range.
@@ -164,7 +168,7 @@ class TableDiscretizer {
     if (!have) d = Triple::identity();
   }
 
-  using Reader = TableStorage<Storage>;
+  using Reader = TableStorage<Storage, SlotId>;
   using Slot = typename Reader::Slot;
 
   /// d = the triple over δ = residual_us < g from the slot polynomials in r = δ/g.
@@ -173,16 +177,16 @@ class TableDiscretizer {
     const F r = ScalarTraits<F>::fraction(residual_us, fraction_scale_);
     Slot slot_values[kMaxSlots];  // slots [0, used) written; expand() reads no other
     ONESHOT_ASSERT(view_.slots <= kMaxSlots);
-    const std::uint8_t used = with_qd == WithQd::kYes ? view_.slots : view_.transition_slots;
-    for (std::uint8_t s = 0; s < used; ++s) slot_values[s] = Reader::residual(view_, s, r);
+    const std::uint16_t used = with_qd == WithQd::kYes ? view_.slots : view_.transition_slots;
+    for (std::uint16_t s = 0; s < used; ++s) slot_values[s] = Reader::residual(view_, s, r);
     expand(slot_values, with_qd, d);
   }
 
   /// d = the triple of stored entry `entry`.
   constexpr void load_entry(std::size_t entry, WithQd with_qd, Triple& d) const {
     Slot slot_values[kMaxSlots];  // slots [0, used) written; expand() reads no other
-    const std::uint8_t used = with_qd == WithQd::kYes ? view_.slots : view_.transition_slots;
-    for (std::uint8_t s = 0; s < used; ++s) slot_values[s] = Reader::entry(view_, entry, s);
+    const std::uint16_t used = with_qd == WithQd::kYes ? view_.slots : view_.transition_slots;
+    for (std::uint16_t s = 0; s < used; ++s) slot_values[s] = Reader::entry(view_, entry, s);
     expand(slot_values, with_qd, d);
   }
 
@@ -202,16 +206,17 @@ class TableDiscretizer {
   }
 
   template <typename To>
-  static constexpr To pick(std::int8_t slot, const Slot* slot_values) {
+  static constexpr To pick(SlotId slot, const Slot* slot_values) {
     if (slot == kSlotZero) return ScalarTraits<To>::zero();
     if (slot == kSlotOne) return ScalarTraits<To>::one();
     return Reader::template to<To>(slot_values[slot]);
   }
 
-  /// Free values per entry supported (n² + nm + n(n+1)/2 for n ≤ 4, m ≤ 2 is 34).
-  static constexpr std::size_t kMaxSlots = kN * kN + kN * kM + kN * (kN + 1) / 2;
+  /// Free values per entry supported (n² + nm + n(n+1)/2: 9 for the reference board, 456
+  /// for n = 16, m = 4).
+  static constexpr std::size_t kMaxSlots = max_table_slots(kN, kM);
 
-  TableView<Storage> view_;
+  View view_;
   typename ScalarTraits<typename Fmt::Fraction>::FractionScale fraction_scale_;
 };
 

@@ -20,18 +20,19 @@ struct ScaledValue {
   std::int8_t frac;  ///< Scale.
 };
 
-/// Reading of a table with storage `Storage` (floating specialisation).
-template <typename Storage, typename Enable = void>
+/// Reading of a table with storage `Storage` and slot ids SlotId (floating tables).
+template <typename Storage, typename SlotId = std::int8_t>
 struct TableStorage {
+  using View = TableView<Storage, SlotId>;  ///< The table type read.
   using Slot = Storage;  ///< A decoded slot value.
 
   /// Value of slot s in stored entry `entry`.
-  static constexpr Slot entry(const TableView<Storage>& v, std::size_t entry, std::size_t s) {
+  static constexpr Slot entry(const View& v, std::size_t entry, std::size_t s) {
     return v.values[entry * v.slots + s];
   }
   /// Slot polynomial at r: r^low · (c_low + r·(c_low+1 + … + r·c_high)), Horner.
   template <typename F>
-  static constexpr Slot residual(const TableView<Storage>& v, std::size_t s, F r) {
+  static constexpr Slot residual(const View& v, std::size_t s, F r) {
     const Storage* c = v.residual_coefficients + v.residual_offset[s];  // c[k] ↔ r^(low+k)
     const std::uint8_t low = v.residual_low[s];
     const std::uint8_t high = v.residual_high[s];
@@ -48,17 +49,18 @@ struct TableStorage {
 };
 
 /// Block fixed-point tables.
-template <>
-struct TableStorage<BlockFixedStorage> {
+template <typename SlotId>
+struct TableStorage<BlockFixedStorage, SlotId> {
+  using View = TableView<BlockFixedStorage, SlotId>;  ///< The table type read.
   using Slot = ScaledValue;  ///< A decoded slot value.
 
   /// Value of slot s in stored entry `entry`.
-  static constexpr Slot entry(const TableView<BlockFixedStorage>& v, std::size_t entry, std::size_t s) {
+  static constexpr Slot entry(const View& v, std::size_t entry, std::size_t s) {
     return Slot{v.values[entry * v.slots + s].raw, v.value_frac[s]};
   }
   /// Slot polynomial at r (Horner on 32-bit mantissas at the slot's residual scale).
   template <typename F>
-  static constexpr Slot residual(const TableView<BlockFixedStorage>& v, std::size_t s, F r) {
+  static constexpr Slot residual(const View& v, std::size_t s, F r) {
     static_assert(kIsFixed<F>, "block fixed tables need a fixed-point fraction r");
     const Mantissa32* c = v.residual_coefficients + v.residual_offset[s];
     const std::uint8_t low = v.residual_low[s];

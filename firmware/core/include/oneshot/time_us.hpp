@@ -82,4 +82,22 @@ constexpr Status checked_duration(InstantUs<Rep> from, InstantUs<Rep> to, Durati
   return Status::kOk;
 }
 
+/// Largest |τ| (µs) a filter takes: 2^29 µs ≈ 537 s, far beyond any table's composed range
+/// and any interval a job can mean, small enough that h − τ, a + b and rounding to a grid
+/// cannot overflow 32 bits.
+inline constexpr DurationUs kMaxTauUs = DurationUs{1} << 29;
+
+/// Bounds τ to ±kMaxTauUs where it enters the core: kClamped (τ moved) beyond, else kOk.
+constexpr Status bound_tau(DurationUs& tau_us) {
+  if (tau_us > kMaxTauUs) {
+    tau_us = kMaxTauUs;
+    return Status::kClamped;
+  }
+  if (tau_us < -kMaxTauUs) {
+    tau_us = -kMaxTauUs;
+    return Status::kClamped;
+  }
+  return Status::kOk;
+}
+
 }  // namespace oneshot

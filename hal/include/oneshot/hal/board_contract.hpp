@@ -2,14 +2,19 @@
 /// @brief The peripherals a control task needs, as compile-time contracts.
 ///
 /// A board is a struct of small static classes, injected as a template parameter:
-///   Board::Clock      static std::uint32_t now_us();                 free-running µs time
-///   Board::Timer      static std::uint32_t next_actuation_us();      compare value of the
-///                                                                     actuation timer
+///   Board::Time       static TimeSnapshot<Rep> snapshot();           the free-running µs
+///                     clock and the actuation timer's compare value, read together (one
+///                     critical section on an MCU, so τ never mixes two timer periods), as
+///                     wrap-safe instants (time_us.hpp): Rep = uint32_t on an MCU's 32-bit
+///                     timer, uint64_t on the host (no wrap in any run)
 ///   Board::Pwm        static void write_duty(std::size_t ch, std::int32_t code);
 ///   Board::Adc        static std::int32_t sample(std::size_t ch);    converts now
-///   Board::Setpoint   static std::int32_t setpoint_code(std::size_t ch, std::uint32_t at_us);
-///                     the reference valid at time at_us, in ADC codes (a reference
+///   Board::Setpoint   static std::int32_t setpoint_code(std::size_t ch, InstantUs<Rep> at);
+///                     the reference valid at instant `at`, in ADC codes (a reference
 ///                     generator: the trajectory is known ahead of time)
+/// The older separate Clock (now_us()) and Timer (next_actuation_us()) contracts, 32-bit,
+/// remain detectable (kHasClock, kHasTimer, kHasSetpoint) for code that still uses them;
+/// the control task needs Time and the instant-taking Setpoint.
 /// Each is checked with a static_assert in the task that uses it; there is no virtual
 /// dispatch on the control path. Ports: hal/host_sim (emulated board), hal/mcu.
 #pragma once
@@ -18,7 +23,16 @@
 #include <cstdint>
 #include <type_traits>
 
+#include "oneshot/time_us.hpp"
+
 namespace oneshot::hal {
+
+/// The clock and the actuation timer read as one snapshot.
+template <typename Rep>
+struct TimeSnapshot {
+  InstantUs<Rep> now;             ///< Free-running µs clock.
+  InstantUs<Rep> next_actuation;  ///< Compare value of the actuation timer.
+};
 
 namespace detail {
 template <typename T, typename = void>
@@ -49,7 +63,33 @@ template <typename T>
 struct has_setpoint<
     T, std::enable_if_t<std::is_same_v<decltype(T::setpoint_code(std::size_t{}, std::uint32_t{})), std::int32_t>>>
     : std::true_type {};
+template <typename T>
+struct is_time_snapshot : std::false_type {};
+template <typename Rep>
+struct is_time_snapshot<TimeSnapshot<Rep>> : std::true_type {};
+
+template <typename T, typename = void>
+struct has_time : std::false_type {};
+template <typename T>
+struct has_time<T, std::enable_if_t<is_time_snapshot<decltype(T::snapshot())>::value>> : std::true_type {};
+
+template <typename T, typename Instant, typename = void>
+struct has_setpoint_at : std::false_type {};
+template <typename T, typename Instant>
+struct has_setpoint_at<
+    T, Instant, std::enable_if_t<std::is_same_v<decltype(T::setpoint_code(std::size_t{}, Instant{})), std::int32_t>>>
+    : std::true_type {};
 }  // namespace detail
+
+/// Board::Time fulfils the time-snapshot contract.
+template <typename Board>
+inline constexpr bool kHasTime = detail::has_time<typename Board::Time>::value;
+/// The instant type of a board with the Time contract.
+template <typename Board>
+using InstantOf = decltype(Board::Time::snapshot().now);
+/// Board::Setpoint takes the board's instants (needs kHasTime).
+template <typename Board>
+inline constexpr bool kHasSetpointAt = detail::has_setpoint_at<typename Board::Setpoint, InstantOf<Board>>::value;
 
 /// Board::Clock fulfils the clock contract.
 template <typename Board>

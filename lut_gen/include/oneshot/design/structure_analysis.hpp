@@ -10,6 +10,7 @@
 /// arithmetic turns structural zeros into non-zeros), so the kernels may skip them.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <string>
 
@@ -18,20 +19,31 @@
 
 namespace oneshot::design {
 
-/// Run-time form of oneshot::Pattern (bit i*cols + j).
+/// Run-time form of oneshot::Pattern (bit i*cols + j, in four 64-bit words).
 struct PatternMask {
-  std::size_t rows = 0;     ///< Rows.
-  std::size_t cols = 0;     ///< Columns.
-  std::uint64_t zero = 0;   ///< Structural zeros.
-  std::uint64_t one = 0;    ///< Structural ones.
+  std::size_t rows = 0;                  ///< Rows.
+  std::size_t cols = 0;                  ///< Columns.
+  std::array<std::uint64_t, 4> zero{};   ///< Structural zeros.
+  std::array<std::uint64_t, 4> one{};    ///< Structural ones.
   /// Entry (i, j) is structurally zero.
-  bool is_zero(std::size_t i, std::size_t j) const { return ((zero >> (i * cols + j)) & 1U) != 0U; }
+  bool is_zero(std::size_t i, std::size_t j) const { return test(zero, i * cols + j); }
   /// Entry (i, j) is structurally one.
-  bool is_one(std::size_t i, std::size_t j) const { return ((one >> (i * cols + j)) & 1U) != 0U; }
+  bool is_one(std::size_t i, std::size_t j) const { return test(one, i * cols + j); }
   /// Entry (i, j) carries data.
   bool is_free(std::size_t i, std::size_t j) const { return !is_zero(i, j) && !is_one(i, j); }
-  /// C++ spelling: oneshot::Pattern<rows, cols, zero, one>.
+  /// Marks entry (i, j) structurally zero.
+  void set_zero(std::size_t i, std::size_t j) { set(zero, i * cols + j); }
+  /// Marks entry (i, j) structurally one.
+  void set_one(std::size_t i, std::size_t j) { set(one, i * cols + j); }
+  /// C++ spelling: oneshot::Pattern<rows, cols, zero₀, one₀[, zero₁, one₁, …]> (as many
+  /// word pairs as rows·cols needs; refused beyond 256 entries).
   std::string cpp_type() const;
+
+ private:
+  static bool test(const std::array<std::uint64_t, 4>& w, std::size_t b) {
+    return b < 256 && ((w[b / 64] >> (b % 64)) & 1U) != 0U;
+  }
+  static void set(std::array<std::uint64_t, 4>& w, std::size_t b) { w.at(b / 64) |= std::uint64_t{1} << (b % 64); }
 };
 
 /// Patterns of every matrix the control job uses.

@@ -13,7 +13,9 @@
 #include "oneshot/control_law.hpp"
 #include "oneshot/controller.hpp"
 #include "oneshot/hal/board_contract.hpp"
+#include "oneshot/fixed_point.hpp"
 #include "oneshot/status.hpp"
+#include "oneshot/time_us.hpp"
 
 namespace oneshot::app {
 
@@ -35,12 +37,11 @@ struct TaskStatistics {
 /// Control task over board `Board` running controller `Ctrl`.
 template <typename Board, typename Ctrl, TaskModel kModel>
 class ControlTask {
-  static_assert(hal::kHasClock<Board>, "Board::Clock must provide static std::uint32_t now_us()");
-  static_assert(hal::kHasTimer<Board>, "Board::Timer must provide static std::uint32_t next_actuation_us()");
+  static_assert(hal::kHasTime<Board>, "Board::Time must provide static hal::TimeSnapshot<Rep> snapshot()");
   static_assert(hal::kHasPwm<Board>, "Board::Pwm must provide static void write_duty(std::size_t, std::int32_t)");
   static_assert(hal::kHasAdc<Board>, "Board::Adc must provide static std::int32_t sample(std::size_t)");
-  static_assert(hal::kHasSetpoint<Board>,
-                "Board::Setpoint must provide static std::int32_t setpoint_code(std::size_t, std::uint32_t)");
+  static_assert(hal::kHasSetpointAt<Board>,
+                "Board::Setpoint must provide static std::int32_t setpoint_code(std::size_t, InstantUs<Rep>)");
 
  public:
   static constexpr std::size_t kM = Ctrl::kM;
@@ -67,21 +68,35 @@ class ControlTask {
     }
   }
 
-  /// The control job: sample, τ, estimator, control law, actuation codes.
+  /// The control job: sample, τ, estimator, control law, actuation codes. Status: the
+  /// worst of the estimator's, kOutOfRange when τ lies beyond ±kMaxTauUs (garbage timer
+  /// values: τ bounded), and kOverflow when a fixed-point operation of the job saturated.
   Status run_job() {
-    const std::uint32_t t_sample = Board::Clock::now_us();
+    const auto time = Board::Time::snapshot();  // clock and timer of the same instant
+    const auto t_sample = time.now;
     // One-shot: the output is applied at the next actuation instant t_k; standard: now.
-    const std::uint32_t t_apply = kModel == TaskModel::kOneShot ? Board::Timer::next_actuation_us() : t_sample;
+    const auto t_apply = kModel == TaskModel::kOneShot ? time.next_actuation : t_sample;
     typename Ctrl::OutputVec y;
     typename Ctrl::OutputVec r;
     for (std::size_t o = 0; o < kP; ++o) {
       y[o] = output_of_code(controller_->design().sensor, o, Board::Adc::sample(o));
       r[o] = output_of_code(controller_->design().sensor, o, Board::Setpoint::setpoint_code(o, t_apply));
     }
-    // τ = t_k − t_sample in wrapping 32-bit µs arithmetic (standard model: assumed 0).
-    const std::int32_t tau_us = static_cast<std::int32_t>(t_apply - t_sample);
+    // τ = t_k − t_sample, wrap-safe, range-checked where it enters the core.
+    DurationUs tau_us = 0;
+    Status status = checked_duration(t_sample, t_apply, -kMaxTauUs, kMaxTauUs, tau_us);
+    if (status != Status::kOk) tau_us = (t_apply - t_sample) > 0 ? kMaxTauUs : -kMaxTauUs;
     std::int32_t codes[kM] = {};
-    const Status status = controller_->job(tau_us, y, r, codes);
+    if constexpr (kIsFixed<typename Ctrl::CovScalar>) {
+      // The sticky flag keeps its meaning for the caller; this job's saturations become its status.
+      const bool saturated_before = saturation_flag();
+      clear_saturation_flag();
+      status = worst_of(status, controller_->job(tau_us, y, r, codes));
+      if (saturation_flag()) status = worst_of(status, Status::kOverflow);
+      if (saturated_before) raise_saturation_flag();
+    } else {
+      status = worst_of(status, controller_->job(tau_us, y, r, codes));
+    }
     ++stats_.jobs;
     stats_.last_tau_us = tau_us;
     stats_.last_status = status;

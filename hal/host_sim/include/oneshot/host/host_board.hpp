@@ -19,16 +19,16 @@ namespace oneshot::host {
 struct PwmWrite {
   std::size_t channel;  ///< PWM channel.
   std::int32_t code;    ///< Duty code.
-  std::uint32_t at_us;  ///< Clock value when written.
+  std::uint64_t at_us;  ///< Clock value when written.
 };
 
 /// The emulated peripherals' registers.
 struct HostBoardState {
-  std::uint32_t now_us = 0;                 ///< Clock::now_us().
-  std::uint32_t next_actuation_us = 0;      ///< Timer::next_actuation_us().
+  std::uint64_t now_us = 0;                 ///< The clock (64-bit µs: no wrap in any run).
+  std::uint64_t next_actuation_us = 0;      ///< The actuation timer's compare value.
   std::vector<std::int32_t> adc_codes;      ///< What Adc::sample(ch) returns.
   /// Set-point schedule: code of channel ch valid at time t (µs); set by the harness.
-  std::int32_t (*setpoint_at)(const void* context, std::size_t ch, std::uint32_t at_us) = nullptr;
+  std::int32_t (*setpoint_at)(const void* context, std::size_t ch, std::uint64_t at_us) = nullptr;
   const void* setpoint_context = nullptr;   ///< Argument of setpoint_at.
   std::vector<PwmWrite> pwm_writes;         ///< Writes since the harness last cleared them.
 };
@@ -50,13 +50,12 @@ HostBoardState& current_board();
 
 /// The board contract on the host.
 struct HostBoard {
-  /// Free-running µs clock.
-  struct Clock {
-    static std::uint32_t now_us() { return current_board().now_us; }
-  };
-  /// Actuation timer compare value.
-  struct Timer {
-    static std::uint32_t next_actuation_us() { return current_board().next_actuation_us; }
+  /// The µs clock and the actuation timer, read together.
+  struct Time {
+    static hal::TimeSnapshot<std::uint64_t> snapshot() {
+      const HostBoardState& b = current_board();
+      return {HostInstant(b.now_us), HostInstant(b.next_actuation_us)};
+    }
   };
   /// PWM duty registers.
   struct Pwm {
@@ -71,14 +70,14 @@ struct HostBoard {
   };
   /// Set-point input (ADC code scale), valid at time at_us.
   struct Setpoint {
-    static std::int32_t setpoint_code(std::size_t channel, std::uint32_t at_us) {
+    static std::int32_t setpoint_code(std::size_t channel, HostInstant at) {
       const HostBoardState& b = current_board();
-      return b.setpoint_at(b.setpoint_context, channel, at_us);
+      return b.setpoint_at(b.setpoint_context, channel, at.ticks());
     }
   };
 };
 
-static_assert(hal::kHasClock<HostBoard> && hal::kHasTimer<HostBoard> && hal::kHasPwm<HostBoard> &&
-              hal::kHasAdc<HostBoard> && hal::kHasSetpoint<HostBoard>);
+static_assert(hal::kHasTime<HostBoard> && hal::kHasPwm<HostBoard> && hal::kHasAdc<HostBoard> &&
+              hal::kHasSetpointAt<HostBoard>);
 
 }  // namespace oneshot::host

@@ -35,13 +35,11 @@ extern PilRegisters g_pil;
 
 /// Board contract backed by g_pil.
 struct PilBoard {
-  /// Free-running µs clock.
-  struct Clock {
-    static std::uint32_t now_us() { return g_pil.now_us; }
-  };
-  /// Actuation timer compare value.
-  struct Timer {
-    static std::uint32_t next_actuation_us() { return g_pil.next_actuation_us; }
+  /// The µs clock and the actuation timer of this request (one frame: one snapshot).
+  struct Time {
+    static hal::TimeSnapshot<std::uint32_t> snapshot() {
+      return {McuInstant(g_pil.now_us), McuInstant(g_pil.next_actuation_us)};
+    }
   };
   /// PWM duty registers.
   struct Pwm {
@@ -59,11 +57,11 @@ struct PilBoard {
   };
   /// Set-point (the harness sends the value for the instant the job asks about).
   struct Setpoint {
-    static std::int32_t setpoint_code(std::size_t channel, std::uint32_t /*at_us*/) { return g_pil.setpoint[channel]; }
+    static std::int32_t setpoint_code(std::size_t channel, McuInstant /*at*/) { return g_pil.setpoint[channel]; }
   };
 };
 
-static_assert(hal::kHasClock<PilBoard> && hal::kHasTimer<PilBoard> && hal::kHasPwm<PilBoard> &&
-              hal::kHasAdc<PilBoard> && hal::kHasSetpoint<PilBoard>);
+static_assert(hal::kHasTime<PilBoard> && hal::kHasPwm<PilBoard> && hal::kHasAdc<PilBoard> &&
+              hal::kHasSetpointAt<PilBoard>);
 
 }  // namespace oneshot::mcu
