@@ -1,6 +1,7 @@
 /// @file ncs_live_roles.cpp
 /// @brief The five processes of a live run (see ncs_live.hpp): plant, sensor, controller,
 ///        actuator on the POSIX UDP port, and the delay relay.
+#include <sys/prctl.h>
 #include <sys/socket.h>
 
 #include <cstdio>
@@ -55,8 +56,7 @@ void attach(posix::UdpNetworkState& net, int fd, std::uint8_t address, const Liv
   };
 }
 
-int run_plant(const LiveRun& r, int fd, const Clock& c) {
-  const auto ctx = Context::load(r.plant_file);
+int run_plant(const LiveRun& r, const std::shared_ptr<const Context>& ctx, int fd, const Clock& c) {
   const Scenario& sc = r.scenario;
   engine::Kernel streams(r.seed);  // the simulation's streams: process, measurement
   Plant plant(plant_config(*ctx, sc, !r.noise_free), streams.stream("process"));
@@ -127,8 +127,7 @@ int run_plant(const LiveRun& r, int fd, const Clock& c) {
   return 0;
 }
 
-int run_sensor(const LiveRun& r, int net_fd, int io_fd, const Clock& c) {
-  const auto ctx = Context::load(r.plant_file);
+int run_sensor(const LiveRun& r, const std::shared_ptr<const Context>& ctx, int net_fd, int io_fd, const Clock& c) {
   const std::int32_t late_us = r.approach == Approach::kAKl ? ctx->worst_chain_us(r.scenario) : 0;
   LogWriter log(r.dir, "sensor");
   posix::UdpNetworkState net;
@@ -219,8 +218,7 @@ int controller_loop(const LiveRun& r, const Context& ctx, Est est, int net_fd, c
   return 0;
 }
 
-int run_controller(const LiveRun& r, int net_fd, const Clock& c) {
-  const auto ctx = Context::load(r.plant_file);
+int run_controller(const LiveRun& r, const std::shared_ptr<const Context>& ctx, int net_fd, const Clock& c) {
   const Design d = ctx->controller_design(r.scenario.noise_scale);
   const Disc disc(ctx->discretizer_model(r.scenario.noise_scale));
   int code = 1;
@@ -229,8 +227,7 @@ int run_controller(const LiveRun& r, int net_fd, const Clock& c) {
   return code;
 }
 
-int run_actuator(const LiveRun& r, int net_fd, int io_fd, const Clock& c) {
-  const auto ctx = Context::load(r.plant_file);
+int run_actuator(const LiveRun& r, const std::shared_ptr<const Context>& ctx, int net_fd, int io_fd, const Clock& c) {
   LogWriter log(r.dir, "actuator");
   posix::UdpNetworkState net;
   attach(net, net_fd, kLiveActuator, r, log, c);
@@ -271,8 +268,7 @@ int run_actuator(const LiveRun& r, int net_fd, int io_fd, const Clock& c) {
   return 0;
 }
 
-int run_relay(const LiveRun& r, int fd, const Clock& c) {
-  const auto ctx = Context::load(r.plant_file);
+int run_relay(const LiveRun& r, const std::shared_ptr<const Context>& ctx, int fd, const Clock& c) {
   struct Route {
     std::uint8_t src, dst;
     const char* name;
@@ -338,12 +334,14 @@ int run_live_role(const std::string& role, const LiveRun& run, int net_fd, int i
   const Clock c{run.t0_ns};
   for (int fd : {net_fd, io_fd})
     if (fd >= 0) posix::set_nonblocking(fd);
-  wait_readable(-1, run.t0_ns);  // everything starts at t0
-  if (role == "plant") return run_plant(run, net_fd, c);
-  if (role == "sensor") return run_sensor(run, net_fd, io_fd, c);
-  if (role == "controller") return run_controller(run, net_fd, c);
-  if (role == "actuator") return run_actuator(run, net_fd, io_fd, c);
-  if (role == "relay") return run_relay(run, net_fd, c);
+  const auto ctx = Context::load(run.plant_file);  // the design step runs before t0
+  ::prctl(PR_SET_TIMERSLACK, 1UL, 0UL, 0UL, 0UL);  // wake-ups as close to the deadline as the kernel can
+  const auto start = [&]() { wait_readable(-1, run.t0_ns); };  // everything starts at t0
+  if (role == "plant") return start(), run_plant(run, ctx, net_fd, c);
+  if (role == "sensor") return start(), run_sensor(run, ctx, net_fd, io_fd, c);
+  if (role == "controller") return start(), run_controller(run, ctx, net_fd, c);
+  if (role == "actuator") return start(), run_actuator(run, ctx, net_fd, io_fd, c);
+  if (role == "relay") return start(), run_relay(run, ctx, net_fd, c);
   throw std::invalid_argument("ncs node: unknown role '" + role + "' (plant, sensor, controller, actuator, relay)");
 }
 
