@@ -17,6 +17,7 @@
 #include <sstream>
 
 #include "ncs_live_nodes.hpp"
+#include "ncs_loop.hpp"
 #include "oneshot/engine/quantiles.hpp"
 #include "oneshot/host/child_process.hpp"
 #include "oneshot/posix/udp_network.hpp"
@@ -184,6 +185,7 @@ nlohmann::json analyse_live(const std::string& dir) {
                 {"max_forwarding_lag_ms", lag}};
   }
   const ReplayResult rep = replay_live(dir);
+  const ReplayResult ideal = replay_live(dir, true);
   nlohmann::json j;
   j["experiment"] = "live";
   j["approach"] = name(run.approach);
@@ -206,6 +208,12 @@ nlohmann::json analyse_live(const std::string& dir) {
   j["replay_late"] = rep.late;
   j["replay_missing_frames"] = rep.missing_frames;
   j["replay_max_abs_u_difference"] = rep.max_abs_u_difference;
+  j["ideal_instants_cost"] = ideal.cost;
+  j["live_over_ideal_instants"] = live_cost / ideal.cost;
+  j["ideal_instants_late"] = ideal.late;
+  RunOptions sim_options;
+  sim_options.noise_free = run.noise_free;
+  j["simulated_cost"] = ncs::run(*ctx, run.approach, run.scenario, run.seed, sim_options).cost;  // the engine alone, same seed
   return j;
 }
 
@@ -297,6 +305,10 @@ void print_summary(const nlohmann::json& j) {
   std::printf("cost: live %.9g, replay %.9g, replay/live %.9f (max |u_replay - u_live| %.3g, missing frames %u)\n",
               j.at("live_cost").get<double>(), j.at("replay_cost").get<double>(), j.at("replay_over_live").get<double>(),
               j.at("replay_max_abs_u_difference").get<double>(), j.at("replay_missing_frames").get<unsigned>());
+  std::printf("same draws at ideal instants (actuation at t_k, samples at t_s): cost %.9g, live/ideal %.6f (late %u)\n",
+              j.at("ideal_instants_cost").get<double>(), j.at("live_over_ideal_instants").get<double>(),
+              j.at("ideal_instants_late").get<unsigned>());
+  std::printf("the engine alone (same approach, scenario, seed, duration): cost %.9g\n", j.at("simulated_cost").get<double>());
 }
 
 std::string self_executable() {

@@ -92,8 +92,11 @@ struct ReplayResult {
   std::uint32_t missing_frames = 0;   ///< Logged receipts whose frame the replay never sent.
   double max_abs_u_difference = 0;    ///< max |u_replay − u_live| over the applied commands.
 };
-/// Replays the logs of DIR on the engine with the same node code.
-ReplayResult replay_live(const std::string& dir);
+/// Replays the logs of DIR on the engine with the same node code. `ideal_instants`: the
+/// actuator's timer and the plant's applications exactly at t_k = k h and every sample at
+/// the sensor's stamp t_s (the delays, frames and draws as recorded): what the run would
+/// cost without the host's real-time errors.
+ReplayResult replay_live(const std::string& dir, bool ideal_instants = false);
 
 /// Summary of a live run's logs beside its replay (the figures of docs/ncs.md).
 nlohmann::json analyse_live(const std::string& dir);

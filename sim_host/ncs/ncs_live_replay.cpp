@@ -10,6 +10,8 @@
 /// the plant process read them, the set-point switches, the end. Process noise comes from
 /// the same seeded stream with the same sequence of propagation instants, hence the same
 /// draws. The commands are recomputed, not copied: the replay's cost checks the live one.
+/// With ideal instants the process-noise draws are the same normals over slightly different
+/// intervals (paired, not identical).
 #include <cmath>
 #include <map>
 #include <tuple>
@@ -57,7 +59,7 @@ void collect_invocations(const std::vector<LogRecord>& log, std::uint8_t node, s
 
 }  // namespace
 
-ReplayResult replay_live(const std::string& dir) {
+ReplayResult replay_live(const std::string& dir, bool ideal_instants) {
   const LiveRun run = load_live_run(dir);
   const auto ctx = Context::load(run.plant_file);
   const Scenario& sc = run.scenario;
@@ -127,7 +129,14 @@ ReplayResult replay_live(const std::string& dir) {
             act.on_timer(v.k, McuInstant((v.k + 1) * h_us));
           }
           InputVec u;
-          if (act.take_output(u)) commands[v.k] = u;
+          if (act.take_output(u)) {
+            commands[v.k] = u;
+            if (ideal_instants) {  // applied at t_k itself
+              plant.advance_to(kernel.now());
+              plant.set_input(u);
+              ++result.applied;
+            }
+          }
         }
       }
       collect(s);
@@ -168,12 +177,18 @@ ReplayResult replay_live(const std::string& dir) {
     kernel.schedule(end, EventClass::kEnd, end_h);
     for (std::size_t i = 0; i < plant_log.size(); ++i) {
       const LogRecord& r = plant_log[i];
-      if ((r.event == "sample" || r.event == "apply") && SimTime{r.t_ns} < end) {
-        kernel.schedule(SimTime{r.t_ns}, r.event == "sample" ? EventClass::kSample : EventClass::kActuation, plant_h, i);
+      if (r.event == "sample") {
+        // Ideal: sampled at the sensor's stamp t_s (its clock when it asked), not when the plant read the request.
+        const SimTime at{ideal_instants ? std::int64_t{r.clock_us} * 1000 : r.t_ns};
+        if (at < end) kernel.schedule(at, EventClass::kSample, plant_h, i);
+      } else if (r.event == "apply" && !ideal_instants && SimTime{r.t_ns} < end) {
+        kernel.schedule(SimTime{r.t_ns}, EventClass::kActuation, plant_h, i);
       }
     }
     for (std::size_t i = 0; i < inv.size(); ++i) {
-      if (inv[i].t_ns >= 0 && SimTime{inv[i].t_ns} < end) kernel.schedule(SimTime{inv[i].t_ns}, EventClass::kCompute, node_h, i);
+      const bool timer = inv[i].timer;
+      const SimTime at{ideal_instants && timer ? std::int64_t{inv[i].k} * h_ns : inv[i].t_ns};
+      if (at >= SimTime{0} && at < end) kernel.schedule(at, timer ? EventClass::kActuation : EventClass::kCompute, node_h, i);
     }
     kernel.run_until(end);
     result.cost = plant.cost().total();
