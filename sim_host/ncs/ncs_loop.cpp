@@ -61,11 +61,8 @@ class Harness {
     if (!(sc.max_delay_ms * 1000 >= static_cast<double>(ctx.timing().leg_min_us))) {
       throw std::invalid_argument("ncs scenario " + sc.name + ": d must be at least 0.5 ms");
     }
-    // R = chol(s·R_n): y = C x + chol·n per sample.
-    const double r00 = design_.r(0, 0);
-    r_chol_[0] = std::sqrt(r00);
-    r_chol_[1] = r00 > 0 ? design_.r(1, 0) / r_chol_[0] : 0;
-    r_chol_[2] = std::sqrt(std::fmax(0.0, design_.r(1, 1) - r_chol_[1] * r_chol_[1]));
+    const auto chol = measurement_cholesky(design_);
+    for (std::size_t i = 0; i < 3; ++i) r_chol_[i] = chol[i];
     for (std::size_t j = 0; j < kM; ++j) {
       u_min_[j] = ctx.design().u_min[j];
       u_max_[j] = ctx.design().u_max[j];
@@ -89,54 +86,7 @@ class Harness {
 
   static bool noisy(Approach a, const RunOptions& opt) { return !opt.noise_free && a != Approach::kI; }
 
-  static engine::ContinuousPlantConfig<kN, kM, kP, 1> plant_config(const Context& ctx, const Scenario& sc, bool noisy) {
-    engine::ContinuousPlantConfig<kN, kM, kP, 1> c;
-    const design::PlantDescription& p = ctx.plant();
-    for (std::size_t i = 0; i < kN; ++i) {
-      for (std::size_t j = 0; j < kN; ++j) {
-        c.a(i, j) = p.a(i, j);
-        c.qc(i, j) = ctx.design().qc(i, j) * sc.noise_scale;
-        c.q1c(i, j) = p.q1c(i, j);
-      }
-      for (std::size_t j = 0; j < kM; ++j) c.b(i, j) = p.b(i, j);
-    }
-    for (std::size_t i = 0; i < kP; ++i)
-      for (std::size_t j = 0; j < kN; ++j) c.c(i, j) = p.c(i, j);
-    c.q2c(0, 0) = p.q2c(0, 0);
-    c.process_noise = noisy;
-    return c;
-  }
-
-  static std::uint64_t half_wave_periods(const Context& ctx, const Scenario& sc) {
-    const double half = sc.period_s * 0.5e6 / ctx.period_us();
-    const auto n = static_cast<std::uint64_t>(std::llround(half));
-    if (n == 0 || std::fabs(half - static_cast<double>(n)) > 1e-9) {
-      throw std::invalid_argument("ncs scenario " + sc.name + ": T_r/2 must be a whole number of periods h");
-    }
-    return n;
-  }
-
-  static Ref reference(const Context& ctx, const Scenario& sc) {
-    const std::size_t out = ctx.design().tracked_outputs.empty() ? 0 : ctx.design().tracked_outputs[0];
-    Vector<double, kN> nx;
-    Vector<double, kM> nu;
-    for (std::size_t i = 0; i < kN; ++i) nx[i] = ctx.design().nx(i, out);
-    for (std::size_t j = 0; j < kM; ++j) nu[j] = ctx.design().nu(j, out);
-    return Ref(sc.amplitude_volts, static_cast<std::uint32_t>(half_wave_periods(ctx, sc)), nx, nu);
-  }
-
-  /// A network leg: U[0.5, d] ms in whole µs (FIFO), or none for the delay-free loops.
-  engine::LinkConfig leg(const char* name) const {
-    engine::LinkConfig c;
-    c.name = name;
-    c.fifo = true;
-    if (delay_free(approach_)) return c;  // constant 0
-    c.delay.kind = engine::DelayModel::Kind::kUniform;
-    c.delay.min = engine::from_us(ctx_.timing().leg_min_us);
-    c.delay.max = engine::from_us(std::llround(sc_.max_delay_ms * 1000));
-    c.delay.resolution = engine::from_us(1);
-    return c;
-  }
+  engine::LinkConfig leg(const char* name) const { return ncs::leg(ctx_, sc_, approach_, name); }
 
   /// τ_c of the next computation (whole µs), 0 for the delay-free loops.
   Duration compute_time() {
@@ -298,6 +248,64 @@ RunResult run_sampling(Harness& hs, Law law, Saturated saturated) {
 }
 
 }  // namespace
+
+engine::ContinuousPlantConfig<kN, kM, kP, 1> plant_config(const Context& ctx, const Scenario& sc, bool noisy) {
+  engine::ContinuousPlantConfig<kN, kM, kP, 1> c;
+  const design::PlantDescription& p = ctx.plant();
+  for (std::size_t i = 0; i < kN; ++i) {
+    for (std::size_t j = 0; j < kN; ++j) {
+      c.a(i, j) = p.a(i, j);
+      c.qc(i, j) = ctx.design().qc(i, j) * sc.noise_scale;
+      c.q1c(i, j) = p.q1c(i, j);
+    }
+    for (std::size_t j = 0; j < kM; ++j) c.b(i, j) = p.b(i, j);
+  }
+  for (std::size_t i = 0; i < kP; ++i)
+    for (std::size_t j = 0; j < kN; ++j) c.c(i, j) = p.c(i, j);
+  c.q2c(0, 0) = p.q2c(0, 0);
+  c.process_noise = noisy;
+  return c;
+}
+
+std::uint64_t half_wave_periods(const Context& ctx, const Scenario& sc) {
+  const double half = sc.period_s * 0.5e6 / ctx.period_us();
+  const auto n = static_cast<std::uint64_t>(std::llround(half));
+  if (n == 0 || std::fabs(half - static_cast<double>(n)) > 1e-9) {
+    throw std::invalid_argument("ncs scenario " + sc.name + ": T_r/2 must be a whole number of periods h");
+  }
+  return n;
+}
+
+node::SquareWaveReference<double, kN, kM> reference(const Context& ctx, const Scenario& sc) {
+  const std::size_t out = ctx.design().tracked_outputs.empty() ? 0 : ctx.design().tracked_outputs[0];
+  Vector<double, kN> nx;
+  Vector<double, kM> nu;
+  for (std::size_t i = 0; i < kN; ++i) nx[i] = ctx.design().nx(i, out);
+  for (std::size_t j = 0; j < kM; ++j) nu[j] = ctx.design().nu(j, out);
+  return node::SquareWaveReference<double, kN, kM>(sc.amplitude_volts,
+                                                   static_cast<std::uint32_t>(half_wave_periods(ctx, sc)), nx, nu);
+}
+
+engine::LinkConfig leg(const Context& ctx, const Scenario& sc, Approach a, const char* name) {
+  engine::LinkConfig c;
+  c.name = name;
+  c.fifo = true;
+  if (delay_free(a)) return c;  // constant 0
+  c.delay.kind = engine::DelayModel::Kind::kUniform;
+  c.delay.min = engine::from_us(ctx.timing().leg_min_us);
+  c.delay.max = engine::from_us(std::llround(sc.max_delay_ms * 1000));
+  c.delay.resolution = engine::from_us(1);
+  return c;
+}
+
+std::array<double, 3> measurement_cholesky(const Design& d) {
+  std::array<double, 3> c{};
+  const double r00 = d.r(0, 0);
+  c[0] = std::sqrt(r00);
+  c[1] = r00 > 0 ? d.r(1, 0) / c[0] : 0;
+  c[2] = std::sqrt(std::fmax(0.0, d.r(1, 1) - c[1] * c[1]));
+  return c;
+}
 
 RunResult run(const Context& ctx, Approach a, const Scenario& sc, std::uint64_t seed, const RunOptions& options) {
   Harness hs(ctx, a, sc, seed, options);

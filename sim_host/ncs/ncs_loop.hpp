@@ -12,10 +12,14 @@
 /// measurement, compute, link/<as|sc|ca>/delay.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <vector>
 
 #include "ncs_model.hpp"
+#include "oneshot/engine/continuous_plant.hpp"
+#include "oneshot/engine/link.hpp"
+#include "oneshot/node/square_wave_reference.hpp"
 
 namespace oneshot::ncs {
 
@@ -44,6 +48,17 @@ struct RunResult {
   std::vector<Point> estimates;  ///< Controller's x̂ at the instant it targets (t_k, or kh).
   std::vector<Point> setpoint;   ///< x_ref,1 and u at each trace step.
 };
+
+/// The plant of a run (process noise when `noisy`), shared by the simulation and the live plant.
+engine::ContinuousPlantConfig<kN, kM, kP, 1> plant_config(const Context& ctx, const Scenario& sc, bool noisy);
+/// Periods h in half a set-point period; std::invalid_argument unless whole.
+std::uint64_t half_wave_periods(const Context& ctx, const Scenario& sc);
+/// The set-point square wave of a scenario (x_ref, u_ref per period index).
+node::SquareWaveReference<double, kN, kM> reference(const Context& ctx, const Scenario& sc);
+/// Network leg `name` ("as", "sc", "ca"): U[0.5, d] ms in whole µs, FIFO; none for I, IK.
+engine::LinkConfig leg(const Context& ctx, const Scenario& sc, Approach a, const char* name);
+/// Lower Cholesky factor of R = s·R_n: y = C x + [[c0, 0], [c1, c2]] n, n ~ N(0, I).
+std::array<double, 3> measurement_cholesky(const Design& d);
 
 /// Runs approach `a` on `scenario` with `seed`.
 RunResult run(const Context& ctx, Approach a, const Scenario& scenario, std::uint64_t seed, const RunOptions& options);

@@ -10,6 +10,7 @@
 #include <sstream>
 
 #include "ncs_experiments.hpp"
+#include "ncs_live.hpp"
 #include "oneshot/engine/sweep_registry.hpp"
 #include "oneshot/sim/cli_commands.hpp"
 #include "oneshot/sim/output_files.hpp"
@@ -185,6 +186,7 @@ void register_ncs_study(CLI::App& app) {
       emit(*c, j);
     });
   }
+  add_ncs_live_commands(study);
   engine::register_summarizer("ncs", "table", [](const engine::SweepResults& r, const std::string& out, bool plots) {
     return ncs::table_outputs(r, out, plots);
   });

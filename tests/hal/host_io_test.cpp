@@ -168,5 +168,18 @@ TEST(ChildProcess, RunsInItsOwnProcessGroupAndIsEndedWithIt) {
   EXPECT_EQ(::kill(child.pid(), 0), -1);  // reaped: gone
 }
 
+TEST(ChildProcess, WaitForIsBounded) {
+  ProcessSpec spec;
+  spec.argv = {"sleep", "600"};
+  ChildProcess running(spec);
+  EXPECT_FALSE(running.wait_for(20));  // still running: returns after the timeout
+  EXPECT_EQ(running.terminate(2000).signal, SIGTERM);
+  spec.argv = {"true"};
+  ChildProcess quick(spec);
+  EXPECT_TRUE(quick.wait_for(60000));  // ends long before the bound
+  EXPECT_TRUE(quick.wait().success());
+  EXPECT_TRUE(quick.wait_for(0));  // already reaped
+}
+
 }  // namespace
 }  // namespace oneshot::host

@@ -168,6 +168,25 @@ ExitStatus ChildProcess::wait() {
   return reap(status);
 }
 
+bool ChildProcess::wait_for(int timeout_ms) {
+  if (done_) return true;
+  for (int waited = 0;; waited += 5) {
+    int status = 0;
+    const pid_t r = ::waitpid(pid_, &status, WNOHANG);
+    if (r == pid_) {
+      reap(status);
+      return true;
+    }
+    if (r < 0 && errno != EINTR) {
+      done_ = true;
+      unregister_child_group(pid_);
+      return true;
+    }
+    if (waited >= timeout_ms) return false;
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  }
+}
+
 ExitStatus ChildProcess::terminate(int grace_ms) {
   if (done_) return status_;
   ::kill(-pid_, SIGTERM);

@@ -59,6 +59,9 @@ class ChildProcess {
   int pid() const { return pid_; }
   /// Waits for the child to end.
   ExitStatus wait();
+  /// Waits at most `timeout_ms` for the child to end; true when it has (then wait() returns
+  /// its status at once).
+  bool wait_for(int timeout_ms);
   /// SIGTERM to the group, SIGKILL after `grace_ms` if the child has not ended; waits.
   ExitStatus terminate(int grace_ms = 2000);
 

@@ -1,0 +1,348 @@
+/// @file ncs_live_roles.cpp
+/// @brief The five processes of a live run (see ncs_live.hpp): plant, sensor, controller,
+///        actuator on the POSIX UDP port, and the delay relay.
+#include <sys/prctl.h>
+#include <sys/socket.h>
+
+#include <cstdio>
+#include <cstring>
+#include <map>
+#include <memory>
+#include <stdexcept>
+
+#include "ncs_live_nodes.hpp"
+#include "oneshot/engine/kernel.hpp"
+#include "oneshot/engine/link.hpp"
+#include "oneshot/node/sync_actuator_node.hpp"
+#include "oneshot/node/sync_controller_node.hpp"
+#include "oneshot/node/sync_sensor_node.hpp"
+#include "oneshot/posix/udp_network.hpp"
+
+namespace oneshot::ncs {
+namespace {
+
+using namespace live;
+using posix::monotonic_ns;
+using posix::wait_readable;
+using Plant = engine::ContinuousPlant<kN, kM, kP, 1>;
+using Board = posix::UdpNetwork;
+
+/// Processes keep serving this long after the end (frames in flight), then exit.
+constexpr std::int64_t kTailNs = 300'000'000;
+/// A sensor waits this long for the plant's answer before giving the sample up.
+constexpr std::int64_t kSampleTimeoutNs = 20'000'000;
+
+/// Time since t0 (ns).
+struct Clock {
+  std::int64_t t0;
+  std::int64_t now() const { return monotonic_ns() - t0; }
+};
+
+std::int64_t end_ns(const LiveRun& r) { return engine::from_seconds(r.scenario.duration_s, "live duration").count(); }
+
+/// The node's UDP interface, logging every frame as send/recv with its k (bytes 0–3).
+void attach(posix::UdpNetworkState& net, int fd, std::uint8_t address, const LiveRun& r, LogWriter& log, const Clock& c) {
+  net.fd = fd;
+  net.address = address;
+  net.relay = posix::loopback(r.relay_port);
+  net.on_frame = [&log, &c, address](bool send, std::uint8_t peer, const std::uint8_t* data, std::size_t size) {
+    const std::int64_t t = c.now();
+    const std::uint32_t k = size >= 4 ? get_u32(data) : 0;
+    if (send) {
+      log.write("send", t, clock_us(t), address, peer, k);
+    } else {
+      log.write("recv", t, clock_us(t), peer, address, k);
+    }
+  };
+}
+
+int run_plant(const LiveRun& r, const std::shared_ptr<const Context>& ctx, int fd, const Clock& c) {
+  const Scenario& sc = r.scenario;
+  engine::Kernel streams(r.seed);  // the simulation's streams: process, measurement
+  Plant plant(plant_config(*ctx, sc, !r.noise_free), streams.stream("process"));
+  engine::RandomStream measurement = streams.stream("measurement");
+  const auto chol = measurement_cholesky(ctx->controller_design(sc.noise_scale));
+  const Ref ref = reference(*ctx, sc);
+  plant.set_state(ref.state(0));
+  plant.set_reference(ref.state(0), ref.input(0));
+  const std::uint64_t half = half_wave_periods(*ctx, sc);
+  const std::int64_t h_ns = std::int64_t{ctx->period_us()} * 1000;
+  const std::int64_t end = end_ns(r);
+  std::uint64_t next_switch = half;
+  LogWriter log(r.dir, "plant");
+  // Propagates exactly to t, switching the set-point on the kh grid on the way.
+  const auto advance = [&](std::int64_t t) {
+    for (; static_cast<std::int64_t>(next_switch) * h_ns <= t && static_cast<std::int64_t>(next_switch) * h_ns < end;
+         next_switch += half) {
+      plant.advance_to(engine::SimTime{static_cast<std::int64_t>(next_switch) * h_ns});
+      const auto k = static_cast<node::SequenceNumber>(next_switch);
+      plant.set_reference(ref.state(k), ref.input(k));
+    }
+    plant.advance_to(engine::SimTime{t});
+  };
+  std::uint8_t buf[64];
+  while (wait_readable(fd, c.t0 + end) || c.now() < end) {
+    for (;;) {
+      sockaddr_in from{};
+      socklen_t len = sizeof from;
+      const ssize_t n = ::recvfrom(fd, buf, sizeof buf, MSG_DONTWAIT, reinterpret_cast<sockaddr*>(&from), &len);
+      if (n < 0) break;
+      const std::int64_t t = c.now();
+      if (t >= end || t < 0) continue;
+      const auto size = static_cast<std::size_t>(n);
+      if (size == kSampleRequestBytes && buf[0] == 'S') {
+        const std::uint32_t k = get_u32(buf + 1);
+        const std::uint32_t sensor_clock = get_u32(buf + 5);
+        advance(t);
+        OutputVec y = plant.output();
+        double n0 = 0, n1 = 0;
+        if (!r.noise_free) {
+          n0 = measurement.normal();
+          n1 = measurement.normal();
+          y[0] += chol[0] * n0;
+          y[1] += chol[1] * n0 + chol[2] * n1;
+        }
+        std::uint8_t out[kSampleAnswerBytes];
+        out[0] = 'Y';
+        put_u32(out + 1, k);
+        std::memcpy(out + 5, &y[0], 8);
+        std::memcpy(out + 13, &y[1], 8);
+        ::sendto(fd, out, sizeof out, MSG_DONTWAIT, reinterpret_cast<const sockaddr*>(&from), len);
+        log.write("sample", t, sensor_clock, 0, 0, k, n0, n1);
+      } else if (size == kCommandBytes && buf[0] == 'U') {
+        const std::uint32_t k = get_u32(buf + 1);
+        InputVec u;
+        std::memcpy(&u[0], buf + 9, 8);
+        advance(t);
+        plant.set_input(u);
+        log.write("apply", t, get_u32(buf + 5), 0, 0, k, u[0]);
+      } else {
+        log.write("bad", t, 0, 0, 0, 0, static_cast<double>(size));
+      }
+    }
+    if (c.now() >= end) break;
+  }
+  advance(end);
+  log.write("end", end, clock_us(end), 0, 0, 0, plant.cost().total());
+  return 0;
+}
+
+int run_sensor(const LiveRun& r, const std::shared_ptr<const Context>& ctx, int net_fd, int io_fd, const Clock& c) {
+  const std::int32_t late_us = r.approach == Approach::kAKl ? ctx->worst_chain_us(r.scenario) : 0;
+  LogWriter log(r.dir, "sensor");
+  posix::UdpNetworkState net;
+  attach(net, net_fd, kLiveSensor, r, log, c);
+  std::uint32_t request_k = 0;
+  auto logged = net.on_frame;
+  net.on_frame = [&](bool send, std::uint8_t peer, const std::uint8_t* d, std::size_t n) {
+    if (!send && n >= 4) request_k = get_u32(d);
+    logged(send, peer, d, n);
+  };
+  posix::ScopedUdpNetwork scope(net);
+  node::SyncSensorNode<Board, double, kP, kM> sensor(kLiveController, late_us);
+  const sockaddr_in plant = posix::loopback(r.plant_port);
+  const std::int64_t stop = end_ns(r) + kTailNs;
+  bool pending = false;
+  std::int64_t at_ns = 0;
+  std::uint32_t pending_k = 0;
+  while (c.now() < stop) {
+    if (wait_readable(net_fd, c.t0 + (pending ? at_ns : stop))) {
+      const std::int64_t t = c.now();
+      log.write("invoke", t, clock_us(t), 0, kLiveSensor, 0);
+      McuInstant at;
+      if (sensor.on_receive(McuInstant(clock_us(t)), at)) {
+        pending = true;
+        pending_k = request_k;
+        at_ns = t + (at - McuInstant(clock_us(t))) * 1000;
+      }
+    }
+    if (!pending || c.now() < at_ns) continue;
+    pending = false;
+    const std::int64_t t = c.now();
+    const std::uint32_t clk = clock_us(t);
+    std::uint8_t req[kSampleRequestBytes] = {'S'};
+    put_u32(req + 1, pending_k);
+    put_u32(req + 5, clk);
+    ::sendto(io_fd, req, sizeof req, MSG_DONTWAIT, reinterpret_cast<const sockaddr*>(&plant), sizeof plant);
+    bool answered = false;
+    OutputVec y;
+    while (!answered && wait_readable(io_fd, c.t0 + t + kSampleTimeoutNs)) {
+      std::uint8_t ans[64];
+      const ssize_t n = ::recv(io_fd, ans, sizeof ans, MSG_DONTWAIT);
+      if (n == static_cast<ssize_t>(kSampleAnswerBytes) && ans[0] == 'Y' && get_u32(ans + 1) == pending_k) {
+        std::memcpy(&y[0], ans + 5, 8);
+        std::memcpy(&y[1], ans + 13, 8);
+        answered = true;
+      }
+    }
+    if (!answered) {
+      log.write("sample_timeout", c.now(), clk, 0, 0, pending_k);
+      continue;
+    }
+    sensor.on_sample(McuInstant(clk), y);
+  }
+  const auto& s = sensor.statistics();
+  log.write("stats", c.now(), 0, 0, 0, 0, s.requests, s.stale, s.refused);
+  return 0;
+}
+
+template <typename Est>
+int controller_loop(const LiveRun& r, const Context& ctx, Est est, int net_fd, const Clock& c) {
+  LogWriter log(r.dir, "controller");
+  posix::UdpNetworkState net;
+  attach(net, net_fd, kLiveController, r, log, c);
+  posix::ScopedUdpNetwork scope(net);
+  const Design d = ctx.controller_design(r.scenario.noise_scale);
+  InputVec u_min, u_max;
+  for (std::size_t j = 0; j < kM; ++j) {
+    u_min[j] = ctx.design().u_min[j];
+    u_max[j] = ctx.design().u_max[j];
+  }
+  node::SyncControllerNode<Board, Est, Ref, double, kN, kP, kM> ctrl(kLiveActuator, d.l, u_min, u_max, est,
+                                                                    reference(ctx, r.scenario));
+  engine::RandomStream compute = engine::Kernel(r.seed).stream("compute");
+  const std::int64_t stop = end_ns(r) + kTailNs;
+  while (c.now() < stop) {
+    if (!wait_readable(net_fd, c.t0 + stop)) continue;
+    // τ_c ~ U[1, 5] ms between the arrival and the computation (brief §3).
+    const std::int64_t tau_c = compute.uniform_int(ctx.timing().compute_min_us, ctx.timing().compute_max_us) * 1000;
+    wait_readable(-1, c.t0 + c.now() + tau_c);
+    const std::int64_t t = c.now();
+    log.write("invoke", t, clock_us(t), 0, kLiveController, 0);
+    ctrl.on_receive(McuInstant(clock_us(t)));
+    const auto x = ctrl.estimator().estimate();
+    log.write("estimate", c.now(), 0, 0, 0, ctrl.last_k(), x[0], x[1], ctrl.last_command()[0]);
+  }
+  const auto& s = ctrl.statistics();
+  log.write("stats", c.now(), 0, 0, 0, 0, s.computations, s.saturated, s.faults);
+  return 0;
+}
+
+int run_controller(const LiveRun& r, const std::shared_ptr<const Context>& ctx, int net_fd, const Clock& c) {
+  const Design d = ctx->controller_design(r.scenario.noise_scale);
+  const Disc disc(ctx->discretizer_model(r.scenario.noise_scale));
+  int code = 1;
+  with_sync_estimator(*ctx, r.scenario, r.approach, d, disc,
+                      [&](auto est, std::int32_t) { code = controller_loop(r, *ctx, est, net_fd, c); });
+  return code;
+}
+
+int run_actuator(const LiveRun& r, const std::shared_ptr<const Context>& ctx, int net_fd, int io_fd, const Clock& c) {
+  LogWriter log(r.dir, "actuator");
+  posix::UdpNetworkState net;
+  attach(net, net_fd, kLiveActuator, r, log, c);
+  posix::ScopedUdpNetwork scope(net);
+  node::SyncActuatorNode<Board, double, kM> act(kLiveSensor, InputVec{});
+  const sockaddr_in plant = posix::loopback(r.plant_port);
+  const std::int64_t h_ns = std::int64_t{ctx->period_us()} * 1000;
+  const auto h_us = static_cast<std::uint32_t>(ctx->period_us());
+  const std::int64_t end = end_ns(r);
+  for (std::uint32_t n = 0; std::int64_t{n} * h_ns < end; ++n) {
+    const std::int64_t due = std::int64_t{n} * h_ns;
+    while (wait_readable(net_fd, c.t0 + due)) {
+      const std::int64_t t = c.now();
+      log.write("invoke", t, clock_us(t), 0, kLiveActuator, 0);
+      act.on_receive();
+    }
+    const std::int64_t t = c.now();
+    const std::uint32_t clk = clock_us(t);
+    log.write("timer", t, clk, 0, 0, n);
+    // The timer is periodic: t_{k+1} = (k + 1) h on the shared clock, whatever the wake-up jitter.
+    if (n == 0) {
+      act.start(McuInstant(h_us));
+    } else {
+      act.on_timer(n, McuInstant((n + 1) * h_us));
+    }
+    InputVec u;
+    if (act.take_output(u)) {
+      std::uint8_t cmd[kCommandBytes] = {'U'};
+      put_u32(cmd + 1, n);
+      put_u32(cmd + 5, clk);
+      std::memcpy(cmd + 9, &u[0], 8);
+      ::sendto(io_fd, cmd, sizeof cmd, MSG_DONTWAIT, reinterpret_cast<const sockaddr*>(&plant), sizeof plant);
+      log.write("command", c.now(), clk, 0, 0, n, u[0]);
+    }
+  }
+  const auto& s = act.statistics();
+  log.write("stats", c.now(), 0, 0, 0, 0, s.late, act.refused());
+  return 0;
+}
+
+int run_relay(const LiveRun& r, const std::shared_ptr<const Context>& ctx, int fd, const Clock& c) {
+  struct Route {
+    std::uint8_t src, dst;
+    const char* name;
+    std::uint16_t port;
+  };
+  const Route routes[3] = {{kLiveActuator, kLiveSensor, "as", r.sensor_port},
+                           {kLiveSensor, kLiveController, "sc", r.controller_port},
+                           {kLiveController, kLiveActuator, "ca", r.actuator_port}};
+  std::vector<std::unique_ptr<engine::Link>> links;
+  for (const Route& rt : routes) links.push_back(std::make_unique<engine::Link>(leg(*ctx, r.scenario, r.approach, rt.name), r.seed));
+  struct Held {
+    std::size_t route;
+    std::vector<std::uint8_t> bytes;
+    std::int64_t arrival;
+  };
+  std::multimap<std::int64_t, Held> queue;  // by release instant; FIFO among equal instants
+  LogWriter log(r.dir, "relay");
+  const std::int64_t stop = end_ns(r) + kTailNs;
+  std::uint8_t buf[posix::kUdpHeaderBytes + posix::kUdpMaxPayloadBytes + 1];
+  while (c.now() < stop) {
+    const std::int64_t deadline = queue.empty() ? stop : std::min(stop, queue.begin()->first);
+    if (wait_readable(fd, c.t0 + deadline)) {
+      for (;;) {
+        const ssize_t n = ::recv(fd, buf, sizeof buf, MSG_DONTWAIT);
+        if (n < 0) break;
+        const std::int64_t t = c.now();
+        const auto size = static_cast<std::size_t>(n);
+        std::size_t route = 3;
+        for (std::size_t i = 0; i < 3 && size >= posix::kUdpHeaderBytes + 4; ++i)
+          if (buf[0] == routes[i].src && buf[1] == routes[i].dst) route = i;
+        if (route == 3) {
+          log.write("drop", t, 0, size > 0 ? buf[0] : 0, size > 1 ? buf[1] : 0, 0, static_cast<double>(size));
+          continue;
+        }
+        const auto arrival = links[route]->transmit(engine::SimTime{t});  // the engine's link: delay model, FIFO
+        const std::uint32_t k = get_u32(buf + posix::kUdpHeaderBytes);
+        if (!arrival) {
+          log.write("lost", t, 0, buf[0], buf[1], k);
+          continue;
+        }
+        log.write("in", t, 0, buf[0], buf[1], k, static_cast<double>(arrival->count() - t));
+        queue.emplace(arrival->count(), Held{route, std::vector<std::uint8_t>(buf, buf + size), t});
+      }
+    }
+    for (std::int64_t t = c.now(); !queue.empty() && queue.begin()->first <= t; t = c.now()) {
+      const auto it = queue.begin();
+      const Route& rt = routes[it->second.route];
+      const sockaddr_in to = posix::loopback(rt.port);
+      ::sendto(fd, it->second.bytes.data(), it->second.bytes.size(), MSG_DONTWAIT, reinterpret_cast<const sockaddr*>(&to),
+               sizeof to);
+      log.write("out", t, 0, rt.src, rt.dst, get_u32(it->second.bytes.data() + posix::kUdpHeaderBytes),
+                static_cast<double>(it->first - it->second.arrival), static_cast<double>(it->first),
+                static_cast<double>(it->second.arrival));
+      queue.erase(it);
+    }
+  }
+  return 0;
+}
+
+}  // namespace
+
+int run_live_role(const std::string& role, const LiveRun& run, int net_fd, int io_fd) {
+  const Clock c{run.t0_ns};
+  for (int fd : {net_fd, io_fd})
+    if (fd >= 0) posix::set_nonblocking(fd);
+  const auto ctx = Context::load(run.plant_file);  // the design step runs before t0
+  ::prctl(PR_SET_TIMERSLACK, 1UL, 0UL, 0UL, 0UL);  // wake-ups as close to the deadline as the kernel can
+  const auto start = [&]() { wait_readable(-1, run.t0_ns); };  // everything starts at t0
+  if (role == "plant") return start(), run_plant(run, ctx, net_fd, c);
+  if (role == "sensor") return start(), run_sensor(run, ctx, net_fd, io_fd, c);
+  if (role == "controller") return start(), run_controller(run, ctx, net_fd, c);
+  if (role == "actuator") return start(), run_actuator(run, ctx, net_fd, io_fd, c);
+  if (role == "relay") return start(), run_relay(run, ctx, net_fd, c);
+  throw std::invalid_argument("ncs node: unknown role '" + role + "' (plant, sensor, controller, actuator, relay)");
+}
+
+}  // namespace oneshot::ncs
