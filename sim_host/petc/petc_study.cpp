@@ -175,8 +175,13 @@ void register_petc_study(CLI::App& app) {
   CLI::App* exectime = study->add_subcommand(
       "exectime", "instructions of one NUMRE arrival by N on the Cortex-M4F image (QEMU), beside its multiply-adds; "
                   "bit-identity with the host float node; flash, RAM, stack");
-  add_sim_options(exectime, *cli);
-  exectime->add_option("--case", cli->exectime.case_name, "case whose trace gives y, the typical and largest N (3, 4, 5; default 4)");
+  add_model_options(exectime, *cli);
+  exectime->add_option("--steps", cli->design.steps, "run length K of the traces that give y and N (default 464)");
+  exectime->add_flag("--frozen-noise", cli->design.frozen_noise, "printed eq. 13 instead of W_e(N)");
+  exectime->add_flag("--sample-at-update", cli->design.sample_at_update, "slow modes sample e at their own update");
+  exectime->add_option("--sigma-w", cli->design.sigma_w, "sigma_w (default: the plant file's, 3e-4)");
+  exectime->add_option("--sigma-v", cli->design.sigma_v, "sigma_v (default: the plant file's, 5e-4)");
+  exectime->add_option("--case", cli->exectime.case_name, "case whose measurements give y (3, 4, 5; default 4); N comes from cases 3-5");
   exectime->add_option("--seed", cli->exectime.seed, "seed of that trace (default 1)");
   exectime->add_option("--multiplicity", cli->exectime.extra, "more multiplicities N to measure (besides 1, median, max)");
   exectime->add_option("--firmware-dir", cli->exectime.firmware_dir, "build tree holding firmware-cortex-m4f/ (default: this build's)");
