@@ -161,3 +161,23 @@ target_compile_definitions(${og_probe} PRIVATE ${soc_define}
   ONESHOT_MCU_IRQ_COUNT=${irq_count} ONESHOT_MCU_ACTUATION_IRQ=8 ONESHOT_MCU_UART_IRQ=${uart_irq} ${extra_defines}
   ONESHOT_FW_FIXED=1 ONESHOT_FW_DISC=0)
 oneshot_firmware_link(${og_probe})
+
+# The petc image (Cortex-M4F only: the node with H = 200 needs ~45 KB of RAM, the nRF51 has 16 KB):
+# the PETC controller node behind the PIL link, one NUMRE arrival per request between the
+# instruction-count markers (firmware/app/mcu/petc_main.cpp); <image>.stack.txt as above.
+if(ONESHOT_FIRMWARE_TARGET STREQUAL "cortex-m4f")
+  set(image oneshot-${ONESHOT_FIRMWARE_TARGET}-petc)
+  add_executable(${image} firmware/app/mcu/petc_main.cpp firmware/app/mcu/startup.cpp)
+  set_target_properties(${image} PROPERTIES SUFFIX ".elf")
+  target_include_directories(${image} PRIVATE
+    firmware/core/include firmware/app/include firmware/node/include hal/include hal/mcu/include)
+  target_compile_options(${image} PRIVATE ${fw_common_options})
+  target_compile_definitions(${image} PRIVATE ${soc_define}
+    ONESHOT_MCU_IRQ_COUNT=${irq_count} ONESHOT_MCU_ACTUATION_IRQ=8 ONESHOT_MCU_UART_IRQ=${uart_irq} ${extra_defines})
+  oneshot_firmware_link(${image})
+  add_custom_command(TARGET ${image} POST_BUILD
+    COMMAND arm-none-eabi-size $<TARGET_FILE:${image}>
+    COMMAND ${CMAKE_COMMAND} -DDIR=${CMAKE_CURRENT_BINARY_DIR}/CMakeFiles/${image}.dir
+            -DOUT=$<TARGET_FILE:${image}>.stack.txt -P ${PROJECT_SOURCE_DIR}/cmake/oneshot_stack_bound.cmake
+    COMMENT "size and stack bound of ${image}")
+endif()

@@ -8,7 +8,9 @@
 #include "oneshot/engine/sweep_registry.hpp"
 #include "oneshot/sim/cli_commands.hpp"
 #include "oneshot/sim/output_files.hpp"
+#include "oneshot/sim/pil_link.hpp"
 #include "oneshot/sim/study_report.hpp"
+#include "petc_exectime.hpp"
 #include "petc_experiments.hpp"
 
 namespace oneshot::sim {
@@ -25,6 +27,7 @@ struct Cli {
   std::size_t grid = 7;
   std::uint64_t seed = 1;
   bool no_plots = false;
+  ExectimeOptions exectime;
 };
 
 void add_model_options(CLI::App* cmd, Cli& c) {
@@ -106,7 +109,17 @@ StudyReportResult report_section(const StudyReportContext& ctx) {
   if (ctx.plots)
     md << "![GPI](" << ctx.rel_dir << "/gpi.png)\n![case 5](" << ctx.rel_dir << "/trace_case5.png)\n![case 6]("
        << ctx.rel_dir << "/trace_case6.png)\n";
-  return {md.str(), {{"design", design}, {"table", table}, {"gpi", gpi}, {"traces", traces}}};
+  // One NUMRE arrival on the Cortex-M4F image (QEMU); skipped without the toolchain or QEMU.
+  nlohmann::json exectime;
+  md << "\n### One NUMRE arrival on the Cortex-M4F (`oneshot-sim petc exectime --json -`)\n\n";
+  try {
+    exectime = run_exectime(setup, ExectimeOptions{});
+    md << exectime_markdown(exectime);
+  } catch (const PilError& e) {
+    md << "Skipped: " << e.what() << "\n";
+    exectime = {{"skipped", e.what()}};
+  }
+  return {md.str(), {{"design", design}, {"table", table}, {"gpi", gpi}, {"traces", traces}, {"exectime", exectime}}};
 }
 
 }  // namespace
@@ -156,6 +169,26 @@ void register_petc_study(CLI::App& app) {
   traces->callback([cli] {
     const nlohmann::json j = run_traces(make_setup(cli->design), cli->seed, cli->sweep.out_dir, !cli->no_plots);
     if (cli->json != "-") std::cout << j.dump(2) << "\n";
+    emit(*cli, j);
+  });
+
+  CLI::App* exectime = study->add_subcommand(
+      "exectime", "instructions of one NUMRE arrival by N on the Cortex-M4F image (QEMU), beside its multiply-adds; "
+                  "bit-identity with the host float node; flash, RAM, stack");
+  add_model_options(exectime, *cli);
+  exectime->add_option("--steps", cli->design.steps, "run length K of the traces that give y and N (default 464)");
+  exectime->add_flag("--frozen-noise", cli->design.frozen_noise, "printed eq. 13 instead of W_e(N)");
+  exectime->add_flag("--sample-at-update", cli->design.sample_at_update, "slow modes sample e at their own update");
+  exectime->add_option("--sigma-w", cli->design.sigma_w, "sigma_w (default: the plant file's, 3e-4)");
+  exectime->add_option("--sigma-v", cli->design.sigma_v, "sigma_v (default: the plant file's, 5e-4)");
+  exectime->add_option("--case", cli->exectime.case_name, "case whose measurements give y (3, 4, 5; default 4); N comes from cases 3-5");
+  exectime->add_option("--seed", cli->exectime.seed, "seed of that trace (default 1)");
+  exectime->add_option("--multiplicity", cli->exectime.extra, "more multiplicities N to measure (besides 1, median, max)");
+  exectime->add_option("--firmware-dir", cli->exectime.firmware_dir, "build tree holding firmware-cortex-m4f/ (default: this build's)");
+  exectime->add_option("--json", cli->json, "write the result as JSON to PATH ('-' for standard output)");
+  exectime->callback([cli] {
+    const nlohmann::json j = run_exectime(make_setup(cli->design), cli->exectime);
+    if (cli->json != "-") std::cout << exectime_markdown(j);
     emit(*cli, j);
   });
 

@@ -15,6 +15,36 @@
 #include "oneshot/sim/statistics.hpp"
 
 namespace oneshot::sim {
+
+std::pair<std::size_t, std::size_t> image_memory(const std::string& path) {
+  const std::string d = host::read_text_file(path, "firmware image", kMaxImageBytes);
+  const auto u16 = [&](std::size_t o) {
+    return static_cast<std::uint32_t>(static_cast<unsigned char>(d.at(o)) | static_cast<unsigned char>(d.at(o + 1)) << 8);
+  };
+  const auto u32 = [&](std::size_t o) { return u16(o) | u16(o + 2) << 16; };
+  std::size_t flash = 0;
+  std::size_t ram = 0;
+  const std::uint32_t shoff = u32(32);
+  const std::uint32_t entsize = u16(46);
+  const std::uint32_t num = u16(48);
+  for (std::uint32_t i = 0; i < num; ++i) {
+    const std::size_t sh = shoff + i * entsize;
+    const std::uint32_t type = u32(sh + 4);
+    const std::uint32_t flags = u32(sh + 8);
+    const std::uint32_t size = u32(sh + 20);
+    if ((flags & 0x2U) == 0) continue;  // SHF_ALLOC
+    const bool write = (flags & 0x1U) != 0;
+    const bool nobits = type == 8;
+    if (!write) flash += size;
+    if (write && !nobits) {
+      flash += size;
+      ram += size;
+    }
+    if (write && nobits) ram += size;
+  }
+  return {flash, ram};
+}
+
 namespace {
 
 /// Host run options that record every job, for the comparison with the MCU.
@@ -56,36 +86,6 @@ Comparison compare(const RunResult& host, const RunResult& mcu) {
     if (same) ++c.identical_estimates;
   }
   return c;
-}
-
-/// Flash (text + rodata + initialised data) and RAM (data + bss) of an ELF image.
-std::pair<std::size_t, std::size_t> image_memory(const std::string& path) {
-  const std::string d = host::read_text_file(path, "firmware image", kMaxImageBytes);
-  const auto u16 = [&](std::size_t o) {
-    return static_cast<std::uint32_t>(static_cast<unsigned char>(d.at(o)) | static_cast<unsigned char>(d.at(o + 1)) << 8);
-  };
-  const auto u32 = [&](std::size_t o) { return u16(o) | u16(o + 2) << 16; };
-  std::size_t flash = 0;
-  std::size_t ram = 0;
-  const std::uint32_t shoff = u32(32);
-  const std::uint32_t entsize = u16(46);
-  const std::uint32_t num = u16(48);
-  for (std::uint32_t i = 0; i < num; ++i) {
-    const std::size_t sh = shoff + i * entsize;
-    const std::uint32_t type = u32(sh + 4);
-    const std::uint32_t flags = u32(sh + 8);
-    const std::uint32_t size = u32(sh + 20);
-    if ((flags & 0x2U) == 0) continue;  // SHF_ALLOC
-    const bool write = (flags & 0x1U) != 0;
-    const bool nobits = type == 8;
-    if (!write) flash += size;
-    if (write && !nobits) {
-      flash += size;
-      ram += size;
-    }
-    if (write && nobits) ram += size;
-  }
-  return {flash, ram};
 }
 
 /// Approach id of the generated C99 job in the firmware (main.cpp).

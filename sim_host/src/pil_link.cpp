@@ -22,8 +22,9 @@ namespace pil = app::pil;
 
 std::string firmware_image_path(const PilOptions& o) {
   const std::string dir = o.firmware_dir.empty() ? std::string(ONESHOT_DEFAULT_FIRMWARE_DIR) : o.firmware_dir;
-  return (fs::path(dir) / ("firmware-" + o.target) / ("oneshot-" + o.target + "-" + o.format + "-" + o.discretizer + ".elf"))
-      .string();
+  const std::string name =
+      o.image_name.empty() ? "oneshot-" + o.target + "-" + o.format + "-" + o.discretizer + ".elf" : o.image_name;
+  return (fs::path(dir) / ("firmware-" + o.target) / name).string();
 }
 
 std::uint32_t elf_symbol_address(const std::string& path, const std::string& name) {

@@ -7,6 +7,7 @@
 #include <memory>
 #include <stdexcept>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "oneshot/app/pil_protocol.hpp"
@@ -29,6 +30,7 @@ struct PilOptions {
   std::string format = "float";      ///< float or fixed.
   std::string discretizer = "table"; ///< table or generic.
   std::string firmware_dir;          ///< Build tree holding firmware-<target>/ (default: this build's).
+  std::string image_name;            ///< Image file under firmware-<target>/ (empty: by format and discretizer).
   bool count_instructions = false;   ///< Load the insn_window plugin.
   std::string plugin_path;           ///< The plugin (default: this build's).
   std::string profile_dir;           ///< With count_instructions: write <image>.profile here
@@ -49,7 +51,8 @@ struct FirmwareInfo {
   int stack_peak_bytes = 0; ///< Deepest stack use since reset when the kHello was sent.
 };
 
-/// Path of the image for `options` (firmware_dir/firmware-<target>/oneshot-<target>-<format>-<disc>.elf).
+/// Path of the image for `options` (firmware_dir/firmware-<target>/oneshot-<target>-<format>-<disc>.elf,
+/// or image_name in that folder).
 std::string firmware_image_path(const PilOptions& options);
 
 /// Largest firmware image read (ELF with debug information): 64 MiB.
@@ -57,6 +60,9 @@ inline constexpr std::size_t kMaxImageBytes = std::size_t{64} << 20;
 
 /// Address of symbol `name` in a 32-bit little-endian ELF file (PilError when absent).
 std::uint32_t elf_symbol_address(const std::string& elf_path, const std::string& name);
+
+/// Flash (text + rodata + initialised data) and static RAM (data + bss) of an ELF image, bytes.
+std::pair<std::size_t, std::size_t> image_memory(const std::string& elf_path);
 
 /// Link faults for tests: corrupt or drop one byte of the next request, or lose its reply
 /// (the firmware has run the job: the resend must not run it again).

@@ -113,6 +113,10 @@ class PetcController {
   constexpr const S* packet() const { return packet_; }
   /// Period of the packet in force.
   constexpr std::uint32_t packet_start() const { return k_sent_; }
+  /// The last arrival's cascade (kEntries inputs), sent or withheld.
+  constexpr const S* last_cascade() const { return new_packet_; }
+  /// d̂ of each entry of the last arrival's cascade (kEntries values).
+  constexpr const S* last_cascade_d_hat() const { return new_d_hat_; }
   /// The estimator.
   constexpr const NumreEstimator<S, N>& estimator() const { return est_; }
   /// Multiply-adds: estimator + cascades (model, law, observer).
