@@ -207,7 +207,7 @@ class KalmanEstimator {
                                const OutputMatrix& c) {
     Matrix<typename Fmt::KalmanGain, kN, 1> k{};  // absent output: zero gain
     Status status = Status::kOk;
-    if (((present >> O) & 1U) != 0U) {
+    if (((static_cast<unsigned>(present) >> O) & 1U) != 0U) {
       for (std::size_t i = 0; i < kN; ++i) k(i, 0) = k_(i, O);  // kept when singular
       Vector<typename Fmt::State, 1> yo;
       yo[0] = y[O];
