@@ -101,7 +101,7 @@ class EstimatorCase {
   void oracle_correct(const VecX& y, OutputMask mask, const VecX& r) {
     std::vector<Eigen::Index> rows;
     for (std::size_t o = 0; o < P; ++o)
-      if (((mask >> o) & 1U) != 0U) rows.push_back(static_cast<Eigen::Index>(o));
+      if (((static_cast<unsigned>(mask) >> o) & 1U) != 0U) rows.push_back(static_cast<Eigen::Index>(o));
     if (rows.empty()) return;
     const auto k = static_cast<Eigen::Index>(rows.size());
     MatX cs(k, static_cast<Eigen::Index>(N));
@@ -164,7 +164,7 @@ void irregular_run(std::uint64_t seed, double tolerance, double& worst_x, double
     ASSERT_EQ(tc.est_.correct(y, mask, r, tc.c_), Status::kOk);
     tc.oracle_correct(ye, mask, re);
     for (std::size_t o = 0; o < P; ++o) {
-      if (((mask >> o) & 1U) != 0U) continue;
+      if (((static_cast<unsigned>(mask) >> o) & 1U) != 0U) continue;
       for (std::size_t i = 0; i < N; ++i) {
         ASSERT_EQ(tc.est_.gain()(i, o), 0.0) << "absent output, zero gain";
       }
