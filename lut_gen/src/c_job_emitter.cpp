@@ -9,6 +9,7 @@
 #include "c_job/c_arith.hpp"
 #include "c_job/c_job_variant.hpp"
 #include "c_job/c_writer.hpp"
+#include "c_job/q15_arith.hpp"
 
 namespace oneshot::design {
 namespace {
@@ -37,6 +38,18 @@ cjob::TableText fixed_text(const TableData<BlockFixedStorage>& t) {
     for (std::size_t k = 0; k <= static_cast<std::size_t>(t.residual_high[s] - t.residual_low[s]); ++k)
       c.push_back(t.residual_coefficients[t.residual_offset[s] + k].raw);
     x.coeff_raw.push_back(c);
+  }
+  return x;
+}
+
+/// The fixed table for the q15 variants: the same 16-bit entries, residual polynomials
+/// requantised to 16-bit coefficients (residual16).
+cjob::TableText q15_text(const TableData<BlockFixedStorage>& t) {
+  cjob::TableText x = fixed_text(t);
+  for (std::size_t s = 0; s < x.slots; ++s) {
+    const cjob::Residual16 r = cjob::residual16(x.coeff_raw[s], x.residual_frac[s]);
+    x.coeff_raw[s] = r.coeff;
+    x.residual_frac[s] = r.frac;
   }
   return x;
 }
@@ -103,6 +116,10 @@ void header_prologue(CodeWriter& w, const PlantDescription& plant, const DesignR
   w.line(" *   float_table    IEEE single precision, exact between grid points: bit-identical to the C++");
   w.line(" *                  float core when compiled without floating contraction (-ffp-contract=off)");
   w.line(" *   float_nearest  IEEE single precision, tau rounded to the grid");
+  w.line(" *   q15_table      16-bit Q formats (estimate, covariance, input, tables), 16x16->32 products");
+  w.line(" *                  and 32-bit accumulators (a dsPIC's MAC format), exact between grid points;");
+  w.line(" *                  its own arithmetic (no C++ core twin): rounding half up, saturation flagged");
+  w.line(" *   q15_nearest    the same, tau rounded to the grid");
   w.line(" * The fixed variants use only integer arithmetic (no floating point, no division, no library");
   w.line(" * call) and are safe with a 16-bit int: every intermediate is an explicitly typed int32_t or");
   w.line(" * int64_t. They need an arithmetic right shift of negative values (GCC, Clang, XC16, IAR and");
@@ -185,11 +202,15 @@ CJobSources emit_c_job(const PlantDescription& plant, const DesignResult& design
   CJobSources out;
   const cjob::FloatArith float_arith;
   std::unique_ptr<cjob::FixedArith> fixed_arith;
+  std::unique_ptr<cjob::Q15Arith> q15_arith;
   std::vector<cjob::VariantSpec> specs;
   if (formats != nullptr && table_fixed != nullptr) {
     fixed_arith = std::make_unique<cjob::FixedArith>(*formats);
     specs.push_back({"fixed_table", true, fixed_arith.get(), fixed_text(*table_fixed)});
     specs.push_back({"fixed_nearest", false, fixed_arith.get(), fixed_text(*table_fixed)});
+    q15_arith = std::make_unique<cjob::Q15Arith>(cjob::q15_formats(*formats));
+    specs.push_back({"q15_table", true, q15_arith.get(), q15_text(*table_fixed)});
+    specs.push_back({"q15_nearest", false, q15_arith.get(), q15_text(*table_fixed)});
   }
   specs.push_back({"float_table", true, &float_arith, float_text(table_float)});
   specs.push_back({"float_nearest", false, &float_arith, float_text(table_float)});
@@ -234,7 +255,7 @@ CJobSources emit_c_job(const PlantDescription& plant, const DesignResult& design
     // Only when a fixed variant is compiled in (the seed table would be an unused constant).
     std::string guard;
     for (const std::string& v : out.variants)
-      if (v.rfind("fixed_", 0) == 0) guard += (guard.empty() ? "" : " || ") + std::string("!defined(ONESHOT_JOB_WITHOUT_") + upper_identifier(v) + ")";
+      if (v.rfind("fixed_", 0) == 0 || v.rfind("q15_", 0) == 0) guard += (guard.empty() ? "" : " || ") + std::string("!defined(ONESHOT_JOB_WITHOUT_") + upper_identifier(v) + ")";
     helpers = "#if " + guard + "\n" + fixed_helpers(body) + "#endif\n\n";
   }
   out.source = c.str() + helpers + body;

@@ -66,6 +66,8 @@ class Arith {
   virtual ~Arith() = default;
   /// Fixed point (else float).
   virtual bool fixed() const = 0;
+  /// The 16-bit format with 32-bit accumulators (q15_arith.hpp); implies fixed().
+  virtual bool q15() const { return false; }
   /// C type holding quantity q.
   virtual std::string ctype(Qty q) const = 0;
   /// Format of q (fixed point).

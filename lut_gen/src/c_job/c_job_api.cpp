@@ -20,7 +20,7 @@ void VariantEmitter::header(CodeWriter& w) const {
   const bool scalar = m_ == 1;
   std::string states;
   for (std::size_t i = 0; i < n_; ++i) states += (i ? ", " : "") + comment_text(plant_.states[i]);
-  w.line("/* ---- " + spec_.name + ": " + (fixed() ? "fixed point" : "IEEE single precision") + ", " +
+  w.line("/* ---- " + spec_.name + ": " + (ar().q15() ? "16-bit Q formats, 32-bit accumulators" : fixed() ? "fixed point" : "IEEE single precision") + ", " +
          (spec_.exact_subgrid ? "exact between grid points (table + residual polynomial)"
                               : "tau rounded to the nearest grid point") +
          " ---- */");

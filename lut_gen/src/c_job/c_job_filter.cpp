@@ -103,7 +103,11 @@ void VariantEmitter::emit_correct(CodeWriter& w) const {
   }
   const Val r = ar().constant(Qty::kCovariance, design_.r(0, 0), "R");
   const std::string inv_t = ar().ctype(Qty::kInverseCovariance);
-  if (fixed()) {
+  if (ar().q15()) {
+    w.line("sv = os_sat16((int32_t)sv + " + r.expr + ", sat);");
+    w.open("if (sv <= 0) {").line("return ONESHOT_JOB_STATUS_SINGULAR;").close();
+    w.open("{").line("const " + inv_t + " inv = " + fn("reciprocal") + "(sv, sat);");
+  } else if (fixed()) {
     w.line("sv = os_sat32((int64_t)sv + " + r.expr + ", sat);");
     w.open("if (sv <= 0) {").line("return ONESHOT_JOB_STATUS_SINGULAR;").close();
     w.open("{").line("const " + inv_t + " inv = " + fn("reciprocal") + "(sv, sat);");
@@ -173,6 +177,22 @@ void VariantEmitter::emit_quantize(CodeWriter& w, std::size_t j, const std::stri
            ") : (int32_t)(steps + " + float_literal(0.5F) + ");");
     w.open("if (" + code + " > " + n + ") {").line(code + " = " + n + ";").close();
     w.close().close().close();
+    return;
+  }
+  if (ar().q15()) {
+    // offset = u - u_min in (0, 2^16) when positive, steps/volt in (0, 2^15): one unsigned
+    // 32-bit product, rounded half up to a code.
+    const Val umin = ar().constant(Qty::kInput, design_.u_min[j], "u_min");
+    const Val spv = ar().constant(Qty::kInverseInput, design_.steps_per_volt[j], "PWM steps per volt");
+    if (design_.steps_per_volt[j] <= 0) throw DesignError("C job q15: PWM steps per volt must be positive");
+    const int shift = ar().fmt(Qty::kInput).frac + ar().fmt(Qty::kInverseInput).frac;
+    if (shift < 1 || shift > 31) throw DesignError("C job q15: input and steps-per-volt formats too fine");
+    w.open("{").line("const int32_t offset = (int32_t)" + u + " - (int32_t)" + umin.expr + ";");
+    w.open("if (offset <= 0) {").line(code + " = 0;").middle("} else {");
+    w.line("const uint32_t steps = ((uint32_t)offset * (uint32_t)" + spv.expr + " + " + u32_literal(1ULL << (shift - 1)) +
+           ") >> " + std::to_string(shift) + ";");
+    w.line(code + " = steps > (uint32_t)" + n + " ? " + n + " : (int32_t)steps;");
+    w.close().close();
     return;
   }
   const QFormat sf = ar().fmt(Qty::kActuatorSteps);
