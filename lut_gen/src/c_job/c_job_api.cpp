@@ -32,6 +32,8 @@ void VariantEmitter::header(CodeWriter& w) const {
     const auto frac = [&](Qty q) { return std::to_string(ar().fmt(q).frac); };
     w.line("/** Fractional bits of the estimate and the input: value = raw * 2^-bits (volts). */");
     w.line("#define " + up + "_STATE_FRAC_BITS " + frac(Qty::kState));
+    w.line("/** Fractional bits of the input s->u (volts). */");
+    w.line("#define " + up + "_INPUT_FRAC_BITS " + frac(Qty::kInput));
     w.line("/** Fractional bits of the covariance entries (volts squared). */");
     w.line("#define " + up + "_COVARIANCE_FRAC_BITS " + frac(Qty::kCovariance));
     w.line("/** Fractional bits of 1/S, the inverse innovation variance. */");
