@@ -248,6 +248,10 @@ CJobSources emit_c_job(const PlantDescription& plant, const DesignResult& design
   c.line("");
   c.line("/* The fixed-point code relies on >> of a negative value being arithmetic. */");
   c.line("typedef char oneshot_job_needs_arithmetic_shift[(INT32_C(-2) >> 1) == INT32_C(-1) ? 1 : -1];");
+  if (q15_arith) {
+    c.line("/* The q15 code's saturation test relies on narrowing to int16_t being modulo 2^16. */");
+    c.line("typedef char oneshot_job_needs_modulo_narrowing[(int16_t)INT32_C(0x18000) == INT16_MIN ? 1 : -1];");
+  }
   c.line("");
   const std::string body = variants_c.str();
   std::string helpers;

@@ -78,15 +78,24 @@ void VariantEmitter::source(CodeWriter& w) {
   w.line("/* ======== " + spec_.name + " ======== */");
   w.line("#ifndef ONESHOT_JOB_WITHOUT_" + upper(spec_.name));
   w.line("");
-  emit_table(w);
-  emit_triple(w);
-  emit_load(w);
-  if (spec_.exact_subgrid) emit_residual(w);
-  emit_identity(w);
-  emit_compose(w);
-  emit_in_range(w);
-  emit_discretize(w);
-  emit_predict(w);
+  if (ar().q15()) {
+    emit_q15_table(w);
+    emit_triple(w);
+    emit_q15_load(w);
+    if (spec_.exact_subgrid) emit_residual(w);
+    emit_predict(w);
+    emit_q15_advance(w);
+  } else {
+    emit_table(w);
+    emit_triple(w);
+    emit_load(w);
+    if (spec_.exact_subgrid) emit_residual(w);
+    emit_identity(w);
+    emit_compose(w);
+    emit_in_range(w);
+    emit_discretize(w);
+    emit_predict(w);
+  }
   if (fixed()) emit_reciprocal(w);
   emit_correct(w);
   emit_init(w);

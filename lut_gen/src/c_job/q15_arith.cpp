@@ -53,10 +53,10 @@ std::string pow2(int k) { return int_literal(static_cast<long long>(1) << k, 32)
 
 constexpr double kLimit = 2147483647.0;  // 2^31 − 1: every int32 sum stays below it
 
-/// v stored in 16 bits: a cast when |v| ≤ bound < 2^15 − 1, else sat16 (flag).
+/// v stored in 16 bits: a cast when |v| ≤ bound < 2^15 − 1, else os_q15_sat (clamp, flag).
 std::string store16(const std::string& v, double bound) {
   if (bound <= 32767.0) return "(int16_t)(" + v + ")";
-  return "os_sat16(" + v + ", sat)";
+  return "os_q15_sat(" + v + ", sat)";
 }
 
 }  // namespace
