@@ -82,7 +82,7 @@ void VariantEmitter::source(CodeWriter& w) {
     emit_q15_table(w);
     emit_triple(w);
     emit_q15_load(w);
-    if (spec_.exact_subgrid) emit_residual(w);
+    if (spec_.exact_subgrid) emit_q15_residual(w);
     emit_predict(w);
     emit_q15_advance(w);
   } else {
@@ -96,7 +96,11 @@ void VariantEmitter::source(CodeWriter& w) {
     emit_discretize(w);
     emit_predict(w);
   }
-  if (fixed()) emit_reciprocal(w);
+  if (ar().q15()) {
+    emit_q15_reciprocal(w);
+  } else if (fixed()) {
+    emit_reciprocal(w);
+  }
   emit_correct(w);
   emit_init(w);
   emit_run(w);

@@ -118,8 +118,7 @@ void VariantEmitter::emit_pick(CodeWriter& w, const std::string& dest, Qty q, st
   } else {
     const auto s = static_cast<std::size_t>(slot);
     const int frac = fixed() ? (residual ? spec_.table.residual_frac[s] : spec_.table.value_frac[s]) : 0;
-    const int bits = residual && !ar().q15() ? 32 : 16;
-    w.line(dest + " = " + ar().slot_to(q, raw_prefix + std::to_string(s) + (residual ? "" : "]"), frac, bits) + ";");
+    w.line(dest + " = " + ar().slot_to(q, raw_prefix + std::to_string(s) + (residual ? "" : "]"), frac, residual ? 32 : 16) + ";");
   }
 }
 
@@ -150,28 +149,7 @@ void VariantEmitter::emit_residual(CodeWriter& w) const {
   w.line("/* d over delta = residual_us < g from each slot's Taylor polynomial in r = delta/g, Horner");
   w.line("   (TableDiscretizer::residual). */");
   w.open("static void " + fn("residual") + "(int32_t residual_us, " + triple_type() + " *d" + sat_param() + ") {");
-  if (ar().q15()) {
-    // 16-bit coefficients (residual16): |v| < 2^15 at every step, 16x16->32 products only.
-    w.line("(void)sat;");
-    const int f = ar().fmt(Qty::kFraction).frac;
-    if (f < 1 || f > 15) throw DesignError("C job: the sub-grid fraction needs 1..15 fractional bits");
-    const auto scale = static_cast<std::uint32_t>(((std::uint64_t{1} << (f + 16)) + static_cast<std::uint64_t>(g) / 2) /
-                                                  static_cast<std::uint64_t>(g));
-    w.line("/* r = delta/g: one 32-bit multiply by the precomputed 2^" + std::to_string(f + 16) + "/g. */");
-    w.line("const int16_t r = (int16_t)(((uint32_t)residual_us * " + u32_literal(scale) +
-           " + UINT32_C(0x8000)) >> 16);  /* residual_us < g: r < 2^" + std::to_string(f) + " */");
-    const std::string half = int_literal(std::int64_t{1} << (f - 1), 32);
-    for (std::size_t s = 0; s < t.slots; ++s) {
-      const auto& c = t.coeff_raw[s];
-      const std::string v = "v" + std::to_string(s);
-      w.line("int16_t " + v + " = " + int_literal(c.back(), 16) + ";");
-      for (std::size_t k = c.size() - 1; k > 0; --k)
-        w.line(v + " = (int16_t)(((os_m16(" + v + ", r) + " + half + ") >> " + std::to_string(f) + ") + " +
-               int_literal(c[k - 1], 16) + ");");
-      for (std::uint8_t k = 0; k < t.low[s]; ++k)
-        w.line(v + " = (int16_t)((os_m16(" + v + ", r) + " + half + ") >> " + std::to_string(f) + ");");
-    }
-  } else if (fixed()) {
+  if (fixed()) {
     const int f = ar().fmt(Qty::kFraction).frac;
     if (f < 0 || f + 16 > 31) throw DesignError("C job: the sub-grid fraction needs 0..15 fractional bits");
     const std::uint64_t scale = ((std::uint64_t{1} << (f + 16)) + static_cast<std::uint64_t>(g) / 2) /

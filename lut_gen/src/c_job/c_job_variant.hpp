@@ -93,10 +93,12 @@ class VariantEmitter {
                        const std::string& q, const std::string& out_prefix) const;
   void emit_in_range(CodeWriter& w);
   void emit_discretize(CodeWriter& w);
-  // The q15 variants' one-level grid table and piecewise prediction (c_job_q15_advance.cpp).
+  // The q15 variants' grid table, residual, piecewise prediction and reciprocal (c_job_q15.cpp).
   std::size_t q15_entries() const;
   void emit_q15_table(CodeWriter& w) const;
   void emit_q15_load(CodeWriter& w) const;
+  void emit_q15_residual(CodeWriter& w) const;
+  void emit_q15_reciprocal(CodeWriter& w) const;
   void emit_q15_advance(CodeWriter& w);
   // Pieces of the filter and the control law (c_job_filter.cpp).
   void emit_predict(CodeWriter& w) const;
