@@ -70,6 +70,8 @@ class Arith {
   virtual bool q15() const { return false; }
   /// C type holding quantity q.
   virtual std::string ctype(Qty q) const = 0;
+  /// C type of q in the per-interval scratch (Φ, Γ, Q_d of one interval); ctype unless faster.
+  virtual std::string scratch_ctype(Qty q) const { return ctype(q); }
   /// Format of q (fixed point).
   virtual QFormat fmt(Qty q) const = 0;
   /// Statements assigning dest = Accumulator<q> over `terms`, value().

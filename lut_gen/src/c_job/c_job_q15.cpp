@@ -145,12 +145,12 @@ void VariantEmitter::emit_q15_residual(CodeWriter& w) const {
     }
     w.line("int16_t " + v + " = " + int_literal(c.back(), 16) + ";");
     for (std::size_t k = c.size() - 1; k > 0; --k)
-      w.line(v + " = (int16_t)(((os_m16(" + v + ", r) + " + half + ") >> " + std::to_string(f) + ") + " +
+      w.line(v + " = (int16_t)(((os_q15_m(" + v + ", r) + " + half + ") >> " + std::to_string(f) + ") + " +
              int_literal(c[k - 1], 16) + ");");
     for (int k = 0; k + 1 < low; ++k)
-      w.line(v + " = (int16_t)((os_m16(" + v + ", r) + " + half + ") >> " + std::to_string(f) + ");");
+      w.line(v + " = (int16_t)((os_q15_m(" + v + ", r) + " + half + ") >> " + std::to_string(f) + ");");
     if (low > 0) {  // the last r: kept as the 32-bit product
-      expr[s] = "os_m16(" + v + ", r)";
+      expr[s] = "os_q15_m(" + v + ", r)";
       frac[s] = t.residual_frac[s] + f;
       bound[s] = (sum + static_cast<double>(c.size() + static_cast<std::size_t>(low))) * std::ldexp(1.0, f);
     } else {

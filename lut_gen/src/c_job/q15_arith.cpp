@@ -45,7 +45,7 @@ Raw product16(const Val& a0, const Val& b0) {
   Raw r;
   r.frac = a.fmt.frac + (b.count ? 0 : b.fmt.frac);
   r.bound = bound_of(a) * bound_of(b);
-  r.expr = b.count ? "os_m16u(" + a.expr + ", (uint16_t)(" + b.expr + "))" : "os_m16(" + a.expr + ", " + b.expr + ")";
+  r.expr = b.count ? "os_m16u(" + a.expr + ", (uint16_t)(" + b.expr + "))" : "os_q15_m(" + a.expr + ", " + b.expr + ")";
   return r;
 }
 
@@ -156,19 +156,31 @@ void Q15Arith::accumulate(CodeWriter& w, const std::string& dest, Qty out, const
   };
   int base = top;
   while (bound_at(base) > kLimit) --base;
+  const int round = base - o.frac;
+  // The rounding half folds into a positive term scaled by exactly 2^round:
+  // x 2^r + 2^(r-1) = (2x + 1) 2^(r-1), one constant fewer to build.
+  std::size_t folded = raws.size();
+  for (std::size_t i = 0; i < raws.size() && round > 0; ++i)
+    if (!neg[i] && terms[i].kind != Term::Kind::kProduct && base - raws[i].frac == round) {
+      folded = i;
+      break;
+    }
   std::string sum;
   for (std::size_t i = 0; i < raws.size(); ++i) {
     const int left = base - raws[i].frac;
     std::string e = "(int32_t)" + raws[i].expr;
-    if (left > 0) e += " * " + pow2(left);
+    if (i == folded) {
+      e = "((int32_t)" + raws[i].expr + " * 2 + 1)" + (left > 1 ? " * " + pow2(left - 1) : "");
+    } else if (left > 0) {
+      e += " * " + pow2(left);
+    }
     if (left < 0) e = "(" + e + " >> " + std::to_string(-left) + ")";
     sum += i == 0 ? (neg[i] ? "-" + e : e) : (neg[i] ? " - " : " + ") + e;
   }
   const double bound = bound_at(base);
-  const int round = base - o.frac;
   if (round > 0) {
-    w.line(dest + " = " + store16("(" + sum + " + " + pow2(round - 1) + ") >> " + std::to_string(round),
-                                  std::ldexp(bound, -round) + 1) + ";");
+    const std::string rounded = folded < raws.size() ? sum : sum + " + " + pow2(round - 1);
+    w.line(dest + " = " + store16("(" + rounded + ") >> " + std::to_string(round), std::ldexp(bound, -round) + 1) + ";");
   } else if (round == 0) {
     w.line(dest + " = " + store16(sum, bound) + ";");
   } else {

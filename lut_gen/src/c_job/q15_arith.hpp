@@ -48,6 +48,8 @@ class Q15Arith final : public Arith {
   bool fixed() const override { return true; }
   bool q15() const override { return true; }
   std::string ctype(Qty) const override { return "int16_t"; }
+  /// 16-bit values in a register-width int where that is faster (32-bit cores).
+  std::string scratch_ctype(Qty) const override { return "int_fast16_t"; }
   QFormat fmt(Qty q) const override;
   void accumulate(CodeWriter& w, const std::string& dest, Qty out, const std::vector<Term>& terms) const override;
   void mul(CodeWriter& w, const std::string& dest, Qty to, const Val& a, const Val& b) const override;
