@@ -42,18 +42,6 @@ cjob::TableText fixed_text(const TableData<BlockFixedStorage>& t) {
   return x;
 }
 
-/// The fixed table for the q15 variants: the same 16-bit entries, residual polynomials
-/// requantised to 16-bit coefficients (residual16).
-cjob::TableText q15_text(const TableData<BlockFixedStorage>& t) {
-  cjob::TableText x = fixed_text(t);
-  for (std::size_t s = 0; s < x.slots; ++s) {
-    const cjob::Residual16 r = cjob::residual16(x.coeff_raw[s], x.residual_frac[s]);
-    x.coeff_raw[s] = r.coeff;
-    x.residual_frac[s] = r.frac;
-  }
-  return x;
-}
-
 cjob::TableText float_text(const TableData<float>& t) {
   cjob::TableText x;
   x.granularity_us = t.granularity_us;
@@ -209,8 +197,8 @@ CJobSources emit_c_job(const PlantDescription& plant, const DesignResult& design
     specs.push_back({"fixed_table", true, fixed_arith.get(), fixed_text(*table_fixed)});
     specs.push_back({"fixed_nearest", false, fixed_arith.get(), fixed_text(*table_fixed)});
     q15_arith = std::make_unique<cjob::Q15Arith>(cjob::q15_formats(*formats));
-    specs.push_back({"q15_table", true, q15_arith.get(), q15_text(*table_fixed)});
-    specs.push_back({"q15_nearest", false, q15_arith.get(), q15_text(*table_fixed)});
+    specs.push_back({"q15_table", true, q15_arith.get(), fixed_text(*table_fixed)});
+    specs.push_back({"q15_nearest", false, q15_arith.get(), fixed_text(*table_fixed)});
   }
   specs.push_back({"float_table", true, &float_arith, float_text(table_float)});
   specs.push_back({"float_nearest", false, &float_arith, float_text(table_float)});

@@ -79,10 +79,9 @@ void VariantEmitter::source(CodeWriter& w) {
   w.line("#ifndef ONESHOT_JOB_WITHOUT_" + upper(spec_.name));
   w.line("");
   if (ar().q15()) {
-    emit_q15_table(w);
     emit_triple(w);
-    emit_q15_load(w);
-    if (spec_.exact_subgrid) emit_q15_residual(w);
+    emit_q15_table(w);
+    emit_q15_interval(w);
     emit_predict(w);
     emit_q15_advance(w);
   } else {

@@ -80,21 +80,6 @@ FixedFormats q15_formats(const FixedFormats& fixed) {
   return f;
 }
 
-Residual16 residual16(const std::vector<long long>& c, int frac) {
-  double sum = 0;
-  for (long long v : c) sum += std::fabs(static_cast<double>(v));
-  const double budget = 32767.0 - 2.0 * static_cast<double>(c.size());  // Horner rounding adds ≤ 1 per step
-  Residual16 r;
-  int s = 0;
-  if (sum > 0) {
-    while (std::ldexp(sum, -s) + static_cast<double>(c.size()) > budget) ++s;
-    while (s > -40 && std::ldexp(sum, -(s - 1)) + static_cast<double>(c.size()) <= budget) --s;
-  }
-  for (long long v : c) r.coeff.push_back(std::llround(std::ldexp(static_cast<double>(v), -s)));
-  r.frac = frac - s;
-  return r;
-}
-
 QFormat Q15Arith::fmt(Qty q) const {
   switch (q) {
     case Qty::kTransition: return f_.transition;

@@ -31,16 +31,6 @@ namespace oneshot::design::cjob {
 /// volt exactly their constants; Φ, Γ, gains and the sub-grid fraction as the fixed design.
 FixedFormats q15_formats(const FixedFormats& fixed);
 
-/// A slot's residual polynomial in 16-bit coefficients: coefficients ĉ_k = round(c_k·2^−s)
-/// (s chosen so that Σ|ĉ_k| + degree < 2^15: Horner in 16×16→32 never overflows) and the
-/// slot's new fraction F − s.
-struct Residual16 {
-  std::vector<long long> coeff;  ///< low … high degree.
-  int frac = 0;                  ///< value = Horner result · 2^−frac.
-};
-/// Requantises coefficients `c` (raw at fraction `frac`) to 16 bits.
-Residual16 residual16(const std::vector<long long>& c, int frac);
-
 /// 16-bit storage, 32-bit accumulation (see the file comment).
 class Q15Arith final : public Arith {
  public:
