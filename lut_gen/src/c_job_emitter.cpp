@@ -9,6 +9,7 @@
 #include "c_job/c_arith.hpp"
 #include "c_job/c_job_variant.hpp"
 #include "c_job/c_writer.hpp"
+#include "c_job/q15_arith.hpp"
 
 namespace oneshot::design {
 namespace {
@@ -103,6 +104,10 @@ void header_prologue(CodeWriter& w, const PlantDescription& plant, const DesignR
   w.line(" *   float_table    IEEE single precision, exact between grid points: bit-identical to the C++");
   w.line(" *                  float core when compiled without floating contraction (-ffp-contract=off)");
   w.line(" *   float_nearest  IEEE single precision, tau rounded to the grid");
+  w.line(" *   q15_table      16-bit Q formats (estimate, covariance, input, tables), 16x16->32 products");
+  w.line(" *                  and 32-bit accumulators (a dsPIC's MAC format), exact between grid points;");
+  w.line(" *                  its own arithmetic (no C++ core twin): rounding half up, saturation flagged");
+  w.line(" *   q15_nearest    the same, tau rounded to the grid");
   w.line(" * The fixed variants use only integer arithmetic (no floating point, no division, no library");
   w.line(" * call) and are safe with a 16-bit int: every intermediate is an explicitly typed int32_t or");
   w.line(" * int64_t. They need an arithmetic right shift of negative values (GCC, Clang, XC16, IAR and");
@@ -185,11 +190,15 @@ CJobSources emit_c_job(const PlantDescription& plant, const DesignResult& design
   CJobSources out;
   const cjob::FloatArith float_arith;
   std::unique_ptr<cjob::FixedArith> fixed_arith;
+  std::unique_ptr<cjob::Q15Arith> q15_arith;
   std::vector<cjob::VariantSpec> specs;
   if (formats != nullptr && table_fixed != nullptr) {
     fixed_arith = std::make_unique<cjob::FixedArith>(*formats);
     specs.push_back({"fixed_table", true, fixed_arith.get(), fixed_text(*table_fixed)});
     specs.push_back({"fixed_nearest", false, fixed_arith.get(), fixed_text(*table_fixed)});
+    q15_arith = std::make_unique<cjob::Q15Arith>(cjob::q15_formats(*formats));
+    specs.push_back({"q15_table", true, q15_arith.get(), fixed_text(*table_fixed)});
+    specs.push_back({"q15_nearest", false, q15_arith.get(), fixed_text(*table_fixed)});
   }
   specs.push_back({"float_table", true, &float_arith, float_text(table_float)});
   specs.push_back({"float_nearest", false, &float_arith, float_text(table_float)});
@@ -227,6 +236,10 @@ CJobSources emit_c_job(const PlantDescription& plant, const DesignResult& design
   c.line("");
   c.line("/* The fixed-point code relies on >> of a negative value being arithmetic. */");
   c.line("typedef char oneshot_job_needs_arithmetic_shift[(INT32_C(-2) >> 1) == INT32_C(-1) ? 1 : -1];");
+  if (q15_arith) {
+    c.line("/* The q15 code's saturation test relies on narrowing to int16_t being modulo 2^16. */");
+    c.line("typedef char oneshot_job_needs_modulo_narrowing[(int16_t)INT32_C(0x18000) == INT16_MIN ? 1 : -1];");
+  }
   c.line("");
   const std::string body = variants_c.str();
   std::string helpers;
@@ -234,7 +247,7 @@ CJobSources emit_c_job(const PlantDescription& plant, const DesignResult& design
     // Only when a fixed variant is compiled in (the seed table would be an unused constant).
     std::string guard;
     for (const std::string& v : out.variants)
-      if (v.rfind("fixed_", 0) == 0) guard += (guard.empty() ? "" : " || ") + std::string("!defined(ONESHOT_JOB_WITHOUT_") + upper_identifier(v) + ")";
+      if (v.rfind("fixed_", 0) == 0 || v.rfind("q15_", 0) == 0) guard += (guard.empty() ? "" : " || ") + std::string("!defined(ONESHOT_JOB_WITHOUT_") + upper_identifier(v) + ")";
     helpers = "#if " + guard + "\n" + fixed_helpers(body) + "#endif\n\n";
   }
   out.source = c.str() + helpers + body;

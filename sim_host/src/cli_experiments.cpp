@@ -34,7 +34,10 @@ struct CliCommon {
 
   CommonOptions resolve() const {
     CommonOptions o = opt;
-    o.format = format == "double" ? NumberFormat::kDouble : format == "fixed" ? NumberFormat::kFixed : NumberFormat::kFloat;
+    o.format = format == "double" ? NumberFormat::kDouble
+               : format == "fixed" ? NumberFormat::kFixed
+               : format == "q15"   ? NumberFormat::kQ15
+                                   : NumberFormat::kFloat;
     o.discretizer = discretizer == "generic"   ? DiscretizerKind::kGeneric
                     : discretizer == "nearest" ? DiscretizerKind::kNearest
                                                : DiscretizerKind::kTable;
@@ -93,8 +96,10 @@ void add_common(CLI::App* cmd, CliCommon& c, const std::string& default_out) {
   cmd->add_option("--seed", c.opt.seed, "random seed (first seed of a sweep)")
       ->check(unsigned_up_to(kMaxSeed, "written exactly as a JSON/CSV number"))
       ->capture_default_str();
-  cmd->add_option("--number-format", c.format, "number format of the control job")
-      ->check(CLI::IsMember({"float", "double", "fixed"}))
+  cmd->add_option("--number-format", c.format,
+                  "number format of the control job (q15: approach B as the generated 16-bit C99 job, the "
+                  "other approaches in double)")
+      ->check(CLI::IsMember({"float", "double", "fixed", "q15"}))
       ->capture_default_str();
   cmd->add_option("--discretizer", c.discretizer,
                   "Phi/Gamma/Qd of the one-shot filters: table (exact between grid points), nearest (table at "

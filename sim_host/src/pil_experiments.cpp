@@ -8,6 +8,7 @@
 #include <sstream>
 
 #include "oneshot/host/file_io.hpp"
+#include "oneshot/sim/c_job_host.hpp"
 #include "oneshot/sim/experiments.hpp"
 #include "oneshot/sim/output_files.hpp"
 #include "oneshot/sim/pil_link.hpp"
@@ -88,12 +89,26 @@ Comparison compare(const RunResult& host, const RunResult& mcu) {
   return c;
 }
 
-/// Approach id of the generated C99 job in the firmware (main.cpp).
-constexpr std::uint32_t kCJobApproach = 5;
+/// Approach ids of the generated C99 jobs in the firmware (main.cpp).
+constexpr std::uint32_t kCJobApproach = app::pil::kCJobApproach;
+constexpr std::uint32_t kCJobQ15Approach = app::pil::kCJobQ15Approach;
+
+/// u[0], x[0..n), k[0] of a job reply (the firmware's raw values), empty when malformed.
+std::vector<std::int32_t> reply_values(const app::pil::Frame& reply, std::size_t n) {
+  app::pil::Reader in(reply);
+  in.u(1);  // status
+  in.s(4);  // tau
+  in.u(1);  // saturated
+  const std::size_t writes = in.u(1);
+  for (std::size_t i = 0; i < writes; ++i) in.u(3);
+  std::vector<std::int32_t> v;
+  for (std::size_t i = 0; i < n + 2; ++i) v.push_back(static_cast<std::int32_t>(in.u(4)));
+  if (in.bad()) return {};
+  return v;
+}
 
 /// Flash, RAM and stack bound of the job-only image of the C job variant (no PIL link).
-nlohmann::json c_job_only_image(const PilOptions& base, const std::string& format, const std::string& disc) {
-  const std::string variant = format + "_" + disc;
+nlohmann::json c_job_only_image(const PilOptions& base, const std::string& variant) {
   PilOptions p = base;
   const std::string dir = std::filesystem::path(firmware_image_path(p)).parent_path().string();
   const std::string image = dir + "/oneshot-" + base.target + "-cjob-" + variant + ".elf";
@@ -109,8 +124,9 @@ nlohmann::json c_job_only_image(const PilOptions& base, const std::string& forma
     j["stack_bound_bytes"] = bound;
     j["ram_total_bound_bytes"] = ram + bound;
   }
-  j["flash_target_bytes"] = 12 * 1024;
-  j["ram_target_bytes"] = 1024;
+  const bool q15 = variant.rfind("q15_", 0) == 0;  // issue 25: the 16-bit job's tighter budget
+  j["flash_target_bytes"] = q15 ? 6 * 1024 : 12 * 1024;
+  j["ram_target_bytes"] = q15 ? 512 : 1024;
   return j;
 }
 
@@ -246,8 +262,13 @@ nlohmann::json run_exectime_target(const SimContext& ctx, const CommonOptions& o
       std::vector<std::uint32_t> approaches = {static_cast<std::uint32_t>(Approach::kB),
                                                static_cast<std::uint32_t>(Approach::kC)};
       if (c_job) approaches.push_back(kCJobApproach);
+      // Fixed-point table images also carry the q15 C job (approach 6), whose oracle is the
+      // same C compiled into this program.
+      const bool q15 = c_job && std::string(format) == "fixed" && HostCJobQ15::available();
+      if (q15) approaches.push_back(kCJobQ15Approach);
       std::vector<std::vector<std::uint8_t>> replies_b;
       std::size_t c_job_identical = 0;
+      std::size_t q15_identical = 0;
       for (std::uint32_t a : approaches) {
         app::pil::Frame cfg;
         app::pil::Writer cw(cfg);
@@ -256,6 +277,12 @@ nlohmann::json run_exectime_target(const SimContext& ctx, const CommonOptions& o
         // Initial PWM code: the one nearest 0 V, as in simulate().
         cw.u(static_cast<std::uint32_t>(std::lround(-ctx.design().u_min[0] * ctx.design().steps_per_volt[0])), 2);
         link.request(app::pil::Type::kConfig, cfg);
+        std::unique_ptr<HostCJobQ15> host_q15;
+        if (a == kCJobQ15Approach) {
+          host_q15 = std::make_unique<HostCJobQ15>(
+              std::string(disc) == "nearest",
+              static_cast<std::uint16_t>(std::lround(-ctx.design().u_min[0] * ctx.design().steps_per_volt[0])));
+        }
         for (const JobRecord& r : jobs) {
           app::pil::Frame f;
           app::pil::Writer w(f);
@@ -268,6 +295,15 @@ nlohmann::json run_exectime_target(const SimContext& ctx, const CommonOptions& o
           if (a == static_cast<std::uint32_t>(Approach::kB)) replies_b.push_back(bytes);
           // Same inputs, same job: status, τ, saturation, estimate, gain and applied input byte for byte.
           if (a == kCJobApproach && bytes == replies_b.at(static_cast<std::size_t>(&r - jobs.data()))) ++c_job_identical;
+          if (host_q15) {
+            // The MCU's τ (from its timer) and the same codes through the host-compiled C.
+            app::pil::Reader head(reply);
+            head.u(1);
+            const std::int32_t tau = head.s(4);
+            const std::vector<std::int32_t> host = host_q15->run(tau, static_cast<std::uint16_t>(r.y_code),
+                                                                 static_cast<std::uint16_t>(r.setpoint_code));
+            if (host == reply_values(reply, ctx.plant().n())) ++q15_identical;
+          }
         }
       }
       const std::vector<std::uint64_t> counts = link.instruction_counts();
@@ -284,8 +320,9 @@ nlohmann::json run_exectime_target(const SimContext& ctx, const CommonOptions& o
         const Summary s = summarize(per_job);
         double total = 0;
         for (double x : per_job) total += x;
-        const std::string name =
-            std::string(v == 0 ? "half" : v == 1 ? "complete" : "c99_half") + "_" + disc + "_" + format;
+        const bool is_q15 = approaches[v] == kCJobQ15Approach;
+        const std::string name = std::string(v == 0 ? "half" : v == 1 ? "complete" : "c99_half") + "_" + disc + "_" +
+                                 (is_q15 ? "q15" : format);
         j["variants"][name] = {{"instructions_per_job", s.mean},
                                {"instructions_per_job_min", *std::min_element(per_job.begin(), per_job.end())},
                                {"instructions_per_job_max", *std::max_element(per_job.begin(), per_job.end())},
@@ -294,7 +331,13 @@ nlohmann::json run_exectime_target(const SimContext& ctx, const CommonOptions& o
                                {"ram_bytes", ram},
                                {"stack_peak_bytes", stack},
                                {"image", link.image()}};
-        if (v == 2) {
+        if (is_q15) {
+          j["variants"][name]["noise_model"] = "exact";
+          j["variants"][name]["bit_identical_to_host_c_job"] = q15_identical;
+          j["variants"][name]["jobs"] = jobs.size();
+          j["variants"][name]["job_only_image"] = c_job_only_image(base, std::string("q15_") + disc);
+          j["variants"][name]["instructions_target"] = 1000;
+        } else if (v == 2) {
           // The C job always predicts with the exact Q_d(τ): compared with B only under that model.
           j["variants"][name]["noise_model"] = "exact";
           if (opt.noise == NoiseModel::kExact) {
@@ -303,7 +346,7 @@ nlohmann::json run_exectime_target(const SimContext& ctx, const CommonOptions& o
             j["variants"][name]["note"] = "B ran with the constant Q: use --noise-model exact to compare";
           }
           j["variants"][name]["jobs"] = jobs.size();
-          j["variants"][name]["job_only_image"] = c_job_only_image(base, format, disc);
+          j["variants"][name]["job_only_image"] = c_job_only_image(base, std::string(format) + "_" + disc);
         }
       }
       j["marker_overhead_instructions"] = overhead;

@@ -3,7 +3,9 @@
 #include "oneshot/sim/simulation.hpp"
 
 #include "board_loop.hpp"
+#include "c_job_driver.hpp"
 #include "control_drivers.hpp"
+#include "oneshot_job.h"  // the generated C99 job, compiled into this build (oneshot_c_job)
 
 #include <cmath>
 #include <cstring>
@@ -35,6 +37,7 @@ const char* to_string(NumberFormat f) {
     case NumberFormat::kFloat: return "float";
     case NumberFormat::kDouble: return "double";
     case NumberFormat::kFixed: return "fixed";
+    case NumberFormat::kQ15: return "q15";
   }
   return "?";
 }
@@ -207,6 +210,46 @@ RunResult simulate_pil(const SimContext& ctx, const Scenario& scenario, std::uin
   throw std::invalid_argument(std::string("no firmware number format ") + to_string(opt.format));
 }
 
+#if defined(ONESHOT_JOB_HAS_Q15_TABLE) && defined(ONESHOT_JOB_HAS_Q15_NEAREST) && ONESHOT_JOB_INPUTS == 1
+#define ONESHOT_SIM_Q15_TRAITS(Name, prefix, up)                                                \
+  struct Name {                                                                                 \
+    using State = prefix##t;                                                                    \
+    static constexpr bool kFixed = true;                                                        \
+    static constexpr int kStateFrac = up##_STATE_FRAC_BITS;                                     \
+    static constexpr int kGainFrac = up##_GAIN_FRAC_BITS;                                       \
+    static constexpr int kInputFrac = up##_INPUT_FRAC_BITS;                                     \
+    static void init(State* s, std::uint16_t code) { prefix##init(s, code); }                   \
+    static std::uint16_t run(State* s, std::int32_t tau, std::uint16_t adc, std::uint16_t sp) { \
+      return prefix##run(s, tau, adc, sp);                                                      \
+    }                                                                                           \
+  };
+ONESHOT_SIM_Q15_TRAITS(Q15Table, oneshot_job_q15_table_, ONESHOT_JOB_Q15_TABLE)
+ONESHOT_SIM_Q15_TRAITS(Q15Nearest, oneshot_job_q15_nearest_, ONESHOT_JOB_Q15_NEAREST)
+#define ONESHOT_SIM_HAS_Q15 1
+#endif
+
+/// simulate() of approach B as the generated q15 C job (the code the MCU images run).
+RunResult simulate_q15(const SimContext& ctx, const Scenario& scenario, std::uint64_t seed, const RunOptions& opt) {
+  if (!ctx.generated()) {
+    throw std::invalid_argument("--number-format q15 runs the generated C job of the compiled-in plant: run without --plant");
+  }
+  if (opt.noise != NoiseModel::kExact) throw std::invalid_argument("the q15 C job predicts with the exact Q_d: --noise-model exact");
+  if (opt.discretizer == DiscretizerKind::kGeneric) throw std::invalid_argument("the q15 C job uses the table: --discretizer table or nearest");
+#ifdef ONESHOT_SIM_HAS_Q15
+  using S = generated::PlantStructure;
+  if (opt.discretizer == DiscretizerKind::kNearest) {
+    CJobDriver<Q15Nearest, S::kStates> d;
+    return run_board_loop<S::kStates, 1, 1, app::TaskModel::kOneShot>(ctx, scenario, seed, opt, d);
+  }
+  CJobDriver<Q15Table, S::kStates> d;
+  return run_board_loop<S::kStates, 1, 1, app::TaskModel::kOneShot>(ctx, scenario, seed, opt, d);
+#else
+  static_cast<void>(scenario);
+  static_cast<void>(seed);
+  throw std::invalid_argument("this plant's generated C job has no q15 variant (single input, fixed-point design needed)");
+#endif
+}
+
 }  // namespace
 
 bool approach_available(const SimContext& ctx, Approach a) { return a != Approach::kE || ctx.design().deadbeat; }
@@ -218,6 +261,13 @@ RunResult simulate(const SimContext& ctx, const Scenario& scenario, std::uint64_
                                 " is unavailable for this plant: " + ctx.design().deadbeat_unavailable_reason);
   }
   if (options.pil != nullptr) return simulate_pil(ctx, scenario, seed, options);
+  if (options.format == NumberFormat::kQ15) {
+    // The q15 C job is B's job; the other approaches run as the double oracle beside it.
+    if (options.approach == Approach::kB) return simulate_q15(ctx, scenario, seed, options);
+    RunOptions d = options;
+    d.format = NumberFormat::kDouble;
+    return simulate(ctx, scenario, seed, d);
+  }
   return with_controller_parts(ctx, options, [&](auto structure, auto model, const auto& design, const auto& estimator) {
     using Design = std::decay_t<decltype(design)>;
     using Ctrl = Controller<typename Design::Format, typename decltype(structure)::type, std::decay_t<decltype(estimator)>>;

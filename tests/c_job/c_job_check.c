@@ -1,4 +1,5 @@
-/* The generated C job against the C++ core, compiled by the host C compiler as strict C99
+/* The generated C job against the C++ core (the q15 variants: against the same C compiled into
+ * the reference writer, with other flags), compiled by the host C compiler as strict C99
  * (-std=c99 -pedantic -Wall -Wextra -Wconversion -Werror): every job of the reference file
  * must give the same PWM code, status, saturation flag, estimate, gain and applied input,
  * bit for bit. Usage: c_job_check REFERENCE_FILE */
@@ -63,6 +64,12 @@ DEFINE_CHECK(float_table, FLT)
 #if defined(ONESHOT_JOB_HAS_FLOAT_NEAREST)
 DEFINE_CHECK(float_nearest, FLT)
 #endif
+#if defined(ONESHOT_JOB_HAS_Q15_TABLE)
+DEFINE_CHECK(q15_table, FIX)
+#endif
+#if defined(ONESHOT_JOB_HAS_Q15_NEAREST)
+DEFINE_CHECK(q15_nearest, FIX)
+#endif
 
 int main(int argc, char **argv) {
   static ref_file_t ref;
@@ -92,6 +99,12 @@ int main(int argc, char **argv) {
 #endif
 #if defined(ONESHOT_JOB_HAS_FLOAT_NEAREST)
     if (strcmp(r->name, "float_nearest") == 0) bad = check_float_nearest(r, statuses, &saturated);
+#endif
+#if defined(ONESHOT_JOB_HAS_Q15_TABLE)
+    if (strcmp(r->name, "q15_table") == 0) bad = check_q15_table(r, statuses, &saturated);
+#endif
+#if defined(ONESHOT_JOB_HAS_Q15_NEAREST)
+    if (strcmp(r->name, "q15_nearest") == 0) bad = check_q15_nearest(r, statuses, &saturated);
 #endif
     if (bad < 0) {
       fprintf(stderr, "variant %s: not in the generated job\n", r->name);

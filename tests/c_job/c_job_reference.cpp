@@ -1,7 +1,9 @@
 /// @file c_job_reference.cpp
 /// @brief Reference job sequences for the generated C job: the C++ core (approach B: half
 ///        Kalman, one-shot controller, table discretizer, exact Q_d) run on long random τ /
-///        ADC / set-point sequences, every output written bit for bit.
+///        ADC / set-point sequences, every output written bit for bit; for the q15 variants
+///        (no C++ twin) the generated C itself compiled into this program, checked against the
+///        double core on the same inputs within stated tolerances.
 ///
 /// Usage: c_job_reference OUT_FILE JOBS_PER_VARIANT [SEED]
 /// Per variant the file holds "variant NAME JOBS PWM0", then one line per job:
@@ -12,7 +14,9 @@
 /// τ off the table's range (negative, beyond h and 4h, huge), exact grid points, garbage
 /// ADC codes and extreme set-points, so that every branch (clamp, extension, saturation)
 /// is exercised.
+#include <algorithm>
 #include <cmath>
+#include <cstdlib>
 #include <cstdint>
 #include <cstdio>
 #include <cstring>
@@ -25,6 +29,7 @@
 #include "oneshot/generic_discretizer.hpp"
 #include "oneshot/half_kalman.hpp"
 #include "oneshot/table_discretizer.hpp"
+#include "oneshot_job.h"  // the generated C job: its q15 variants are their own oracle
 
 namespace {
 
@@ -69,48 +74,26 @@ struct Plant {
   }
 };
 
-template <typename Tag, SubGrid kSub>
-void run_variant(std::FILE* out, const char* name, int jobs, std::uint64_t seed) {
-  using K = generated::PlantConstants<Tag>;
-  using Fmt = typename K::Format;
-  using Storage = typename StorageOf<std::remove_cv_t<decltype(K::kTable)>>::type;
-  using Disc = TableDiscretizer<Fmt, Structure, Storage, OutOfRange::kExtend, kSub>;
-  using Est = HalfKalman<Fmt, Structure, Disc>;
-  using Ctrl = Controller<Fmt, Structure, Est>;
+/// The closed-loop job sequence: the reference plant (exact double model, process and
+/// measurement noise) under a jittered one-shot task, interleaved with stress jobs (τ off the
+/// table's range, exact grid points, garbage ADC codes, extreme set-points).
+class JobSequence {
+ public:
   using KD = generated::PlantConstants<double>;
-  const auto& design = KD::kDesign;
-  const std::int32_t h = design.period_us;
-  const std::int32_t g = K::kTable.granularity_us;
-  const std::int32_t steps = design.actuator.steps;
-  const Disc disc(K::kTable);
-  Ctrl ctrl(K::kDesign, Est(K::kDesign, disc, NoiseModel::kExact));
-  std::mt19937_64 rng(seed);
-  const auto uniform = [&](double a, double b) { return a + (b - a) * (static_cast<double>(rng() >> 11) * 0x1p-53); };
-  const auto integer = [&](std::int64_t a, std::int64_t b) {  // inclusive
-    return a + static_cast<std::int64_t>(rng() % static_cast<std::uint64_t>(b - a + 1));
-  };
-  std::normal_distribution<double> normal(0.0, 1.0);
-  const double lsb = design.sensor.volts_per_code[0];
-  const double y0 = design.sensor.y_offset[0];
-  const auto code_of = [&](double v) {
-    const double c = std::round((v - y0) / lsb);
-    return static_cast<std::int32_t>(std::min(4095.0, std::max(0.0, c)));
-  };
-  const std::int32_t pwm0 = static_cast<std::int32_t>(std::lround(-design.actuator.u_min[0] * design.actuator.steps_per_volt[0]));
-  typename Ctrl::InputVec u0;
-  u0[0] = input_of_code(K::kDesign.actuator, 0, pwm0);
-  ctrl.estimator().reset(typename Ctrl::StateVec{}, K::kDesign.p0, u0);
-  std::fprintf(out, "variant %s %d %d\n", name, jobs, pwm0);
-
-  Plant plant;
-  double u_volts = design.actuator.u_min[0] + pwm0 * design.actuator.volts_per_step[0];
-  double setpoint = 0;
-  const double rn = std::sqrt(design.r(0, 0));
-  for (int k = 0; k < jobs; ++k) {
-    if (k % 20 == 0) setpoint = uniform(-0.5, 0.5);
+  JobSequence(std::uint64_t seed, bool nearest) : rng_(seed), nearest_(nearest) {
+    u_volts_ = design().actuator.u_min[0] + pwm0() * design().actuator.volts_per_step[0];
+  }
+  static const auto& design() { return KD::kDesign; }
+  /// The PWM code nearest 0 V (the initial input).
+  static std::int32_t pwm0() {
+    return static_cast<std::int32_t>(std::lround(-design().actuator.u_min[0] * design().actuator.steps_per_volt[0]));
+  }
+  /// The next job's τ, ADC and set-point codes (the plant advanced to its sampling instant).
+  void next(std::int32_t g, std::int32_t& tau, std::int32_t& adc, std::int32_t& sp) {
+    const std::int32_t h = design().period_us;
+    if (k_++ % 20 == 0) setpoint_ = uniform(-0.5, 0.5);
     // τ of a one-shot job released 0–20 ms after the previous actuation (B's regime), mostly;
     // otherwise anywhere in the table, on its grid, or outside it.
-    std::int32_t tau = 0;
     const int kind = static_cast<int>(integer(0, 99));
     if (kind < 60) {
       tau = static_cast<std::int32_t>(integer(h - 20'000 - 600, h - 200));
@@ -127,34 +110,173 @@ void run_variant(std::FILE* out, const char* name, int jobs, std::uint64_t seed)
     }
     // The C++ core's nearest policy leaves τ ≤ 0 unrounded and then asserts that h − τ is on
     // the grid: a negative τ is only valid there on the grid.
-    if constexpr (kSub == SubGrid::kNearest) {
-      if (tau < 0) tau = -static_cast<std::int32_t>(((-static_cast<std::int64_t>(tau)) / g) * g);
+    if (nearest_ && tau < 0) tau = -static_cast<std::int32_t>(((-static_cast<std::int64_t>(tau)) / g) * g);
+    physical_ = std::min(h, std::max<std::int32_t>(0, tau));
+    plant_.advance(h - physical_, u_volts_);
+    for (std::size_t i = 0; i < kN; ++i) plant_.x[i] += 1e-4 * normal_(rng_);
+    adc = code_of(plant_.x[0] + std::sqrt(design().r(0, 0)) * normal_(rng_));
+    sp = code_of(setpoint_);
+    stress_ = integer(0, 99) < 3;
+    if (stress_) adc = static_cast<std::int32_t>(integer(0, 4095));  // garbage samples
+    if (integer(0, 199) == 0) {
+      sp = integer(0, 1) != 0 ? 4095 : 0;  // extreme set-points
+      stress_ = true;
     }
-    const std::int32_t physical = std::min(h, std::max<std::int32_t>(0, tau));
-    plant.advance(h - physical, u_volts);
-    for (std::size_t i = 0; i < kN; ++i) plant.x[i] += 1e-4 * normal(rng);
-    std::int32_t adc = code_of(plant.x[0] + rn * normal(rng));
-    std::int32_t sp = code_of(setpoint);
-    if (integer(0, 99) < 3) adc = static_cast<std::int32_t>(integer(0, 4095));  // garbage samples
-    if (integer(0, 199) == 0) sp = integer(0, 1) != 0 ? 4095 : 0;             // extreme set-points
+  }
+  /// The job's PWM code takes effect at the actuation instant.
+  void apply(std::int32_t code) {
+    plant_.advance(physical_, u_volts_);
+    u_volts_ = design().actuator.u_min[0] + code * design().actuator.volts_per_step[0];
+    if (code < 0 || code > design().actuator.steps) std::fprintf(stderr, "c_job_reference: code out of range\n");
+  }
+  /// True state at the actuation instant (after apply()).
+  const Vector<double, kN>& state() const { return plant_.x; }
+  /// This job's inputs were a stress case (garbage sample, extreme set-point).
+  bool stress() const { return stress_; }
+
+ private:
+  double uniform(double a, double b) { return a + (b - a) * (static_cast<double>(rng_() >> 11) * 0x1p-53); }
+  std::int64_t integer(std::int64_t a, std::int64_t b) {  // inclusive
+    return a + static_cast<std::int64_t>(rng_() % static_cast<std::uint64_t>(b - a + 1));
+  }
+  static std::int32_t code_of(double v) {
+    const double c = std::round((v - design().sensor.y_offset[0]) / design().sensor.volts_per_code[0]);
+    return static_cast<std::int32_t>(std::min(4095.0, std::max(0.0, c)));
+  }
+  std::mt19937_64 rng_;
+  bool nearest_;
+  std::normal_distribution<double> normal_{0.0, 1.0};
+  Plant plant_;
+  double u_volts_ = 0;
+  double setpoint_ = 0;
+  std::int32_t physical_ = 0;
+  int k_ = 0;
+  bool stress_ = false;
+};
+
+/// The C++ core's approach-B controller in format Tag.
+template <typename Tag, SubGrid kSub>
+struct CoreJob {
+  using K = generated::PlantConstants<Tag>;
+  using Fmt = typename K::Format;
+  using Storage = typename StorageOf<std::remove_cv_t<decltype(K::kTable)>>::type;
+  using Disc = TableDiscretizer<Fmt, Structure, Storage, OutOfRange::kExtend, kSub>;
+  using Est = HalfKalman<Fmt, Structure, Disc>;
+  using Ctrl = Controller<Fmt, Structure, Est>;
+  Disc disc{K::kTable};
+  Ctrl ctrl{K::kDesign, Est(K::kDesign, disc, NoiseModel::kExact)};
+  CoreJob() {
+    typename Ctrl::InputVec u0;
+    u0[0] = input_of_code(K::kDesign.actuator, 0, JobSequence::pwm0());
+    ctrl.estimator().reset(typename Ctrl::StateVec{}, K::kDesign.p0, u0);
+  }
+  Status run(std::int32_t tau, std::int32_t adc, std::int32_t sp, std::int32_t& code) {
     typename Ctrl::OutputVec y;
     typename Ctrl::OutputVec r;
     y[0] = output_of_code(K::kDesign.sensor, 0, adc);
     r[0] = output_of_code(K::kDesign.sensor, 0, sp);
     std::int32_t codes[kM] = {};
+    const Status s = ctrl.job(tau, y, r, codes);
+    code = codes[0];
+    return s;
+  }
+};
+
+template <typename Tag, SubGrid kSub>
+void run_variant(std::FILE* out, const char* name, int jobs, std::uint64_t seed) {
+  CoreJob<Tag, kSub> job;
+  JobSequence seq(seed, kSub == SubGrid::kNearest);
+  std::fprintf(out, "variant %s %d %d\n", name, jobs, JobSequence::pwm0());
+  for (int k = 0; k < jobs; ++k) {
+    std::int32_t tau = 0, adc = 0, sp = 0, code = 0;
+    seq.next(CoreJob<Tag, kSub>::K::kTable.granularity_us, tau, adc, sp);
     clear_saturation_flag();
-    const Status status = ctrl.job(tau, y, r, codes);
+    const Status status = job.run(tau, adc, sp, code);
     const bool saturated = saturation_flag();
-    std::fprintf(out, "%ld %d %d | %d %d %d", static_cast<long>(tau), adc, sp, codes[0], static_cast<int>(status),
+    std::fprintf(out, "%ld %d %d | %d %d %d", static_cast<long>(tau), adc, sp, code, static_cast<int>(status),
                  saturated ? 1 : 0);
-    for (std::size_t i = 0; i < kN; ++i) std::fprintf(out, " %lld", raw_bits(ctrl.estimator().prediction()[i]));
-    for (std::size_t i = 0; i < kN; ++i) std::fprintf(out, " %lld", raw_bits(ctrl.estimator().gain()(i, 0)));
-    std::fprintf(out, " %lld\n", raw_bits(ctrl.applied_input()[0]));
-    plant.advance(physical, u_volts);
-    u_volts = design.actuator.u_min[0] + codes[0] * design.actuator.volts_per_step[0];
-    if (codes[0] < 0 || codes[0] > steps) std::fprintf(stderr, "c_job_reference: code out of range\n");
+    for (std::size_t i = 0; i < kN; ++i) std::fprintf(out, " %lld", raw_bits(job.ctrl.estimator().prediction()[i]));
+    for (std::size_t i = 0; i < kN; ++i) std::fprintf(out, " %lld", raw_bits(job.ctrl.estimator().gain()(i, 0)));
+    std::fprintf(out, " %lld\n", raw_bits(job.ctrl.applied_input()[0]));
+    seq.apply(code);
   }
 }
+
+/// e^T P^-1 e for n = 2 (NEES); 0 when P is not positive definite.
+double nees2(const double e[2], double p00, double p01, double p11) {
+  const double det = p00 * p11 - p01 * p01;
+  return det > 0 ? (p11 * e[0] * e[0] - 2 * p01 * e[0] * e[1] + p00 * e[1] * e[1]) / det : 0.0;
+}
+
+#if defined(ONESHOT_JOB_HAS_Q15_TABLE) && defined(ONESHOT_JOB_HAS_Q15_NEAREST) && ONESHOT_JOB_INPUTS == 1
+/// Tolerances of the q15 job against the double core on the same inputs, in the regular regime
+/// (0 <= τ <= h, no stress input in the last 20 jobs): a few times the deviation measured on
+/// 4000 jobs per variant (README, "The C99 job"): estimate 3.6 mV, PWM code 2 steps.
+constexpr double kQ15EstimateTolVolts = 0.01;
+constexpr int kQ15CodeTol = 6;
+
+/// One q15 variant: the generated C drives the loop (written raw like the fixed variants); the
+/// double core runs beside it on the same τ and codes.
+template <typename St, SubGrid kSub, typename Init, typename Run>
+bool run_q15(std::FILE* out, const char* name, int jobs, std::uint64_t seed, Init init, Run run, int state_frac,
+             int cov_frac) {
+  static_assert(kN == 2, "the NEES summary is written for two states");
+  St s{};
+  init(&s, static_cast<std::uint16_t>(JobSequence::pwm0()));
+  CoreJob<double, kSub> twin;
+  JobSequence seq(seed, kSub == SubGrid::kNearest);
+  std::fprintf(out, "variant %s %d %d\n", name, jobs, JobSequence::pwm0());
+  const std::int32_t h = JobSequence::design().period_us;
+  double max_dx = 0, nees_q15 = 0, nees_double = 0;
+  int max_dcode = 0, regular = 0, since_stress = 0;
+  for (int k = 0; k < jobs; ++k) {
+    std::int32_t tau = 0, adc = 0, sp = 0, twin_code = 0;
+    seq.next(CoreJob<generated::FixedTag, kSub>::K::kTable.granularity_us, tau, adc, sp);
+    s.saturated = 0u;
+    const std::int32_t code = run(&s, tau, static_cast<std::uint16_t>(adc), static_cast<std::uint16_t>(sp));
+    twin.run(tau, adc, sp, twin_code);
+    std::fprintf(out, "%ld %d %d | %d %d %d", static_cast<long>(tau), adc, sp, code, static_cast<int>(s.status),
+                 static_cast<int>(s.saturated));
+    for (std::size_t i = 0; i < kN; ++i) std::fprintf(out, " %lld", static_cast<long long>(s.x[i]));
+    for (std::size_t i = 0; i < kN; ++i) std::fprintf(out, " %lld", static_cast<long long>(s.k[i]));
+    std::fprintf(out, " %lld\n", static_cast<long long>(s.u[0]));
+    seq.apply(code);
+    since_stress = seq.stress() || tau < 0 || tau > h ? 0 : since_stress + 1;
+    if (since_stress < 20) continue;
+    ++regular;
+    double e_q[2], e_d[2];
+    for (std::size_t i = 0; i < kN; ++i) {
+      const double xq = std::ldexp(static_cast<double>(s.x[i]), -state_frac);
+      const double xd = twin.ctrl.estimator().prediction()[i];
+      max_dx = std::max(max_dx, std::fabs(xq - xd));
+      e_q[i] = seq.state()[i] - xq;
+      e_d[i] = seq.state()[i] - xd;
+    }
+    max_dcode = std::max(max_dcode, std::abs(code - twin_code));
+    const auto cov = [&](int k2) { return std::ldexp(static_cast<double>(s.p[k2]), -cov_frac); };
+    nees_q15 += nees2(e_q, cov(0), cov(1), cov(2));
+    const auto& pd = twin.ctrl.estimator().covariance();
+    nees_double += nees2(e_d, pd(0, 0), pd(0, 1), pd(1, 1));
+  }
+  std::printf("%s vs double core (%d regular jobs): max |estimate difference| %.3g V (tolerance %.3g), max |PWM code "
+              "difference| %d (tolerance %d); mean NEES q15 %.3f, double %.3f (2 = consistent)\n",
+              name, regular, max_dx, kQ15EstimateTolVolts, max_dcode, kQ15CodeTol,
+              regular > 0 ? nees_q15 / regular : 0.0, regular > 0 ? nees_double / regular : 0.0);
+  return regular > 0 && max_dx <= kQ15EstimateTolVolts && max_dcode <= kQ15CodeTol;
+}
+
+bool run_q15_variants(std::FILE* out, int jobs, std::uint64_t seed) {
+  const bool a = run_q15<oneshot_job_q15_table_t, SubGrid::kExact>(
+      out, "q15_table", jobs, seed, oneshot_job_q15_table_init, oneshot_job_q15_table_run,
+      ONESHOT_JOB_Q15_TABLE_STATE_FRAC_BITS, ONESHOT_JOB_Q15_TABLE_COVARIANCE_FRAC_BITS);
+  const bool b = run_q15<oneshot_job_q15_nearest_t, SubGrid::kNearest>(
+      out, "q15_nearest", jobs, seed + 1, oneshot_job_q15_nearest_init, oneshot_job_q15_nearest_run,
+      ONESHOT_JOB_Q15_NEAREST_STATE_FRAC_BITS, ONESHOT_JOB_Q15_NEAREST_COVARIANCE_FRAC_BITS);
+  return a && b;
+}
+#else
+bool run_q15_variants(std::FILE*, int, std::uint64_t) { return true; }  // no q15 variant for this plant
+#endif
 
 }  // namespace
 
@@ -181,6 +303,7 @@ int main(int argc, char** argv) {
 #endif
   run_variant<float, SubGrid::kExact>(out, "float_table", jobs, seed + 2);
   run_variant<float, SubGrid::kNearest>(out, "float_nearest", jobs, seed + 3);
+  if (!run_q15_variants(out, jobs, seed + 4)) return 1;
   const bool ok = std::fclose(out) == 0;
   return ok ? 0 : 1;
 }

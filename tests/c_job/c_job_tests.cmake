@@ -1,7 +1,10 @@
 # The generated C99 job (lut_gen --c-job-dir) against the C++ core, bit for bit:
-#   CJob.Reference                 the C++ core writes long random job sequences (fixture)
+#   CJob.Reference                 the C++ core writes long random job sequences (fixture); the
+#                                  q15 variants' sequences come from the generated C itself, and
+#                                  must stay within stated tolerances of the double core
 #   CJob.HostGccBitIdentical       the job compiled by the host C compiler as strict C99
 #   CJob.DivisionFreeReciprocal    the reciprocal without division against the core's algorithm
+#   CJob.Q15Arithmetic             the q15 variant's saturation, reciprocal and rounding rules
 #   CJob.AvrSimavrBitIdentical     the job compiled by avr-gcc (16-bit int) and run in simavr,
 #                                  with the cycles per job
 set(c_job_dir ${ONESHOT_GENERATED_DIR}/oneshot_c)
@@ -10,12 +13,13 @@ set(c_job_ref ${CMAKE_CURRENT_BINARY_DIR}/c_job_reference.txt)
 set(c_job_strict -pedantic -Wall -Wextra -Wconversion -Werror)
 
 add_executable(c_job_reference c_job/c_job_reference.cpp)
-target_link_libraries(c_job_reference PRIVATE oneshot_plant oneshot_host_port)
+target_link_libraries(c_job_reference PRIVATE oneshot_plant oneshot_host_port oneshot_c_job)
 oneshot_warnings(c_job_reference)
 
 add_executable(c_job_check c_job/c_job_check.c ${c_job_dir}/oneshot_job.c)
 add_executable(c_job_division_check c_job/c_job_division_check.c)
-foreach(t c_job_check c_job_division_check)
+add_executable(c_job_q15_check c_job/c_job_q15_check.c)
+foreach(t c_job_check c_job_division_check c_job_q15_check)
   set_target_properties(${t} PROPERTIES C_STANDARD 99 C_STANDARD_REQUIRED ON C_EXTENSIONS OFF)
   target_include_directories(${t} PRIVATE ${c_job_dir} ${CMAKE_CURRENT_SOURCE_DIR}/c_job)
   target_compile_options(${t} PRIVATE ${c_job_strict})
@@ -27,6 +31,8 @@ set_tests_properties(CJob.Reference PROPERTIES FIXTURES_SETUP c_job_reference TI
 add_test(NAME CJob.HostGccBitIdentical COMMAND c_job_check ${c_job_ref})
 set_tests_properties(CJob.HostGccBitIdentical PROPERTIES FIXTURES_REQUIRED c_job_reference TIMEOUT 120)
 add_test(NAME CJob.DivisionFreeReciprocal COMMAND c_job_division_check)
+add_test(NAME CJob.Q15Arithmetic COMMAND c_job_q15_check)
+set_tests_properties(CJob.Q15Arithmetic PROPERTIES TIMEOUT 60)
 set_tests_properties(CJob.DivisionFreeReciprocal PROPERTIES TIMEOUT 120)
 
 # avr-gcc + simavr: required by the ci preset (ONESHOT_REQUIRE_AVR), skipped elsewhere when missing.

@@ -153,7 +153,7 @@ TEST_P(PilLinkTest, TheGeneratedCJobIsRefusedByAnImageWithoutIt) {
   PilLink link(o);
   pil::Frame cfg;
   pil::Writer w(cfg);
-  w.u(pil::kMaxApproach, 1);
+  w.u(pil::kCJobApproach, 1);
   w.u(1, 1);
   w.u(2000, 2);
   EXPECT_NE(refusal(link, pil::Type::kConfig, cfg).find("refused a malformed request"), std::string::npos);

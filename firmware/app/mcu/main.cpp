@@ -23,7 +23,8 @@
 #include "oneshot/mcu/rx_ring.hpp"
 #include "oneshot/standard_kalman.hpp"
 #include "oneshot/table_discretizer.hpp"
-#include "oneshot_job.h"  // the generated C99 job (lut_gen --c-job-dir), approach 5
+#include "oneshot_job.h"  // the generated C99 job (lut_gen --c-job-dir), approaches 5 and 6
+#include "c_job_loop.hpp"
 
 #if defined(ONESHOT_MCU_NRF51)
 #include "oneshot/mcu/nrf51.hpp"
@@ -145,88 +146,44 @@ struct Loop {
   }
 };
 
-// The generated C99 job of this image's format and sub-grid policy, as approach 5: the same
-// job as B (half Kalman, one-shot) behind the same task interface, for instruction counts and
-// the comparison with the C++ job on the MCU (table images, when the plant has that variant).
+// The generated C99 jobs: approach 5 is the job of this image's format and sub-grid policy
+// (B's job behind the same task interface, for instruction counts and the comparison with the
+// C++ job on the MCU), approach 6 its 16-bit q15 twin (fixed-point table images).
+#define ONESHOT_CJOB_TRAITS(Name, prefix, fixed)                                             \
+  struct Name {                                                                              \
+    using State = prefix##t;                                                                 \
+    static constexpr bool kFixed = fixed;                                                    \
+    static void init(State* s, std::uint16_t code) { prefix##init(s, code); }                \
+    static std::uint16_t run(State* s, std::int32_t tau, std::uint16_t adc, std::uint16_t sp) { \
+      return prefix##run(s, tau, adc, sp);                                                   \
+    }                                                                                        \
+  };
 #if ONESHOT_FW_FIXED && ONESHOT_FW_DISC == 2 && defined(ONESHOT_JOB_HAS_FIXED_NEAREST)
-#define ONESHOT_CJOB(name) oneshot_job_fixed_nearest_##name
+#define ONESHOT_CJOB 1
+ONESHOT_CJOB_TRAITS(CJobMain, oneshot_job_fixed_nearest_, true)
 #elif ONESHOT_FW_FIXED && ONESHOT_FW_DISC == 0 && defined(ONESHOT_JOB_HAS_FIXED_TABLE)
-#define ONESHOT_CJOB(name) oneshot_job_fixed_table_##name
+#define ONESHOT_CJOB 1
+ONESHOT_CJOB_TRAITS(CJobMain, oneshot_job_fixed_table_, true)
 #elif !ONESHOT_FW_FIXED && ONESHOT_FW_DISC == 2 && defined(ONESHOT_JOB_HAS_FLOAT_NEAREST)
-#define ONESHOT_CJOB(name) oneshot_job_float_nearest_##name
+#define ONESHOT_CJOB 1
+ONESHOT_CJOB_TRAITS(CJobMain, oneshot_job_float_nearest_, false)
 #elif !ONESHOT_FW_FIXED && ONESHOT_FW_DISC == 0 && defined(ONESHOT_JOB_HAS_FLOAT_TABLE)
-#define ONESHOT_CJOB(name) oneshot_job_float_table_##name
+#define ONESHOT_CJOB 1
+ONESHOT_CJOB_TRAITS(CJobMain, oneshot_job_float_table_, false)
 #endif
-#ifdef ONESHOT_CJOB
+#if ONESHOT_FW_FIXED && ONESHOT_FW_DISC == 2 && defined(ONESHOT_JOB_HAS_Q15_NEAREST)
+#define ONESHOT_CJOB_Q15 1
+ONESHOT_CJOB_TRAITS(CJobQ15, oneshot_job_q15_nearest_, true)
+#elif ONESHOT_FW_FIXED && ONESHOT_FW_DISC == 0 && defined(ONESHOT_JOB_HAS_Q15_TABLE)
+#define ONESHOT_CJOB_Q15 1
+ONESHOT_CJOB_TRAITS(CJobQ15, oneshot_job_q15_table_, true)
+#endif
 static_assert(kM == 1 && kP == 1, "the C job adapter serves one input and one output");
-
-struct CJobLoop {
-  ONESHOT_CJOB(t) state{};
-  struct Task {
-    CJobLoop* self;
-    volatile std::int32_t prepared = 0;  // shared with the interrupt
-    volatile bool ready = false;
-    app::TaskStatistics stats{};
-    Status run_job() {
-      const auto time = PilBoard::Time::snapshot();
-      const auto t_apply = time.next_actuation;
-      DurationUs tau_us = 0;
-      Status status = checked_duration(time.now, t_apply, -kMaxTauUs, kMaxTauUs, tau_us);
-      if (status != Status::kOk) tau_us = (t_apply - time.now) > 0 ? kMaxTauUs : -kMaxTauUs;
-      const auto adc = static_cast<std::uint16_t>(PilBoard::Adc::sample(0));
-      const auto sp = static_cast<std::uint16_t>(PilBoard::Setpoint::setpoint_code(0, t_apply));
-#if ONESHOT_FW_FIXED
-      const std::uint8_t saturated_before = self->state.saturated;
-      self->state.saturated = 0U;
+#ifdef ONESHOT_CJOB
+mcu::CJobLoop<CJobMain, PilBoard, kN> g_cjob;
 #endif
-      prepared = ONESHOT_CJOB(run)(&self->state, tau_us, adc, sp);
-      ready = true;
-      ++stats.jobs;
-      stats.last_tau_us = tau_us;
-      status = worst_of(status, static_cast<Status>(self->state.status));
-#if ONESHOT_FW_FIXED
-      // As ControlTask: this job's saturation is its status, the sticky flags keep their meaning.
-      if (self->state.saturated != 0U) {
-        status = worst_of(status, Status::kOverflow);
-        detail::g_saturated = true;  // the reply's flag, as for the C++ job
-      }
-      if (saturated_before != 0U) self->state.saturated = 1U;
-#endif
-      stats.last_status = status;
-      if (!is_exact(stats.last_status)) ++stats.faults;
-      return stats.last_status;
-    }
-    void on_actuation_interrupt() {
-      if (!ready) {
-        ++stats.overruns;
-        return;
-      }
-      PilBoard::Pwm::write_duty(0, prepared);
-      ready = false;
-    }
-    const app::TaskStatistics& statistics() const { return stats; }
-  } task{this};
-
-  void configure(const std::int32_t (&codes)[kM]) {
-    ONESHOT_CJOB(init)(&state, static_cast<std::uint16_t>(codes[0]));
-    task.ready = false;
-    task.stats = app::TaskStatistics{};
-  }
-  template <typename T>
-  static std::uint32_t raw(T v) {
-    if constexpr (std::is_floating_point_v<T>) {
-      return raw32(v);
-    } else {
-      return static_cast<std::uint32_t>(static_cast<std::int32_t>(v));
-    }
-  }
-  void results(pil::Writer& w) const {
-    w.u(raw(state.u[0]), 4);
-    for (std::size_t i = 0; i < kN; ++i) w.u(raw(state.x[i]), 4);
-    w.u(raw(state.k[0]), 4);
-  }
-};
-CJobLoop g_cjob;
+#ifdef ONESHOT_CJOB_Q15
+mcu::CJobLoop<CJobQ15, PilBoard, kN> g_cjob_q15;
 #endif
 
 using HalfEst = HalfKalman<Fmt, Structure, Disc>;
@@ -246,7 +203,7 @@ struct JobOutcome {
 };
 
 /// Approach letters A–E as 0–4: A, D standard Kalman; B half; C complete; E deadbeat; 5: the
-/// generated C99 job (B's job, table images only).
+/// generated C99 job (B's job, table images only); 6: its q15 twin (fixed table images).
 std::uint8_t g_approach = 1;
 volatile bool g_tick_done = false;
 mcu::RxRing g_rx;
@@ -283,6 +240,9 @@ decltype(auto) with_loop(F&& f) {
     case 4: return f(g_deadbeat);
 #ifdef ONESHOT_CJOB
     case 5: return f(g_cjob);
+#endif
+#ifdef ONESHOT_CJOB_Q15
+    case 6: return f(g_cjob_q15);
 #endif
     default: return f(g_standard);
   }
@@ -344,7 +304,10 @@ void handle(const pil::Frame& q, pil::Frame& r) {
       pil::ConfigRequest<kM> c;
       if (!pil::decode(q, c)) return malformed(r);
 #ifndef ONESHOT_CJOB
-      if (c.approach == pil::kMaxApproach) return malformed(r);  // no generated C job in this image
+      if (c.approach == pil::kCJobApproach) return malformed(r);  // no generated C job in this image
+#endif
+#ifndef ONESHOT_CJOB_Q15
+      if (c.approach == pil::kCJobQ15Approach) return malformed(r);  // no q15 C job in this image
 #endif
       const NoiseModel noise = c.exact_noise ? NoiseModel::kExact : NoiseModel::kConstant;
       g_approach = c.approach;
@@ -354,6 +317,9 @@ void handle(const pil::Frame& q, pil::Frame& r) {
       g_deadbeat.configure(DeadbeatEst(K::kDesign), c.codes);
 #ifdef ONESHOT_CJOB
       g_cjob.configure(c.codes);
+#endif
+#ifdef ONESHOT_CJOB_Q15
+      g_cjob_q15.configure(c.codes);
 #endif
       clear_saturation_flag();
       w.u(g_approach, 1);

@@ -291,6 +291,16 @@ void FixedArith::emit_helpers(CodeWriter& w) {
       .open("if (v < (int32_t)INT16_MIN) {").line("*sat = 1u;").line("return INT16_MIN;").close()
       .line("return (int16_t)v;")
       .close();
+  w.line("/* 16x16->32 product of the q15 variants: operands in 16-bit range held in int_fast16_t (a");
+  w.line("   register-width int on 32-bit cores, int16_t on 16- and 8-bit ones). */");
+  w.open("static inline int32_t os_q15_m(int_fast16_t a, int_fast16_t b) {").line("return (int32_t)a * (int32_t)b;").close();
+  w.line("/* 16-bit store of a 32-bit sum (q15 variants): one sign extension and one compare; out of");
+  w.line("   range it clamps and raises the sticky flag (narrowing is modulo: checked at compile time). */");
+  w.open("static inline int16_t os_q15_sat(int32_t v, uint8_t *sat) {")
+      .line("const int16_t t = (int16_t)v;")
+      .open("if ((int32_t)t != v) {").line("*sat = 1u;").line("return v > 0 ? INT16_MAX : INT16_MIN;").close()
+      .line("return t;")
+      .close();
   w.open("static inline int16_t os_sat16_64(int64_t v, uint8_t *sat) {")
       .open("if (v > (int64_t)INT16_MAX) {").line("*sat = 1u;").line("return INT16_MAX;").close()
       .open("if (v < (int64_t)INT16_MIN) {").line("*sat = 1u;").line("return INT16_MIN;").close()

@@ -66,8 +66,12 @@ class Arith {
   virtual ~Arith() = default;
   /// Fixed point (else float).
   virtual bool fixed() const = 0;
+  /// The 16-bit format with 32-bit accumulators (q15_arith.hpp); implies fixed().
+  virtual bool q15() const { return false; }
   /// C type holding quantity q.
   virtual std::string ctype(Qty q) const = 0;
+  /// C type of q in the per-interval scratch (Φ, Γ, Q_d of one interval); ctype unless faster.
+  virtual std::string scratch_ctype(Qty q) const { return ctype(q); }
   /// Format of q (fixed point).
   virtual QFormat fmt(Qty q) const = 0;
   /// Statements assigning dest = Accumulator<q> over `terms`, value().

@@ -20,7 +20,7 @@ void VariantEmitter::header(CodeWriter& w) const {
   const bool scalar = m_ == 1;
   std::string states;
   for (std::size_t i = 0; i < n_; ++i) states += (i ? ", " : "") + comment_text(plant_.states[i]);
-  w.line("/* ---- " + spec_.name + ": " + (fixed() ? "fixed point" : "IEEE single precision") + ", " +
+  w.line("/* ---- " + spec_.name + ": " + (ar().q15() ? "16-bit Q formats, 32-bit accumulators" : fixed() ? "fixed point" : "IEEE single precision") + ", " +
          (spec_.exact_subgrid ? "exact between grid points (table + residual polynomial)"
                               : "tau rounded to the nearest grid point") +
          " ---- */");
@@ -32,6 +32,8 @@ void VariantEmitter::header(CodeWriter& w) const {
     const auto frac = [&](Qty q) { return std::to_string(ar().fmt(q).frac); };
     w.line("/** Fractional bits of the estimate and the input: value = raw * 2^-bits (volts). */");
     w.line("#define " + up + "_STATE_FRAC_BITS " + frac(Qty::kState));
+    w.line("/** Fractional bits of the input s->u (volts). */");
+    w.line("#define " + up + "_INPUT_FRAC_BITS " + frac(Qty::kInput));
     w.line("/** Fractional bits of the covariance entries (volts squared). */");
     w.line("#define " + up + "_COVARIANCE_FRAC_BITS " + frac(Qty::kCovariance));
     w.line("/** Fractional bits of 1/S, the inverse innovation variance. */");
@@ -76,16 +78,28 @@ void VariantEmitter::source(CodeWriter& w) {
   w.line("/* ======== " + spec_.name + " ======== */");
   w.line("#ifndef ONESHOT_JOB_WITHOUT_" + upper(spec_.name));
   w.line("");
-  emit_table(w);
-  emit_triple(w);
-  emit_load(w);
-  if (spec_.exact_subgrid) emit_residual(w);
-  emit_identity(w);
-  emit_compose(w);
-  emit_in_range(w);
-  emit_discretize(w);
-  emit_predict(w);
-  if (fixed()) emit_reciprocal(w);
+  if (ar().q15()) {
+    emit_triple(w);
+    emit_q15_table(w);
+    emit_q15_interval(w);
+    emit_predict(w);
+    emit_q15_advance(w);
+  } else {
+    emit_table(w);
+    emit_triple(w);
+    emit_load(w);
+    if (spec_.exact_subgrid) emit_residual(w);
+    emit_identity(w);
+    emit_compose(w);
+    emit_in_range(w);
+    emit_discretize(w);
+    emit_predict(w);
+  }
+  if (ar().q15()) {
+    emit_q15_reciprocal(w);
+  } else if (fixed()) {
+    emit_reciprocal(w);
+  }
   emit_correct(w);
   emit_init(w);
   emit_run(w);

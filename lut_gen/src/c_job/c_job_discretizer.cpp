@@ -97,7 +97,7 @@ void VariantEmitter::emit_triple(CodeWriter& w) const {
     if (v.empty()) return;
     std::string list;
     for (const auto& [i, j] : v) list += (list.empty() ? "" : ", ") + std::string("(") + std::to_string(i) + "," + std::to_string(j) + ")";
-    w.line(ar().ctype(q) + " " + name + "[" + std::to_string(v.size()) + "];  /* " + list + " */");
+    w.line(ar().scratch_ctype(q) + " " + name + "[" + std::to_string(v.size()) + "];  /* " + list + " */");
   };
   member(Qty::kTransition, "phi", phi_free_);
   member(Qty::kInputGain, "gamma", gamma_free_);

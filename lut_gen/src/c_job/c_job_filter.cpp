@@ -103,7 +103,11 @@ void VariantEmitter::emit_correct(CodeWriter& w) const {
   }
   const Val r = ar().constant(Qty::kCovariance, design_.r(0, 0), "R");
   const std::string inv_t = ar().ctype(Qty::kInverseCovariance);
-  if (fixed()) {
+  if (ar().q15()) {
+    w.line("sv = os_q15_sat((int32_t)sv + " + r.expr + ", sat);");
+    w.open("if (sv <= 0) {").line("return ONESHOT_JOB_STATUS_SINGULAR;").close();
+    w.open("{").line("const " + inv_t + " inv = " + fn("reciprocal") + "(sv, sat);");
+  } else if (fixed()) {
     w.line("sv = os_sat32((int64_t)sv + " + r.expr + ", sat);");
     w.open("if (sv <= 0) {").line("return ONESHOT_JOB_STATUS_SINGULAR;").close();
     w.open("{").line("const " + inv_t + " inv = " + fn("reciprocal") + "(sv, sat);");
@@ -175,6 +179,22 @@ void VariantEmitter::emit_quantize(CodeWriter& w, std::size_t j, const std::stri
     w.close().close().close();
     return;
   }
+  if (ar().q15()) {
+    // offset = u - u_min in (0, 2^16) when positive, steps/volt in (0, 2^15): one unsigned
+    // 32-bit product, rounded half up to a code.
+    const Val umin = ar().constant(Qty::kInput, design_.u_min[j], "u_min");
+    const Val spv = ar().constant(Qty::kInverseInput, design_.steps_per_volt[j], "PWM steps per volt");
+    if (design_.steps_per_volt[j] <= 0) throw DesignError("C job q15: PWM steps per volt must be positive");
+    const int shift = ar().fmt(Qty::kInput).frac + ar().fmt(Qty::kInverseInput).frac;
+    if (shift < 1 || shift > 31) throw DesignError("C job q15: input and steps-per-volt formats too fine");
+    w.open("{").line("const int32_t offset = (int32_t)" + u + " - (int32_t)" + umin.expr + ";");
+    w.open("if (offset <= 0) {").line(code + " = 0;").middle("} else {");
+    w.line("const uint32_t steps = ((uint32_t)offset * (uint32_t)" + spv.expr + " + " + u32_literal(1ULL << (shift - 1)) +
+           ") >> " + std::to_string(shift) + ";");
+    w.line(code + " = steps > (uint32_t)" + n + " ? " + n + " : (int32_t)steps;");
+    w.close().close();
+    return;
+  }
   const QFormat sf = ar().fmt(Qty::kActuatorSteps);
   const Val umin = ar().constant(Qty::kInput, design_.u_min[j], "u_min");
   const Val spv = ar().constant(Qty::kInverseInput, design_.steps_per_volt[j], "PWM steps per volt");
@@ -233,7 +253,7 @@ void VariantEmitter::emit_run(CodeWriter& w) {
          " *s, int32_t tau_us, uint16_t adc_code, uint16_t setpoint_code" +
          (scalar ? "" : ", uint16_t pwm_code[" + std::to_string(m_) + "]") + ") {");
   if (fixed()) w.line("uint8_t *const sat = &s->saturated;");
-  w.line(triple_type() + " d;");
+  if (!ar().q15()) w.line(triple_type() + " d;");
   w.line("uint8_t status, next;");
   for (std::size_t j = 0; j < m_; ++j) w.line("int32_t code" + std::to_string(j) + ";");
   w.line("/* The ADC and set-point codes in volts (output_of_code). */");
@@ -263,13 +283,21 @@ void VariantEmitter::emit_run(CodeWriter& w) {
   }
   const std::string h = int_literal(plant_.period_us, 32);
   w.line("/* Half Kalman (HalfKalman::update): predict to the sample, correct, predict to the actuation. */");
-  w.line("status = " + fn("discretize") + "(" + h + " - tau_us, &d" + sat_arg() + ");");
-  w.line(fn("predict") + "(s, &d" + sat_arg() + ");");
-  w.line("next = " + fn("correct") + "(s, y" + sat_arg() + ");");
-  w.line("status = next > status ? next : status; /* worst_of: the codes rise with severity */");
-  w.line("next = " + fn("discretize") + "(tau_us, &d" + sat_arg() + ");");
-  w.line("status = next > status ? next : status;");
-  w.line(fn("predict") + "(s, &d" + sat_arg() + ");");
+  if (ar().q15()) {
+    w.line("status = " + fn("advance") + "(s, " + h + " - tau_us, sat);");
+    w.line("next = " + fn("correct") + "(s, y, sat);");
+    w.line("status = next > status ? next : status; /* worst_of: the codes rise with severity */");
+    w.line("next = " + fn("advance") + "(s, tau_us, sat);");
+    w.line("status = next > status ? next : status;");
+  } else {
+    w.line("status = " + fn("discretize") + "(" + h + " - tau_us, &d" + sat_arg() + ");");
+    w.line(fn("predict") + "(s, &d" + sat_arg() + ");");
+    w.line("next = " + fn("correct") + "(s, y" + sat_arg() + ");");
+    w.line("status = next > status ? next : status; /* worst_of: the codes rise with severity */");
+    w.line("next = " + fn("discretize") + "(tau_us, &d" + sat_arg() + ");");
+    w.line("status = next > status ? next : status;");
+    w.line(fn("predict") + "(s, &d" + sat_arg() + ");");
+  }
   w.line("/* Control law u = N_u r - L (x - N_x r), actuator codes, and the input they realise. */");
   w.open("{");
   const auto& pat = pat_;

@@ -6,6 +6,7 @@
 #pragma once
 
 #include <cstdint>
+#include <memory>
 #include <string>
 #include <utility>
 #include <vector>
@@ -17,6 +18,8 @@
 #include "oneshot/design/structure_analysis.hpp"
 
 namespace oneshot::design::cjob {
+
+struct Q15PolyTable;  // q15_poly_table.hpp
 
 /// A table as the generated code stores it: layout, and the values as C literals.
 struct TableText {
@@ -93,6 +96,11 @@ class VariantEmitter {
                        const std::string& q, const std::string& out_prefix) const;
   void emit_in_range(CodeWriter& w);
   void emit_discretize(CodeWriter& w);
+  // The q15 variants' interval polynomials, piecewise prediction and reciprocal (c_job_q15.cpp).
+  void emit_q15_table(CodeWriter& w);
+  void emit_q15_interval(CodeWriter& w) const;
+  void emit_q15_advance(CodeWriter& w);
+  void emit_q15_reciprocal(CodeWriter& w) const;
   // Pieces of the filter and the control law (c_job_filter.cpp).
   void emit_predict(CodeWriter& w) const;
   void emit_reciprocal(CodeWriter& w) const;
@@ -110,6 +118,7 @@ class VariantEmitter {
   std::size_t n_, m_, p_;
   std::vector<std::pair<std::size_t, std::size_t>> phi_free_, gamma_free_, qd_free_;  // qd: upper only
   int divisions_ = 0;
+  std::shared_ptr<const Q15PolyTable> q15_table_;  // q15 variants: built by emit_q15_table
 };
 
 }  // namespace oneshot::design::cjob

@@ -39,9 +39,10 @@ enum class NumberFormat : std::uint8_t {
   kFloat,   ///< IEEE single, as on an MCU without double support.
   kDouble,  ///< IEEE double (the oracle).
   kFixed,   ///< The design step's Q formats (built-in plant, or one compiled in with ONESHOT_PLANT).
+  kQ15,     ///< Approach B as the generated q15 C99 job (oneshot_job.c); the other approaches in double.
 };
 
-/// Name of a number format ("float", "double", "fixed").
+/// Name of a number format ("float", "double", "fixed", "q15").
 const char* to_string(NumberFormat f);
 /// Name of a discretizer ("table", "nearest", "generic").
 const char* to_string(DiscretizerKind d);

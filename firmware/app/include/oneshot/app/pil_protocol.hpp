@@ -200,14 +200,17 @@ inline constexpr std::uint32_t kFaultHard = 0xFFFFFFFFU;              ///< Hard 
 inline constexpr std::uint32_t kFaultUnknownRequest = 0xFFFFFFFEU;    ///< Request type not known.
 inline constexpr std::uint32_t kFaultMalformedRequest = 0xFFFFFFFDU;  ///< Wrong payload length or value.
 
-/// Largest approach id of kConfig: 0–4 are A–E, 5 the generated C99 job (B's job; an image
-/// without one refuses it).
-inline constexpr std::uint8_t kMaxApproach = 5;
+/// Approach id of the generated C99 job of the image's format (B's job; an image without one refuses it).
+inline constexpr std::uint8_t kCJobApproach = 5;
+/// Approach id of the generated q15 C99 job (fixed-point table images; others refuse it).
+inline constexpr std::uint8_t kCJobQ15Approach = 6;
+/// Largest approach id of kConfig: 0–4 are A–E, 5 and 6 the generated C99 jobs.
+inline constexpr std::uint8_t kMaxApproach = kCJobQ15Approach;
 
-/// kConfig: approach (0–5), noise model (0 constant, 1 exact), initial PWM code per input.
+/// kConfig: approach (0–6), noise model (0 constant, 1 exact), initial PWM code per input.
 template <std::size_t M>
 struct ConfigRequest {
-  std::uint8_t approach = 0;       ///< Approach A–E as 0–4, the generated C job as 5.
+  std::uint8_t approach = 0;       ///< Approach A–E as 0–4, the generated C jobs as 5, 6.
   bool exact_noise = false;        ///< Exact Q_d(τ) instead of the constant Q.
   std::int32_t codes[M] = {};      ///< Initial PWM code of each input (0–65535).
   /// Exact payload length: 1 + 1 + 2·M bytes.
