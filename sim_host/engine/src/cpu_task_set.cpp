@@ -84,7 +84,9 @@ void read_exectime_file(ExecModel& m, const std::string& path, const std::string
                                                  : std::string());
 }
 
-ExecModel parse_exec(const nlohmann::json& j, const std::string& f, const std::string& base_dir) {
+}  // namespace
+
+ExecModel parse_exec_model(const nlohmann::json& j, const std::string& f, const std::string& base_dir) {
   ExecModel m;
   const std::string model = string_of(j, f, "model");
   if (model == "constant") {
@@ -152,6 +154,8 @@ ExecModel parse_exec(const nlohmann::json& j, const std::string& f, const std::s
   return m;
 }
 
+namespace {
+
 OverrunPolicy parse_overrun(const std::string& s, const std::string& field) {
   if (s == "continue") return OverrunPolicy::kContinue;
   if (s == "skip") return OverrunPolicy::kSkip;
@@ -183,7 +187,7 @@ TaskSpec parse_task(const nlohmann::json& j, const std::string& f, bool isr, con
   const char* wkey = isr ? "cost_us" : "wcet_us";
   if (!isr && j.contains("exec")) {
     if (j.contains("wcet_us") || j.contains("bcet_us")) fail(at(f, "exec"), "give either exec or wcet_us/bcet_us");
-    t.exec = parse_exec(member(j, f, "exec"), at(f, "exec"), base_dir);
+    t.exec = parse_exec_model(member(j, f, "exec"), at(f, "exec"), base_dir);
   } else {
     t.exec.wcet = us(integer_in(j, f, wkey, 1, kMaxUs));
     t.exec.bcet = us(integer_in(j, f, "bcet_us", 1, kMaxUs, true, t.exec.wcet.count() / 1000));
@@ -319,15 +323,15 @@ nlohmann::json task_set_json(const TaskSet& set) {
                         {"period_us", t.period.count() / 1000},
                         {"offset_us", t.offset.count() / 1000},
                         {"priority", t.priority},
-                        {isr ? "cost_us" : "wcet_us", static_cast<double>(t.exec.wcet.count()) * 1e-3},
-                        {"bcet_us", static_cast<double>(t.exec.bcet.count()) * 1e-3}};
+                        {isr ? "cost_us" : "wcet_us", (t.exec.wcet.count() + 999) / 1000},
+                        {"bcet_us", std::max<std::int64_t>(1, t.exec.bcet.count() / 1000)}};
+    if (t.sporadic) j["max_interarrival_us"] = t.max_interarrival.count() / 1000;
     if (!isr) {
       j["deadline_us"] = t.deadline.count() / 1000;
       j["overrun"] = to_string(t.overrun);
     }
     if (t.release_jitter.count() > 0) j["jitter_us"] = t.release_jitter.count() / 1000;
     if (t.nonpreemptive.count() > 0) j["nonpreemptive_us"] = t.nonpreemptive.count() / 1000;
-    if (!t.exec.source.empty()) j["exec_source"] = t.exec.source;
     return j;
   };
   nlohmann::json j = {{"name", set.name},

@@ -93,10 +93,13 @@ const char* to_string(OverrunPolicy p);
 /// "tasks.json: field 'tasks[1].bcet_us': exceeds wcet_us". Relative trace and exectime files
 /// are read from `base_dir`.
 TaskSet parse_task_set(const std::string& text, const std::string& source, const std::string& base_dir);
+/// Parses one execution-time model object (the task file's "exec"; `field` names it in errors).
+ExecModel parse_exec_model(const nlohmann::json& j, const std::string& field, const std::string& base_dir);
 /// Reads (bounded) and parses a task file.
 TaskSet load_task_set(const std::string& path);
 
-/// The task set as JSON in the task-file format (times in µs; the exec model summarized).
+/// The task set as a task file (times in µs; execution as wcet_us = ⌈wcet⌉, bcet_us = ⌊bcet⌋,
+/// uniform): `kernel analyze` reads it back.
 nlohmann::json task_set_json(const TaskSet& set);
 
 }  // namespace oneshot::engine::cpu
