@@ -65,7 +65,7 @@ void register_kernel_experiment(CLI::App& study) {
 StudyReportResult kernel_report_section(const StudyReportContext& r) {
   CommonOptions o;
   o.out_dir = r.out_dir;
-  o.threads = r.threads;
+  o.threads = static_cast<unsigned>(r.threads);
   o.seed = r.seed;
   o.plots = r.plots;
   KernelExperimentOptions k;

@@ -8,7 +8,7 @@ namespace oneshot::engine::cpu {
 
 namespace {
 
-std::uint64_t pack(std::size_t e, std::uint64_t job) { return (static_cast<std::uint64_t>(e) << 32) | (job & 0xFFFFFFFFULL); }
+std::uint64_t pack(std::size_t e, std::uint64_t job) { return (e << 32) | (job & 0xFFFFFFFFULL); }
 
 }  // namespace
 
@@ -36,7 +36,7 @@ Cpu::Cpu(Kernel& kernel, TaskSet set) : kernel_(kernel), set_(std::move(set)) {
                           kernel_.stream(stream_name("cpu", n, "arrival"))});
   }
   stats_.resize(specs_.size());
-  h_arrive_ = kernel_.add_handler("cpu arrival", [this](std::uint64_t e) { arrive(static_cast<std::size_t>(e)); });
+  h_arrive_ = kernel_.add_handler("cpu arrival", [this](std::uint64_t e) { arrive(e); });
   h_ready_ = kernel_.add_handler("cpu release", [this](std::uint64_t a) { make_ready(a); });
   h_complete_ = kernel_.add_handler("cpu completion", [this](std::uint64_t g) { complete(g); });
   h_abort_ = kernel_.add_handler("cpu abort", [this](std::uint64_t a) { abort_job(a); });
@@ -110,7 +110,7 @@ void Cpu::arrive(std::size_t e) {
 }
 
 void Cpu::make_ready(std::uint64_t arg) {
-  const auto e = static_cast<std::size_t>(arg >> 32);
+  const std::size_t e = arg >> 32;
   for (Job& j : ent_[e].pending) {
     if ((j.index & 0xFFFFFFFFULL) == (arg & 0xFFFFFFFFULL)) {
       j.ready = kernel_.now();
@@ -163,7 +163,7 @@ void Cpu::complete(std::uint64_t generation) {
 }
 
 void Cpu::abort_job(std::uint64_t arg) {
-  const auto e = static_cast<std::size_t>(arg >> 32);
+  const std::size_t e = arg >> 32;
   Entity& en = ent_[e];
   if (en.pending.empty() || (en.pending.front().index & 0xFFFFFFFFULL) != (arg & 0xFFFFFFFFULL)) return;  // finished
   if (running_ == e) {

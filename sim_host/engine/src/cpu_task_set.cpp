@@ -222,7 +222,7 @@ Duration ExecModel::draw(RandomStream& rng, std::uint64_t k) const {
                                                                           static_cast<std::int64_t>(instructions_max))),
                               clock_mips);
     case Kind::kEmpirical:
-      if (weights.empty()) return values[static_cast<std::size_t>(k % values.size())];
+      if (weights.empty()) return values[k % values.size()];
       {
         double total = 0;
         for (double w : weights) total += w;

@@ -230,9 +230,15 @@ TEST(Cpu, OverrunPoliciesAreCounted) {
     s.tasks[1].overrun = p;
     const auto st = simulate(s, from_us(1000), 1);
     EXPECT_GT(st[1].deadline_misses, 0U) << to_string(p);
-    if (p == OverrunPolicy::kSkip) EXPECT_GT(st[1].skipped, 0U);
-    if (p == OverrunPolicy::kAbort) EXPECT_EQ(st[1].aborted, st[1].released);
-    if (p == OverrunPolicy::kContinue) EXPECT_GT(st[1].overruns, 0U);
+    if (p == OverrunPolicy::kSkip) {
+      EXPECT_GT(st[1].skipped, 0U);
+    }
+    if (p == OverrunPolicy::kAbort) {
+      EXPECT_EQ(st[1].aborted, st[1].released);
+    }
+    if (p == OverrunPolicy::kContinue) {
+      EXPECT_GT(st[1].overruns, 0U);
+    }
     EXPECT_EQ(st[0].deadline_misses, 0U);
   }
 }
