@@ -34,12 +34,13 @@ TaskSpec task(const std::string& name, std::int64_t period_us, std::int64_t wcet
   return t;
 }
 
-/// Simulates `set` for `duration` (seed `seed`); per entity: stats.
+/// Simulates `set` for `duration` (seed `seed`); per entity: stats of the jobs finished by
+/// then (a job finishing later could miss interference from arrivals after the end).
 std::vector<CpuTaskStats> simulate(const TaskSet& set, SimTime duration, std::uint64_t seed) {
   Kernel k(seed);
   Cpu cpu(k, set);
   cpu.start(duration);
-  k.run_until(duration + from_us(10'000'000));  // let the last jobs finish
+  k.run_until(duration);
   return cpu.stats();
 }
 
@@ -109,7 +110,8 @@ TEST(Cpu, RandomSetsStayWithinAnalysisBounds) {
       if (!b.bounded || st[i].finished == 0) continue;
       ++checked_tasks;
       ASSERT_LE(st[i].response_max, b.wcrt) << "set " << n << " task " << b.name << " U " << u;
-      ASSERT_GE(st[i].response_min, b.bcrt) << "set " << n << " task " << b.name << " U " << u;
+      ASSERT_GE(st[i].response_min, b.bcrt) << "set " << n << " task " << b.name << " U " << u << "\n"
+                                            << oneshot::engine::cpu::task_set_json(s).dump();
       ASSERT_LE(st[i].start_max, b.sampling_latency_max) << "set " << n << " task " << b.name;
       if (st[i].response_max == b.wcrt) ++exact;
     }
@@ -159,6 +161,7 @@ TEST(Cpu, EdfImplicitDeadlinesSchedulableIffUtilizationAtMostOne) {
   for (int n = 0; n < 400; ++n) {
     const double u = n % 4 == 3 ? r.uniform(1.01, 1.2) : r.uniform(0.3, 1.0);
     TaskSet s = random_set(r, u, SchedulerKind::kEdf, false);
+    for (TaskSpec& t : s.tasks) t.exec.bcet = t.exec.wcet;  // every job at its wcet: U is the real load
     const double real_u = s.utilization();
     const Analysis a = analyze(s);
     const std::int64_t h = hyperperiod_us(s);
@@ -234,7 +237,8 @@ TEST(Cpu, OverrunPoliciesAreCounted) {
       EXPECT_GT(st[1].skipped, 0U);
     }
     if (p == OverrunPolicy::kAbort) {
-      EXPECT_EQ(st[1].aborted, st[1].released);
+      EXPECT_EQ(st[1].finished, 0U);  // 6 of 10 never fits beside 5 of 10: every job aborted
+      EXPECT_GE(st[1].aborted + 1, st[1].released);  // the last one may still run at the end
     }
     if (p == OverrunPolicy::kContinue) {
       EXPECT_GT(st[1].overruns, 0U);
