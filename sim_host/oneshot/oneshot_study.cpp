@@ -69,7 +69,7 @@ StudyReportResult kernel_report_section(const StudyReportContext& r) {
   o.seed = r.seed;
   o.plots = r.plots;
   KernelExperimentOptions k;
-  k.seeds = 4;
+  k.seeds = 10;
   const nlohmann::json j = run_kernel_experiment(*SimContext::reference(), o, k);
   std::string md = "## Study 000 on a modeled RTOS (`oneshot-sim oneshot kernel`)\n\n"
                    "The control job as one task of a dsPIC33-class CPU (fixed-priority preemptive kernel, timer ISR "

@@ -70,8 +70,8 @@ TEST(KernelTaskFile, BadFilesNameTheField) {
 TEST(KernelTaskFile, ExecModels) {
   const TaskSet s = parse_task_set(
       R"({"scheduler": "edf", "tasks": [
-        {"name": "h", "period_us": 1000, "exec": {"model": "histogram", "values_us": [10, 30], "weights": [1, 3]}},
-        {"name": "i", "period_us": 1000, "exec": {"model": "instructions", "clock_mips": 40, "instructions_min": 4000, "instructions_max": 4400}}]})",
+        {"name": "h", "period_us": 1000, "priority": 1, "exec": {"model": "histogram", "values_us": [10, 30], "weights": [1, 3]}},
+        {"name": "i", "period_us": 1000, "priority": 2, "exec": {"model": "instructions", "clock_mips": 40, "instructions_min": 4000, "instructions_max": 4400}}]})",
       "m.json", ".");
   EXPECT_EQ(s.tasks[0].exec.bcet, engine::from_us(10));
   EXPECT_EQ(s.tasks[0].exec.wcet, engine::from_us(30));
