@@ -57,7 +57,7 @@ nlohmann::json write_gantt(const Cpu& cpu, engine::Duration span, const std::str
     g << "set terminal pngcairo size 1200," << 160 + 40 * cpu.entities() << " font 'Sans,10' noenhanced\n"
       << "set output 'gantt.png'\nset datafile separator ','\nset xlabel 'time (ms)'\nset grid xtics\n"
       << "set yrange [-0.7:" << static_cast<double>(cpu.entities()) - 0.3 << "]\nset xrange [0:" << end_ms << "]\n"
-      << "set title " << gnuplot_quote("first hyperperiod: " + std::to_string(end_ms) + " ms") << "\nset ytics (";
+      << "set title " << gnuplot_quote("first hyperperiod (at most 1 s): " + std::to_string(span.count() / 1000) + " us") << "\nset ytics (";
     for (std::size_t r = 0; r < cpu.entities(); ++r) g << (r ? ", " : "") << gnuplot_quote(cpu.entity_name(r)) << " " << r;
     g << ")\nset style fill solid 0.8\nunset key\n"
       << "plot 'gantt.csv' skip 1 using (($2+$3)/2):1:(($3-$2)/2):(0.35):1 with boxxyerror lc variable\n";

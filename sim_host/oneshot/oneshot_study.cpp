@@ -2,6 +2,7 @@
 /// @brief The one-shot study (seed 000) under `oneshot-sim oneshot …`: the reference board,
 ///        approaches A–E, its experiments, the summarizers that merge Table I and kernel
 ///        shards, and the kernel experiment's report section.
+#include <filesystem>
 #include <iostream>
 #include <memory>
 
@@ -70,6 +71,10 @@ StudyReportResult kernel_report_section(const StudyReportContext& r) {
   o.plots = r.plots;
   KernelExperimentOptions k;
   k.seeds = 10;
+  // The M0 instruction counts the report measured a moment ago (mcu section), when it ran.
+  const std::filesystem::path counts = std::filesystem::path(r.out_dir).parent_path() / "exectime-cortex-m0.json";
+  std::error_code ec;
+  if (std::filesystem::is_regular_file(counts, ec)) k.exectime_file = counts.string();
   const nlohmann::json j = run_kernel_experiment(*SimContext::reference(), o, k);
   std::string md = "## Study 000 on a modeled RTOS (`oneshot-sim oneshot kernel`)\n\n"
                    "The control job as one task of a dsPIC33-class CPU (fixed-priority preemptive kernel, timer ISR "

@@ -77,8 +77,12 @@ void read_exectime_file(ExecModel& m, const std::string& path, const std::string
   }
   const nlohmann::json& v = j["variants"][variant];
   const std::string w = field + ".variant";
-  m.instructions_min = static_cast<std::uint64_t>(integer_in(v, w, "instructions_per_job_min", 1, INT64_MAX / 2));
-  m.instructions_max = static_cast<std::uint64_t>(integer_in(v, w, "instructions_per_job_max", 1, INT64_MAX / 2));
+  // Counts are written as JSON numbers (possibly 3822.0): whole, positive.
+  for (const char* key : {"instructions_per_job_min", "instructions_per_job_max"}) {
+    const double x = number_in(v, w, key, 1, 1e15);
+    if (x != std::floor(x)) fail(w + "." + key, "must be a whole number of instructions");
+    (std::string(key).back() == 'n' ? m.instructions_min : m.instructions_max) = static_cast<std::uint64_t>(x);
+  }
   m.source = path + " variant " + variant + (j.contains("target") && j["target"].is_string()
                                                  ? " (target " + j["target"].get<std::string>() + ")"
                                                  : std::string());
