@@ -129,4 +129,39 @@ TEST(KernelExperiment, TaskSetHitsUtilizationAndPositions) {
   }
 }
 
+/// The study-000 experiment, small: every simulated control response and sampling latency
+/// within the analysis' WCRT, the unschedulable configuration excluded, and two shards merged
+/// into the same table as one run.
+TEST(KernelExperiment, SmallSweepWithinBoundsAndShardsMerge) {
+  const std::string dir = test::made_dir("oneshot_kernel_cli", "exp");
+  const std::vector<std::string> common = {"oneshot", "kernel", "--seeds", "2", "--duration", "2", "--utilizations", "0.3",
+                                           "0.95", "--no-plots", "--threads", "1"};
+  auto argv = [&](std::vector<std::string> extra) {
+    std::vector<std::string> a = {sim()};
+    a.insert(a.end(), common.begin(), common.end());
+    a.insert(a.end(), extra.begin(), extra.end());
+    return a;
+  };
+  const auto whole = test::run_command(argv({"--out", dir + "/whole", "--json", dir + "/whole.json"}));
+  ASSERT_EQ(whole.exit_code, 0) << whole.output;
+  const nlohmann::json j = nlohmann::json::parse(test::read_file(dir + "/whole.json"));
+  ASSERT_EQ(j.at("configurations").size() + j.at("config").at("excluded").size(), 6U);
+  EXPECT_EQ(j.at("config").at("excluded").at(0).at("name"), "U0.95/lowest");
+  for (const auto& c : j.at("configurations")) {
+    const double wcrt_ms = c.at("control_wcrt_us").get<double>() * 1e-3;
+    EXPECT_LE(c.at("response_max_ms").get<double>(), wcrt_ms) << c.at("name");
+    EXPECT_LE(c.at("sampling_latency_max_ms").get<double>(), wcrt_ms) << c.at("name");
+    EXPECT_TRUE(c.at("ratio_to_A").contains("B"));
+  }
+  EXPECT_TRUE(j.at("largest_utilization_within_1pct").at("D").contains("lowest"));
+  for (const char* shard : {"0/2", "1/2"}) {
+    const auto r = test::run_command(argv({"--out", dir + "/shards", "--shard", shard}));
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+  }
+  const auto m = test::run_command({sim(), "merge", dir + "/shards/kernel.shard-0-of-2.json",
+                                    dir + "/shards/kernel.shard-1-of-2.json", "--out", dir + "/merged", "--no-plots"});
+  ASSERT_EQ(m.exit_code, 0) << m.output;
+  EXPECT_EQ(test::read_file(dir + "/merged/kernel.md"), test::read_file(dir + "/whole/kernel.md"));
+}
+
 }  // namespace
