@@ -12,6 +12,9 @@ namespace {
 
 using I = std::int64_t;
 
+/// Most jobs of a busy period examined before the analysis calls it unbounded.
+constexpr I kMaxJobs = 1'000'000;
+
 I ceil_div(I a, I b) { return a <= 0 ? -((-a) / b) : (a + b - 1) / b; }
 I floor_div(I a, I b) { return a >= 0 ? a / b : -((-a + b - 1) / b); }
 
@@ -81,7 +84,7 @@ TaskBound isr_bound(const TaskSet& s, std::size_t k, I limit) {
   I best = 0;
   for (I q = 0;; ++q) {
     const I w = fixed_point((q + 1) * t.exec.wcet.count(), 0, hp, limit);
-    if (w < 0) {
+    if (w < 0 || q >= kMaxJobs) {
       b.bounded = false;
       break;
     }
@@ -141,7 +144,7 @@ TaskBound fp_bound(const TaskSet& s, std::size_t i, I limit) {
         f = -1;
       }
     }
-    if (f < 0) {
+    if (f < 0 || q >= kMaxJobs) {
       b.bounded = false;
       break;
     }

@@ -29,6 +29,8 @@
 /// done: `wcrt_method` says so). Implicit deadlines without jitter, blocking or ISRs:
 /// schedulable iff U ≤ 1 (Liu & Layland 1973). Jitter bounds: sampling at the job's start
 /// lies in [cs, WCRT − C^b_i] after the arrival; actuation at its end in [BCRT, WCRT].
+/// A busy period longer than 10^4 of the largest period (at most 2^50 ns), or holding more than
+/// 10^6 jobs of the task, is reported unbounded (the WCRT is null in the JSON).
 #pragma once
 
 #include <cstddef>
