@@ -104,8 +104,13 @@ void register_kernel_study(CLI::App& app) {
       std::cout << (a.schedulable ? "schedulable" : "NOT schedulable: " + a.first_miss + " (" + a.reason + ")")
                 << ", U = " << a.utilization << "\n";
       for (const TaskBound& b : a.tasks) {
-        std::cout << "  " << b.name << ": WCRT " << (b.bounded ? std::to_string(us_of(b.wcrt)) : std::string("unbounded"))
-                  << " us, BCRT " << us_of(b.bcrt) << " us" << (b.schedulable ? "" : "  MISSES") << "\n";
+        std::cout << "  " << b.name << ": WCRT ";
+        if (b.bounded) {
+          std::cout << us_of(b.wcrt) << " us";
+        } else {
+          std::cout << "unbounded";
+        }
+        std::cout << ", BCRT " << us_of(b.bcrt) << " us" << (b.schedulable ? "" : "  MISSES") << "\n";
       }
     }
   });
