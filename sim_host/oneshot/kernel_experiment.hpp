@@ -33,7 +33,7 @@ struct KernelExperimentOptions {
   std::int64_t context_switch_us = 2;  ///< Erika context switch (assumption: ~80 cycles at 40 MIPS).
   std::uint64_t isr_instructions = 120;  ///< Actuation timer ISR (assumption: PWM write + flag).
   double duration_s = 20;              ///< Simulated time per run.
-  std::size_t seeds = 10;              ///< Seeds.
+  std::size_t seeds = 20;              ///< Seeds (as Table I).
   engine::Shard shard;                 ///< Part of the sweep.
 };
 

@@ -46,7 +46,7 @@ void register_kernel_experiment(CLI::App& study) {
   cmd->add_option("--isr-instructions", c->k.isr_instructions, "actuation timer ISR cost (default 120 instructions)")
       ->check(CLI::Range(1, 1000000));
   cmd->add_option("--duration", c->k.duration_s, "simulated seconds per run (default 20)")->check(CLI::Range(1.0, 100000.0));
-  cmd->add_option("--seeds", c->k.seeds, "seeds (default 10)")->check(CLI::Range(2, 1000000));
+  cmd->add_option("--seeds", c->k.seeds, "seeds (default 20)")->check(CLI::Range(2, 1000000));
   cmd->add_option("--seed", c->common.seed, "first seed (default 1)");
   cmd->add_option("--threads", c->common.threads, "worker threads (0: all cores)");
   cmd->add_option("--shard", c->shard, "run part i/N of the sweep (merge with `oneshot-sim merge`)");
@@ -70,7 +70,7 @@ StudyReportResult kernel_report_section(const StudyReportContext& r) {
   o.seed = r.seed;
   o.plots = r.plots;
   KernelExperimentOptions k;
-  k.seeds = 10;
+  k.seeds = 20;
   // The M0 instruction counts the report measured a moment ago (mcu section), when it ran.
   const std::filesystem::path counts = std::filesystem::path(r.out_dir).parent_path() / "exectime-cortex-m0.json";
   std::error_code ec;
