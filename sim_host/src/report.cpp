@@ -109,6 +109,9 @@ nlohmann::json mcu_section(const SimContext& ctx, const CommonOptions& o, const 
       CommonOptions oe = o;
       oe.noise = NoiseModel::kConstant;
       j["exectime"][target] = run_exectime_target(ctx, oe, p);
+      // The measured counts as a file of their own: `oneshot kernel` (and its report section) reads them.
+      write_json((std::filesystem::path(o.out_dir) / (std::string("exectime-") + target + ".json")).string(),
+                 j["exectime"][target]);
     }
     md << "Instructions per control job (QEMU TCG plugin, exact), over the " << j["exectime"]["cortex-m0"]["jobs_per_4s"]
        << " jobs of 4 s, constant Q as in the brief's experiment 5; image sizes from the ELF files, stack peak from "

@@ -17,6 +17,7 @@ void register_studies(CLI::App& app) {
   register_dropping_study(app);  // sim_host/dropping/: over-delay dropping Kalman (issue 13)
   register_sod_study(app);       // sim_host/sod/:      send-on-delta estimation (issue 14)
   register_petc_study(app);      // sim_host/petc/:     NUMRE periodic event-triggered control (issue 15)
+  register_kernel_study(app);    // sim_host/kernel/:   CPUs, schedulers, response-time analysis (issue 22)
 }
 
 }  // namespace oneshot::sim

@@ -33,4 +33,7 @@ void register_sod_study(CLI::App& app);
 /// `petc <experiment>`: NUMRE periodic event-triggered control, seed 003 (sim_host/petc/).
 void register_petc_study(CLI::App& app);
 
+/// `oneshot-sim kernel analyze|simulate`: task sets on the engine's CPU model (sim_host/kernel/).
+void register_kernel_study(CLI::App& app);
+
 }  // namespace oneshot::sim
