@@ -1,5 +1,6 @@
 /// @file study_plant.cpp
 /// @brief The plant section of a study file (see study_parse_detail.hpp).
+#include <array>
 #include <cmath>
 #include <vector>
 
@@ -77,6 +78,30 @@ void dimension_limits(std::size_t n, std::size_t m, std::size_t p, std::size_t w
   }
 }
 
+/// Both plant forms share one shape: state matrix F (n×n), input matrix G (n×m), optional
+/// disturbance matrix G_w (n×w), output matrix C (p×n), noise covariance (n×n, PSD) and
+/// optional PSD weights on the state (n×n) and the input (m×m), read from `keys` in that order.
+void linear_model(const json& c, const std::string& g, const std::array<const char*, 7>& keys,
+                  const std::array<DenseMatrix*, 7>& out) {
+  const auto field = [&](std::size_t k) { return g + "." + keys[k]; };
+  DenseMatrix& f = *out[0] = matrix(c, g, keys[0], false);
+  const std::size_t n = f.rows;
+  shape(f, n, n, field(0));
+  DenseMatrix& in = *out[1] = matrix(c, g, keys[1], false);
+  shape(in, n, in.cols, field(1));
+  DenseMatrix& dist = *out[2] = matrix(c, g, keys[2], true);
+  if (dist.rows != 0) shape(dist, n, dist.cols, field(2));
+  DenseMatrix& out_c = *out[3] = matrix(c, g, keys[3], false);
+  shape(out_c, out_c.rows, n, field(3));
+  dimension_limits(n, in.cols, out_c.rows, dist.cols, g);
+  *out[4] = matrix(c, g, keys[4], false);
+  psd(*out[4], n, field(4));
+  *out[5] = matrix(c, g, keys[5], true);
+  psd(*out[5], n, field(5));
+  *out[6] = matrix(c, g, keys[6], true);
+  psd(*out[6], in.cols, field(6));
+}
+
 }  // namespace
 
 PlantSpec parse_plant(const json& j, const std::string& f) {
@@ -90,26 +115,10 @@ PlantSpec parse_plant(const json& j, const std::string& f) {
   }
   if (j.contains("continuous")) {
     const std::string g = f + ".continuous";
-    const json& c = j["continuous"];
-    require_keys(c, g, {"A", "B", "B_w", "C", "Q_c", "Q1c", "Q2c"});
+    require_keys(j["continuous"], g, {"A", "B", "B_w", "C", "Q_c", "Q1c", "Q2c"});
     p.kind = PlantSpec::Kind::kContinuous;
     ContinuousModel& m = p.continuous;
-    m.a = matrix(c, g, "A", false);
-    const std::size_t n = m.a.rows;
-    shape(m.a, n, n, g + ".A");
-    m.b = matrix(c, g, "B", false);
-    shape(m.b, n, m.b.cols, g + ".B");
-    m.bw = matrix(c, g, "B_w", true);
-    if (m.bw.rows != 0) shape(m.bw, n, m.bw.cols, g + ".B_w");
-    m.c = matrix(c, g, "C", false);
-    shape(m.c, m.c.rows, n, g + ".C");
-    dimension_limits(n, m.b.cols, m.c.rows, m.bw.cols, g);
-    m.qc = matrix(c, g, "Q_c", false);
-    psd(m.qc, n, g + ".Q_c");
-    m.q1c = matrix(c, g, "Q1c", true);
-    psd(m.q1c, n, g + ".Q1c");
-    m.q2c = matrix(c, g, "Q2c", true);
-    psd(m.q2c, m.b.cols, g + ".Q2c");
+    linear_model(j["continuous"], g, {"A", "B", "B_w", "C", "Q_c", "Q1c", "Q2c"}, {&m.a, &m.b, &m.bw, &m.c, &m.qc, &m.q1c, &m.q2c});
     return p;
   }
   const std::string g = f + ".discrete";
@@ -117,22 +126,7 @@ PlantSpec parse_plant(const json& j, const std::string& f) {
   require_keys(c, g, {"Phi", "Gamma", "Gamma_w", "C", "Q", "Q1", "Q2", "period_us"});
   p.kind = PlantSpec::Kind::kDiscrete;
   DiscreteModel& m = p.discrete;
-  m.phi = matrix(c, g, "Phi", false);
-  const std::size_t n = m.phi.rows;
-  shape(m.phi, n, n, g + ".Phi");
-  m.gamma = matrix(c, g, "Gamma", false);
-  shape(m.gamma, n, m.gamma.cols, g + ".Gamma");
-  m.gamma_w = matrix(c, g, "Gamma_w", true);
-  if (m.gamma_w.rows != 0) shape(m.gamma_w, n, m.gamma_w.cols, g + ".Gamma_w");
-  m.c = matrix(c, g, "C", false);
-  shape(m.c, m.c.rows, n, g + ".C");
-  dimension_limits(n, m.gamma.cols, m.c.rows, m.gamma_w.cols, g);
-  m.q = matrix(c, g, "Q", false);
-  psd(m.q, n, g + ".Q");
-  m.q1 = matrix(c, g, "Q1", true);
-  psd(m.q1, n, g + ".Q1");
-  m.q2 = matrix(c, g, "Q2", true);
-  psd(m.q2, m.gamma.cols, g + ".Q2");
+  linear_model(c, g, {"Phi", "Gamma", "Gamma_w", "C", "Q", "Q1", "Q2"}, {&m.phi, &m.gamma, &m.gamma_w, &m.c, &m.q, &m.q1, &m.q2});
   m.period = from_us(integer_in(c, g, "period_us", 1, 3'600'000'000));
   return p;
 }

@@ -19,37 +19,32 @@
 #include <cstddef>
 #include <cstdint>
 
-#include "oneshot/kalman_estimator.hpp"
+#include "oneshot/kalman_filter_base.hpp"
 #include "oneshot/time_us.hpp"
 
 namespace oneshot {
 
-/// Complete Kalman filter; Disc is a GenericDiscretizer or TableDiscretizer.
+/// Complete Kalman filter; Disc is a GenericDiscretizer or TableDiscretizer. covariance() is
+/// P_s,k (corrected at the last sample).
 template <typename Fmt, typename Structure, typename Disc,
           CovarianceUpdate kForm = CovarianceUpdate::kSymmetric>
-class CompleteKalman {
+class CompleteKalman : public KalmanFilterBase<Fmt, Structure, kForm> {
  public:
-  static constexpr std::size_t kN = Structure::kStates;
-  static constexpr std::size_t kM = Structure::kInputs;
-  static constexpr std::size_t kP = Structure::kOutputs;
-  using Design = ControllerDesign<Fmt, kN, kM, kP>;
-  using Core = KalmanEstimator<Fmt, Structure, kForm>;  ///< The estimator it runs on.
-  using StateVec = typename Core::StateVec;
-  using OutputVec = typename Core::OutputVec;
-  using InputVec = typename Core::InputVec;
-  using Cov = typename Core::Cov;
-  using Gain = typename Core::Gain;
+  using Base = KalmanFilterBase<Fmt, Structure, kForm>;
+  using Base::kM, Base::kN;
+  using typename Base::Core, typename Base::Cov, typename Base::Design;
+  using typename Base::InputVec, typename Base::OutputVec, typename Base::StateVec;
 
   /// Filter over `design` and `disc` (both must outlive it).
   constexpr CompleteKalman(const Design& design, const Disc& disc, NoiseModel noise)
-      : design_(&design), disc_(&disc), noise_(noise) {
+      : Base(design, noise), disc_(&disc) {
     reset(StateVec{}, design.p0, InputVec{});
   }
 
   /// Estimate x0 with covariance p0 at an actuation instant, input u0 applied there
   /// (treated as a sample with τ = 0: a zero-length segment of u0, then u0).
   constexpr void reset(const StateVec& x0, const Cov& p0, const InputVec& u0) {
-    core_.reset(x0, p0);
+    this->core_.reset(x0, p0);
     x_ = x0;
     inputs_.reset(u0);
     (void)inputs_.push(0, u0);
@@ -63,14 +58,14 @@ class CompleteKalman {
   constexpr Status update(std::int32_t tau_us, const OutputVec& y) {
     Status status = bound_tau(tau_us);
     tau_us = disc_->quantize(tau_us);  // the discretizer's sub-grid policy
-    const std::int32_t b_us = design_->period_us - tau_us;
+    const std::int32_t b_us = this->design_->period_us - tau_us;
     if (inputs_.size() == 1) (void)inputs_.push(tau_prev_us_, inputs_.latest());  // no new input at t_k
-    status = worst_of(status, core_.predict_across(*disc_, b_us + tau_prev_us_, inputs_, noise_,
-                                                   design_->q_constant, &gamma_a_, !first_job_));
-    status = worst_of(status, core_.correct_all(y, design_->c, design_->r));
+    status = worst_of(status, this->core_.predict_across(*disc_, b_us + tau_prev_us_, inputs_, this->noise_,
+                                                   this->design_->q_constant, &gamma_a_, !first_job_));
+    status = worst_of(status, this->core_.correct_all(y, this->design_->c, this->design_->r));
     typename Disc::Triple c{NoInit{}};
     status = worst_of(status, disc_->discretize(tau_us, c, WithQd::kNo));
-    x_ = predict_state<Fmt, Structure>(c, core_.state(), inputs_.latest());
+    x_ = predict_state<Fmt, Structure>(c, this->core_.state(), inputs_.latest());
     gamma_a_ = c.gamma;
     tau_prev_us_ = tau_us < 0 ? 0 : tau_us;
     inputs_.reset(inputs_.latest());  // u_k is active at the sample
@@ -85,18 +80,9 @@ class CompleteKalman {
   }
   /// x̂_k: the estimate at the next actuation instant.
   constexpr const StateVec& prediction() const { return x_; }
-  /// P_s,k: the corrected covariance at the last sample.
-  constexpr const Cov& covariance() const { return core_.covariance(); }
-  /// The gain of the last correction.
-  constexpr const Gain& gain() const { return core_.gain(); }
-  /// The estimator underneath (at the last sample).
-  constexpr const Core& core() const { return core_; }
 
  private:
-  const Design* design_;
   const Disc* disc_;
-  NoiseModel noise_;
-  Core core_{};
   StateVec x_{};                                 // prediction to the next actuation
   InputHistory<typename Fmt::Input, kM, 2> inputs_{};  // u_{k−1} from the sample, u_k from t_k
   typename Core::InputGain gamma_a_{};           // Γ(τ_k)

@@ -14,36 +14,31 @@
 #include <cstddef>
 #include <cstdint>
 
-#include "oneshot/kalman_estimator.hpp"
+#include "oneshot/kalman_filter_base.hpp"
 #include "oneshot/time_us.hpp"
 
 namespace oneshot {
 
-/// Half Kalman filter; Disc is a GenericDiscretizer or TableDiscretizer.
+/// Half Kalman filter; Disc is a GenericDiscretizer or TableDiscretizer. covariance() is P⁻_k
+/// (at the next actuation instant).
 template <typename Fmt, typename Structure, typename Disc,
           CovarianceUpdate kForm = CovarianceUpdate::kSymmetric>
-class HalfKalman {
+class HalfKalman : public KalmanFilterBase<Fmt, Structure, kForm> {
  public:
-  static constexpr std::size_t kN = Structure::kStates;
-  static constexpr std::size_t kM = Structure::kInputs;
-  static constexpr std::size_t kP = Structure::kOutputs;
-  using Design = ControllerDesign<Fmt, kN, kM, kP>;
-  using Core = KalmanEstimator<Fmt, Structure, kForm>;  ///< The estimator it runs on.
-  using StateVec = typename Core::StateVec;
-  using OutputVec = typename Core::OutputVec;
-  using InputVec = typename Core::InputVec;
-  using Cov = typename Core::Cov;
-  using Gain = typename Core::Gain;
+  using Base = KalmanFilterBase<Fmt, Structure, kForm>;
+  using Base::kM, Base::kN;
+  using typename Base::Core, typename Base::Cov, typename Base::Design;
+  using typename Base::InputVec, typename Base::OutputVec, typename Base::StateVec;
 
   /// Filter over `design` and `disc` (both must outlive it).
   constexpr HalfKalman(const Design& design, const Disc& disc, NoiseModel noise)
-      : design_(&design), disc_(&disc), noise_(noise) {
+      : Base(design, noise), disc_(&disc) {
     reset(StateVec{}, design.p0, InputVec{});
   }
 
   /// Estimate x0 with covariance p0 at an actuation instant, input u0 applied there.
   constexpr void reset(const StateVec& x0, const Cov& p0, const InputVec& u0) {
-    core_.reset(x0, p0);
+    this->core_.reset(x0, p0);
     u_ = u0;
   }
 
@@ -52,28 +47,20 @@ class HalfKalman {
   constexpr Status update(std::int32_t tau_us, const OutputVec& y) {
     Status status = bound_tau(tau_us);
     tau_us = disc_->quantize(tau_us);  // the discretizer's sub-grid policy
-    status = worst_of(status, core_.predict(*disc_, design_->period_us - tau_us, u_, noise_, design_->q_constant));
-    status = worst_of(status, core_.correct_all(y, design_->c, design_->r));
-    status = worst_of(status, core_.predict(*disc_, tau_us, u_, noise_, design_->q_constant));
+    const Design& d = *this->design_;
+    status = worst_of(status, this->core_.predict(*disc_, d.period_us - tau_us, u_, this->noise_, d.q_constant));
+    status = worst_of(status, this->core_.correct_all(y, d.c, d.r));
+    status = worst_of(status, this->core_.predict(*disc_, tau_us, u_, this->noise_, d.q_constant));
     return status;
   }
 
   /// The input applied at the actuation instant the last update predicted to.
   constexpr void set_applied_input(const InputVec& u) { u_ = u; }
   /// x̂⁻_k: the estimate at the next actuation instant.
-  constexpr const StateVec& prediction() const { return core_.state(); }
-  /// P⁻_k.
-  constexpr const Cov& covariance() const { return core_.covariance(); }
-  /// The gain of the last correction.
-  constexpr const Gain& gain() const { return core_.gain(); }
-  /// The estimator underneath (at the next actuation instant).
-  constexpr const Core& core() const { return core_; }
+  constexpr const StateVec& prediction() const { return this->core_.state(); }
 
  private:
-  const Design* design_;
   const Disc* disc_;
-  NoiseModel noise_;
-  Core core_{};
   InputVec u_{};
 };
 

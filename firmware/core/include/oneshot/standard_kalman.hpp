@@ -12,33 +12,28 @@
 #include <cstddef>
 #include <cstdint>
 
-#include "oneshot/kalman_estimator.hpp"
+#include "oneshot/kalman_filter_base.hpp"
 
 namespace oneshot {
 
-/// Time-varying Kalman filter on the nominal discrete model (Φ(h), Γ(h)).
+/// Time-varying Kalman filter on the nominal discrete model (Φ(h), Γ(h)). covariance() is P
+/// after the last correction.
 template <typename Fmt, typename Structure, CovarianceUpdate kForm = CovarianceUpdate::kSymmetric>
-class StandardKalman {
+class StandardKalman : public KalmanFilterBase<Fmt, Structure, kForm> {
  public:
-  static constexpr std::size_t kN = Structure::kStates;
-  static constexpr std::size_t kM = Structure::kInputs;
-  static constexpr std::size_t kP = Structure::kOutputs;
-  using Design = ControllerDesign<Fmt, kN, kM, kP>;
-  using Core = KalmanEstimator<Fmt, Structure, kForm>;  ///< The estimator it runs on.
-  using StateVec = typename Core::StateVec;
-  using OutputVec = typename Core::OutputVec;
-  using InputVec = typename Core::InputVec;
-  using Cov = typename Core::Cov;
-  using Gain = typename Core::Gain;
+  using Base = KalmanFilterBase<Fmt, Structure, kForm>;
+  using Base::kM, Base::kN;
+  using typename Base::Core, typename Base::Cov, typename Base::Design;
+  using typename Base::InputVec, typename Base::OutputVec, typename Base::StateVec;
 
   /// Filter over `design` (must outlive it).
-  constexpr StandardKalman(const Design& design, NoiseModel noise) : design_(&design), noise_(noise) {
+  constexpr StandardKalman(const Design& design, NoiseModel noise) : Base(design, noise) {
     reset(StateVec{}, design.p0, InputVec{});
   }
 
   /// Estimate x0 with covariance p0 at the first sampling instant.
   constexpr void reset(const StateVec& x0, const Cov& p0, const InputVec& u0) {
-    core_.reset(x0, p0);
+    this->core_.reset(x0, p0);
     u_ = u0;
     first_ = true;
   }
@@ -47,30 +42,21 @@ class StandardKalman {
   constexpr Status update(std::int32_t /*tau_us*/, const OutputVec& y) {
     if (!first_) {
       Discretization<Fmt, kN, kM> d;
-      d.phi = design_->phi_h;
-      d.gamma = design_->gamma_h;
-      d.qd = design_->qd_h;
-      core_.predict(d, u_, noise_, design_->q_constant);
+      d.phi = this->design_->phi_h;
+      d.gamma = this->design_->gamma_h;
+      d.qd = this->design_->qd_h;
+      this->core_.predict(d, u_, this->noise_, this->design_->q_constant);
     }
     first_ = false;
-    return core_.correct_all(y, design_->c, design_->r);
+    return this->core_.correct_all(y, this->design_->c, this->design_->r);
   }
 
   /// The input applied after this job.
   constexpr void set_applied_input(const InputVec& u) { u_ = u; }
   /// x̂ at the last sample (used as if it were the actuation instant).
-  constexpr const StateVec& prediction() const { return core_.state(); }
-  /// P after the last correction.
-  constexpr const Cov& covariance() const { return core_.covariance(); }
-  /// The gain of the last correction.
-  constexpr const Gain& gain() const { return core_.gain(); }
-  /// The estimator underneath (at the last sample).
-  constexpr const Core& core() const { return core_; }
+  constexpr const StateVec& prediction() const { return this->core_.state(); }
 
  private:
-  const Design* design_;
-  NoiseModel noise_;
-  Core core_{};
   InputVec u_{};
   bool first_ = true;
 };

@@ -27,15 +27,14 @@
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
-#include <unordered_map>
 #include <vector>
 
 #include "oneshot/assert_handler.hpp"
 #include "oneshot/engine/cost.hpp"
+#include "oneshot/engine/exact_segment.hpp"
 #include "oneshot/engine/process_noise.hpp"
 #include "oneshot/engine/sim_time.hpp"
 #include "oneshot/matrix.hpp"
-#include "oneshot/matrix_exponential.hpp"
 #include "oneshot/engine/random_stream.hpp"
 
 namespace oneshot::engine {
@@ -91,7 +90,7 @@ class BoardPlant {
 
   /// Board at t = 0, state 0, duty 0, set-point 0; `noise` feeds the process noise.
   BoardPlant(const CircuitConfig<N, M, P>& config, RandomStream noise)
-      : cfg_(config), noise_rng_(std::move(noise)), noise_(config.a, config.qc, config.q1c) {
+      : cfg_(config), noise_rng_(std::move(noise)), noise_(config.a, config.qc, config.q1c), segments_(config.a, config.b, config.q1c) {
     ONESHOT_ASSERT(cfg_.pwm_period_ns > 0 && cfg_.duty_steps > 0);
     set_setpoint(Vector<double, P>{});
   }
@@ -205,11 +204,7 @@ class BoardPlant {
   double expected_noise_cost(Duration delta) const { return noise_.expected_cost(delta); }
 
  private:
-  struct Segment {
-    Matrix<double, N, N> phi;
-    Matrix<double, N, M> gamma;
-    Matrix<double, kK, kK> g;
-  };
+  using Segment = ExactSegment<N, M>;
 
   static double seconds(std::int64_t ns) { return static_cast<double>(ns) * 1e-9; }
 
@@ -227,31 +222,6 @@ class BoardPlant {
   }
 
   void invalidate() { powers_ = 0; }
-
-  const Segment& segment(std::int64_t d_ns) {
-    auto it = segments_.find(d_ns);
-    if (it != segments_.end()) return it->second;
-    if (segments_.size() > 8192) segments_.clear();
-    const double d = seconds(d_ns);
-    Matrix<double, kK, kK> f;
-    f.template set_block<0, 0>(cfg_.a);
-    f.template set_block<0, N>(cfg_.b);
-    Matrix<double, kK, kK> w;
-    w.template set_block<0, 0>(cfg_.q1c);
-    Matrix<double, 2 * kK, 2 * kK> v;
-    v.template set_block<0, 0>(-(f.transposed() * d));
-    v.template set_block<0, kK>(w * d);
-    v.template set_block<kK, kK>(f * d);
-    Matrix<double, 2 * kK, 2 * kK> e;
-    ONESHOT_ASSERT(matrix_exponential(v, e) == Status::kOk);
-    const Matrix<double, kK, kK> e22 = e.template block<kK, kK, kK, kK>();
-    Segment s;
-    s.phi = e22.template block<0, 0, N, N>();
-    s.gamma = e22.template block<0, N, N, M>();
-    s.g = e22.transposed() * e.template block<0, kK, kK, kK>();
-    mirror_upper(s.g);
-    return segments_.emplace(d_ns, s).first->second;
-  }
 
   Vector<double, M> levels_at_phase(std::int64_t phase_ns) const {
     Vector<double, M> v;
@@ -277,25 +247,14 @@ class BoardPlant {
   }
 
   void apply_segment(State& e, std::int64_t d, const Vector<double, M>& dv, bool cost) {
-    const Segment& s = segment(d);
+    const Segment& s = segments_.get(d);
     if (cost) {
       Vector<double, kK> z;
       z.template set_block<0, 0>(e);
       z.template set_block<N, 0>(dv);
-      cost_.state += quadratic(s.g, z);
+      cost_.state += quadratic_form(s.g, z);
     }
     e = s.phi * e + s.gamma * dv;
-  }
-
-  template <std::size_t K>
-  static double quadratic(const Matrix<double, K, K>& g, const Vector<double, K>& z) {
-    double q = 0;
-    for (std::size_t i = 0; i < K; ++i) {
-      double row = 0;
-      for (std::size_t j = 0; j < K; ++j) row += g(i, j) * z[j];
-      q += z[i] * row;
-    }
-    return q;
   }
 
   /// e over [t0, t1] with the duties in force; the state cost is added when `cost`.
@@ -320,7 +279,7 @@ class BoardPlant {
     Aug s = Aug::identity();
     Aug c;
     for_each_segment(0, 0, cfg_.pwm_period_ns, [&](std::int64_t d, const Vector<double, M>& dv) {
-      const Segment& seg = segment(d);
+      const Segment& seg = segments_.get(d);
       // z = T w with T = [[I, 0], [0, ṽ]]; segment map [[Φ, Γṽ], [0, 1]].
       Matrix<double, kK, N + 1> tm;
       for (std::size_t i = 0; i < N; ++i) tm(i, i) = 1;
@@ -354,7 +313,7 @@ class BoardPlant {
         ++powers_;
       }
       if ((n & 1) != 0) {
-        if (cost) cost_.state += quadratic(c_pow_[j], w);
+        if (cost) cost_.state += quadratic_form(c_pow_[j], w);
         w = s_pow_[j] * w;
       }
     }
@@ -389,18 +348,7 @@ class BoardPlant {
 
   /// Adds the bridged noise path to the trace points from index `first` (interval from `start`).
   void trace_noise(SimTime start, std::size_t first, const State& n_end) {
-    if (!cfg_.process_noise) return;
-    State n_prev{};
-    SimTime t_prev = start;
-    for (std::size_t i = first; i < trace_.size(); ++i) {
-      const SimTime s = trace_[i].t;
-      // Noise still to come after t_prev given n(t_prev): n_end − Φ(now − t_prev) n(t_prev).
-      const State rest = n_end - noise_.transition(now_ - t_prev) * n_prev;
-      const State n_s = noise_.transition(s - t_prev) * n_prev + noise_.bridge(s - t_prev, now_ - t_prev, rest, trace_rng_);
-      trace_[i].x = trace_[i].x + n_s;
-      n_prev = n_s;
-      t_prev = s;
-    }
+    if (cfg_.process_noise) bridge_trace_noise(trace_, first, start, now_, n_end, noise_, trace_rng_);
   }
 
   static constexpr std::size_t kMaxPowers = 48;
@@ -418,7 +366,7 @@ class BoardPlant {
   bool pending_ = false;
   SimTime pending_at_{0};
   CostBreakdown cost_{};
-  std::unordered_map<std::int64_t, Segment> segments_;
+  ExactSegmentCache<N, M> segments_;
   Aug s_pow_[kMaxPowers];
   Aug c_pow_[kMaxPowers];
   std::size_t powers_ = 0;

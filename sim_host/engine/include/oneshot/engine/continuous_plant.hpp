@@ -19,16 +19,15 @@
 #include <cstddef>
 #include <cstdint>
 #include <stdexcept>
-#include <unordered_map>
 #include <vector>
 
 #include "oneshot/assert_handler.hpp"
 #include "oneshot/engine/board_plant.hpp"
 #include "oneshot/engine/cost.hpp"
+#include "oneshot/engine/exact_segment.hpp"
 #include "oneshot/engine/process_noise.hpp"
 #include "oneshot/engine/sim_time.hpp"
 #include "oneshot/matrix.hpp"
-#include "oneshot/matrix_exponential.hpp"
 
 namespace oneshot::engine {
 
@@ -63,7 +62,8 @@ class ContinuousPlant {
 
   /// Plant at t = 0, x = 0, u = 0, d = 0, reference 0; `noise` feeds the process noise.
   ContinuousPlant(const ContinuousPlantConfig<N, M, P, W>& config, RandomStream noise)
-      : cfg_(config), noise_rng_(std::move(noise)), noise_(config.a, config.qc, config.q1c) {}
+      : cfg_(config), noise_rng_(std::move(noise)), noise_(config.a, config.qc, config.q1c),
+        segments_(config.a, held_input_matrix(config), config.q1c) {}
 
   /// Current time.
   SimTime now() const { return now_; }
@@ -126,85 +126,46 @@ class ContinuousPlant {
     const Input du = u_ - u_ref_;
     const std::size_t first_new = trace_.size();
     while (trace_step_.count() > 0 && trace_next_ <= t1) {
-      const Segment& s = segment(trace_next_ - start);
-      trace_.push_back(Sample{trace_next_, s.phi * e0 + s.gamma * du + s.gamma_w * d_ + x_ref_, x_ref_c(), u_});
+      trace_.push_back(Sample{trace_next_, propagated(segments_.get((trace_next_ - start).count()), e0, du), x_ref_c(), u_});
       trace_next_ += trace_step_;
     }
-    const Segment& seg = segment(delta);
+    const Segment& seg = segments_.get(delta.count());
     Vector<double, kK> z;
     z.template set_block<0, 0>(e0);
     z.template set_block<N, 0>(du);
     z.template set_block<N + M, 0>(d_);
-    cost_.state += quadratic(seg.g, z);
+    cost_.state += quadratic_form(seg.g, z);
     double u_cost = 0;
     for (std::size_t i = 0; i < M; ++i)
       for (std::size_t k = 0; k < M; ++k) u_cost += du[i] * cfg_.q2c(i, k) * du[k];
     cost_.input += u_cost * to_seconds(delta);
-    x_ = seg.phi * e0 + seg.gamma * du + seg.gamma_w * d_ + x_ref_;
+    x_ = propagated(seg, e0, du);
     now_ = t1;
     if (!cfg_.process_noise) return;
     const State n_end = noise_.draw(delta, noise_rng_);
     x_ = x_ + n_end;
     cost_.noise += noise_.interval_cost(delta);
-    State n_prev{};
-    SimTime t_prev = start;
-    for (std::size_t i = first_new; i < trace_.size(); ++i) {
-      const SimTime s = trace_[i].t;
-      const State rest = n_end - noise_.transition(t1 - t_prev) * n_prev;
-      const State n_s = noise_.transition(s - t_prev) * n_prev + noise_.bridge(s - t_prev, t1 - t_prev, rest, trace_rng_);
-      trace_[i].x = trace_[i].x + n_s;
-      n_prev = n_s;
-      t_prev = s;
-    }
+    bridge_trace_noise(trace_, first_new, start, t1, n_end, noise_, trace_rng_);
   }
 
-  /// Φ(Δ), Γ(Δ), Γ_w(Δ) and the cost Gramian G(Δ) (cached).
-  struct Segment {
-    Matrix<double, N, N> phi;      ///< Φ(Δ).
-    Matrix<double, N, M> gamma;    ///< Γ(Δ).
-    Matrix<double, N, W> gamma_w;  ///< Γ_w(Δ).
-    Matrix<double, kK, kK> g;      ///< ∫ eᵀQ1c e = zᵀ G z.
-  };
-  /// The exact interval map of length Δ.
-  const Segment& segment(Duration delta) {
-    const auto it = segments_.find(delta.count());
-    if (it != segments_.end()) return it->second;
-    if (segments_.size() > 8192) segments_.clear();
-    const double d = to_seconds(delta);
-    Matrix<double, kK, kK> f;
-    f.template set_block<0, 0>(cfg_.a);
-    f.template set_block<0, N>(cfg_.b);
-    f.template set_block<0, N + M>(cfg_.bw);
-    Matrix<double, kK, kK> w;
-    w.template set_block<0, 0>(cfg_.q1c);
-    Matrix<double, 2 * kK, 2 * kK> v;
-    v.template set_block<0, 0>(-(f.transposed() * d));
-    v.template set_block<0, kK>(w * d);
-    v.template set_block<kK, kK>(f * d);
-    Matrix<double, 2 * kK, 2 * kK> e;
-    ONESHOT_ASSERT(matrix_exponential(v, e) == Status::kOk);
-    const Matrix<double, kK, kK> e22 = e.template block<kK, kK, kK, kK>();
-    Segment s;
-    s.phi = e22.template block<0, 0, N, N>();
-    s.gamma = e22.template block<0, N, N, M>();
-    s.gamma_w = e22.template block<0, N + M, N, W>();
-    s.g = e22.transposed() * e.template block<0, kK, kK, kK>();
-    mirror_upper(s.g);
-    return segments_.emplace(delta.count(), s).first->second;
-  }
   /// Q_d(Δ) of the process noise.
   Matrix<double, N, N> process_covariance(Duration delta) const { return noise_.covariance(delta); }
 
  private:
   Output x_ref_c() const { return cfg_.c * x_ref_; }
-  static double quadratic(const Matrix<double, kK, kK>& g, const Vector<double, kK>& z) {
-    double q = 0;
-    for (std::size_t i = 0; i < kK; ++i) {
-      double row = 0;
-      for (std::size_t j = 0; j < kK; ++j) row += g(i, j) * z[j];
-      q += z[i] * row;
-    }
-    return q;
+  using Segment = ExactSegment<N, M + W>;
+  /// [B, B_w]: the columns held over an interval.
+  static Matrix<double, N, M + W> held_input_matrix(const ContinuousPlantConfig<N, M, P, W>& c) {
+    Matrix<double, N, M + W> b;
+    b.template set_block<0, 0>(c.b);
+    b.template set_block<0, M>(c.bw);
+    return b;
+  }
+  /// Φ e0 + Γ ũ + Γ_w d + x_ref.
+  State propagated(const Segment& s, const State& e0, const Input& du) const {
+    const Matrix<double, N, M> gamma = s.gamma.template block<0, 0, N, M>();
+    const Matrix<double, N, W> gamma_w = s.gamma.template block<0, M, N, W>();
+    return s.phi * e0 + gamma * du + gamma_w * d_ + x_ref_;
   }
 
   ContinuousPlantConfig<N, M, P, W> cfg_;
@@ -217,7 +178,7 @@ class ContinuousPlant {
   State x_ref_{};
   Input u_ref_{};
   CostBreakdown cost_{};
-  std::unordered_map<std::int64_t, Segment> segments_;
+  ExactSegmentCache<N, M + W> segments_;
   Duration trace_step_{0};
   SimTime trace_next_{0};
   RandomStream trace_rng_{0, "trace"};

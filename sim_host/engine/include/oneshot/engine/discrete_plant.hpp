@@ -20,6 +20,7 @@
 #include "oneshot/engine/cost.hpp"
 #include "oneshot/engine/kernel.hpp"
 #include "oneshot/engine/psd_math.hpp"
+#include "oneshot/engine/quadratic_form.hpp"
 #include "oneshot/engine/sim_time.hpp"
 #include "oneshot/matrix.hpp"
 
@@ -105,8 +106,8 @@ class DiscretePlant {
   void step() {
     const State e = x_ - e_ref_;
     const Input du = u_latched_ - u_ref_latched_;
-    cost_.state += quadratic(cfg_.q1, e);
-    cost_.input += quadratic(cfg_.q2, du);
+    cost_.state += quadratic_form(cfg_.q1, e);
+    cost_.input += quadratic_form(cfg_.q2, du);
     x_ = cfg_.phi * x_ + cfg_.gamma * u_latched_ + cfg_.gamma_w * d_latched_;
     if (cfg_.process_noise) {
       State w;
@@ -118,17 +119,6 @@ class DiscretePlant {
   }
 
  private:
-  template <std::size_t K>
-  static double quadratic(const Matrix<double, K, K>& g, const Vector<double, K>& z) {
-    double q = 0;
-    for (std::size_t i = 0; i < K; ++i) {
-      double row = 0;
-      for (std::size_t j = 0; j < K; ++j) row += g(i, j) * z[j];
-      q += z[i] * row;
-    }
-    return q;
-  }
-
   DiscretePlantConfig<N, M, P, W> cfg_;
   RandomStream noise_rng_;
   Matrix<double, N, N> chol_;
