@@ -247,32 +247,30 @@ TEST(Cpu, EdfImplicitDeadlinesSchedulableIffUtilizationAtMostOne) {
   EXPECT_GT(overloaded, 50U);
 }
 
-/// Buttazzo, Hard Real-Time Computing Systems (3rd ed.), RTA example: C = (1, 2, 3),
-/// T = (4, 6, 10) gives R = (1, 3, 10); Redell–Sanfridson by hand gives BCRT = 3 for τ3.
-TEST(Cpu, TextbookButtazzo) {
-  TaskSet s;
-  s.tasks = {task("t1", 4, 1, 1, 1), task("t2", 6, 2, 2, 2), task("t3", 10, 3, 3, 3)};
-  const Analysis a = analyze(s);
-  ASSERT_TRUE(a.schedulable);
-  EXPECT_EQ(a.tasks[0].wcrt, from_us(1));
-  EXPECT_EQ(a.tasks[1].wcrt, from_us(3));
-  EXPECT_EQ(a.tasks[2].wcrt, from_us(10));
-  EXPECT_EQ(a.tasks[2].bcrt, from_us(3));
-  const auto st = simulate(s, from_us(60), 1);
-  EXPECT_EQ(st[2].response_max, from_us(10));
-}
-
-/// Burns & Wellings, Real-Time Systems and Programming Languages, RTA example:
-/// (C, T) = (3, 7), (3, 12), (5, 20) gives R = 3, 6, 20.
-TEST(Cpu, TextbookBurnsWellings) {
-  TaskSet s;
-  s.tasks = {task("a", 7, 3, 3, 1), task("b", 12, 3, 3, 2), task("c", 20, 5, 5, 3)};
-  const Analysis a = analyze(s);
-  EXPECT_TRUE(a.schedulable);
-  EXPECT_EQ(a.tasks[0].wcrt, from_us(3));
-  EXPECT_EQ(a.tasks[1].wcrt, from_us(6));
-  EXPECT_EQ(a.tasks[2].wcrt, from_us(20));
-  EXPECT_EQ(simulate(s, from_us(420), 1)[2].response_max, from_us(20));
+/// Textbook sets with published response times, analysis and simulation (synchronous release):
+/// Buttazzo, Hard Real-Time Computing Systems (3rd ed.), C = (1, 2, 3), T = (4, 6, 10) gives
+/// R = (1, 3, 10) (Redell–Sanfridson by hand: BCRT = 3 for τ3); Burns & Wellings, Real-Time
+/// Systems and Programming Languages, (C, T) = (3, 7), (3, 12), (5, 20) gives R = (3, 6, 20).
+TEST(Cpu, TextbookSets) {
+  struct Case {
+    const char* source;
+    std::vector<TaskSpec> tasks;
+    std::vector<std::int64_t> wcrt_us;
+  };
+  const std::vector<Case> cases = {
+      {"Buttazzo", {task("t1", 4, 1, 1, 1), task("t2", 6, 2, 2, 2), task("t3", 10, 3, 3, 3)}, {1, 3, 10}},
+      {"Burns & Wellings", {task("a", 7, 3, 3, 1), task("b", 12, 3, 3, 2), task("c", 20, 5, 5, 3)}, {3, 6, 20}}};
+  for (const Case& c : cases) {
+    TaskSet s;
+    s.tasks = c.tasks;
+    const Analysis a = analyze(s);
+    EXPECT_TRUE(a.schedulable) << c.source;
+    for (std::size_t i = 0; i < c.wcrt_us.size(); ++i) EXPECT_EQ(a.tasks[i].wcrt, from_us(c.wcrt_us[i])) << c.source << " " << i;
+    EXPECT_EQ(simulate(s, from_us(420), 1)[2].response_max, from_us(c.wcrt_us[2])) << c.source;
+    if (std::string(c.source) == "Buttazzo") {
+      EXPECT_EQ(a.tasks[2].bcrt, from_us(3));
+    }
+  }
 }
 
 /// (C, T) = (1, 3), (1, 4), (2, 5), U = 0.983: rate monotonic misses with the third task
