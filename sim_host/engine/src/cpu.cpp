@@ -111,7 +111,9 @@ void Cpu::arrive(std::size_t e) {
 
 void Cpu::make_ready(std::uint64_t arg) {
   const std::size_t e = arg >> 32;
-  for (Job& j : ent_[e].pending) {
+  // Newest first: the job made ready is nearly always the last one queued.
+  for (auto it = ent_[e].pending.rbegin(); it != ent_[e].pending.rend(); ++it) {
+    Job& j = *it;
     if ((j.index & 0xFFFFFFFFULL) == (arg & 0xFFFFFFFFULL)) {
       j.ready = kernel_.now();
       ++stats_[e].released;

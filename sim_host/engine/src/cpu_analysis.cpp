@@ -123,34 +123,50 @@ TaskBound fp_bound(const TaskSet& s, std::size_t i, I limit) {
   const I period = t.period.count();
   const I jitter = t.release_jitter.count();
   I worst = 0;
+  std::vector<Load> all = hp;  // hp tasks and ISRs
+  all.insert(all.end(), isr.begin(), isr.end());
+  // Level-i utilization above 1: the busy period never closes (checked first: the iterations
+  // below would only creep towards the limit).
+  double u_hep = static_cast<double>(c) / static_cast<double>(period);
+  for (const Load& l : all) u_hep += static_cast<double>(l.c) / static_cast<double>(l.t);
+  // Non-preemptive: the jobs of the level-i busy period t = B + Σ_{hep, ISR} ⌈(t + J)/T⌉ C'
+  // (Davis et al. 2007: the preemptive stopping rule below is optimistic here).
+  I jobs_np = 0;
+  if (np && u_hep <= 1.0) {
+    std::vector<Load> with_own = all;
+    with_own.push_back(Load{c, 0, period, jitter, true});
+    const I busy = fixed_point(blocking, c, with_own, limit);
+    jobs_np = busy < 0 ? -1 : ceil_div(busy + jitter, period);  // −1: the busy period does not close
+  }
+  std::vector<Load> all_np = all;  // ⌊x/T⌋ + 1 = ⌈(x + 1)/T⌉ for integer ns
+  for (Load& l : all_np) l.j += 1;
+  // w(q) and s(q) grow with q: each fixed point starts from the previous one.
+  I prev_f = 0, prev_start = 0;
   for (I q = 0;; ++q) {
-    I f = 0;
-    if (!np) {
-      std::vector<Load> all = hp;
-      all.insert(all.end(), isr.begin(), isr.end());
-      f = fixed_point(blocking + (q + 1) * c, 0, all, limit);
+    I f = -1;
+    if (u_hep > 1.0 || (np && jobs_np < 0) || q >= kMaxJobs) {
+      f = -1;
+    } else if (!np) {
+      f = fixed_point(blocking + (q + 1) * c, prev_f, all, limit);
     } else {
-      // s = B + qC' + Σ (⌊(s + J)/T⌋ + 1) C' over hp tasks and ISRs: the fixed point of the
-      // ceiling form with w + J + 1 ns (⌊x/T⌋ + 1 = ⌈(x + 1)/T⌉ for integer ns).
-      std::vector<Load> all = hp;
-      all.insert(all.end(), isr.begin(), isr.end());
-      for (Load& l : all) l.j += 1;
-      const I start = fixed_point(blocking + q * c, 0, all, limit);
+      // s = B + qC' + Σ (⌊(s + J)/T⌋ + 1) C' over hp tasks and ISRs; then the own job and the
+      // ISRs until it ends.
+      const I start = fixed_point(blocking + q * c, prev_start, all_np, limit);
       if (start >= 0) {
         I hp_part = blocking + q * c;
         for (const Load& l : hp) hp_part += ceil_div(start + l.j + 1, l.t) * l.c;
         f = fixed_point(hp_part + c, start + c, isr, limit);
-      } else {
-        f = -1;
+        prev_start = start;
       }
     }
-    if (f < 0 || q >= kMaxJobs) {
+    if (f < 0) {
       b.bounded = false;
       break;
     }
+    prev_f = f;
     worst = std::max(worst, f - q * period + jitter);
     b.jobs_examined = static_cast<std::size_t>(q + 1);
-    if (f <= (q + 1) * period - jitter) break;
+    if (np ? q + 1 >= jobs_np : f <= (q + 1) * period - jitter) break;
   }
   b.wcrt = Duration{worst};
   std::vector<Load> best_loads = isr;
@@ -179,7 +195,16 @@ void edf_analysis(const TaskSet& s, Analysis& a, I limit) {
   for (const Load& l : all) u += static_cast<double>(l.c) / static_cast<double>(l.t);
   std::string miss;
   std::string reason;
-  if (simple && cs == 0) {
+  for (const TaskSpec& t : s.tasks) {
+    // A job released J late still needs C: J + C' > D misses whatever the others do.
+    if (miss.empty() && t.release_jitter.count() + t.exec.wcet.count() + cs > t.deadline.count()) {
+      miss = t.name;
+      reason = "release jitter plus execution time exceed the deadline";
+    }
+  }
+  if (!miss.empty()) {
+    // already decided
+  } else if (simple && cs == 0) {
     if (u > 1.0 + 1e-12) {
       miss = s.tasks.front().name;
       reason = "EDF with implicit deadlines: utilization above 1";

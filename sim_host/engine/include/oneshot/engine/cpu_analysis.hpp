@@ -14,7 +14,8 @@
 ///     B_i  = max_{j ∈ lp(i)} NP_j                        (non-preemptive first sections)
 ///     w(q) = B_i + (q+1) C'_i + Σ_{hp} ⌈(w + J_j)/T_j⌉ C'_j + Σ_{ISR} ⌈(w + J_k)/T_k⌉ C_k
 ///     R_i  = max_q w(q) − q T_i + J_i,   q = 0, 1, … while w(q) > (q+1) T_i − J_i
-/// Fixed priority, non-preemptive (George et al. 1996; Davis et al. 2007, eq. of the CAN form):
+/// Fixed priority, non-preemptive (George et al. 1996; Davis et al. 2007, eq. of the CAN form;
+/// q over the jobs of the level-i busy period t = B_i + Σ_{hep, ISR} ⌈(t + J)/T⌉ C'):
 ///     B_i  = max_{j ∈ lp(i)} (C_j + cs),  C'_j = C_j + cs
 ///     s(q) = B_i + q C'_i + Σ_{hp} (⌊(s + J_j)/T_j⌋ + 1) C'_j + Σ_{ISR} (⌊(s + J_k)/T_k⌋ + 1) C_k
 ///     f(q) = s_hp(q) + (q+1) C'_i + Σ_{ISR} ⌈(f + J_k)/T_k⌉ C_k,   R_i = max_q f(q) − q T_i + J_i
