@@ -56,6 +56,10 @@ RunOptions options_for(const CommonOptions& opt, Approach a) {
 }
 
 PilOptions matching(const PilOptions& base, const CommonOptions& opt) {
+  if (opt.format == NumberFormat::kQ15) {
+    throw std::invalid_argument("the q15 C job runs in the fixed-point table images as approach 6: see `exectime "
+                                "--noise-model exact` (c99_half_*_q15)");
+  }
   PilOptions p = base;
   p.format = to_string(opt.format);
   p.discretizer = to_string(opt.discretizer);
