@@ -105,7 +105,8 @@ void header_prologue(CodeWriter& w, const PlantDescription& plant, const DesignR
   w.line(" *                  float core when compiled without floating contraction (-ffp-contract=off)");
   w.line(" *   float_nearest  IEEE single precision, tau rounded to the grid");
   w.line(" *   q15_table      16-bit Q formats (estimate, covariance, input, tables), 16x16->32 products");
-  w.line(" *                  and 32-bit accumulators (a dsPIC's MAC format), exact between grid points;");
+  w.line(" *                  and 32-bit accumulators (a dsPIC's MAC format); tau between grid points by");
+  w.line(" *                  per-interval polynomials fitted within 1/4 LSB of each entry's format;");
   w.line(" *                  its own arithmetic (no C++ core twin): rounding half up, saturation flagged");
   w.line(" *   q15_nearest    the same, tau rounded to the grid");
   w.line(" * The fixed variants use only integer arithmetic (no floating point, no division, no library");

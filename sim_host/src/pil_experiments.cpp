@@ -5,6 +5,8 @@
 #include <cmath>
 #include <filesystem>
 #include <iostream>
+#include <map>
+#include <random>
 #include <sstream>
 
 #include "oneshot/host/file_io.hpp"
@@ -56,6 +58,10 @@ RunOptions options_for(const CommonOptions& opt, Approach a) {
 }
 
 PilOptions matching(const PilOptions& base, const CommonOptions& opt) {
+  if (opt.format == NumberFormat::kQ15) {
+    throw std::invalid_argument("the q15 C job runs in the fixed-point table images as approach 6: see `exectime "
+                                "--noise-model exact` (c99_half_*_q15)");
+  }
   PilOptions p = base;
   p.format = to_string(opt.format);
   p.discretizer = to_string(opt.discretizer);
@@ -127,6 +133,65 @@ nlohmann::json c_job_only_image(const PilOptions& base, const std::string& varia
   const bool q15 = variant.rfind("q15_", 0) == 0;  // issue 25: the 16-bit job's tighter budget
   j["flash_target_bytes"] = q15 ? 6 * 1024 : 12 * 1024;
   j["ram_target_bytes"] = q15 ? 512 : 1024;
+  return j;
+}
+
+/// Calls of libgcc's soft-float routines per job of approach `approach` (entries of the
+/// __aeabi_f* / __aeabi_*2f routines executed inside the job windows), from the instruction
+/// profile of a run of its own on the same jobs.
+nlohmann::json soft_float_calls(const PilOptions& image, std::uint32_t approach, bool exact_noise, std::uint16_t pwm0,
+                                const std::vector<JobRecord>& jobs) {
+  namespace fs = std::filesystem;
+  PilOptions p = image;
+  p.count_instructions = true;
+  std::random_device entropy;
+  const fs::path dir = fs::temp_directory_path() / ("oneshot-softfloat-" + std::to_string(entropy()) + std::to_string(entropy()));
+  p.profile_dir = dir.string();
+  std::string elf;
+  {
+    PilLink link(p);
+    elf = link.image();
+    app::pil::Frame cfg;
+    app::pil::Writer cw(cfg);
+    cw.u(approach, 1);
+    cw.u(exact_noise ? 1U : 0U, 1);
+    cw.u(pwm0, 2);
+    link.request(app::pil::Type::kConfig, cfg);
+    for (const JobRecord& r : jobs) {
+      app::pil::Frame f;
+      app::pil::Writer w(f);
+      w.u(static_cast<std::uint32_t>(std::llround(r.t_sample_s * 1e6)), 4);
+      w.u(static_cast<std::uint32_t>(std::llround(r.t_apply_s * 1e6)), 4);
+      w.s(r.y_code, 2);
+      w.s(r.setpoint_code, 2);
+      link.request(app::pil::Type::kSample, f);
+    }
+  }  // QEMU ends: the plugin writes the profile
+  std::map<std::uint32_t, std::string> entries;
+  for (const char* name : {"__aeabi_fadd", "__aeabi_fsub", "__aeabi_frsub", "__aeabi_fmul", "__aeabi_fdiv",
+                           "__aeabi_fcmpeq", "__aeabi_fcmplt", "__aeabi_fcmple", "__aeabi_fcmpgt", "__aeabi_fcmpge",
+                           "__aeabi_i2f", "__aeabi_ui2f", "__aeabi_f2iz", "__aeabi_f2uiz"}) {
+    try {
+      entries.emplace(elf_symbol_address(elf, name) & ~1U, name);
+    } catch (const PilError&) {
+      // not linked into this image
+    }
+  }
+  const fs::path file = dir / (fs::path(elf).stem().string() + ".profile");
+  std::istringstream in(fs::exists(file) ? host::read_text_file(file.string(), "instruction profile", kMaxImageBytes) : "");
+  fs::remove_all(dir);
+  std::map<std::string, double> per_routine;
+  double total = 0;
+  std::string address;
+  std::uint64_t count = 0;
+  while (in >> address >> count) {
+    const auto it = entries.find(static_cast<std::uint32_t>(std::stoul(address, nullptr, 16)) & ~1U);
+    if (it == entries.end()) continue;
+    per_routine[it->second] += static_cast<double>(count) / static_cast<double>(jobs.size());
+    total += static_cast<double>(count) / static_cast<double>(jobs.size());
+  }
+  nlohmann::json j{{"per_job", total}};
+  for (const auto& [name, n] : per_routine) j["by_routine"][name] = n;
   return j;
 }
 
@@ -338,6 +403,14 @@ nlohmann::json run_exectime_target(const SimContext& ctx, const CommonOptions& o
           j["variants"][name]["job_only_image"] = c_job_only_image(base, std::string("q15_") + disc);
           j["variants"][name]["instructions_target"] = 1000;
         } else if (v == 2) {
+          if (std::string(format) == "float") {
+            PilOptions img = base;
+            img.format = format;
+            img.discretizer = disc;
+            j["variants"][name]["soft_float_calls"] = soft_float_calls(
+                img, kCJobApproach, opt.noise == NoiseModel::kExact,
+                static_cast<std::uint16_t>(std::lround(-ctx.design().u_min[0] * ctx.design().steps_per_volt[0])), jobs);
+          }
           // The C job always predicts with the exact Q_d(τ): compared with B only under that model.
           j["variants"][name]["noise_model"] = "exact";
           if (opt.noise == NoiseModel::kExact) {

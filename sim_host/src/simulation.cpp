@@ -136,6 +136,9 @@ decltype(auto) with_estimator(const RunOptions& opt, const Design& design, const
 /// Dispatches on the context (generated header or run-time plant) and the number format.
 template <typename F>
 decltype(auto) with_controller_parts(const SimContext& ctx, const RunOptions& opt, F&& f) {
+  if (opt.format == NumberFormat::kQ15) {
+    throw std::invalid_argument("--number-format q15 is the generated C job: closed-loop runs only (not the C++ core)");
+  }
   if (ctx.generated()) {
     if (opt.format == NumberFormat::kFloat) {
       using K = generated::PlantConstants<float>;

@@ -22,6 +22,7 @@
 #include <cstring>
 #include <random>
 #include <string>
+#include <type_traits>
 
 #include "oneshot/controller.hpp"
 #include "oneshot/fixed_point.hpp"
@@ -62,13 +63,27 @@ struct Plant {
   using K = generated::PlantConstants<double>;
   GenericDiscretizer<UniformFormat<double>, kN, kM> gen{K::kModel};
   Vector<double, kN> x{};
-  void advance(std::int32_t dt_us, double u) {
+  /// x <- Phi(dt) x + Gamma(dt) u, plus w ~ N(0, Q_d(dt)) (the design's process noise) when a
+  /// generator is given (n = 2: Q_d's Cholesky factor in closed form).
+  void advance(std::int32_t dt_us, double u, std::mt19937_64* rng = nullptr) {
     Discretization<UniformFormat<double>, kN, kM> d;
-    gen.discretize(dt_us, d, WithQd::kNo);
+    gen.discretize(dt_us, d, rng != nullptr ? WithQd::kYes : WithQd::kNo);
     Vector<double, kN> next;
     for (std::size_t i = 0; i < kN; ++i) {
       next[i] = d.gamma(i, 0) * u;
       for (std::size_t k = 0; k < kN; ++k) next[i] += d.phi(i, k) * x[k];
+    }
+    if constexpr (kN == 2) {
+      if (rng != nullptr && d.qd(0, 0) > 0) {
+        std::normal_distribution<double> n01(0.0, 1.0);
+        const double l00 = std::sqrt(d.qd(0, 0));
+        const double l10 = d.qd(1, 0) / l00;
+        const double l11 = std::sqrt(std::max(0.0, d.qd(1, 1) - l10 * l10));
+        const double a = n01(*rng);
+        const double b = n01(*rng);
+        next[0] += l00 * a;
+        next[1] += l10 * a + l11 * b;
+      }
     }
     x = next;
   }
@@ -80,10 +95,14 @@ struct Plant {
 class JobSequence {
  public:
   using KD = generated::PlantConstants<double>;
-  JobSequence(std::uint64_t seed, bool nearest) : rng_(seed), nearest_(nearest) {
+  /// consistent: B's jitter only, no stress job, process noise from the design's Q_d and
+  /// measurement noise from R (the filter's own model: its NEES should be about n).
+  JobSequence(std::uint64_t seed, bool nearest, bool consistent = false)
+      : rng_(seed), nearest_(nearest), consistent_(consistent) {
     u_volts_ = design().actuator.u_min[0] + pwm0() * design().actuator.volts_per_step[0];
   }
-  static const auto& design() { return KD::kDesign; }
+  using Design = std::remove_cv_t<std::remove_reference_t<decltype(KD::kDesign)>>;
+  static const Design& design() { return KD::kDesign; }
   /// The PWM code nearest 0 V (the initial input).
   static std::int32_t pwm0() {
     return static_cast<std::int32_t>(std::lround(-design().actuator.u_min[0] * design().actuator.steps_per_volt[0]));
@@ -94,7 +113,7 @@ class JobSequence {
     if (k_++ % 20 == 0) setpoint_ = uniform(-0.5, 0.5);
     // τ of a one-shot job released 0–20 ms after the previous actuation (B's regime), mostly;
     // otherwise anywhere in the table, on its grid, or outside it.
-    const int kind = static_cast<int>(integer(0, 99));
+    const int kind = consistent_ ? 0 : static_cast<int>(integer(0, 99));
     if (kind < 60) {
       tau = static_cast<std::int32_t>(integer(h - 20'000 - 600, h - 200));
     } else if (kind < 80) {
@@ -112,10 +131,12 @@ class JobSequence {
     // the grid: a negative τ is only valid there on the grid.
     if (nearest_ && tau < 0) tau = -static_cast<std::int32_t>(((-static_cast<std::int64_t>(tau)) / g) * g);
     physical_ = std::min(h, std::max<std::int32_t>(0, tau));
-    plant_.advance(h - physical_, u_volts_);
-    for (std::size_t i = 0; i < kN; ++i) plant_.x[i] += 1e-4 * normal_(rng_);
+    plant_.advance(h - physical_, u_volts_, consistent_ ? &rng_ : nullptr);
+    if (!consistent_)
+      for (std::size_t i = 0; i < kN; ++i) plant_.x[i] += 1e-4 * normal_(rng_);
     adc = code_of(plant_.x[0] + std::sqrt(design().r(0, 0)) * normal_(rng_));
     sp = code_of(setpoint_);
+    if (consistent_) return;
     stress_ = integer(0, 99) < 3;
     if (stress_) adc = static_cast<std::int32_t>(integer(0, 4095));  // garbage samples
     if (integer(0, 199) == 0) {
@@ -125,7 +146,7 @@ class JobSequence {
   }
   /// The job's PWM code takes effect at the actuation instant.
   void apply(std::int32_t code) {
-    plant_.advance(physical_, u_volts_);
+    plant_.advance(physical_, u_volts_, consistent_ ? &rng_ : nullptr);
     u_volts_ = design().actuator.u_min[0] + code * design().actuator.volts_per_step[0];
     if (code < 0 || code > design().actuator.steps) std::fprintf(stderr, "c_job_reference: code out of range\n");
   }
@@ -145,6 +166,7 @@ class JobSequence {
   }
   std::mt19937_64 rng_;
   bool nearest_;
+  bool consistent_;
   std::normal_distribution<double> normal_{0.0, 1.0};
   Plant plant_;
   double u_volts_ = 0;
@@ -209,60 +231,90 @@ double nees2(const double e[2], double p00, double p01, double p11) {
 }
 
 #if defined(ONESHOT_JOB_HAS_Q15_TABLE) && defined(ONESHOT_JOB_HAS_Q15_NEAREST) && ONESHOT_JOB_INPUTS == 1
-/// Tolerances of the q15 job against the double core on the same inputs, in the regular regime
-/// (0 <= τ <= h, no stress input in the last 20 jobs): a few times the deviation measured on
-/// 4000 jobs per variant (README, "The C99 job"): estimate 3.6 mV, PWM code 2 steps.
+/// Tolerances of the q15 job against the double core on the same τ and codes, on a loop whose
+/// noise is the filter's own model (4000 jobs, seeds 16, 5, 99): estimate within 3.2 mV of the
+/// double core's (4 ADC steps), PWM code within 2 steps, NEES 2.02-2.19 against 1.92-2.13 (ratio
+/// <= 1.06). Asserted at about 3x: 10 mV, 6 steps, NEES ratio 1.25.
 constexpr double kQ15EstimateTolVolts = 0.01;
+constexpr double kQ15NeesRatioTol = 1.25;
 constexpr int kQ15CodeTol = 6;
 
-/// One q15 variant: the generated C drives the loop (written raw like the fixed variants); the
-/// double core runs beside it on the same τ and codes.
+/// One q15 variant: the generated C drives the stress sequence (written raw like the fixed
+/// variants, the oracle of the host and AVR checks); then, on a loop whose noise is the
+/// filter's own model, the double core runs beside it on the same τ and codes: estimate and
+/// PWM code differences against the stated tolerances, and both filters' NEES.
 template <typename St, SubGrid kSub, typename Init, typename Run>
 bool run_q15(std::FILE* out, const char* name, int jobs, std::uint64_t seed, Init init, Run run, int state_frac,
              int cov_frac) {
   static_assert(kN == 2, "the NEES summary is written for two states");
+  const std::int32_t g = CoreJob<generated::FixedTag, kSub>::K::kTable.granularity_us;
+  {
+    St s{};
+    init(&s, static_cast<std::uint16_t>(JobSequence::pwm0()));
+    JobSequence seq(seed, kSub == SubGrid::kNearest);
+    std::fprintf(out, "variant %s %d %d\n", name, jobs, JobSequence::pwm0());
+    for (int k = 0; k < jobs; ++k) {
+      std::int32_t tau = 0, adc = 0, sp = 0;
+      seq.next(g, tau, adc, sp);
+      s.saturated = 0u;
+      const std::int32_t code = run(&s, tau, static_cast<std::uint16_t>(adc), static_cast<std::uint16_t>(sp));
+      std::fprintf(out, "%ld %d %d | %d %d %d", static_cast<long>(tau), adc, sp, code, static_cast<int>(s.status),
+                   static_cast<int>(s.saturated));
+      for (std::size_t i = 0; i < kN; ++i) std::fprintf(out, " %lld", static_cast<long long>(s.x[i]));
+      for (std::size_t i = 0; i < kN; ++i) std::fprintf(out, " %lld", static_cast<long long>(s.k[i]));
+      std::fprintf(out, " %lld\n", static_cast<long long>(s.u[0]));
+      seq.apply(code);
+    }
+  }
   St s{};
   init(&s, static_cast<std::uint16_t>(JobSequence::pwm0()));
   CoreJob<double, kSub> twin;
-  JobSequence seq(seed, kSub == SubGrid::kNearest);
-  std::fprintf(out, "variant %s %d %d\n", name, jobs, JobSequence::pwm0());
-  const std::int32_t h = JobSequence::design().period_us;
+  JobSequence seq(seed + 100, kSub == SubGrid::kNearest, true);
   double max_dx = 0, nees_q15 = 0, nees_double = 0;
-  int max_dcode = 0, regular = 0, since_stress = 0;
+  int max_dcode = 0, counted = 0;
+  bool saturated = false;
   for (int k = 0; k < jobs; ++k) {
     std::int32_t tau = 0, adc = 0, sp = 0, twin_code = 0;
-    seq.next(CoreJob<generated::FixedTag, kSub>::K::kTable.granularity_us, tau, adc, sp);
-    s.saturated = 0u;
+    seq.next(g, tau, adc, sp);
     const std::int32_t code = run(&s, tau, static_cast<std::uint16_t>(adc), static_cast<std::uint16_t>(sp));
     twin.run(tau, adc, sp, twin_code);
-    std::fprintf(out, "%ld %d %d | %d %d %d", static_cast<long>(tau), adc, sp, code, static_cast<int>(s.status),
-                 static_cast<int>(s.saturated));
-    for (std::size_t i = 0; i < kN; ++i) std::fprintf(out, " %lld", static_cast<long long>(s.x[i]));
-    for (std::size_t i = 0; i < kN; ++i) std::fprintf(out, " %lld", static_cast<long long>(s.k[i]));
-    std::fprintf(out, " %lld\n", static_cast<long long>(s.u[0]));
     seq.apply(code);
-    since_stress = seq.stress() || tau < 0 || tau > h ? 0 : since_stress + 1;
-    if (since_stress < 20) continue;
-    ++regular;
-    double e_q[2], e_d[2];
+    saturated = saturated || s.saturated != 0u;
+    if (k < 100) continue;  // the prior's transient
+    ++counted;
+    double e_q[2];
     for (std::size_t i = 0; i < kN; ++i) {
       const double xq = std::ldexp(static_cast<double>(s.x[i]), -state_frac);
-      const double xd = twin.ctrl.estimator().prediction()[i];
-      max_dx = std::max(max_dx, std::fabs(xq - xd));
+      max_dx = std::max(max_dx, std::fabs(xq - twin.ctrl.estimator().prediction()[i]));
       e_q[i] = seq.state()[i] - xq;
-      e_d[i] = seq.state()[i] - xd;
     }
     max_dcode = std::max(max_dcode, std::abs(code - twin_code));
     const auto cov = [&](int k2) { return std::ldexp(static_cast<double>(s.p[k2]), -cov_frac); };
     nees_q15 += nees2(e_q, cov(0), cov(1), cov(2));
-    const auto& pd = twin.ctrl.estimator().covariance();
-    nees_double += nees2(e_d, pd(0, 0), pd(0, 1), pd(1, 1));
   }
-  std::printf("%s vs double core (%d regular jobs): max |estimate difference| %.3g V (tolerance %.3g), max |PWM code "
-              "difference| %d (tolerance %d); mean NEES q15 %.3f, double %.3f (2 = consistent)\n",
-              name, regular, max_dx, kQ15EstimateTolVolts, max_dcode, kQ15CodeTol,
-              regular > 0 ? nees_q15 / regular : 0.0, regular > 0 ? nees_double / regular : 0.0);
-  return regular > 0 && max_dx <= kQ15EstimateTolVolts && max_dcode <= kQ15CodeTol;
+  {
+    // The double core's NEES in its own closed loop (same noise draws: same seed, same count).
+    CoreJob<double, kSub> alone;
+    JobSequence own(seed + 100, kSub == SubGrid::kNearest, true);
+    for (int k = 0; k < jobs; ++k) {
+      std::int32_t tau = 0, adc = 0, sp = 0, code = 0;
+      own.next(g, tau, adc, sp);
+      alone.run(tau, adc, sp, code);
+      own.apply(code);
+      if (k < 100) continue;
+      double e[2];
+      for (std::size_t i = 0; i < kN; ++i) e[i] = own.state()[i] - alone.ctrl.estimator().prediction()[i];
+      const auto& pd = alone.ctrl.estimator().covariance();
+      nees_double += nees2(e, pd(0, 0), pd(0, 1), pd(1, 1));
+    }
+  }
+  std::printf("%s vs double core, %d jobs on the filter's own noise model: max |estimate difference| %.3g V "
+              "(tolerance %.3g), max |PWM code difference| %d (tolerance %d), saturated %s; mean NEES q15 %.3f, "
+              "double (its own loop, same noise) %.3f (n = 2 when consistent)\n",
+              name, counted, max_dx, kQ15EstimateTolVolts, max_dcode, kQ15CodeTol, saturated ? "yes" : "no",
+              nees_q15 / counted, nees_double / counted);
+  return counted > 0 && !saturated && max_dx <= kQ15EstimateTolVolts && max_dcode <= kQ15CodeTol &&
+         nees_q15 <= kQ15NeesRatioTol * nees_double;
 }
 
 bool run_q15_variants(std::FILE* out, int jobs, std::uint64_t seed) {
