@@ -59,7 +59,7 @@ struct Plant {
   Vector<double, kN> x{};
   void advance(std::int32_t dt_us, double u) {
     Discretization<UniformFormat<double>, kN, kM> d;
-    gen.discretize(dt_us, d, WithQd::kNo);
+    ONESHOT_ASSERT(is_exact(gen.discretize(dt_us, d, WithQd::kNo)));
     Vector<double, kN> next;
     for (std::size_t i = 0; i < kN; ++i) {
       next[i] = d.gamma(i, 0) * u;
