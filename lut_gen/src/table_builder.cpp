@@ -8,6 +8,7 @@
 #include <type_traits>
 #include <utility>
 #include <limits>
+#include <stdexcept>
 #include <string>
 
 #include "oneshot/design/dimension_dispatch.hpp"
@@ -360,7 +361,10 @@ TableAccuracy accuracy_fixed(const TableData<S>& table, const PlantDescription& 
     Discretization<F64, N, M> ref;
     Discretization<Fmt, N, M> got;
     if (generic.discretize(tau, ref, WithQd::kYes) != Status::kOk) continue;
-    lut.discretize(tau, got, WithQd::kYes);
+    const Status looked_up = lut.discretize(tau, got, WithQd::kYes);
+    if (looked_up != Status::kOk && looked_up != Status::kExtended) {  // beyond the range: composed, still exact
+      throw std::runtime_error("table accuracy: the table failed at tau = " + std::to_string(tau) + " us");
+    }
     const auto compare = [](const auto& r, const auto& v, double& abs_max, double& rel_max) {
       double scale = 0;
       double err = 0;

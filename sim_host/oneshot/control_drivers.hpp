@@ -84,7 +84,7 @@ class LocalDriver final : public BoardDriver<Ctrl::kN, Ctrl::kM> {
   }
   void actuation(host::HostBoardState&) override { task_.on_actuation_interrupt(); }
   JobReport<kN> job(host::HostBoardState&) override {
-    task_.run_job();
+    (void)task_.run_job();  // the task keeps the status in its statistics (statistics())
     JobReport<kN> r;
     r.tau_us = task_.statistics().last_tau_us;
     for (std::size_t i = 0; i < kN; ++i) r.estimate[i] = to_double(ctrl_->estimator().prediction()[i]);

@@ -67,7 +67,7 @@ struct Plant {
   /// generator is given (n = 2: Q_d's Cholesky factor in closed form).
   void advance(std::int32_t dt_us, double u, std::mt19937_64* rng = nullptr) {
     Discretization<UniformFormat<double>, kN, kM> d;
-    gen.discretize(dt_us, d, rng != nullptr ? WithQd::kYes : WithQd::kNo);
+    ONESHOT_ASSERT(is_exact(gen.discretize(dt_us, d, rng != nullptr ? WithQd::kYes : WithQd::kNo)));
     Vector<double, kN> next;
     for (std::size_t i = 0; i < kN; ++i) {
       next[i] = d.gamma(i, 0) * u;

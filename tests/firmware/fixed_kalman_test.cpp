@@ -46,8 +46,8 @@ void compare_discretizer(const Lut& lut, double phi_tol, double gamma_tol, doubl
   for (std::int32_t tau = 0; tau <= 100'000; tau += 97) {
     Discretization<FixedFormat, 2, 1> got;
     Discretization<F64, 2, 1> want;
-    lut.discretize(tau, got, WithQd::kYes);
-    ref.discretize(tau, want, WithQd::kYes);
+    EXPECT_TRUE(is_exact(lut.discretize(tau, got, WithQd::kYes)));
+    EXPECT_TRUE(is_exact(ref.discretize(tau, want, WithQd::kYes)));
     phi = std::max(phi, (test::to_eigen(got.phi) - test::to_eigen(want.phi)).cwiseAbs().maxCoeff());
     gamma = std::max(gamma, (test::to_eigen(got.gamma) - test::to_eigen(want.gamma)).cwiseAbs().maxCoeff());
     // Relative to Q_d's size, beyond the covariance format's resolution (tiny τ: a few LSB).
@@ -117,11 +117,11 @@ Deviation run_pair(Variant v, const FixedDisc& fq, const DoubleDisc& fd, int job
     Vector<double, 1> yd;
     yd[0] = output_of_code(KD::kDesign.sensor, 0, code);
     if (v == Variant::kHalf) {
-      hq.update(t, yq);
-      hd.update(t, yd);
+      EXPECT_TRUE(is_exact(hq.update(t, yq)));
+      EXPECT_TRUE(is_exact(hd.update(t, yd)));
     } else {
-      cq.update(t, yq);
-      cd.update(t, yd);
+      EXPECT_TRUE(is_exact(cq.update(t, yq)));
+      EXPECT_TRUE(is_exact(cd.update(t, yd)));
     }
     const auto& pq = v == Variant::kHalf ? hq.prediction() : cq.prediction();
     const auto& pd = v == Variant::kHalf ? hd.prediction() : cd.prediction();
@@ -193,7 +193,7 @@ TEST(FixedKalman, SaturationRaisesTheFlagAndNeverWraps) {
   p(1, 1) = p(0, 0);
   const FixedTable table(KQ::kTable);
   Discretization<FixedFormat, 2, 1> d;
-  table.discretize(50'000, d, WithQd::kYes);
+  ASSERT_EQ(table.discretize(50'000, d, WithQd::kYes), Status::kOk);
   clear_saturation_flag();
   // WHEN the prediction Φ P Φᵀ + Q_d exceeds the format
   const auto out = predict_covariance<FixedFormat, PlantStructure>(d, p, NoiseModel::kExact, KQ::kDesign.q_constant);

@@ -178,8 +178,8 @@ TEST(KalmanFilters, HalfAndCompleteAreTheSameEstimator) {
       const std::int32_t t = tau(rng);
       Vector<double, 1> yk;
       yk[0] = y(rng);
-      half.update(t, yk);
-      complete.update(t, yk);
+      ASSERT_TRUE(is_exact(half.update(t, yk)));
+      ASSERT_TRUE(is_exact(complete.update(t, yk)));
       EXPECT_LT(std::fabs(half.prediction()[0] - complete.prediction()[0]), 1e-12);
       EXPECT_LT(std::fabs(half.prediction()[1] - complete.prediction()[1]), 1e-12);
       EXPECT_LT(std::fabs(half.gain()[0] - complete.gain()[0]), 1e-12);
@@ -212,10 +212,8 @@ TEST(KalmanFilters, NearestPolicyFilterEqualsTheExactFilterOnRoundedTau) {
     const std::int32_t rounded = ((t + g / 2) / g) * g;
     Vector<double, 1> yk;
     yk[0] = y(rng);
-    half_n.update(t, yk);
-    half_e.update(rounded, yk);
-    comp_n.update(t, yk);
-    comp_e.update(rounded, yk);
+    ASSERT_EQ(half_n.update(t, yk), half_e.update(rounded, yk));
+    ASSERT_EQ(comp_n.update(t, yk), comp_e.update(rounded, yk));
     // THEN they are the same computation
     for (std::size_t i = 0; i < 2; ++i) {
       ASSERT_EQ(half_n.prediction()[i], half_e.prediction()[i]) << "job " << k;
@@ -282,8 +280,7 @@ TEST(KalmanFilters, JosephAndSymmetricFormsAgree) {
     const std::int32_t t = tau(rng);
     Vector<double, 1> yk;
     yk[0] = y(rng);
-    sym.update(t, yk);
-    jos.update(t, yk);
+    ASSERT_EQ(sym.update(t, yk), jos.update(t, yk));
     EXPECT_LT(test::relative_error(test::to_eigen(sym.covariance()), test::to_eigen(jos.covariance())), 1e-12);
   }
 }
@@ -293,7 +290,7 @@ TEST(KalmanFilters, StandardFilterConvergesToTheDesignGain) {
   const auto d = design::synthesize(design::reference_plant());
   StandardKalman<K::Format, PlantStructure> filter(K::kDesign, NoiseModel::kExact);
   Vector<double, 1> y;
-  for (int k = 0; k < 400; ++k) filter.update(0, y);
+  for (int k = 0; k < 400; ++k) ASSERT_EQ(filter.update(0, y), Status::kOk);
   EXPECT_NEAR(filter.gain()[0], d.kalman_gain(0, 0), 1e-10);
   EXPECT_NEAR(filter.gain()[1], d.kalman_gain(1, 0), 1e-10);
 }
@@ -323,7 +320,7 @@ TEST(DeadbeatObserver, ReconstructsTheStateAfterNNoiseFreeSamples) {
   for (int k = 0; k < 10; ++k) {
     Vector<double, 1> y;
     y[0] = x[0];
-    obs.update(0, y);
+    ASSERT_EQ(obs.update(0, y), Status::kOk);
     if (k >= 1) {  // n = 2 samples
       EXPECT_NEAR(obs.prediction()[0], x[0], 1e-12);
       EXPECT_NEAR(obs.prediction()[1], x[1], 1e-12);

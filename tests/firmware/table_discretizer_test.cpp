@@ -195,7 +195,7 @@ TEST(TableDiscretizer, NearestPolicyRefusesAnUnquantizedTau) {
   using K = PlantConstants<double>;
   const TableDiscretizer<F64, PlantStructure, double, OutOfRange::kExtend, SubGrid::kNearest> nearest(K::kTable);
   Discretization<F64, 2, 1> d;
-  EXPECT_THROW(nearest.discretize(K::kTable.granularity_us + 1, d, WithQd::kYes), test::InvariantViolation);
+  EXPECT_THROW((void)nearest.discretize(K::kTable.granularity_us + 1, d, WithQd::kYes), test::InvariantViolation);
 }
 
 TEST(TableDiscretizer, StructuredAndDenseEvaluationAgreeBitForBit) {
@@ -205,8 +205,7 @@ TEST(TableDiscretizer, StructuredAndDenseEvaluationAgreeBitForBit) {
   for (std::int32_t tau = 0; tau <= 2 * K::kTable.range_us; tau += 37) {
     Discretization<K::Format, 2, 1> a;
     Discretization<K::Format, 2, 1> b;
-    structured.discretize(tau, a, WithQd::kYes);
-    dense.discretize(tau, b, WithQd::kYes);
+    ASSERT_EQ(structured.discretize(tau, a, WithQd::kYes), dense.discretize(tau, b, WithQd::kYes));
     for (std::size_t k = 0; k < 4; ++k) {
       EXPECT_EQ(a.phi[k], b.phi[k]);
       EXPECT_EQ(a.qd[k], b.qd[k]);

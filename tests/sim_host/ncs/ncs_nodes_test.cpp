@@ -137,7 +137,9 @@ TEST(NcsNodes, GainWithExactQdAndConstantTauEqualsThePeriodicGain) {
   for (std::int32_t tau_as : {500, 7'300, 14'000, 30'000}) {
     HalfEst est(design, disc, NoiseModel::kExact);
     est.reset(Vector<double, kN>{}, design.p0, Vector<double, kM>{});
-    for (int k = 0; k < 400; ++k) ASSERT_TRUE(is_exact(est.update(design.period_us - tau_as, Vector<double, kP>{}, Vector<double, kM>{})));
+    for (int k = 0; k < 400; ++k) {
+      ASSERT_TRUE(is_exact(est.update(design.period_us - tau_as, Vector<double, kP>{}, Vector<double, kM>{})));
+    }
     double err = 0;
     for (std::size_t i = 0; i < kN; ++i)
       for (std::size_t j = 0; j < kP; ++j) err = std::fmax(err, std::fabs(est.filter().gain()(i, j) - k_ref(i, j)));
@@ -146,7 +148,9 @@ TEST(NcsNodes, GainWithExactQdAndConstantTauEqualsThePeriodicGain) {
   // With the constant Q of the paper the gain depends on τ_as: the check is not vacuous.
   HalfEst est(design, disc, NoiseModel::kConstant);
   est.reset(Vector<double, kN>{}, design.p0, Vector<double, kM>{});
-  for (int k = 0; k < 400; ++k) ASSERT_TRUE(is_exact(est.update(design.period_us - 14'000, Vector<double, kP>{}, Vector<double, kM>{})));
+  for (int k = 0; k < 400; ++k) {
+    ASSERT_TRUE(is_exact(est.update(design.period_us - 14'000, Vector<double, kP>{}, Vector<double, kM>{})));
+  }
   EXPECT_GT(std::fabs(est.filter().gain()(0, 0) - k_ref(0, 0)), 1e-4);
 }
 
@@ -288,11 +292,11 @@ TEST(NcsNodes, LateCommandIsHeldCountedAndItsEchoUsed) {
   ctrl_net.deliver(frame(1, 2, r));
   ctrl.on_receive(McuInstant(120'000));
   with_echo.set_applied_input(q3.u_applied);
-  with_echo.update(r.tau_us, r.y);
+  ASSERT_TRUE(is_exact(with_echo.update(r.tau_us, r.y)));
   Vector<double, kM> own;
   own[0] = -0.9;
   with_own.set_applied_input(own);
-  with_own.update(r.tau_us, r.y);
+  ASSERT_TRUE(is_exact(with_own.update(r.tau_us, r.y)));
   EXPECT_EQ(ctrl.estimator().estimate()[1], with_echo.prediction()[1]);
   EXPECT_NE(ctrl.estimator().estimate()[1], with_own.prediction()[1]);
 }

@@ -12,8 +12,10 @@
 
 namespace oneshot {
 
-/// Outcome of a fallible core operation; `kOk` is the only unconditional success.
-enum class Status : std::uint8_t {
+/// Outcome of a fallible core operation; `kOk` is the only unconditional success. The type is
+/// [[nodiscard]]: every function returning a Status must have its result used (or cast to void
+/// where a failure is impossible, with the reason beside it).
+enum class [[nodiscard]] Status : std::uint8_t {
   kOk = 0,            ///< Exact result.
   kExtended,          ///< Result exact, time beyond the table obtained by composition.
   kClamped,           ///< Input time clamped into the supported range; result approximate.
