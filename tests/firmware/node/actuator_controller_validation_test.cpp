@@ -70,13 +70,12 @@ TEST(ActuatorValidation, ForgedSequenceNeverBlocksABufferSlot) {
   ActuatorNode<host::HostNetwork, double, 1, 8> act(ActuatorMode::kOnTimer, v1(0));
   const host::ScopedHostNetwork cur(net);
   deliver(net, 3 + 8 * 1000, 0.9);
-  deliver(net, 1, 0.1);
-  deliver(net, 2, 0.2);
-  deliver(net, 3, 0.3);
+  const double u[4] = {0, 0.1, 0.2, 0.3};
+  for (SequenceNumber k = 1; k <= 3; ++k) deliver(net, k, u[k]);
   act.on_receive();
   for (SequenceNumber k = 1; k <= 3; ++k) {
     act.on_timer(k);
-    EXPECT_EQ(act.applied()[0], 0.1 * k) << k;
+    EXPECT_EQ(act.applied()[0], u[k]) << k;
   }
   EXPECT_EQ(act.statistics().late, 0U);
   EXPECT_EQ(act.statistics().refused_sequence, 1U);
@@ -88,7 +87,10 @@ TEST(ActuatorValidation, OnArrivalModeRefusesNanAndFollowsARestartedController) 
   ActuatorNode<host::HostNetwork, double, 1> act(ActuatorMode::kOnArrival, v1(0));
   act.expect_source(kController);
   const host::ScopedHostNetwork cur(net);
-  for (SequenceNumber k = 0; k < 100; ++k) deliver(net, k, 0.01 * k);
+  for (SequenceNumber k = 0; k < 100; ++k) {  // the inbox holds 32 frames: receive as they come
+    deliver(net, k, 0.01 * k);
+    act.on_receive();
+  }
   deliver(net, 100, kNaN);
   deliver(net, 101, -std::numeric_limits<double>::infinity());
   deliver(net, 102, 0.5, kSensor);  // not the controller
