@@ -34,23 +34,25 @@ void add_term(std::vector<Term>& terms, bool negative, const Val& a, const Val& 
 // ---------------------------------------------------------------------------------------
 // Fixed point.
 
-QFormat FixedArith::fmt(Qty q) const {
+QFormat format_of(const FixedFormats& f, Qty q) {
   switch (q) {
-    case Qty::kTransition: return f_.transition;
-    case Qty::kInputGain: return f_.input_gain;
-    case Qty::kCovariance: return f_.covariance;
-    case Qty::kInverseCovariance: return f_.inverse_covariance;
-    case Qty::kState: return f_.state;
-    case Qty::kInput: return f_.input;
-    case Qty::kInverseInput: return f_.inverse_input;
-    case Qty::kActuatorSteps: return f_.actuator_steps;
-    case Qty::kCodeStep: return f_.code_step;
-    case Qty::kKalmanGain: return f_.kalman_gain;
-    case Qty::kFeedbackGain: return f_.feedback_gain;
-    case Qty::kFraction: return f_.fraction;
+    case Qty::kTransition: return f.transition;
+    case Qty::kInputGain: return f.input_gain;
+    case Qty::kCovariance: return f.covariance;
+    case Qty::kInverseCovariance: return f.inverse_covariance;
+    case Qty::kState: return f.state;
+    case Qty::kInput: return f.input;
+    case Qty::kInverseInput: return f.inverse_input;
+    case Qty::kActuatorSteps: return f.actuator_steps;
+    case Qty::kCodeStep: return f.code_step;
+    case Qty::kKalmanGain: return f.kalman_gain;
+    case Qty::kFeedbackGain: return f.feedback_gain;
+    case Qty::kFraction: return f.fraction;
   }
   throw std::logic_error("unknown quantity");
 }
+
+QFormat FixedArith::fmt(Qty q) const { return format_of(f_, q); }
 
 long long FixedArith::one_raw(QFormat f, bool& saturates) {
   // As ScalarTraits<Fixed>::from_double(1.0).

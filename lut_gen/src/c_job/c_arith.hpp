@@ -25,6 +25,9 @@ enum class Qty {
   kActuatorSteps, kCodeStep, kKalmanGain, kFeedbackGain, kFraction
 };
 
+/// The format of quantity q in the design-step formats f.
+QFormat format_of(const FixedFormats& f, Qty q);
+
 /// An operand: structurally 0 or 1 (skipped or turned into a copy, as in the core's
 /// structured kernels), or a C expression in a known format.
 struct Val {

@@ -80,23 +80,7 @@ FixedFormats q15_formats(const FixedFormats& fixed) {
   return f;
 }
 
-QFormat Q15Arith::fmt(Qty q) const {
-  switch (q) {
-    case Qty::kTransition: return f_.transition;
-    case Qty::kInputGain: return f_.input_gain;
-    case Qty::kCovariance: return f_.covariance;
-    case Qty::kInverseCovariance: return f_.inverse_covariance;
-    case Qty::kState: return f_.state;
-    case Qty::kInput: return f_.input;
-    case Qty::kInverseInput: return f_.inverse_input;
-    case Qty::kActuatorSteps: return f_.actuator_steps;
-    case Qty::kCodeStep: return f_.code_step;
-    case Qty::kKalmanGain: return f_.kalman_gain;
-    case Qty::kFeedbackGain: return f_.feedback_gain;
-    case Qty::kFraction: return f_.fraction;
-  }
-  throw std::logic_error("unknown quantity");
-}
+QFormat Q15Arith::fmt(Qty q) const { return format_of(f_, q); }
 
 std::string Q15Arith::one(Qty q, bool& saturates) const { return int_literal(FixedArith::one_raw(fmt(q), saturates), 16); }
 
