@@ -46,7 +46,7 @@ else()
   message(FATAL_ERROR "unknown firmware target ${ONESHOT_FIRMWARE_TARGET}")
 endif()
 
-# -O3 gives the fewest instructions per job; -Os the smallest flash and stack (see README).
+# -O3 gives the fewest instructions per job; -Os the smallest flash and stack (see docs/oneshot.md).
 set(ONESHOT_FIRMWARE_OPT "-O3" CACHE STRING "optimisation of the firmware images: -O3, -O2 or -Os")
 set_property(CACHE ONESHOT_FIRMWARE_OPT PROPERTY STRINGS -O3 -O2 -Os)
 if(NOT ONESHOT_FIRMWARE_OPT MATCHES "^-O[23s]$")

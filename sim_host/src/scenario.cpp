@@ -45,7 +45,7 @@ Scenario uniform_scenario(const std::string& name, std::int32_t jitter_us, doubl
 
 std::vector<Scenario> default_scenarios() {
   // The brief's protocol: sampling jitter within 0–20 ms; set-point amplitudes from the
-  // ±0.2 V demonstration up to 1 V; change periods 0.5–2 s (README, "Scenarios").
+  // ±0.2 V demonstration up to 1 V; change periods 0.5–2 s (docs/oneshot.md, "Scenarios").
   return {
       uniform_scenario("j5-a0.2-p1", 5'000, 0.2, 1.0),
       uniform_scenario("j10-a0.2-p1", 10'000, 0.2, 1.0),

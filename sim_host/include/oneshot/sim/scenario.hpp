@@ -31,7 +31,7 @@ struct Scenario {
 Scenario uniform_scenario(const std::string& name, std::int32_t jitter_us, double amplitude_volts,
                           double change_period_s, double duration_s = 20.0);
 
-/// The ten scenarios of Table I (documented in the README).
+/// The ten scenarios of Table I (documented in docs/oneshot.md).
 std::vector<Scenario> default_scenarios();
 
 /// The scenario called `name` in `scenarios` (ScenarioError listing the names otherwise).

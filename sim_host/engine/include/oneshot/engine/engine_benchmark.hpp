@@ -1,5 +1,5 @@
 /// @file engine_benchmark.hpp
-/// @brief Throughput of the engine on a networked loop (a benchmark for the README, not a
+/// @brief Throughput of the engine on a networked loop (a benchmark for the docs, not a
 ///        test): events per wall second and the real-time factor.
 #pragma once
 
