@@ -15,7 +15,7 @@
 #include <map>
 #include <sstream>
 
-#include "oneshot/engine/engine_benchmark.hpp"
+#include "oneshot/sim/engine_benchmark.hpp"
 #include "oneshot/host/child_process.hpp"
 #include "oneshot/host/file_io.hpp"
 #include "oneshot/sim/output_files.hpp"
@@ -472,7 +472,7 @@ nlohmann::json run_benchmark(const SimContext& ctx, const CommonOptions& opt, do
   // The engine on a networked loop (firmware nodes, a lossy link, a CAN bus with background traffic).
   nlohmann::json best_net;
   for (int rep = 0; rep < 3; ++rep) {
-    const nlohmann::json n = engine::networked_loop_benchmark(simulated_s, opt.seed + static_cast<std::uint64_t>(rep));
+    const nlohmann::json n = networked_loop_benchmark(simulated_s, opt.seed + static_cast<std::uint64_t>(rep));
     if (best_net.is_null() || n["events_per_second"].get<double>() > best_net["events_per_second"].get<double>()) best_net = n;
   }
   j["networked_loop"] = best_net;

@@ -5,7 +5,7 @@
 
 #include <nlohmann/json.hpp>
 
-namespace oneshot::engine {
+namespace oneshot::sim {
 
 /// Runs the reference networked loop for `simulated_s` seconds on one core: the board's
 /// double integrator (continuous, exact, with noise), a time-triggered sensor, a controller
@@ -14,4 +14,4 @@ namespace oneshot::engine {
 /// Returns {"events", "wall_time_s", "events_per_second", "real_time_factor", …}.
 nlohmann::json networked_loop_benchmark(double simulated_s, std::uint64_t seed);
 
-}  // namespace oneshot::engine
+}  // namespace oneshot::sim

@@ -1,7 +1,7 @@
 /// @file engine_benchmark.cpp
 /// @brief The networked-loop benchmark (see engine_benchmark.hpp); also a compact example
 ///        of wiring firmware nodes, links, a CAN bus and a plant on the engine.
-#include "oneshot/engine/engine_benchmark.hpp"
+#include "oneshot/sim/engine_benchmark.hpp"
 
 #include <chrono>
 #include <memory>
@@ -14,7 +14,10 @@
 #include "oneshot/node/periodic_trigger.hpp"
 #include "oneshot/node/sensor_node.hpp"
 
-namespace oneshot::engine {
+namespace oneshot::sim {
+
+using namespace oneshot::engine;  // NOLINT: this file is a wiring example of the engine
+
 namespace {
 
 using Board = host::HostNetwork;
@@ -104,4 +107,4 @@ nlohmann::json networked_loop_benchmark(double simulated_s, std::uint64_t seed) 
           {"cost", plant.cost().total()}};
 }
 
-}  // namespace oneshot::engine
+}  // namespace oneshot::sim
