@@ -9,16 +9,24 @@
 ///     W_e(N) = Σ_{c=0}^{N−1} A^c B_w W B_wᵀ (A^c)ᵀ            (the brief's correction).
 /// The printed eq. 13 (w frozen over the interval) is kept as a switch: P ← A P Aᵀ per step
 /// and G ← A G + B_w, then M = P + G W Gᵀ with G = Σ A^c B_w.
-/// On arrival (one output, p = 1), Joseph form:
-///     S = C M Cᵀ + V,  K = M Cᵀ / S,  x̂ ← x̂ + K (y − C x̂),
-///     P = (I − K C) M (I − K C)ᵀ + K V Kᵀ.
-/// Multiply-adds are counted as executed (dense), for the study's cost figures.
+/// predict_along(N, …) does the same N periods at once from the span table (numre_span_table.hpp,
+/// A^j and W_e(j) for j = d·6^p): P ← A^j P (A^j)ᵀ + W_e(j) for each base-6 digit of N (at
+/// most 3 for N < 216), and x̂ from a model trajectory x_r under the same applied inputs:
+///     x̂(k|k−N) = x_r(k) + A^N (x̂(k−N|k−N) − x_r(k−N))
+/// (the inputs cancel in the difference), so its cost does not grow with N.
+/// On arrival (one output, p = 1), Joseph form expanded for the scalar output (O(n²), exact
+/// for any gain K):
+///     m = M Cᵀ,  S = C m + V,  K = m / S,  x̂ ← x̂ + K (y − C x̂),
+///     P = (I − K C) M (I − K C)ᵀ + K V Kᵀ = M − K mᵀ − m Kᵀ + S K Kᵀ.
+/// Multiply-adds are counted as executed (exact zeros of A^j and C skipped), for the
+/// study's cost figures.
 #pragma once
 
 #include <cstddef>
 #include <cstdint>
 
 #include "oneshot/matrix.hpp"
+#include "oneshot/node/numre_span_table.hpp"
 
 namespace oneshot::node {
 
@@ -40,17 +48,56 @@ enum class NoiseAccumulation : std::uint8_t {
   kFrozen,  ///< Printed eq. 13: (Σ A^c B_w) W (Σ A^c B_w)ᵀ (w held over the interval).
 };
 
+/// Q = B_w W B_wᵀ of a model.
+template <typename S, std::size_t N>
+constexpr Matrix<S, N, N> numre_process_noise(const NumreModel<S, N>& m) {
+  Matrix<S, N, N> q;
+  for (std::size_t i = 0; i < N; ++i)
+    for (std::size_t j = 0; j < N; ++j) q(i, j) = m.b_w[i] * m.w * m.b_w[j];
+  return q;
+}
+
 /// The NUMRE filter (single input, single output, one noise input).
 template <typename S, std::size_t N>
 class NumreEstimator {
  public:
   using State = Vector<S, N>;        ///< x̂.
   using Covariance = Matrix<S, N, N>;  ///< P.
+  using Spans = NumreSpanTable<S, N, 6, 3>;  ///< j = d·6^p: N < 216 in at most 3 spans.
 
   /// Filter on `model` (copied) with the noise accumulation `acc`; x̂ = 0, P = 0.
-  constexpr NumreEstimator(const NumreModel<S, N>& model, NoiseAccumulation acc) : m_(model), acc_(acc) {
-    for (std::size_t i = 0; i < N; ++i)
-      for (std::size_t j = 0; j < N; ++j) q_(i, j) = m_.b_w[i] * m_.w * m_.b_w[j];
+  constexpr NumreEstimator(const NumreModel<S, N>& model, NoiseAccumulation acc)
+      : m_(model), acc_(acc), q_(numre_process_noise(model)), spans_(m_.a, m_.b, m_.b_w, q_),
+        c_rows_(row_pattern(m_.c)) {}
+
+  /// N periods at once from the span table: x̂ ← x_r(k) + A^N (x̂ − x_r(k − N)) for a model
+  /// trajectory x_r under the applied inputs (`ref_then` at k − N, `ref_now` at k), and
+  /// P ← A^N P (A^N)ᵀ + W_e(N) (kFrozen: P ← A^N P (A^N)ᵀ, G ← A^N G + G(N)).
+  constexpr void predict_along(std::uint32_t n, const State& ref_then, const State& ref_now) {
+    State d = x_ - ref_then;
+    spans_.for_each_span(n, [&](const typename Spans::Span& sp) {
+      State t;
+      macs_ += sparse_product(sp.a, sp.rows, d, t);
+      d = t;
+      macs_ += sandwich(sp.a, p_);
+      if (acc_ == NoiseAccumulation::kSum) {
+        p_ = p_ + sp.w;
+      } else {
+        macs_ += sparse_product(sp.a, sp.rows, g_, t);
+        g_ = t + sp.g;
+      }
+    });
+    x_ = ref_now + d;
+    steps_ += n;
+  }
+
+  /// x ← A^n x + Γ(n) u: the model n periods on with u held (span table).
+  constexpr void advance(std::uint32_t n, State& x, S u) {
+    spans_.for_each_span(n, [&](const typename Spans::Span& sp) {
+      State t;
+      macs_ += sparse_product(sp.a, sp.rows, x, t) + N;
+      x = t + sp.gamma * u;
+    });
   }
 
   /// Sets x̂ and P (the last arrival's values).
@@ -84,10 +131,16 @@ class NumreEstimator {
       macs_ += N * N;
       g_ = State{};
     }
-    const State mct = p_ * m_.c.transposed();
+    const std::size_t nc = c_rows_.count[0];
+    State mct;  // m = M Cᵀ
+    for (std::size_t i = 0; i < N; ++i) {
+      S acc = S(0);
+      for (std::size_t q = 0; q < nc; ++q) acc = acc + p_(i, c_rows_.col[0][q]) * m_.c[c_rows_.col[0][q]];
+      mct[i] = acc;
+    }
     S s = m_.v;
-    for (std::size_t i = 0; i < N; ++i) s = s + m_.c[i] * mct[i];
-    macs_ += N * N + N;
+    for (std::size_t q = 0; q < nc; ++q) s = s + m_.c[c_rows_.col[0][q]] * mct[c_rows_.col[0][q]];
+    macs_ += (N + 1) * nc;
     last_multiplicity_ = steps_;
     steps_ = 0;
     if (!(s > S(0))) {
@@ -96,13 +149,16 @@ class NumreEstimator {
     }
     k_ = mct * (S(1) / s);
     S innovation = y;
-    for (std::size_t i = 0; i < N; ++i) innovation = innovation - m_.c[i] * x_[i];
+    for (std::size_t q = 0; q < nc; ++q) innovation = innovation - m_.c[c_rows_.col[0][q]] * x_[c_rows_.col[0][q]];
     x_ = x_ + k_ * innovation;
-    Covariance ikc = Covariance::identity() - k_ * m_.c;
-    p_ = (ikc * p_) * ikc.transposed();
+    // Joseph form expanded: P = M − K mᵀ − m Kᵀ + S K Kᵀ (upper triangle, mirrored).
     for (std::size_t i = 0; i < N; ++i)
-      for (std::size_t j = 0; j < N; ++j) p_(i, j) = p_(i, j) + k_[i] * m_.v * k_[j];
-    macs_ += 3 * N + N * N + 2 * N * N * N + 2 * N * N;
+      for (std::size_t j = i; j < N; ++j) {
+        const S v = p_(i, j) - k_[i] * mct[j] - mct[i] * k_[j] + s * k_[i] * k_[j];
+        p_(i, j) = v;
+        p_(j, i) = v;
+      }
+    macs_ += 2 * N + nc + 4 * (N * (N + 1) / 2);
     return true;
   }
 
@@ -123,6 +179,8 @@ class NumreEstimator {
   NumreModel<S, N> m_;
   NoiseAccumulation acc_;
   Covariance q_{};
+  Spans spans_;
+  RowPattern<1, N> c_rows_;
   State x_{};
   Covariance p_{};
   State g_{};

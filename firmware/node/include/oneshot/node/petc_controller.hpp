@@ -4,15 +4,22 @@
 ///
 /// On the arrival of y_k (k − k_prev = N periods after the previous one):
 ///  1. the NUMRE predicts N periods with the inputs the actuator applied (known: the packet
-///     in force, its last entry held beyond H) and corrects with y_k;
-///  2. cascade from x̂(k|k) and the law state stored with the packet in force at k:
-///        for l = 0 … H: ŷ = C x̂, d̂ = observer(ŷ, C̄ x̂), u_{k+l} = law(k + l, r − ŷ) − d̂,
-///                        x̂ ← A x̂ + B u_{k+l}
+///     in force, its last entry held beyond H) and corrects with y_k. The cascade that built
+///     the packet in force stored its model trajectory x_r (x_r(k_sent + l), l = 0 … H + 1;
+///     beyond, x_r ← A^j x_r + Γ(j) u_H from the span table), and the inputs cancel in
+///        x̂(k|k−N) = x_r(k) + A^N (x̂(k−N|k−N) − x_r(k−N))      (no packet yet: x_r = 0),
+///     so the prediction costs the same for every N (numre_estimator.hpp);
+///  2. the first cascade step from x̂(k|k) and the law state stored with the packet in
+///     force at k gives u_k:
+///        ŷ = C x̂, d̂ = observer(ŷ, C̄ x̂), u_{k+l} = law(k + l, r − ŷ) − d̂, x̂ ← A x̂ + B u_{k+l}
+///     (A's exact zeros skipped: the same sums as the dense product);
 ///  3. send the packet if (ū − u_k)² > σ_c u_k² + δ_c (ū = first entry of the last packet
-///     sent), or k − k_sent ≥ k_max (safety), or on the first arrival; otherwise the packet
-///     in force stays and the estimator keeps propagating its inputs.
-/// Storage: H + 2 law states (the state before each entry and after the last), 2(H + 1)
-/// inputs: about 64 KB for H = 200 with the DOB, DSP-class memory (brief §10).
+///     sent), or k − k_sent ≥ k_max (safety), or on the first arrival: only then the cascade
+///     runs on to l = H, written straight into the packet in force (a withheld cascade is
+///     never applied, so it is not computed); otherwise the packet in force stays and the
+///     estimator keeps propagating its inputs.
+/// Storage: H + 2 law states (the state before each entry and after the last), H + 2 model
+/// states, 2(H + 1) inputs and d̂: about 39 KB in float for H = 200 (brief §10).
 #pragma once
 
 #include <cstddef>
@@ -41,15 +48,17 @@ class PetcController {
   /// Controller at rest (x̂ = 0, P = 0, no packet in force).
   constexpr PetcController(const NumreModel<S, N>& model, NoiseAccumulation acc, const Law& law,
                            const Observer& obs, const MtmTrigger<S, 1>& trigger, S reference)
-      : est_(model, acc), initial_{law, obs}, trigger_(trigger), reference_(reference) {}
+      : est_(model, acc), initial_{law, obs}, trigger_(trigger), reference_(reference), a_rows_(row_pattern(model.a)),
+        b_rows_(row_pattern(model.b)), c_rows_(row_pattern(model.c)), c_bar_rows_(row_pattern(model.c_bar)) {
+    step_macs_ = pattern_size(a_rows_) + pattern_size(b_rows_) + pattern_size(c_rows_) + pattern_size(c_bar_rows_);
+  }
 
   /// The reference from now on (a known change: the sensor is told separately).
   constexpr void set_reference(S r) { reference_ = r; }
 
   /// Arrival of y at period k. Returns the send cause (kNone: no packet).
   constexpr SendCause on_arrival(std::uint32_t k, S y) {
-    if (arrivals_ > 0)
-      for (std::uint32_t j = k_prev_; j != k; ++j) est_.predict(applied(j));
+    if (arrivals_ > 0) est_.predict_along(k - k_prev_, reference_state(k_prev_), reference_state(k));
     est_.correct(y);
     ++arrivals_;
     k_prev_ = k;
@@ -59,41 +68,34 @@ class PetcController {
       const std::uint32_t idx = k - k_sent_;
       ls = idx <= H ? states_[idx] : states_[H + 1];
     }
-    // Cascade.
+    const LawState ls0 = ls;
+    // First cascade step, then the controller trigger on its input.
     Vector<S, N> x = est_.state();
-    const NumreModel<S, N>& m = est_.model();
-    for (std::size_t l = 0; l <= H; ++l) {
-      S y_hat = S(0);
-      S d_model = S(0);
-      for (std::size_t i = 0; i < N; ++i) {
-        y_hat = y_hat + m.c[i] * x[i];
-        d_model = d_model + m.c_bar[i] * x[i];
-      }
-      new_states_[l] = ls;
-      const S d_hat = ls.obs.estimate(y_hat, d_model);
-      const S u = ls.law.step(static_cast<std::uint64_t>(k) + l, reference_ - y_hat) - d_hat;
-      ls.obs.commit(u);
-      new_packet_[l] = u;
-      new_d_hat_[l] = d_hat;
-      x = m.a * x + m.b * u;
-      cascade_macs_ += N * N + 3 * N;
+    S d_hat = S(0);
+    const S u0 = cascade_step(k, ls, x, d_hat);
+    Vector<S, 1> u0v;
+    u0v[0] = u0;
+    const SendCause cause = trigger_.evaluate(k, u0v);
+    if (cause == SendCause::kNone) {
+      cascade_macs_ += (ls.law.macs() - ls0.law.macs()) + (ls.obs.macs() - ls0.obs.macs());
+      return cause;
     }
-    new_states_[H + 1] = ls;
-    cascade_macs_ += (ls.law.macs() - new_states_[0].law.macs()) + (ls.obs.macs() - new_states_[0].obs.macs());
-    // Controller trigger on the first entry.
-    Vector<S, 1> u0;
-    u0[0] = new_packet_[0];
-    const SendCause cause = trigger_.evaluate(k, u0);
-    if (cause != SendCause::kNone) {
-      trigger_.on_sent(k, u0);
-      for (std::size_t l = 0; l < kEntries; ++l) {
-        packet_[l] = new_packet_[l];
-        d_hat_[l] = new_d_hat_[l];
-      }
-      for (std::size_t l = 0; l < H + 2; ++l) states_[l] = new_states_[l];
-      k_sent_ = k;
-      have_packet_ = true;
+    trigger_.on_sent(k, u0v);
+    states_[0] = ls0;
+    packet_[0] = u0;
+    d_hat_[0] = d_hat;
+    trajectory_[0] = est_.state();
+    trajectory_[1] = x;
+    for (std::size_t l = 1; l <= H; ++l) {
+      states_[l] = ls;
+      packet_[l] = cascade_step(static_cast<std::uint64_t>(k) + l, ls, x, d_hat);
+      d_hat_[l] = d_hat;
+      trajectory_[l + 1] = x;
     }
+    states_[H + 1] = ls;
+    cascade_macs_ += (ls.law.macs() - ls0.law.macs()) + (ls.obs.macs() - ls0.obs.macs());
+    k_sent_ = k;
+    have_packet_ = true;
     return cause;
   }
 
@@ -113,10 +115,20 @@ class PetcController {
   constexpr const S* packet() const { return packet_; }
   /// Period of the packet in force.
   constexpr std::uint32_t packet_start() const { return k_sent_; }
-  /// The last arrival's cascade (kEntries inputs), sent or withheld.
-  constexpr const S* last_cascade() const { return new_packet_; }
-  /// d̂ of each entry of the last arrival's cascade (kEntries values).
-  constexpr const S* last_cascade_d_hat() const { return new_d_hat_; }
+  /// The last sent cascade (kEntries inputs): the packet in force (a withheld cascade stops
+  /// after its first entry).
+  constexpr const S* last_cascade() const { return packet_; }
+  /// d̂ of each entry of the last sent cascade (kEntries values).
+  constexpr const S* last_cascade_d_hat() const { return d_hat_; }
+  /// Model state the packet in force predicts at period j: x_r(j) of step 1 (0 before any).
+  constexpr Vector<S, N> reference_state(std::uint32_t j) {
+    if (!have_packet_) return Vector<S, N>{};
+    const std::uint32_t idx = j - k_sent_;
+    if (idx <= H + 1) return trajectory_[idx];
+    Vector<S, N> x = trajectory_[H + 1];
+    est_.advance(idx - static_cast<std::uint32_t>(H + 1), x, packet_[H]);
+    return x;
+  }
   /// The estimator.
   constexpr const NumreEstimator<S, N>& estimator() const { return est_; }
   /// Multiply-adds: estimator + cascades (model, law, observer).
@@ -133,11 +145,29 @@ class PetcController {
   bool have_packet_ = false;
   S packet_[kEntries]{};
   S d_hat_[kEntries]{};
-  S new_packet_[kEntries]{};
-  S new_d_hat_[kEntries]{};
   LawState states_[H + 2]{};
-  LawState new_states_[H + 2]{};
+  Vector<S, N> trajectory_[H + 2]{};
+  RowPattern<N, N> a_rows_{};
+  RowPattern<N, 1> b_rows_{};
+  RowPattern<1, N> c_rows_{}, c_bar_rows_{};
+  std::uint64_t step_macs_ = 0;
   std::uint64_t cascade_macs_ = 0;
+
+  /// One cascade step at period k: ŷ = C x, d̂ = observer(ŷ, C̄ x), u = law(k, r − ŷ) − d̂,
+  /// x ← A x + B u (exact zeros of A, C, C̄ skipped). Returns u; d̂ in `d_hat`.
+  constexpr S cascade_step(std::uint64_t k, LawState& ls, Vector<S, N>& x, S& d_hat) {
+    const NumreModel<S, N>& m = est_.model();
+    const S y_hat = sparse_row_dot(m.c, c_rows_, 0, x);
+    const S d_model = sparse_row_dot(m.c_bar, c_bar_rows_, 0, x);
+    d_hat = ls.obs.estimate(y_hat, d_model);
+    const S u = ls.law.step(k, reference_ - y_hat) - d_hat;
+    ls.obs.commit(u);
+    Vector<S, N> ax;
+    for (std::size_t i = 0; i < N; ++i) ax[i] = sparse_row_dot(m.a, a_rows_, i, x);
+    for (std::size_t i = 0; i < N; ++i) x[i] = b_rows_.count[i] != 0 ? ax[i] + m.b[i] * u : ax[i];
+    cascade_macs_ += step_macs_;
+    return u;
+  }
 };
 
 }  // namespace oneshot::node
