@@ -1,7 +1,8 @@
 /// @file petc_main.cpp
 /// @brief The petc image (Cortex-M4F, single-precision float on the FPU): the PETC controller
-///        node of numre-petc.md behind the PIL link, one NUMRE arrival (N predictions, Joseph
-///        correction, cascade of H + 1 inputs, controller trigger) between the
+///        node of numre-petc.md behind the PIL link, one NUMRE arrival (prediction over N periods
+///        from the span table, Joseph correction, controller trigger, the cascade of H + 1
+///        inputs when it sends) between the
 ///        instruction-count markers per kPetcArrival (oneshot/app/petc_pil.hpp).
 #include <cstddef>
 #include <cstdint>

@@ -14,7 +14,8 @@
 ///   kPetcArrival u32 k, u32 y (float bits)                   → u8 cause, u32 N, u32 multiply-adds
 ///                                                              of the arrival, 12 words x̂(k|k)
 ///   kPetcRead    u8 what (0: cascade inputs, 1: their d̂), u16 first entry
-///                                                            → up to 24 words of the last cascade
+///                                                            → up to 24 words of the packet in
+///                                                              force (the last sent cascade)
 #pragma once
 
 #include <cstddef>
