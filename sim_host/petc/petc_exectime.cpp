@@ -76,6 +76,8 @@ pp::ResetParams reset_params(const PetcSetup& s) {
 template <typename S>
 std::unique_ptr<pp::Node<S>> make_node(const S (&w)[pp::kWordCount], const pp::ResetParams& p) {
   const pp::NodeArgs<S> a = pp::node_args(w, p);
+  if (!pp::Node<S>::fits(a.model))
+    throw std::invalid_argument("petc exectime: the model has a nonzero outside the image's HDD structure");
   return std::make_unique<pp::Node<S>>(a.model, a.acc, a.law, node::ModelDisturbance<S>{}, a.trigger, a.reference);
 }
 

@@ -39,10 +39,10 @@ TEST(PetcPil, ArrivalInstructionsBoundedInMultiplicity) {
   // costs at most the first arrival (no prediction) plus three times what N = 1 adds.
   const std::uint64_t one_span = insns("1") - insns("0");
   for (const auto& [n, v] : by_n.items()) EXPECT_LE(v.get<std::uint64_t>(), insns("0") + 3 * one_span) << "N = " << n;
-  // Counts are stable (same code, same data): measured 171,558 (N = 0), 184,434 (1),
-  // 184,574 (2), 209,686 (97), 209,796 (200). The target is 60,000 (not reached:
-  // the 201-step cascade costs ~850 instructions per step).
-  EXPECT_LE(j.at("instructions_max").get<std::uint64_t>(), 212000U);
+  // Counts are stable (straight-line code over the HDD structure, same data): measured
+  // 115,563 (N = 0), 123,985 (1 and 2: one span), 140,110 (97 and 200: three spans). The
+  // issue's target is 60,000 (not reached: the 201-step cascade is ~560 per step).
+  EXPECT_LE(j.at("instructions_max").get<std::uint64_t>(), 141500U);
 }
 
 TEST(PetcPil, ArrivalBitIdenticalToHostFloat) {

@@ -117,6 +117,7 @@ void handle(const pil::Frame& q, pil::Frame& r) {
     p.k_max = in.u(4);
     if (p.ratio == 0) return malformed(r);
     const pp::NodeArgs<float> a = pp::node_args(g_words, p);
+    if (!Node::fits(a.model)) return malformed(r);  // a nonzero outside HddStructure
     g_node = new (g_node_storage) Node(a.model, a.acc, a.law, node::ModelDisturbance<float>{}, a.trigger, a.reference);
     w.u(static_cast<std::uint32_t>(sizeof(Node)), 4);
     return;

@@ -145,5 +145,20 @@ TEST(PetcNode, SpanPredictionMatchesStepByStepAcrossWithheldPackets) {
   EXPECT_LT(w.u, 6e-5);    // measured 2.0e-5
 }
 
+// The image's node skips the HDD model's structural zeros: the design's model fits the
+// structure, and a model with a nonzero outside it is refused (exectime throws; the image
+// answers kPetcReset with a malformed-request fault).
+TEST(PetcNode, ModelOutsideTheStructureIsRefused) {
+  static const PetcSetup setup = make_setup(PetcOptions{});
+  ArrivalPlan plan = plan_arrivals(setup, ExectimeOptions{});
+  float w[pp::kWordCount];
+  for (std::size_t i = 0; i < pp::kWordCount; ++i) w[i] = pp::float_of(plan.words.at(i));
+  EXPECT_TRUE(pp::Node<float>::fits(pp::model_of(w)));
+  w[pp::kA + 1 * kStates + 5] = 1e-3F;  // A(1, 5): a structural zero of the HDD model
+  EXPECT_FALSE(pp::Node<float>::fits(pp::model_of(w)));
+  plan.words[pp::kA + 1 * kStates + 5] = pp::bits_of(1e-3F);
+  EXPECT_THROW(host_arrivals(setup, plan), std::invalid_argument);
+}
+
 }  // namespace
 }  // namespace oneshot::sim::petc

@@ -27,6 +27,7 @@
 
 #include "oneshot/matrix.hpp"
 #include "oneshot/node/numre_span_table.hpp"
+#include "oneshot/node/numre_structure.hpp"
 
 namespace oneshot::node {
 
@@ -57,18 +58,24 @@ constexpr Matrix<S, N, N> numre_process_noise(const NumreModel<S, N>& m) {
   return q;
 }
 
-/// The NUMRE filter (single input, single output, one noise input).
-template <typename S, std::size_t N>
+/// The NUMRE filter (single input, single output, one noise input) on a model that fits
+/// `Structure` (numre_structure.hpp; the default assumes nothing).
+template <typename S, std::size_t N, typename Structure = DenseModelStructure<N>>
 class NumreEstimator {
  public:
   using State = Vector<S, N>;        ///< x̂.
   using Covariance = Matrix<S, N, N>;  ///< P.
   using Spans = NumreSpanTable<S, N, 6, 3>;  ///< j = d·6^p: N < 216 in at most 3 spans.
+  using Powers = ClosureStructure<Structure, N>;  ///< Where A^j may be nonzero.
+
+  /// True when `model` fits Structure (the filter must not be used otherwise).
+  static constexpr bool fits(const NumreModel<S, N>& model) {
+    return fits_structure<Structure>(model.a, model.b, model.c, model.c_bar);
+  }
 
   /// Filter on `model` (copied) with the noise accumulation `acc`; x̂ = 0, P = 0.
   constexpr NumreEstimator(const NumreModel<S, N>& model, NoiseAccumulation acc)
-      : m_(model), acc_(acc), q_(numre_process_noise(model)), spans_(m_.a, m_.b, m_.b_w, q_),
-        c_rows_(row_pattern(m_.c)) {}
+      : m_(model), acc_(acc), q_(numre_process_noise(model)), spans_(m_.a, m_.b, m_.b_w, q_) {}
 
   /// N periods at once from the span table: x̂ ← x_r(k) + A^N (x̂ − x_r(k − N)) for a model
   /// trajectory x_r under the applied inputs (`ref_then` at k − N, `ref_now` at k), and
@@ -77,13 +84,13 @@ class NumreEstimator {
     State d = x_ - ref_then;
     spans_.for_each_span(n, [&](const typename Spans::Span& sp) {
       State t;
-      macs_ += sparse_product(sp.a, sp.rows, d, t);
+      macs_ += masked_product<Powers>(sp.a, d, t);
       d = t;
-      macs_ += sandwich(sp.a, p_);
+      macs_ += masked_sandwich<Powers>(sp.a, p_);
       if (acc_ == NoiseAccumulation::kSum) {
         p_ = p_ + sp.w;
       } else {
-        macs_ += sparse_product(sp.a, sp.rows, g_, t);
+        macs_ += masked_product<Powers>(sp.a, g_, t);
         g_ = t + sp.g;
       }
     });
@@ -95,7 +102,7 @@ class NumreEstimator {
   constexpr void advance(std::uint32_t n, State& x, S u) {
     spans_.for_each_span(n, [&](const typename Spans::Span& sp) {
       State t;
-      macs_ += sparse_product(sp.a, sp.rows, x, t) + N;
+      macs_ += masked_product<Powers>(sp.a, x, t) + N;
       x = t + sp.gamma * u;
     });
   }
@@ -131,16 +138,13 @@ class NumreEstimator {
       macs_ += N * N;
       g_ = State{};
     }
-    const std::size_t nc = c_rows_.count[0];
-    State mct;  // m = M Cᵀ
-    for (std::size_t i = 0; i < N; ++i) {
-      S acc = S(0);
-      for (std::size_t q = 0; q < nc; ++q) acc = acc + p_(i, c_rows_.col[0][q]) * m_.c[c_rows_.col[0][q]];
-      mct[i] = acc;
-    }
-    S s = m_.v;
-    for (std::size_t q = 0; q < nc; ++q) s = s + m_.c[c_rows_.col[0][q]] * mct[c_rows_.col[0][q]];
-    macs_ += (N + 1) * nc;
+    State mct;  // m = M Cᵀ over C's nonzeros
+    Unrolled<0, N>::run([&](auto ic) {
+      constexpr std::size_t i = decltype(ic)::value;
+      mct[i] = masked_dot<Structure::kC>(m_.c, row_of(p_, i));
+    });
+    const S s = m_.v + masked_dot<Structure::kC>(m_.c, mct);
+    macs_ += (N + 1) * mask_count(Structure::kC);
     last_multiplicity_ = steps_;
     steps_ = 0;
     if (!(s > S(0))) {
@@ -148,8 +152,7 @@ class NumreEstimator {
       return false;
     }
     k_ = mct * (S(1) / s);
-    S innovation = y;
-    for (std::size_t q = 0; q < nc; ++q) innovation = innovation - m_.c[c_rows_.col[0][q]] * x_[c_rows_.col[0][q]];
+    const S innovation = y - masked_dot<Structure::kC>(m_.c, x_);
     x_ = x_ + k_ * innovation;
     // Joseph form expanded: P = M − K mᵀ − m Kᵀ + S K Kᵀ (upper triangle, mirrored).
     for (std::size_t i = 0; i < N; ++i)
@@ -158,7 +161,7 @@ class NumreEstimator {
         p_(i, j) = v;
         p_(j, i) = v;
       }
-    macs_ += 2 * N + nc + 4 * (N * (N + 1) / 2);
+    macs_ += 2 * N + mask_count(Structure::kC) + 4 * (N * (N + 1) / 2);
     return true;
   }
 
@@ -180,7 +183,13 @@ class NumreEstimator {
   NoiseAccumulation acc_;
   Covariance q_{};
   Spans spans_;
-  RowPattern<1, N> c_rows_;
+
+  /// Row i of P as a vector.
+  static constexpr State row_of(const Covariance& p, std::size_t i) {
+    State r;
+    for (std::size_t j = 0; j < N; ++j) r[j] = p(i, j);
+    return r;
+  }
   State x_{};
   Covariance p_{};
   State g_{};

@@ -9,10 +9,8 @@
 ///     G(a+b) = G(a) + A^a G(b),   Γ(a+b) = Γ(a) + A^a Γ(b).
 /// The table holds j = d·r^p (d = 1 … r−1, p = 0 … D−1): (r−1)·D spans built once from A
 /// (no run-time exponentials). N < r^D is the sum of its base-r digits' spans (at most D of
-/// them); a larger N adds whole top spans. Rows of A^j keep the model's exact zeros (block
-/// triangular A: the disturbance rows), so each product skips the zero columns of the row;
-/// skipping exact zeros does not change a sum. The patterns are column lists per row
-/// (the HDD model's A has 56 nonzeros of 144).
+/// them); a larger N adds whole top spans. A^j keeps the model's structural zeros inside
+/// their closure (numre_structure.hpp), which the estimator's products skip.
 #pragma once
 
 #include <cstddef>
@@ -22,54 +20,8 @@
 
 namespace oneshot::node {
 
-/// Columns of the nonzero entries of each row (exact zeros left out).
-template <std::size_t R, std::size_t C>
-struct RowPattern {
-  static_assert(C < 256, "column indices are stored in bytes");
-  std::uint8_t count[R]{};   ///< Nonzero entries of row i.
-  std::uint8_t col[R][C]{};  ///< Their columns, ascending.
-};
-
-/// The nonzero pattern of `m`.
-template <typename S, std::size_t R, std::size_t C>
-constexpr RowPattern<R, C> row_pattern(const Matrix<S, R, C>& m) {
-  RowPattern<R, C> r;
-  for (std::size_t i = 0; i < R; ++i)
-    for (std::size_t j = 0; j < C; ++j)
-      if (m(i, j) != S(0)) r.col[i][r.count[i]++] = static_cast<std::uint8_t>(j);
-  return r;
-}
-
-/// Σ_j m(i, j) x[j] over the nonzeros of row i (x indexed like a vector).
-template <typename S, std::size_t R, std::size_t C, typename X>
-constexpr S sparse_row_dot(const Matrix<S, R, C>& m, const RowPattern<R, C>& rp, std::size_t i, const X& x) {
-  S acc = S(0);
-  for (std::size_t q = 0; q < rp.count[i]; ++q) {
-    const std::size_t l = rp.col[i][q];
-    acc = acc + m(i, l) * x[l];
-  }
-  return acc;
-}
-
-/// Nonzero entries of `rp`.
-template <std::size_t R, std::size_t C>
-constexpr std::uint64_t pattern_size(const RowPattern<R, C>& rp) {
-  std::uint64_t n = 0;
-  for (std::size_t i = 0; i < R; ++i) n += rp.count[i];
-  return n;
-}
-
-/// y = A x over the nonzeros of A; returns the multiply-adds.
-template <typename S, std::size_t N>
-constexpr std::uint64_t sparse_product(const Matrix<S, N, N>& a, const RowPattern<N, N>& rp, const Vector<S, N>& x,
-                                       Vector<S, N>& y) {
-  for (std::size_t i = 0; i < N; ++i) y[i] = sparse_row_dot(a, rp, i, x);
-  return pattern_size(rp);
-}
-
-/// P ← A P Aᵀ for a symmetric P, dense (fixed trip counts: the compiler unrolls; on the
-/// M4F that beats skipping the zeros of a filled-in A^j by index); upper triangle computed
-/// and mirrored. Returns the multiply-adds.
+/// P ← A P Aᵀ for a symmetric P, dense (upper triangle computed and mirrored); returns the
+/// multiply-adds. The estimator skips structural zeros instead (numre_structure.hpp).
 template <typename S, std::size_t N>
 constexpr std::uint64_t sandwich(const Matrix<S, N, N>& a, Matrix<S, N, N>& p) {
   const Matrix<S, N, N> t = a * p;
@@ -90,7 +42,6 @@ struct ModelSpan {
   Matrix<S, N, N> w;    ///< W_e(j).
   Vector<S, N> g;       ///< G(j) = Σ_{c<j} A^c B_w.
   Vector<S, N> gamma;   ///< Γ(j) = Σ_{c<j} A^c B.
-  RowPattern<N, N> rows;  ///< Nonzero columns of each row of A^j.
   std::uint32_t length = 0;  ///< j.
 };
 
@@ -117,7 +68,6 @@ class NumreSpanTable {
     one.w = q;
     one.g = b_w;
     one.gamma = b;
-    one.rows = row_pattern(a);
     one.length = 1;
     spans_[0][0] = one;
     for (std::size_t p = 0; p < kDigits; ++p) {
@@ -154,7 +104,6 @@ class NumreSpanTable {
     s.w = s.w + sa.w;
     s.g = sa.g + sa.a * sb.g;
     s.gamma = sa.gamma + sa.a * sb.gamma;
-    s.rows = row_pattern(s.a);
     s.length = sa.length + sb.length;
     return s;
   }

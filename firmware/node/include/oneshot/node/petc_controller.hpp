@@ -12,7 +12,7 @@
 ///  2. the first cascade step from x̂(k|k) and the law state stored with the packet in
 ///     force at k gives u_k:
 ///        ŷ = C x̂, d̂ = observer(ŷ, C̄ x̂), u_{k+l} = law(k + l, r − ŷ) − d̂, x̂ ← A x̂ + B u_{k+l}
-///     (C, C̄: their nonzeros only, the same sums as the dense products);
+///     (over the model's compile-time structure: the dense sums with exact zeros skipped);
 ///  3. send the packet if (ū − u_k)² > σ_c u_k² + δ_c (ū = first entry of the last packet
 ///     sent), or k − k_sent ≥ k_max (safety), or on the first arrival: only then the cascade
 ///     runs on to l = H, written straight into the packet in force (a withheld cascade is
@@ -34,11 +34,15 @@
 namespace oneshot::node {
 
 /// PETC controller with an N-state NUMRE, a packet of H + 1 inputs, a control law `Law`
-/// (u = law.step(k, e), copyable) and a disturbance estimate `Observer`.
-template <typename S, std::size_t N, std::size_t H, typename Law, typename Observer>
+/// (u = law.step(k, e), copyable), a disturbance estimate `Observer` and the model's
+/// compile-time structure (numre_structure.hpp; the default assumes nothing; a model that
+/// does not fit it must be refused first: fits()).
+template <typename S, std::size_t N, std::size_t H, typename Law, typename Observer,
+          typename Structure = DenseModelStructure<N>>
 class PetcController {
  public:
   static constexpr std::size_t kEntries = H + 1;  ///< Inputs per packet.
+  using Estimator = NumreEstimator<S, N, Structure>;  ///< The NUMRE.
 
   /// What the cascade carries from one period to the next besides x̂.
   struct LawState {
@@ -49,10 +53,10 @@ class PetcController {
   /// Controller at rest (x̂ = 0, P = 0, no packet in force).
   constexpr PetcController(const NumreModel<S, N>& model, NoiseAccumulation acc, const Law& law,
                            const Observer& obs, const MtmTrigger<S, 1>& trigger, S reference)
-      : est_(model, acc), initial_{law, obs}, trigger_(trigger), reference_(reference), c_rows_(row_pattern(model.c)),
-        c_bar_rows_(row_pattern(model.c_bar)) {
-    step_macs_ = N * N + N + pattern_size(c_rows_) + pattern_size(c_bar_rows_);
-  }
+      : est_(model, acc), initial_{law, obs}, trigger_(trigger), reference_(reference) {}
+
+  /// True when `model` fits Structure (the node must not be built on it otherwise).
+  static constexpr bool fits(const NumreModel<S, N>& model) { return Estimator::fits(model); }
 
   /// The reference from now on (a known change: the sensor is told separately).
   constexpr void set_reference(S r) { reference_ = r; }
@@ -131,12 +135,12 @@ class PetcController {
     return x;
   }
   /// The estimator.
-  constexpr const NumreEstimator<S, N>& estimator() const { return est_; }
+  constexpr const Estimator& estimator() const { return est_; }
   /// Multiply-adds: estimator + cascades (model, law, observer).
   constexpr std::uint64_t macs() const { return est_.macs() + cascade_macs_; }
 
  private:
-  NumreEstimator<S, N> est_;
+  NumreEstimator<S, N, Structure> est_;
   LawState initial_;
   MtmTrigger<S, 1> trigger_;
   S reference_;
@@ -148,22 +152,20 @@ class PetcController {
   S d_hat_[kEntries]{};
   LawState states_[H + 2]{};
   Vector<S, N> trajectory_[H + 2]{};
-  RowPattern<1, N> c_rows_{}, c_bar_rows_{};
-  std::uint64_t step_macs_ = 0;
   std::uint64_t cascade_macs_ = 0;
 
   /// One cascade step at period k: ŷ = C x, d̂ = observer(ŷ, C̄ x), u = law(k, r − ŷ) − d̂,
-  /// x ← A x + B u (dense: fixed trip counts unroll, which on the M4F beats skipping A's
-  /// 88 zeros by index; C and C̄ by their few nonzeros). Returns u; d̂ in `d_hat`.
+  /// x ← A x + B u, each over Structure's nonzeros in straight-line code (skipping A's zeros
+  /// by a run-time index list cost more instructions on the M4F than the dense product).
+  /// Returns u; d̂ in `d_hat`.
   constexpr S cascade_step(std::uint64_t k, LawState& ls, Vector<S, N>& x, S& d_hat) {
     const NumreModel<S, N>& m = est_.model();
-    const S y_hat = sparse_row_dot(m.c, c_rows_, 0, x);
-    const S d_model = sparse_row_dot(m.c_bar, c_bar_rows_, 0, x);
+    const S y_hat = masked_dot<Structure::kC>(m.c, x);
+    const S d_model = masked_dot<Structure::kCbar>(m.c_bar, x);
     d_hat = ls.obs.estimate(y_hat, d_model);
     const S u = ls.law.step(k, reference_ - y_hat) - d_hat;
     ls.obs.commit(u);
-    x = m.a * x + m.b * u;
-    cascade_macs_ += step_macs_;
+    cascade_macs_ += masked_step<Structure>(m.a, m.b, x, u) + mask_count(Structure::kC) + mask_count(Structure::kCbar);
     return u;
   }
 };
