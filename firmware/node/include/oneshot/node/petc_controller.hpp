@@ -20,7 +20,7 @@
 ///     estimator keeps propagating its inputs.
 /// Storage: H + 2 law states (the state before each entry and after the last), H + 2 model
 /// states, 2(H + 1) inputs and d̂: 31 KB in float for H = 200, plus the estimator's span
-/// table (21 KB): 54 KB, DSP-class memory (brief §10).
+/// table (19 KB): 52 KB, DSP-class memory (brief §10).
 #pragma once
 
 #include <cstddef>
