@@ -81,6 +81,37 @@ class InterlacedController {
     return u;
   }
 
+  /// Everything step() changes (a node stores this per packet entry, not the constants).
+  struct Modes {
+    S xf[kFast]{};             ///< Fast mode states.
+    S xs[kSlow]{};             ///< Slow mode states.
+    S out[kSlow]{};            ///< Held slow outputs.
+    S e_sample = S(0);         ///< Sampled error.
+    std::uint64_t macs = 0;    ///< Multiply-add counter.
+  };
+  /// The mode states.
+  constexpr Modes modes() const {
+    Modes m;
+    for (std::size_t f = 0; f < kFast; ++f) m.xf[f] = xf_[f];
+    for (std::size_t i = 0; i < kSlow; ++i) {
+      m.xs[i] = xs_[i];
+      m.out[i] = out_[i];
+    }
+    m.e_sample = e_sample_;
+    m.macs = macs_;
+    return m;
+  }
+  /// Restores mode states saved by modes() (same configuration).
+  constexpr void set_modes(const Modes& m) {
+    for (std::size_t f = 0; f < kFast; ++f) xf_[f] = m.xf[f];
+    for (std::size_t i = 0; i < kSlow; ++i) {
+      xs_[i] = m.xs[i];
+      out_[i] = m.out[i];
+    }
+    e_sample_ = m.e_sample;
+    macs_ = m.macs;
+  }
+
   /// Slow mode i's held output.
   constexpr S slow_output(std::size_t i) const { return out_[i]; }
   /// p_i^m.

@@ -25,6 +25,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <type_traits>
 
 #include "oneshot/matrix.hpp"
 #include "oneshot/node/mtm_trigger.hpp"
@@ -32,6 +33,26 @@
 #include "oneshot/node/send_cause.hpp"
 
 namespace oneshot::node {
+
+/// How a packet entry stores a law: the whole law, or only Law::Modes (modes() /
+/// set_modes()) when the law has them (the constants stay in the node's initial law).
+template <typename L, typename = void>
+struct LawStore {
+  using Type = L;  ///< Stored per entry.
+  /// What to store.
+  static constexpr Type save(const L& l) { return l; }
+  /// Restores into `l` (a copy of the initial law).
+  static constexpr void load(L& l, const Type& t) { l = t; }
+};
+/// Laws with mode states.
+template <typename L>
+struct LawStore<L, std::void_t<typename L::Modes>> {
+  using Type = typename L::Modes;  ///< Stored per entry.
+  /// What to store.
+  static constexpr Type save(const L& l) { return l.modes(); }
+  /// Restores into `l` (a copy of the initial law).
+  static constexpr void load(L& l, const Type& t) { l.set_modes(t); }
+};
 
 /// PETC controller with an N-state NUMRE, a packet of H + 1 inputs, a control law `Law`
 /// (u = law.step(k, e), copyable), a disturbance estimate `Observer` and the model's
@@ -48,6 +69,11 @@ class PetcController {
   struct LawState {
     Law law;        ///< Controller modes.
     Observer obs;   ///< Disturbance observer.
+  };
+  /// What a packet entry stores of a LawState (LawStore: the law's modes when it has them).
+  struct Snapshot {
+    typename LawStore<Law>::Type law{};  ///< Law (or its modes).
+    Observer obs{};                      ///< Disturbance observer.
   };
 
   /// Controller at rest (x̂ = 0, P = 0, no packet in force).
@@ -71,7 +97,9 @@ class PetcController {
     LawState ls = initial_;
     if (have_packet_) {
       const std::uint32_t idx = k - k_sent_;
-      ls = idx <= H ? states_[idx] : states_[H + 1];
+      const Snapshot& sn = idx <= H ? states_[idx] : states_[H + 1];
+      LawStore<Law>::load(ls.law, sn.law);
+      ls.obs = sn.obs;
     }
     const LawState ls0 = ls;
     // First cascade step, then the controller trigger on its input.
@@ -86,18 +114,18 @@ class PetcController {
       return cause;
     }
     trigger_.on_sent(k, u0v);
-    states_[0] = ls0;
+    states_[0] = snapshot(ls0);
     packet_[0] = u0;
     d_hat_[0] = d_hat;
     trajectory_[0] = est_.state();
     trajectory_[1] = x;
     for (std::size_t l = 1; l <= H; ++l) {
-      states_[l] = ls;
+      states_[l] = snapshot(ls);
       packet_[l] = cascade_step(static_cast<std::uint64_t>(k) + l, ls, x, d_hat);
       d_hat_[l] = d_hat;
       trajectory_[l + 1] = x;
     }
-    states_[H + 1] = ls;
+    states_[H + 1] = snapshot(ls);
     cascade_macs_ += (ls.law.macs() - ls0.law.macs()) + (ls.obs.macs() - ls0.obs.macs());
     k_sent_ = k;
     have_packet_ = true;
@@ -150,9 +178,12 @@ class PetcController {
   bool have_packet_ = false;
   S packet_[kEntries]{};
   S d_hat_[kEntries]{};
-  LawState states_[H + 2]{};
+  Snapshot states_[H + 2]{};
   Vector<S, N> trajectory_[H + 2]{};
   std::uint64_t cascade_macs_ = 0;
+
+  /// What entry l stores of the cascade's law state.
+  static constexpr Snapshot snapshot(const LawState& ls) { return {LawStore<Law>::save(ls.law), ls.obs}; }
 
   /// One cascade step at period k: ŷ = C x, d̂ = observer(ŷ, C̄ x), u = law(k, r − ŷ) − d̂,
   /// x ← A x + B u, each over Structure's nonzeros in straight-line code (skipping A's zeros
