@@ -35,14 +35,14 @@ TEST(PetcPil, ArrivalInstructionsBoundedInMultiplicity) {
     EXPECT_GT(a[i].at("macs").get<std::uint64_t>(), 0U);
     EXPECT_TRUE(std::isfinite(a[i].at("instructions_per_mac").get<double>()));
   }
-  // The prediction is at most three spans of the table (base-6 digits of N < 216): every N
-  // costs at most the first arrival (no prediction) plus three times what N = 1 adds.
+  // The prediction is at most two spans of the table (base-15 digits of N < 225): every N
+  // costs at most the first arrival (no prediction) plus twice what N = 1 adds.
   const std::uint64_t one_span = insns("1") - insns("0");
-  for (const auto& [n, v] : by_n.items()) EXPECT_LE(v.get<std::uint64_t>(), insns("0") + 3 * one_span) << "N = " << n;
+  for (const auto& [n, v] : by_n.items()) EXPECT_LE(v.get<std::uint64_t>(), insns("0") + 2 * one_span) << "N = " << n;
   // Counts are stable (straight-line code over the HDD structure, same data): measured
-  // 115,563 (N = 0), 123,985 (1 and 2: one span), 140,110 (97 and 200: three spans). The
-  // issue's target is 60,000 (not reached: the 201-step cascade is ~560 per step).
-  EXPECT_LE(j.at("instructions_max").get<std::uint64_t>(), 141500U);
+  // 94,620 (N = 0), 101,852 (1 and 2: one span), 108,884 (97 and 200: two spans). The
+  // issue's target is 60,000 (not reached: the 201-step cascade is ~460 per step).
+  EXPECT_LE(j.at("instructions_max").get<std::uint64_t>(), 110000U);
 }
 
 TEST(PetcPil, ArrivalBitIdenticalToHostFloat) {

@@ -10,8 +10,8 @@
 /// The printed eq. 13 (w frozen over the interval) is kept as a switch: P ← A P Aᵀ per step
 /// and G ← A G + B_w, then M = P + G W Gᵀ with G = Σ A^c B_w.
 /// predict_along(N, …) does the same N periods at once from the span table (numre_span_table.hpp,
-/// A^j and W_e(j) for j = d·6^p): P ← A^j P (A^j)ᵀ + W_e(j) for each base-6 digit of N (at
-/// most 3 for N < 216), and x̂ from a model trajectory x_r under the same applied inputs:
+/// A^j and W_e(j) for j = d·15^p): P ← A^j P (A^j)ᵀ + W_e(j) for each base-15 digit of N (at
+/// most 2 for N < 225), and x̂ from a model trajectory x_r under the same applied inputs:
 ///     x̂(k|k−N) = x_r(k) + A^N (x̂(k−N|k−N) − x_r(k−N))
 /// (the inputs cancel in the difference), so its cost does not grow with N.
 /// On arrival (one output, p = 1), Joseph form expanded for the scalar output (O(n²), exact
@@ -65,7 +65,7 @@ class NumreEstimator {
  public:
   using State = Vector<S, N>;        ///< x̂.
   using Covariance = Matrix<S, N, N>;  ///< P.
-  using Spans = NumreSpanTable<S, N, 6, 3>;  ///< j = d·6^p: N < 216 in at most 3 spans.
+  using Spans = NumreSpanTable<S, N, 15, 2>;  ///< j = d·15^p: N < 225 in at most 2 spans.
   using Powers = ClosureStructure<Structure, N>;  ///< Where A^j may be nonzero.
 
   /// True when `model` fits Structure (the filter must not be used otherwise).
@@ -88,7 +88,13 @@ class NumreEstimator {
       d = t;
       macs_ += masked_sandwich<Powers>(sp.a, p_);
       if (acc_ == NoiseAccumulation::kSum) {
-        p_ = p_ + sp.w;
+        std::size_t q = 0;
+        for (std::size_t i = 0; i < N; ++i)
+          for (std::size_t c = i; c < N; ++c) {
+            const S v = p_(i, c) + sp.w[q++];
+            p_(i, c) = v;
+            p_(c, i) = v;
+          }
       } else {
         macs_ += masked_product<Powers>(sp.a, g_, t);
         g_ = t + sp.g;

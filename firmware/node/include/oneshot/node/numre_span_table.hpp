@@ -35,11 +35,36 @@ constexpr std::uint64_t sandwich(const Matrix<S, N, N>& a, Matrix<S, N, N>& p) {
   return N * N * N + N * N * (N + 1) / 2;
 }
 
+/// Entries of a symmetric N × N matrix's upper triangle.
+template <std::size_t N>
+inline constexpr std::size_t kPackedSize = N * (N + 1) / 2;
+
+/// The upper triangle of symmetric `m`, row by row.
+template <typename S, std::size_t N>
+constexpr void pack_upper(const Matrix<S, N, N>& m, S (&out)[kPackedSize<N>]) {
+  std::size_t q = 0;
+  for (std::size_t i = 0; i < N; ++i)
+    for (std::size_t k = i; k < N; ++k) out[q++] = m(i, k);
+}
+
+/// The symmetric matrix of a packed upper triangle.
+template <typename S, std::size_t N>
+constexpr Matrix<S, N, N> unpack_upper(const S (&in)[kPackedSize<N>]) {
+  Matrix<S, N, N> m;
+  std::size_t q = 0;
+  for (std::size_t i = 0; i < N; ++i)
+    for (std::size_t k = i; k < N; ++k) {
+      m(i, k) = in[q];
+      m(k, i) = in[q++];
+    }
+  return m;
+}
+
 /// One tabulated span of j periods.
 template <typename S, std::size_t N>
 struct ModelSpan {
   Matrix<S, N, N> a;    ///< A^j.
-  Matrix<S, N, N> w;    ///< W_e(j).
+  S w[kPackedSize<N>]{};  ///< W_e(j), upper triangle row by row (symmetric).
   Vector<S, N> g;       ///< G(j) = Σ_{c<j} A^c B_w.
   Vector<S, N> gamma;   ///< Γ(j) = Σ_{c<j} A^c B.
   std::uint32_t length = 0;  ///< j.
@@ -65,7 +90,7 @@ class NumreSpanTable {
                            const Matrix<S, N, N>& q) {
     Span one;
     one.a = a;
-    one.w = q;
+    pack_upper(q, one.w);
     one.g = b_w;
     one.gamma = b;
     one.length = 1;
@@ -99,9 +124,9 @@ class NumreSpanTable {
   static constexpr Span compose(const Span& sa, const Span& sb) {
     Span s;
     s.a = sa.a * sb.a;
-    s.w = sb.w;
-    static_cast<void>(sandwich(sa.a, s.w));
-    s.w = s.w + sa.w;
+    Matrix<S, N, N> w = unpack_upper<S, N>(sb.w);
+    static_cast<void>(sandwich(sa.a, w));
+    pack_upper(w + unpack_upper<S, N>(sa.w), s.w);
     s.g = sa.g + sa.a * sb.g;
     s.gamma = sa.gamma + sa.a * sb.gamma;
     s.length = sa.length + sb.length;
