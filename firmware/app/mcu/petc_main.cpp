@@ -15,7 +15,7 @@
 #include "oneshot/mcu/rx_ring.hpp"
 
 #if !defined(ONESHOT_MCU_MPS2)
-#error "the petc image is built for the Cortex-M4F (MPS2 AN386) only: the node needs ~52 KB of RAM"
+#error "the petc image is built for the Cortex-M4F (MPS2 AN386) only: the node needs ~49 KB of RAM"
 #endif
 
 namespace soc = oneshot::mcu::mps2;

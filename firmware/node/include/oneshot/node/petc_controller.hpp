@@ -18,9 +18,10 @@
 ///     runs on to l = H, written straight into the packet in force (a withheld cascade is
 ///     never applied, so it is not computed); otherwise the packet in force stays and the
 ///     estimator keeps propagating its inputs.
-/// Storage: H + 2 law states (the state before each entry and after the last), H + 2 model
-/// states, 2(H + 1) inputs and d̂: 31 KB in float for H = 200, plus the estimator's span
-/// table (19 KB): 52 KB, DSP-class memory (brief §10).
+/// Storage: H + 2 law states (the state before each entry and after the last; only the law's
+/// mode states when it has them, LawStore), H + 2 model states, 2(H + 1) inputs and d̂:
+/// 19 KB in float for H = 200, plus the estimator's span table (28 KB): 49 KB in all,
+/// DSP-class memory (brief §10).
 #pragma once
 
 #include <cstddef>
