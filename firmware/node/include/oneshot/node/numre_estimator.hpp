@@ -2,8 +2,8 @@
 /// @brief Non-uniform multi-rate estimator (NUMRE, numre-petc.md §4): a Kalman filter that
 ///        runs only when a measurement arrives, N = k − k_prev periods after the previous one.
 ///
-/// Between arrivals the node propagates one period at a time with the inputs actually
-/// applied (the same result as tabulating A^N, and no table):
+/// predict(u) propagates one period at a time with the inputs actually applied (the
+/// step-by-step form, kept as the reference the tests compare with):
 ///     x̂ ← A x̂ + B u_j,   P ← A P Aᵀ + B_w W B_wᵀ          (j = k − N … k − 1)
 /// so after N steps x̂ = x̂(k|k−N) and P = A^N P (A^N)ᵀ + W_e(N),
 ///     W_e(N) = Σ_{c=0}^{N−1} A^c B_w W B_wᵀ (A^c)ᵀ            (the brief's correction).
