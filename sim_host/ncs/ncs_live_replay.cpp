@@ -92,6 +92,9 @@ ReplayResult replay_live(const std::string& dir, bool ideal_instants) {
     node::SyncActuatorNode<Board, double, kM> act(kLiveSensor, InputVec{});
     node::SyncSensorNode<Board, double, kP, kM> sensor(kLiveController, late_us);
     node::SyncControllerNode<Board, Est, Ref, double, kN, kP, kM> ctrl(kLiveActuator, design.l, u_min, u_max, est, ref);
+    check_requests(*ctx, sensor);
+    check_reports(ctrl);
+    check_commands(*ctx, act);
     std::map<std::tuple<int, int, std::uint32_t>, std::vector<std::uint8_t>> sent;
     std::map<std::uint32_t, InputVec> commands;  // the replay's actuator output per period
     const auto collect = [&](host::HostNetworkState& s) {

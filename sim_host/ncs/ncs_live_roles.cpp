@@ -140,6 +140,7 @@ int run_sensor(const LiveRun& r, const std::shared_ptr<const Context>& ctx, int 
   };
   posix::ScopedUdpNetwork scope(net);
   node::SyncSensorNode<Board, double, kP, kM> sensor(kLiveController, late_us);
+  check_requests(*ctx, sensor);
   const sockaddr_in plant = posix::loopback(r.plant_port);
   const std::int64_t stop = end_ns(r) + kTailNs;
   bool pending = false;
@@ -183,6 +184,7 @@ int run_sensor(const LiveRun& r, const std::shared_ptr<const Context>& ctx, int 
   }
   const auto& s = sensor.statistics();
   log.write("stats", c.now(), 0, 0, 0, 0, s.requests, s.stale, s.refused);
+  log_refusals(log, c.now(), s, s.stale);
   return 0;
 }
 
@@ -200,6 +202,7 @@ int controller_loop(const LiveRun& r, const Context& ctx, Est est, int net_fd, c
   }
   node::SyncControllerNode<Board, Est, Ref, double, kN, kP, kM> ctrl(kLiveActuator, d.l, u_min, u_max, est,
                                                                     reference(ctx, r.scenario));
+  check_reports(ctrl);
   engine::RandomStream compute = engine::Kernel(r.seed).stream("compute");
   const std::int64_t stop = end_ns(r) + kTailNs;
   while (c.now() < stop) {
@@ -215,6 +218,8 @@ int controller_loop(const LiveRun& r, const Context& ctx, Est est, int net_fd, c
   }
   const auto& s = ctrl.statistics();
   log.write("stats", c.now(), 0, 0, 0, 0, s.computations, s.saturated, s.faults);
+  log_refusals(log, c.now(), s, s.stale);
+  log.write("resets", c.now(), 0, 0, 0, 0, s.estimator_resets, s.withheld);
   return 0;
 }
 
@@ -233,6 +238,7 @@ int run_actuator(const LiveRun& r, const std::shared_ptr<const Context>& ctx, in
   attach(net, net_fd, kLiveActuator, r, log, c);
   posix::ScopedUdpNetwork scope(net);
   node::SyncActuatorNode<Board, double, kM> act(kLiveSensor, InputVec{});
+  check_commands(*ctx, act);
   const sockaddr_in plant = posix::loopback(r.plant_port);
   const std::int64_t h_ns = std::int64_t{ctx->period_us()} * 1000;
   const auto h_us = static_cast<std::uint32_t>(ctx->period_us());
@@ -265,6 +271,7 @@ int run_actuator(const LiveRun& r, const std::shared_ptr<const Context>& ctx, in
   }
   const auto& s = act.statistics();
   log.write("stats", c.now(), 0, 0, 0, 0, s.late, act.refused());
+  log_refusals(log, c.now(), s, s.stale);
   return 0;
 }
 

@@ -87,8 +87,8 @@ std::pair<double, double> compare(std::uint32_t n, bool frozen, std::uint64_t se
     }
     span.predict_along(n, ref_then, ref);
     const S y = static_cast<S>(g(rng));
-    EXPECT_TRUE(step.correct(y));
-    EXPECT_TRUE(span.correct(y));
+    EXPECT_EQ(step.correct(y), oneshot::Status::kOk);
+    EXPECT_EQ(span.correct(y), oneshot::Status::kOk);
   }
   EXPECT_EQ(span.last_multiplicity(), n);
   double dx = 0, sx = 0, dp = 0, spp = 0;

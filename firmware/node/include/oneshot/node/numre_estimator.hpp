@@ -20,14 +20,19 @@
 ///     P = (I − K C) M (I − K C)ᵀ + K V Kᵀ = M − K mᵀ − m Kᵀ + S K Kᵀ.
 /// Multiply-adds are counted as executed (exact zeros of A^j and C skipped), for the
 /// study's cost figures.
+/// The estimate never stays non-finite: a correction that leaves x̂ or P NaN or ±∞ resets
+/// them to the initial values (reset(); x̂ = 0, P = 0 at construction) and reports
+/// Status::kNonFinite.
 #pragma once
 
 #include <cstddef>
 #include <cstdint>
 
+#include "oneshot/finite.hpp"
 #include "oneshot/matrix.hpp"
 #include "oneshot/node/numre_span_table.hpp"
 #include "oneshot/node/numre_structure.hpp"
+#include "oneshot/status.hpp"
 
 namespace oneshot::node {
 
@@ -113,8 +118,10 @@ class NumreEstimator {
     });
   }
 
-  /// Sets x̂ and P (the last arrival's values).
+  /// Sets x̂ and P (the last arrival's values; also what a non-finite result resets to).
   constexpr void reset(const State& x, const Covariance& p) {
+    x0_ = x;
+    p0_ = p;
     x_ = x;
     p_ = p;
     g_ = State{};
@@ -136,8 +143,9 @@ class NumreEstimator {
   }
 
   /// Arrival of y after `multiplicity()` predictions: finishes M_k and corrects (Joseph).
-  /// Returns false (x̂, P untouched apart from M_k) when C M Cᵀ + V is not positive.
-  constexpr bool correct(S y) {
+  /// kSingular (x̂, P untouched apart from M_k) when C M Cᵀ + V is not positive; kNonFinite
+  /// when x̂ or P turned NaN or ±∞ (reset to the initial values); kOk otherwise.
+  [[nodiscard]] constexpr Status correct(S y) {
     if (acc_ == NoiseAccumulation::kFrozen) {
       for (std::size_t i = 0; i < N; ++i)
         for (std::size_t j = 0; j < N; ++j) p_(i, j) = p_(i, j) + g_[i] * m_.w * g_[j];
@@ -155,7 +163,7 @@ class NumreEstimator {
     steps_ = 0;
     if (!(s > S(0))) {
       k_ = State{};
-      return false;
+      return is_finite(s) ? Status::kSingular : reset_non_finite();
     }
     k_ = mct * (S(1) / s);
     const S innovation = y - masked_dot<Structure::kC>(m_.c, x_);
@@ -168,7 +176,7 @@ class NumreEstimator {
         p_(j, i) = v;
       }
     macs_ += 2 * N + mask_count(Structure::kC) + 4 * (N * (N + 1) / 2);
-    return true;
+    return all_finite(x_) && all_finite(p_) ? Status::kOk : reset_non_finite();
   }
 
   /// x̂ (x̂(k|k) after correct(), the prediction before).
@@ -185,10 +193,20 @@ class NumreEstimator {
   constexpr std::uint64_t macs() const { return macs_; }
 
  private:
+  constexpr Status reset_non_finite() {
+    x_ = x0_;
+    p_ = p0_;
+    g_ = State{};
+    k_ = State{};
+    return Status::kNonFinite;
+  }
+
   NumreModel<S, N> m_;
   NoiseAccumulation acc_;
   Covariance q_{};
   Spans spans_;
+  State x0_{};
+  Covariance p0_{};
 
   /// Row i of P as a vector.
   static constexpr State row_of(const Covariance& p, std::size_t i) {

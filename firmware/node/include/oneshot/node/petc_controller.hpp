@@ -18,6 +18,21 @@
 ///     runs on to l = H, written straight into the packet in force (a withheld cascade is
 ///     never applied, so it is not computed); otherwise the packet in force stays and the
 ///     estimator keeps propagating its inputs.
+/// Arrivals are untrusted (frame_checks.hpp): a non-finite y, a y outside the sensor's range
+/// (once set) or a k beyond the sequence window is refused and counted (no packet); a
+/// restarted sensor is re-acquired on its R-th arrival: no prediction over the unknown
+/// interval then, and the packet in force (numbered in the old periods) is re-based by a
+/// send on that arrival (kFirst when the trigger has no cause of its own). A correction
+/// that turns the NUMRE non-finite resets it (counted, last_status() = kNonFinite) and
+/// sends nothing.
+/// A cascade with a non-finite entry or end state is withheld and the packet in force stays,
+/// with no second packet buffer: the cascade is a deterministic function of (x̂(k|k), the
+/// law state at k, k, r), so the packet in force is kept as its seed (x̂, law snapshot,
+/// k_sent, r at the send: N + 1 values and one snapshot) and, if a cascade turns non-finite
+/// part way through the buffer, the same code regenerates the packet in force from that seed
+/// bit for bit. x̂ is finite here (the estimator resets otherwise) and the law state comes
+/// from a finite cascade, so non-finite can only come from an overflow inside the cascade
+/// (a huge reference or an unstable law or model over H steps): rare, paid only then.
 /// Storage: H + 2 law states (the state before each entry and after the last; only the law's
 /// mode states when it has them, LawStore), H + 2 model states, 2(H + 1) inputs and d̂:
 /// 19 KB in float for H = 200, plus the estimator's span table (28 KB): 49 KB in all,
@@ -28,10 +43,13 @@
 #include <cstdint>
 #include <type_traits>
 
+#include "oneshot/finite.hpp"
 #include "oneshot/matrix.hpp"
+#include "oneshot/node/frame_checks.hpp"
 #include "oneshot/node/mtm_trigger.hpp"
 #include "oneshot/node/numre_estimator.hpp"
 #include "oneshot/node/send_cause.hpp"
+#include "oneshot/status.hpp"
 
 namespace oneshot::node {
 
@@ -53,6 +71,13 @@ struct LawStore<L, std::void_t<typename L::Modes>> {
   static constexpr Type save(const L& l) { return l.modes(); }
   /// Restores into `l` (a copy of the initial law).
   static constexpr void load(L& l, const Type& t) { l.set_modes(t); }
+};
+
+/// Counters of a PETC controller (refusals by cause in the FrameRefusals part).
+struct PetcStatistics : FrameRefusals {
+  std::uint32_t stale = 0;             ///< Arrivals not newer than the last one (dropped).
+  std::uint32_t estimator_resets = 0;  ///< Corrections that turned non-finite (NUMRE reset).
+  std::uint32_t withheld = 0;          ///< Cascades with a non-finite entry (not sent).
 };
 
 /// PETC controller with an N-state NUMRE, a packet of H + 1 inputs, a control law `Law`
@@ -88,48 +113,78 @@ class PetcController {
   /// The reference from now on (a known change: the sensor is told separately).
   constexpr void set_reference(S r) { reference_ = r; }
 
+  /// Accepts y in [y_min, y_max] only (the sensor's range from the design).
+  constexpr void set_measurement_range(S y_min, S y_max) {
+    Vector<S, 1> lo;
+    Vector<S, 1> hi;
+    lo[0] = y_min;
+    hi[0] = y_max;
+    range_ = ValueRange<S, 1>(lo, hi);
+  }
+  /// Sequence window W (the longest silence, periods) and re-acquisition count R.
+  constexpr void set_sequence_window(std::uint32_t window, std::uint32_t reacquire) {
+    gate_ = SequenceGate(window, reacquire);
+  }
+
   /// Arrival of y at period k. Returns the send cause (kNone: no packet).
   constexpr SendCause on_arrival(std::uint32_t k, S y) {
-    if (arrivals_ > 0) est_.predict_along(k - k_prev_, reference_state(k_prev_), reference_state(k));
-    est_.correct(y);
+    Vector<S, 1> yv;
+    yv[0] = y;
+    if (!check_payload(yv, range_, stats_)) return SendCause::kNone;
+    const SequenceVerdict v = gate_.offer(k);
+    if (v == SequenceVerdict::kStale) ++stats_.stale;
+    if (!count_sequence(v, stats_)) return SendCause::kNone;
+    if (v == SequenceVerdict::kReacquired) rebase_ = have_packet_;
+    // A re-acquired arrival (or one before the re-basing send) predicts nothing: the
+    // interval since the last arrival is unknown, and the packet in force is in old periods.
+    if (arrivals_ > 0 && v == SequenceVerdict::kAccepted && !rebase_)
+      est_.predict_along(k - k_prev_, reference_state(k_prev_), reference_state(k));
+    status_ = est_.correct(y);
     ++arrivals_;
     k_prev_ = k;
+    if (status_ == Status::kNonFinite) {
+      ++stats_.estimator_resets;
+      return SendCause::kNone;
+    }
     // The law state in force at k: stored with the packet in force.
     LawState ls = initial_;
     if (have_packet_) {
       const std::uint32_t idx = k - k_sent_;
-      const Snapshot& sn = idx <= H ? states_[idx] : states_[H + 1];
-      LawStore<Law>::load(ls.law, sn.law);
-      ls.obs = sn.obs;
+      ls = restore(idx <= H ? states_[idx] : states_[H + 1]);
     }
     const LawState ls0 = ls;
     // First cascade step, then the controller trigger on its input.
     Vector<S, N> x = est_.state();
     S d_hat = S(0);
-    const S u0 = cascade_step(k, ls, x, d_hat);
+    const S u0 = cascade_step(k, reference_, ls, x, d_hat);
+    cascade_macs_ += (ls.law.macs() - ls0.law.macs()) + (ls.obs.macs() - ls0.obs.macs());
+    if (!is_finite(u0)) {  // nothing written yet: the packet in force stays as it is
+      ++stats_.withheld;
+      return SendCause::kNone;
+    }
     Vector<S, 1> u0v;
     u0v[0] = u0;
-    const SendCause cause = trigger_.evaluate(k, u0v);
-    if (cause == SendCause::kNone) {
-      cascade_macs_ += (ls.law.macs() - ls0.law.macs()) + (ls.obs.macs() - ls0.obs.macs());
-      return cause;
-    }
-    trigger_.on_sent(k, u0v);
+    SendCause cause = trigger_.evaluate(k, u0v);
+    if (cause == SendCause::kNone && rebase_) cause = SendCause::kFirst;
+    if (cause == SendCause::kNone) return cause;
+    // The cascade runs on to l = H straight into the packet in force.
     states_[0] = snapshot(ls0);
     packet_[0] = u0;
     d_hat_[0] = d_hat;
     trajectory_[0] = est_.state();
     trajectory_[1] = x;
-    for (std::size_t l = 1; l <= H; ++l) {
-      states_[l] = snapshot(ls);
-      packet_[l] = cascade_step(static_cast<std::uint64_t>(k) + l, ls, x, d_hat);
-      d_hat_[l] = d_hat;
-      trajectory_[l + 1] = x;
+    if (!write_entries(k, 1, reference_, ls, x)) {
+      ++stats_.withheld;
+      if (have_packet_) regenerate();
+      return SendCause::kNone;
     }
-    states_[H + 1] = snapshot(ls);
-    cascade_macs_ += (ls.law.macs() - ls0.law.macs()) + (ls.obs.macs() - ls0.obs.macs());
+    trigger_.on_sent(k, u0v);
+    seed_x_ = est_.state();
+    seed_state_ = states_[0];
+    seed_reference_ = reference_;
     k_sent_ = k;
     have_packet_ = true;
+    rebase_ = false;
     return cause;
   }
 
@@ -165,6 +220,10 @@ class PetcController {
   }
   /// The estimator.
   constexpr const Estimator& estimator() const { return est_; }
+  /// Status of the last correction (kNonFinite: the NUMRE was reset).
+  constexpr Status last_status() const { return status_; }
+  /// Counters.
+  constexpr const PetcStatistics& statistics() const { return stats_; }
   /// Multiply-adds: estimator + cascades (model, law, observer).
   constexpr std::uint64_t macs() const { return est_.macs() + cascade_macs_; }
 
@@ -182,23 +241,66 @@ class PetcController {
   Snapshot states_[H + 2]{};
   Vector<S, N> trajectory_[H + 2]{};
   std::uint64_t cascade_macs_ = 0;
+  Status status_ = Status::kOk;
+  SequenceGate gate_{};
+  ValueRange<S, 1> range_{};
+  PetcStatistics stats_{};
+  bool rebase_ = false;  ///< Re-acquired: the packet in force is numbered in the old periods.
+  /// Seed of the packet in force (what regenerates it): x̂ and law state at k_sent, r.
+  Vector<S, N> seed_x_{};
+  Snapshot seed_state_{};
+  S seed_reference_{};
 
   /// What entry l stores of the cascade's law state.
   static constexpr Snapshot snapshot(const LawState& ls) { return {LawStore<Law>::save(ls.law), ls.obs}; }
+  /// The law state a snapshot stands for (into a copy of the initial law).
+  constexpr LawState restore(const Snapshot& sn) const {
+    LawState ls = initial_;
+    LawStore<Law>::load(ls.law, sn.law);
+    ls.obs = sn.obs;
+    return ls;
+  }
 
-  /// One cascade step at period k: ŷ = C x, d̂ = observer(ŷ, C̄ x), u = law(k, r − ŷ) − d̂,
-  /// x ← A x + B u, each over Structure's nonzeros in straight-line code (skipping A's zeros
-  /// by a run-time index list cost more instructions on the M4F than the dense product).
-  /// Returns u; d̂ in `d_hat`.
-  constexpr S cascade_step(std::uint64_t k, LawState& ls, Vector<S, N>& x, S& d_hat) {
+  /// One cascade step at period k towards reference r: ŷ = C x, d̂ = observer(ŷ, C̄ x),
+  /// u = law(k, r − ŷ) − d̂, x ← A x + B u, each over Structure's nonzeros in straight-line
+  /// code (skipping A's zeros by a run-time index list cost more instructions on the M4F
+  /// than the dense product). Returns u; d̂ in `d_hat`.
+  constexpr S cascade_step(std::uint64_t k, S r, LawState& ls, Vector<S, N>& x, S& d_hat) {
     const NumreModel<S, N>& m = est_.model();
     const S y_hat = masked_dot<Structure::kC>(m.c, x);
     const S d_model = masked_dot<Structure::kCbar>(m.c_bar, x);
     d_hat = ls.obs.estimate(y_hat, d_model);
-    const S u = ls.law.step(k, reference_ - y_hat) - d_hat;
+    const S u = ls.law.step(k, r - y_hat) - d_hat;
     ls.obs.commit(u);
     cascade_macs_ += masked_step<Structure>(m.a, m.b, x, u) + mask_count(Structure::kC) + mask_count(Structure::kCbar);
     return u;
+  }
+
+  /// Entries l = from … H of the packet from period k (entry `from` from `ls`, `x`), written
+  /// into the packet in force with their law states and model trajectory. False at the first
+  /// non-finite entry, or a non-finite end state (the buffer is then partly overwritten).
+  constexpr bool write_entries(std::uint32_t k, std::size_t from, S r, LawState& ls, Vector<S, N>& x) {
+    const LawState ls0 = ls;
+    bool ok = true;
+    for (std::size_t l = from; l <= H && ok; ++l) {
+      states_[l] = snapshot(ls);
+      S d_hat = S(0);
+      packet_[l] = cascade_step(static_cast<std::uint64_t>(k) + l, r, ls, x, d_hat);
+      d_hat_[l] = d_hat;
+      trajectory_[l + 1] = x;
+      ok = is_finite(packet_[l]);
+    }
+    states_[H + 1] = snapshot(ls);
+    cascade_macs_ += (ls.law.macs() - ls0.law.macs()) + (ls.obs.macs() - ls0.obs.macs());
+    return ok && all_finite(x);
+  }
+
+  /// Regenerates the packet in force from its seed (bit for bit: the same cascade).
+  constexpr void regenerate() {
+    LawState ls = restore(seed_state_);
+    Vector<S, N> x = seed_x_;
+    trajectory_[0] = x;
+    static_cast<void>(write_entries(k_sent_, 0, seed_reference_, ls, x));
   }
 };
 
