@@ -169,14 +169,20 @@ class NumreEstimator {
     const S innovation = y - masked_dot<Structure::kC>(m_.c, x_);
     x_ = x_ + k_ * innovation;
     // Joseph form expanded: P = M − K mᵀ − m Kᵀ + S K Kᵀ (upper triangle, mirrored).
+    // Finiteness: the sum of the new values is non-finite when any is (NaN and ±∞ are
+    // absorbing under +; ∞ − ∞ = NaN), one addition per value instead of a bit test; it
+    // also resets if the sum alone overflows (|entries| near the largest finite value).
+    S sum = innovation;
     for (std::size_t i = 0; i < N; ++i)
       for (std::size_t j = i; j < N; ++j) {
         const S v = p_(i, j) - k_[i] * mct[j] - mct[i] * k_[j] + s * k_[i] * k_[j];
         p_(i, j) = v;
         p_(j, i) = v;
+        sum = sum + v;
       }
+    for (std::size_t i = 0; i < N; ++i) sum = sum + x_[i];
     macs_ += 2 * N + mask_count(Structure::kC) + 4 * (N * (N + 1) / 2);
-    return all_finite(x_) && all_finite(p_) ? Status::kOk : reset_non_finite();
+    return is_finite(sum) ? Status::kOk : reset_non_finite();
   }
 
   /// x̂ (x̂(k|k) after correct(), the prediction before).

@@ -277,22 +277,25 @@ class PetcController {
   }
 
   /// Entries l = from … H of the packet from period k (entry `from` from `ls`, `x`), written
-  /// into the packet in force with their law states and model trajectory. False at the first
-  /// non-finite entry, or a non-finite end state (the buffer is then partly overwritten).
+  /// into the packet in force with their law states and model trajectory. False when an
+  /// entry or the end state is non-finite (or their sum overflows): the buffer is then
+  /// overwritten with a packet that must not be used.
   constexpr bool write_entries(std::uint32_t k, std::size_t from, S r, LawState& ls, Vector<S, N>& x) {
     const LawState ls0 = ls;
-    bool ok = true;
-    for (std::size_t l = from; l <= H && ok; ++l) {
+    S sum = S(0);  // non-finite when any entry is (NaN, ±∞ absorb under +), or it overflows
+    for (std::size_t l = from; l <= H; ++l) {
       states_[l] = snapshot(ls);
       S d_hat = S(0);
-      packet_[l] = cascade_step(static_cast<std::uint64_t>(k) + l, r, ls, x, d_hat);
+      const S u = cascade_step(static_cast<std::uint64_t>(k) + l, r, ls, x, d_hat);
+      packet_[l] = u;
       d_hat_[l] = d_hat;
       trajectory_[l + 1] = x;
-      ok = is_finite(packet_[l]);
+      sum = sum + u;
     }
     states_[H + 1] = snapshot(ls);
     cascade_macs_ += (ls.law.macs() - ls0.law.macs()) + (ls.obs.macs() - ls0.obs.macs());
-    return ok && all_finite(x);
+    for (std::size_t i = 0; i < N; ++i) sum = sum + x[i];
+    return is_finite(sum);
   }
 
   /// Regenerates the packet in force from its seed (bit for bit: the same cascade).
