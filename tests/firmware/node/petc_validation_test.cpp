@@ -140,6 +140,25 @@ TEST(PetcValidation, OverflowingCascadeWithheldPacketInForceRegenerated) {
   EXPECT_TRUE(all_finite(p.estimator().state()));
 }
 
+TEST(PetcValidation, OverflowingFirstCascadeLeavesNoPacket) {
+  // GIVEN the unstable model and r = 1e150 from the start (no packet in force yet)
+  using Petc200 = PetcController<double, 2, 200, Law, ModelDisturbance<double>>;
+  NumreModel<double, 2> m = model();
+  m.a(1, 1) = 10.0;
+  InterlacedConfig<double, 1, 2> c{};
+  c.feedthrough = 0.5;
+  c.ratio = 2;
+  Petc200 p(m, NoiseAccumulation::kSum, Law(c), ModelDisturbance<double>{}, MtmTrigger<double, 1>(0.01, 1e-4, 0, 0), 1e150);
+  // WHEN the first cascade overflows THEN nothing is sent, no packet is in force (all zero)
+  EXPECT_EQ(p.on_arrival(0, 0.05), SendCause::kNone);
+  EXPECT_EQ(p.statistics().withheld, 1U);
+  for (std::size_t l = 0; l < Petc200::kEntries; ++l) EXPECT_EQ(p.packet()[l], 0.0) << l;
+  EXPECT_EQ(p.applied(5), 0.0);
+  // AND a finite reference later gives the first packet (kFirst)
+  p.set_reference(0.3);
+  EXPECT_EQ(p.on_arrival(1, 0.05), SendCause::kFirst);
+}
+
 TEST(PetcValidation, ReacquiredArrivalPredictsNothingAndRebasesThePacket) {
   // GIVEN no safety send (k_max = 0) and a constant measurement: the delta rule stays silent
   InterlacedConfig<double, 1, 2> c{};

@@ -175,7 +175,14 @@ class PetcController {
     trajectory_[1] = x;
     if (!write_entries(k, 1, reference_, ls, x)) {
       ++stats_.withheld;
-      if (have_packet_) regenerate();
+      if (have_packet_) {
+        regenerate();
+      } else {  // no packet in force: back to none (applied() = 0, packet() all zero)
+        for (std::size_t l = 0; l < kEntries; ++l) {
+          packet_[l] = S(0);
+          d_hat_[l] = S(0);
+        }
+      }
       return SendCause::kNone;
     }
     trigger_.on_sent(k, u0v);
