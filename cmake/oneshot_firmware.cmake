@@ -162,7 +162,7 @@ target_compile_definitions(${og_probe} PRIVATE ${soc_define}
   ONESHOT_FW_FIXED=1 ONESHOT_FW_DISC=0)
 oneshot_firmware_link(${og_probe})
 
-# The petc image (Cortex-M4F only: the node with H = 200 needs ~45 KB of RAM, the nRF51 has 16 KB):
+# The petc image (Cortex-M4F only: the node with H = 200 needs ~49 KB of RAM, the nRF51 has 16 KB):
 # the PETC controller node behind the PIL link, one NUMRE arrival per request between the
 # instruction-count markers (firmware/app/mcu/petc_main.cpp); <image>.stack.txt as above.
 if(ONESHOT_FIRMWARE_TARGET STREQUAL "cortex-m4f")

@@ -76,6 +76,8 @@ pp::ResetParams reset_params(const PetcSetup& s) {
 template <typename S>
 std::unique_ptr<pp::Node<S>> make_node(const S (&w)[pp::kWordCount], const pp::ResetParams& p) {
   const pp::NodeArgs<S> a = pp::node_args(w, p);
+  if (!pp::Node<S>::fits(a.model))
+    throw std::invalid_argument("petc exectime: the model has a nonzero outside the image's HDD structure");
   return std::make_unique<pp::Node<S>>(a.model, a.acc, a.law, node::ModelDisturbance<S>{}, a.trigger, a.reference);
 }
 
@@ -112,7 +114,10 @@ ArrivalPlan plan_arrivals(const PetcSetup& setup, const ExectimeOptions& opt) {
   plan.n_typical = ns[(ns.size() - 1) / 2];
   plan.n_mean = static_cast<std::uint32_t>(std::lround(sum / static_cast<double>(ns.size())));
   plan.n_max = ns.back();
-  std::vector<std::uint32_t> wanted = {1, plan.n_typical, std::max<std::uint32_t>(1, plan.n_mean), plan.n_max};
+  // Always N = 1, 2, 97 (case 3's largest at seed 1, the figures) and H = 200 (the
+  // longest silence the safety allows) beside the study's median, mean and largest.
+  std::vector<std::uint32_t> wanted = {1,           2,           97, static_cast<std::uint32_t>(kHorizon),
+                                       plan.n_typical, std::max<std::uint32_t>(1, plan.n_mean), plan.n_max};
   for (std::uint32_t n : opt.extra) {
     if (n == 0) throw std::invalid_argument("petc exectime: a multiplicity must be >= 1");
     wanted.push_back(n);
@@ -248,8 +253,16 @@ nlohmann::json run_exectime(const PetcSetup& setup, const ExectimeOptions& opt) 
     throw PilError("instruction counter: expected " + std::to_string(1 + plan.k.size()) + " windows, got " +
                    std::to_string(counts.size()));
   const std::uint64_t overhead = counts[0];
+  nlohmann::json by_n = nlohmann::json::object();
+  std::uint64_t most = 0;
+  std::uint32_t n_most = 0;
   for (std::size_t a = 0; a < rows.size(); ++a) {
     const std::uint64_t insns = counts[1 + a] - overhead;
+    by_n[std::to_string(rows[a]["N"].get<std::uint32_t>())] = insns;
+    if (insns >= most) {
+      most = insns;
+      n_most = rows[a]["N"].get<std::uint32_t>();
+    }
     rows[a]["instructions"] = insns;
     const auto macs = rows[a]["macs"].get<std::uint64_t>();
     rows[a]["instructions_per_mac"] = macs > 0 ? static_cast<double>(insns) / static_cast<double>(macs) : 0.0;
@@ -272,6 +285,10 @@ nlohmann::json run_exectime(const PetcSetup& setup, const ExectimeOptions& opt) 
                  "subtracted";
   j["marker_overhead_instructions"] = overhead;
   j["arrivals"] = arrivals;
+  j["instructions_by_N"] = by_n;  // per arrival, keyed by N ("0": the first arrival)
+  j["largest_N_measured"] = rows.empty() ? 0U : rows.back()["N"].get<std::uint32_t>();
+  j["instructions_max"] = most;
+  j["instructions_max_at_N"] = n_most;
   j["all_bit_identical_to_host_float"] = all_identical;
   j["node_bytes"] = node_bytes;
   const auto [flash, ram] = image_memory(link.image());

@@ -1,8 +1,8 @@
 /// @file petc_pil_test.cpp
 /// @brief The petc controller node on the Cortex-M4F image under QEMU: one NUMRE arrival per
-///        request, its instruction count (positive, growing with N, a stable multiple of the
-///        node's multiply-adds), the same arrival bit for bit on the host build of the node in
-///        float, and the image inside the MPS2's 64 KB of RAM.
+///        request, its instruction count (bounded whatever N: the span-table prediction), the
+///        same arrival bit for bit on the host build of the node in float, and the image
+///        inside the MPS2's 64 KB of RAM.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -21,38 +21,29 @@ const nlohmann::json& result() {
   return j;
 }
 
-TEST(PetcPil, ArrivalInstructionsGrowWithMultiplicity) {
+TEST(PetcPil, ArrivalInstructionsBoundedInMultiplicity) {
   const nlohmann::json& j = result();
   const auto& a = j.at("arrivals");
-  ASSERT_GE(a.size(), 4U);  // the first arrival (N = 0), N = 1, the median, the largest
+  ASSERT_GE(a.size(), 5U);  // the first arrival (N = 0), N = 1, 2, 97, 200
   EXPECT_EQ(a[0].at("N").get<std::uint32_t>(), 0U);
   EXPECT_EQ(a[1].at("N").get<std::uint32_t>(), 1U);
-  EXPECT_EQ(a.back().at("N").get<std::uint32_t>(), j.at("n_max").get<std::uint32_t>());
+  EXPECT_EQ(a.back().at("N").get<std::uint32_t>(), 200U);
+  const auto& by_n = j.at("instructions_by_N");
+  for (const char* n : {"0", "1", "2", "97", "200"}) ASSERT_TRUE(by_n.contains(n)) << n;
+  const auto insns = [&](const char* n) { return by_n.at(n).get<std::uint64_t>(); };
   for (std::size_t i = 0; i < a.size(); ++i) {
-    const auto insns = a[i].at("instructions").get<std::uint64_t>();
-    const auto macs = a[i].at("macs").get<std::uint64_t>();
-    EXPECT_GT(insns, 0U);
-    EXPECT_GT(macs, 0U);
+    EXPECT_GT(a[i].at("macs").get<std::uint64_t>(), 0U);
     EXPECT_TRUE(std::isfinite(a[i].at("instructions_per_mac").get<double>()));
-    if (i > 1) {
-      EXPECT_GT(a[i].at("N").get<std::uint32_t>(), a[i - 1].at("N").get<std::uint32_t>());
-      EXPECT_GT(insns, a[i - 1].at("instructions").get<std::uint64_t>()) << "arrival " << i;
-      EXPECT_GT(macs, a[i - 1].at("macs").get<std::uint64_t>());
-    }
   }
-  // Each predicted period runs the same code on the same dense multiply-adds (2n³ + n² + n):
-  // the instructions per multiply-add of the extra periods between the last two N equal
-  // those between N = 1 and the one before (a few instructions out of ~16,000 per period).
-  const auto d = [&](std::size_t hi, std::size_t lo, const char* f) {
-    return static_cast<double>(a[hi].at(f).get<std::uint64_t>()) - static_cast<double>(a[lo].at(f).get<std::uint64_t>());
-  };
-  const std::size_t last = a.size() - 1;
-  const std::size_t mid = last - 1;
-  ASSERT_GT(mid, 1U);
-  const double per_mac_low = d(mid, 1, "instructions") / d(mid, 1, "macs");
-  const double per_mac_high = d(last, mid, "instructions") / d(last, mid, "macs");
-  EXPECT_GT(per_mac_high, 1.0);  // an FPU multiply-add is at least one instruction plus loads
-  EXPECT_NEAR(per_mac_low / per_mac_high, 1.0, 1e-4) << per_mac_low << " vs " << per_mac_high;  // measured 4.6e-6
+  // The prediction is at most two spans of the table (base-15 digits of N < 225): every N
+  // costs at most the first arrival (no prediction) plus twice what N = 1 adds.
+  const std::uint64_t one_span = insns("1") - insns("0");
+  for (const auto& [n, v] : by_n.items()) EXPECT_LE(v.get<std::uint64_t>(), insns("0") + 2 * one_span) << "N = " << n;
+  // Counts are stable (straight-line code over the HDD structure, same data): measured
+  // 89,828 (N = 0), 97,370 (1 and 2: one span), 104,399 (97 and 200: two spans), with the
+  // arrival checks of issue 24. The issue's target is 60,000 (not reached: the 201-step
+  // cascade is ~440 per step).
+  EXPECT_LE(j.at("instructions_max").get<std::uint64_t>(), 106000U);
 }
 
 TEST(PetcPil, ArrivalBitIdenticalToHostFloat) {

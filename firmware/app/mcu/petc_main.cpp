@@ -1,7 +1,8 @@
 /// @file petc_main.cpp
 /// @brief The petc image (Cortex-M4F, single-precision float on the FPU): the PETC controller
-///        node of numre-petc.md behind the PIL link, one NUMRE arrival (N predictions, Joseph
-///        correction, cascade of H + 1 inputs, controller trigger) between the
+///        node of numre-petc.md behind the PIL link, one NUMRE arrival (prediction over N periods
+///        from the span table, Joseph correction, controller trigger, the cascade of H + 1
+///        inputs when it sends) between the
 ///        instruction-count markers per kPetcArrival (oneshot/app/petc_pil.hpp).
 #include <cstddef>
 #include <cstdint>
@@ -14,7 +15,7 @@
 #include "oneshot/mcu/rx_ring.hpp"
 
 #if !defined(ONESHOT_MCU_MPS2)
-#error "the petc image is built for the Cortex-M4F (MPS2 AN386) only: the node needs ~45 KB of RAM"
+#error "the petc image is built for the Cortex-M4F (MPS2 AN386) only: the node needs ~49 KB of RAM"
 #endif
 
 namespace soc = oneshot::mcu::mps2;
@@ -116,6 +117,7 @@ void handle(const pil::Frame& q, pil::Frame& r) {
     p.k_max = in.u(4);
     if (p.ratio == 0) return malformed(r);
     const pp::NodeArgs<float> a = pp::node_args(g_words, p);
+    if (!Node::fits(a.model)) return malformed(r);  // a nonzero outside HddStructure
     g_node = new (g_node_storage) Node(a.model, a.acc, a.law, node::ModelDisturbance<float>{}, a.trigger, a.reference);
     w.u(static_cast<std::uint32_t>(sizeof(Node)), 4);
     return;

@@ -99,5 +99,86 @@ TEST(PetcValidation, NonFiniteCorrectionResetsTheNumre) {
   EXPECT_EQ(est.covariance()(1, 1), 1.0);
 }
 
+TEST(PetcValidation, OverflowingCascadeWithheldPacketInForceRegenerated) {
+  // GIVEN an unstable model (a_11 = 10: ×10 per period over H = 200 periods) and a packet in
+  // force sent with r = 0.3 (finite: about 1e198 at its end)
+  using Petc200 = PetcController<double, 2, 200, Law, ModelDisturbance<double>>;
+  NumreModel<double, 2> m = model();
+  m.a(1, 1) = 10.0;
+  InterlacedConfig<double, 1, 2> c{};
+  c.feedthrough = 0.5;
+  c.ratio = 2;
+  Petc200 p(m, NoiseAccumulation::kSum, Law(c), ModelDisturbance<double>{}, MtmTrigger<double, 1>(0.01, 1e-4, 0, 0), 0.3);
+  EXPECT_EQ(p.on_arrival(0, 0.05), SendCause::kFirst);
+  static double before[Petc200::kEntries];
+  static double d_before[Petc200::kEntries];
+  for (std::size_t l = 0; l < Petc200::kEntries; ++l) {
+    before[l] = p.packet()[l];
+    d_before[l] = p.last_cascade_d_hat()[l];
+    ASSERT_TRUE(is_finite(before[l]));
+  }
+  static Vector<double, 2> ref_before[Petc200::kEntries + 1];
+  for (std::uint32_t j = 0; j <= Petc200::kEntries; ++j) ref_before[j] = p.reference_state(j);
+  // WHEN r = 1e150: u_0 ≈ 5e149 is finite and sent by the delta rule, but the cascade
+  // overflows part way through, after entries 0 … l were written into the packet in force
+  p.set_reference(1e150);
+  EXPECT_EQ(p.on_arrival(1, 0.05), SendCause::kNone);
+  // THEN the cascade is withheld and the packet in force is the one before, bit for bit
+  EXPECT_EQ(p.statistics().withheld, 1U);
+  EXPECT_EQ(p.packet_start(), 0U);
+  for (std::size_t l = 0; l < Petc200::kEntries; ++l) {
+    EXPECT_EQ(p.packet()[l], before[l]) << l;
+    EXPECT_EQ(p.last_cascade_d_hat()[l], d_before[l]) << l;
+  }
+  for (std::uint32_t j = 0; j <= Petc200::kEntries; ++j)
+    for (std::size_t i = 0; i < 2; ++i) EXPECT_EQ(p.reference_state(j)[i], ref_before[j][i]) << j;
+  EXPECT_TRUE(all_finite(p.estimator().state()));
+  // AND with r back to 0.3, the next arrival predicts one period along the regenerated packet
+  p.set_reference(0.3);
+  static_cast<void>(p.on_arrival(2, 0.05));
+  EXPECT_EQ(p.estimator().last_multiplicity(), 1U);
+  EXPECT_TRUE(all_finite(p.estimator().state()));
+}
+
+TEST(PetcValidation, OverflowingFirstCascadeLeavesNoPacket) {
+  // GIVEN the unstable model and r = 1e150 from the start (no packet in force yet)
+  using Petc200 = PetcController<double, 2, 200, Law, ModelDisturbance<double>>;
+  NumreModel<double, 2> m = model();
+  m.a(1, 1) = 10.0;
+  InterlacedConfig<double, 1, 2> c{};
+  c.feedthrough = 0.5;
+  c.ratio = 2;
+  Petc200 p(m, NoiseAccumulation::kSum, Law(c), ModelDisturbance<double>{}, MtmTrigger<double, 1>(0.01, 1e-4, 0, 0), 1e150);
+  // WHEN the first cascade overflows THEN nothing is sent, no packet is in force (all zero)
+  EXPECT_EQ(p.on_arrival(0, 0.05), SendCause::kNone);
+  EXPECT_EQ(p.statistics().withheld, 1U);
+  for (std::size_t l = 0; l < Petc200::kEntries; ++l) EXPECT_EQ(p.packet()[l], 0.0) << l;
+  EXPECT_EQ(p.applied(5), 0.0);
+  // AND a finite reference later gives the first packet (kFirst)
+  p.set_reference(0.3);
+  EXPECT_EQ(p.on_arrival(1, 0.05), SendCause::kFirst);
+}
+
+TEST(PetcValidation, ReacquiredArrivalPredictsNothingAndRebasesThePacket) {
+  // GIVEN no safety send (k_max = 0) and a constant measurement: the delta rule stays silent
+  InterlacedConfig<double, 1, 2> c{};
+  c.feedthrough = 0.5;
+  c.ratio = 2;
+  Petc p(model(), NoiseAccumulation::kSum, Law(c), ModelDisturbance<double>{}, MtmTrigger<double, 1>(0.01, 1e-4, 0, 0), 0.3);
+  for (std::uint32_t k = 1000; k < 1010; ++k) static_cast<void>(p.on_arrival(k, 0.05));
+  EXPECT_EQ(p.estimator().last_multiplicity(), 1U);
+  // WHEN the sensor restarts (periods from 0)
+  for (std::uint32_t k = 0; k + 1 < kDefaultReacquireFrames; ++k) EXPECT_EQ(p.on_arrival(k, 0.05), SendCause::kNone);
+  // THEN the re-acquiring arrival predicts nothing over the unknown interval and re-bases the
+  // packet in force (kFirst), so later arrivals predict one period, not 2^32 − 1000
+  EXPECT_EQ(p.on_arrival(kDefaultReacquireFrames - 1, 0.05), SendCause::kFirst);
+  EXPECT_EQ(p.estimator().last_multiplicity(), 0U);
+  EXPECT_EQ(p.packet_start(), kDefaultReacquireFrames - 1);
+  static_cast<void>(p.on_arrival(kDefaultReacquireFrames, 0.05));
+  EXPECT_EQ(p.estimator().last_multiplicity(), 1U);
+  EXPECT_EQ(p.statistics().reacquired, 1U);
+  EXPECT_TRUE(finite_state(p));
+}
+
 }  // namespace
 }  // namespace oneshot::node

@@ -30,7 +30,12 @@ TEST(PetcExectimeHost, MultiplicitiesComeFromTheStudy) {
   ASSERT_GE(plan.k.size(), 3U);
   EXPECT_EQ(plan.k[0], 0U);
   EXPECT_EQ(plan.k[1], 1U);
-  EXPECT_EQ(plan.k.back() - plan.k[plan.k.size() - 2], plan.n_max);
+  // N = 1, 2, 97 and H are always measured, beside the study's median, mean and largest.
+  std::vector<std::uint32_t> ns;
+  for (std::size_t a = 1; a < plan.k.size(); ++a) ns.push_back(plan.k[a] - plan.k[a - 1]);
+  for (std::uint32_t n : {1U, 2U, 97U, static_cast<std::uint32_t>(kHorizon), plan.n_max, plan.n_typical})
+    EXPECT_NE(std::find(ns.begin(), ns.end(), n), ns.end()) << n;
+  EXPECT_TRUE(std::is_sorted(ns.begin(), ns.end()));
   EXPECT_THROW(plan_arrivals(setup(), ExectimeOptions{"2", 1, {}, "", ""}), std::invalid_argument);
   EXPECT_THROW(plan_arrivals(setup(), ExectimeOptions{"4", 1, {400}, "", ""}), std::invalid_argument);
 }

@@ -14,7 +14,8 @@
 ///   kPetcArrival u32 k, u32 y (float bits)                   → u8 cause, u32 N, u32 multiply-adds
 ///                                                              of the arrival, 12 words x̂(k|k)
 ///   kPetcRead    u8 what (0: cascade inputs, 1: their d̂), u16 first entry
-///                                                            → up to 24 words of the last cascade
+///                                                            → up to 24 words of the packet in
+///                                                              force (the last sent cascade)
 #pragma once
 
 #include <cstddef>
@@ -35,9 +36,24 @@ inline constexpr std::size_t kHorizon = 200;  ///< H: packets of H + 1 inputs (t
 /// The MRCI law of the brief: 1 fast and 2 slow first-order modes.
 template <typename S>
 using Law = node::InterlacedController<S, 1, 2>;
-/// The node of cases 3–5: NUMRE on the augmented model, d̂ = C̄ x̂.
+/// Nonzero structure of the augmented HDD model as the design realizes it
+/// (lut_gen/plants/hdd_numre.json: 2nd-order sections as [position, velocity/ω], notches in
+/// series at the input, the disturbance entering through column 11; 56 of A's 144 entries,
+/// 72 in the closure of its powers). kPetcReset refuses a model outside it (Node::fits).
+struct HddStructure {
+  /// Row masks of A (bit j: A_ij may be nonzero).
+  static constexpr std::uint32_t kRows[kStates] = {0x803, 0x001, 0x80F, 0x004, 0x833, 0x833,
+                                                   0x8F3, 0x8F3, 0xBF3, 0xBF3, 0xC00, 0xC00};
+  /// Row mask i of A.
+  static constexpr std::uint32_t row(std::size_t i) { return kRows[i]; }
+  static constexpr std::uint32_t kB = 0x3F5;     ///< B: plant and notch rows.
+  static constexpr std::uint32_t kC = 0x100;     ///< C: the position state.
+  static constexpr std::uint32_t kCbar = 0x800;  ///< C̄: the disturbance output state.
+};
+
+/// The node of cases 3–5: NUMRE on the augmented model, d̂ = C̄ x̂, the HDD structure.
 template <typename S>
-using Node = node::PetcController<S, kStates, kHorizon, Law<S>, node::ModelDisturbance<S>>;
+using Node = node::PetcController<S, kStates, kHorizon, Law<S>, node::ModelDisturbance<S>, HddStructure>;
 
 /// Indices of the constants in the word block (raw IEEE single).
 enum Word : std::size_t {

@@ -60,8 +60,10 @@ class InterlacedController {
 
   /// u_k for the error e_k at absolute period k (periods must come in order, one by one).
   constexpr S step(std::uint64_t k, S e) {
-    const std::uint64_t m = cfg_.ratio;
-    if (k % m == 0) e_sample_ = e;
+    // k mod m once, in 32 bits when k fits (no 64-bit division on a 32-bit core).
+    const std::uint32_t phase = k <= 0xFFFFFFFFU ? static_cast<std::uint32_t>(k) % cfg_.ratio
+                                                 : static_cast<std::uint32_t>(k % cfg_.ratio);
+    if (phase == 0) e_sample_ = e;
     S u = cfg_.feedthrough * e;
     for (std::size_t f = 0; f < kFast; ++f) {
       u = u + cfg_.fast[f].residue * xf_[f];
@@ -69,7 +71,7 @@ class InterlacedController {
     }
     macs_ += 1 + 2 * kFast;
     for (std::size_t i = 0; i < kSlow; ++i) {
-      if (k % m == i % m) {
+      if (phase == i % cfg_.ratio) {
         out_[i] = cfg_.slow[i].residue * xs_[i];
         xs_[i] = pole_m_[i] * xs_[i] + input_gain_[i] * (cfg_.sample_at_update ? e : e_sample_);
         macs_ += 3;
@@ -77,6 +79,37 @@ class InterlacedController {
       u = u + out_[i];
     }
     return u;
+  }
+
+  /// Everything step() changes (a node stores this per packet entry, not the constants).
+  struct Modes {
+    S xf[kFast]{};             ///< Fast mode states.
+    S xs[kSlow]{};             ///< Slow mode states.
+    S out[kSlow]{};            ///< Held slow outputs.
+    S e_sample = S(0);         ///< Sampled error.
+    std::uint64_t macs = 0;    ///< Multiply-add counter.
+  };
+  /// The mode states.
+  constexpr Modes modes() const {
+    Modes m;
+    for (std::size_t f = 0; f < kFast; ++f) m.xf[f] = xf_[f];
+    for (std::size_t i = 0; i < kSlow; ++i) {
+      m.xs[i] = xs_[i];
+      m.out[i] = out_[i];
+    }
+    m.e_sample = e_sample_;
+    m.macs = macs_;
+    return m;
+  }
+  /// Restores mode states saved by modes() (same configuration).
+  constexpr void set_modes(const Modes& m) {
+    for (std::size_t f = 0; f < kFast; ++f) xf_[f] = m.xf[f];
+    for (std::size_t i = 0; i < kSlow; ++i) {
+      xs_[i] = m.xs[i];
+      out_[i] = m.out[i];
+    }
+    e_sample_ = m.e_sample;
+    macs_ = m.macs;
   }
 
   /// Slow mode i's held output.

@@ -2,17 +2,24 @@
 /// @brief Non-uniform multi-rate estimator (NUMRE, numre-petc.md §4): a Kalman filter that
 ///        runs only when a measurement arrives, N = k − k_prev periods after the previous one.
 ///
-/// Between arrivals the node propagates one period at a time with the inputs actually
-/// applied (the same result as tabulating A^N, and no table):
+/// predict(u) propagates one period at a time with the inputs actually applied (the
+/// step-by-step form, kept as the reference the tests compare with):
 ///     x̂ ← A x̂ + B u_j,   P ← A P Aᵀ + B_w W B_wᵀ          (j = k − N … k − 1)
 /// so after N steps x̂ = x̂(k|k−N) and P = A^N P (A^N)ᵀ + W_e(N),
 ///     W_e(N) = Σ_{c=0}^{N−1} A^c B_w W B_wᵀ (A^c)ᵀ            (the brief's correction).
 /// The printed eq. 13 (w frozen over the interval) is kept as a switch: P ← A P Aᵀ per step
 /// and G ← A G + B_w, then M = P + G W Gᵀ with G = Σ A^c B_w.
-/// On arrival (one output, p = 1), Joseph form:
-///     S = C M Cᵀ + V,  K = M Cᵀ / S,  x̂ ← x̂ + K (y − C x̂),
-///     P = (I − K C) M (I − K C)ᵀ + K V Kᵀ.
-/// Multiply-adds are counted as executed (dense), for the study's cost figures.
+/// predict_along(N, …) does the same N periods at once from the span table (numre_span_table.hpp,
+/// A^j and W_e(j) for j = d·15^p): P ← A^j P (A^j)ᵀ + W_e(j) for each base-15 digit of N (at
+/// most 2 for N < 225), and x̂ from a model trajectory x_r under the same applied inputs:
+///     x̂(k|k−N) = x_r(k) + A^N (x̂(k−N|k−N) − x_r(k−N))
+/// (the inputs cancel in the difference), so its cost does not grow with N.
+/// On arrival (one output, p = 1), Joseph form expanded for the scalar output (O(n²), exact
+/// for any gain K):
+///     m = M Cᵀ,  S = C m + V,  K = m / S,  x̂ ← x̂ + K (y − C x̂),
+///     P = (I − K C) M (I − K C)ᵀ + K V Kᵀ = M − K mᵀ − m Kᵀ + S K Kᵀ.
+/// Multiply-adds are counted as executed (exact zeros of A^j and C skipped), for the
+/// study's cost figures.
 /// The estimate never stays non-finite: a correction that leaves x̂ or P NaN or ±∞ resets
 /// them to the initial values (reset(); x̂ = 0, P = 0 at construction) and reports
 /// Status::kNonFinite.
@@ -23,6 +30,8 @@
 
 #include "oneshot/finite.hpp"
 #include "oneshot/matrix.hpp"
+#include "oneshot/node/numre_span_table.hpp"
+#include "oneshot/node/numre_structure.hpp"
 #include "oneshot/status.hpp"
 
 namespace oneshot::node {
@@ -45,17 +54,68 @@ enum class NoiseAccumulation : std::uint8_t {
   kFrozen,  ///< Printed eq. 13: (Σ A^c B_w) W (Σ A^c B_w)ᵀ (w held over the interval).
 };
 
-/// The NUMRE filter (single input, single output, one noise input).
+/// Q = B_w W B_wᵀ of a model.
 template <typename S, std::size_t N>
+constexpr Matrix<S, N, N> numre_process_noise(const NumreModel<S, N>& m) {
+  Matrix<S, N, N> q;
+  for (std::size_t i = 0; i < N; ++i)
+    for (std::size_t j = 0; j < N; ++j) q(i, j) = m.b_w[i] * m.w * m.b_w[j];
+  return q;
+}
+
+/// The NUMRE filter (single input, single output, one noise input) on a model that fits
+/// `Structure` (numre_structure.hpp; the default assumes nothing).
+template <typename S, std::size_t N, typename Structure = DenseModelStructure<N>>
 class NumreEstimator {
  public:
   using State = Vector<S, N>;        ///< x̂.
   using Covariance = Matrix<S, N, N>;  ///< P.
+  using Spans = NumreSpanTable<S, N, 15, 2>;  ///< j = d·15^p: N < 225 in at most 2 spans.
+  using Powers = ClosureStructure<Structure, N>;  ///< Where A^j may be nonzero.
+
+  /// True when `model` fits Structure (the filter must not be used otherwise).
+  static constexpr bool fits(const NumreModel<S, N>& model) {
+    return fits_structure<Structure>(model.a, model.b, model.c, model.c_bar);
+  }
 
   /// Filter on `model` (copied) with the noise accumulation `acc`; x̂ = 0, P = 0.
-  constexpr NumreEstimator(const NumreModel<S, N>& model, NoiseAccumulation acc) : m_(model), acc_(acc) {
-    for (std::size_t i = 0; i < N; ++i)
-      for (std::size_t j = 0; j < N; ++j) q_(i, j) = m_.b_w[i] * m_.w * m_.b_w[j];
+  constexpr NumreEstimator(const NumreModel<S, N>& model, NoiseAccumulation acc)
+      : m_(model), acc_(acc), q_(numre_process_noise(model)), spans_(m_.a, m_.b, m_.b_w, q_) {}
+
+  /// N periods at once from the span table: x̂ ← x_r(k) + A^N (x̂ − x_r(k − N)) for a model
+  /// trajectory x_r under the applied inputs (`ref_then` at k − N, `ref_now` at k), and
+  /// P ← A^N P (A^N)ᵀ + W_e(N) (kFrozen: P ← A^N P (A^N)ᵀ, G ← A^N G + G(N)).
+  constexpr void predict_along(std::uint32_t n, const State& ref_then, const State& ref_now) {
+    State d = x_ - ref_then;
+    spans_.for_each_span(n, [&](const typename Spans::Span& sp) {
+      State t;
+      macs_ += masked_product<Powers>(sp.a, d, t);
+      d = t;
+      macs_ += masked_sandwich<Powers>(sp.a, p_);
+      if (acc_ == NoiseAccumulation::kSum) {
+        std::size_t q = 0;
+        for (std::size_t i = 0; i < N; ++i)
+          for (std::size_t c = i; c < N; ++c) {
+            const S v = p_(i, c) + sp.w[q++];
+            p_(i, c) = v;
+            p_(c, i) = v;
+          }
+      } else {
+        macs_ += masked_product<Powers>(sp.a, g_, t);
+        g_ = t + sp.g;
+      }
+    });
+    x_ = ref_now + d;
+    steps_ += n;
+  }
+
+  /// x ← A^n x + Γ(n) u: the model n periods on with u held (span table).
+  constexpr void advance(std::uint32_t n, State& x, S u) {
+    spans_.for_each_span(n, [&](const typename Spans::Span& sp) {
+      State t;
+      macs_ += masked_product<Powers>(sp.a, x, t) + N;
+      x = t + sp.gamma * u;
+    });
   }
 
   /// Sets x̂ and P (the last arrival's values; also what a non-finite result resets to).
@@ -92,10 +152,13 @@ class NumreEstimator {
       macs_ += N * N;
       g_ = State{};
     }
-    const State mct = p_ * m_.c.transposed();
-    S s = m_.v;
-    for (std::size_t i = 0; i < N; ++i) s = s + m_.c[i] * mct[i];
-    macs_ += N * N + N;
+    State mct;  // m = M Cᵀ over C's nonzeros
+    Unrolled<0, N>::run([&](auto ic) {
+      constexpr std::size_t i = decltype(ic)::value;
+      mct[i] = masked_dot<Structure::kC>(m_.c, row_of(p_, i));
+    });
+    const S s = m_.v + masked_dot<Structure::kC>(m_.c, mct);
+    macs_ += (N + 1) * mask_count(Structure::kC);
     last_multiplicity_ = steps_;
     steps_ = 0;
     if (!(s > S(0))) {
@@ -103,15 +166,23 @@ class NumreEstimator {
       return is_finite(s) ? Status::kSingular : reset_non_finite();
     }
     k_ = mct * (S(1) / s);
-    S innovation = y;
-    for (std::size_t i = 0; i < N; ++i) innovation = innovation - m_.c[i] * x_[i];
+    const S innovation = y - masked_dot<Structure::kC>(m_.c, x_);
     x_ = x_ + k_ * innovation;
-    Covariance ikc = Covariance::identity() - k_ * m_.c;
-    p_ = (ikc * p_) * ikc.transposed();
+    // Joseph form expanded: P = M − K mᵀ − m Kᵀ + S K Kᵀ (upper triangle, mirrored).
+    // Finiteness: the sum of the new values is non-finite when any is (NaN and ±∞ are
+    // absorbing under +; ∞ − ∞ = NaN), one addition per value instead of a bit test; it
+    // also resets if the sum alone overflows (|entries| near the largest finite value).
+    S sum = innovation;
     for (std::size_t i = 0; i < N; ++i)
-      for (std::size_t j = 0; j < N; ++j) p_(i, j) = p_(i, j) + k_[i] * m_.v * k_[j];
-    macs_ += 3 * N + N * N + 2 * N * N * N + 2 * N * N;
-    return all_finite(x_) && all_finite(p_) ? Status::kOk : reset_non_finite();
+      for (std::size_t j = i; j < N; ++j) {
+        const S v = p_(i, j) - k_[i] * mct[j] - mct[i] * k_[j] + s * k_[i] * k_[j];
+        p_(i, j) = v;
+        p_(j, i) = v;
+        sum = sum + v;
+      }
+    for (std::size_t i = 0; i < N; ++i) sum = sum + x_[i];
+    macs_ += 2 * N + mask_count(Structure::kC) + 4 * (N * (N + 1) / 2);
+    return is_finite(sum) ? Status::kOk : reset_non_finite();
   }
 
   /// x̂ (x̂(k|k) after correct(), the prediction before).
@@ -139,8 +210,16 @@ class NumreEstimator {
   NumreModel<S, N> m_;
   NoiseAccumulation acc_;
   Covariance q_{};
+  Spans spans_;
   State x0_{};
   Covariance p0_{};
+
+  /// Row i of P as a vector.
+  static constexpr State row_of(const Covariance& p, std::size_t i) {
+    State r;
+    for (std::size_t j = 0; j < N; ++j) r[j] = p(i, j);
+    return r;
+  }
   State x_{};
   Covariance p_{};
   State g_{};
