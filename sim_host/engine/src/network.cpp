@@ -37,11 +37,12 @@ void Network::set_faults(const FaultSpec& spec) {
 }
 
 void Network::arm_faults(const std::map<std::string, std::function<void()>>& restart_hooks) {
-  std::vector<std::string> links;
   std::vector<std::string> nodes;
-  for (const auto& l : links_) links.push_back(l->config().name);
   for (const auto& [name, hook] : restart_hooks) nodes.push_back(name);
-  check_fault_targets(faults_, links, nodes);
+  FaultSpec restarts;
+  for (const FaultClause& c : faults_.clauses)
+    if (!is_frame_fault(c.kind)) restarts.clauses.push_back(c);
+  check_fault_targets(restarts, {}, nodes);
   for (const auto& [name, hook] : restart_hooks) {
     const std::vector<SimTime> at = restart_instants(faults_, name);
     if (at.empty()) continue;

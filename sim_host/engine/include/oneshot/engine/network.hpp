@@ -68,8 +68,10 @@ class Network {
 
   /// Faults of `spec` on the links added from now on (std::logic_error after the first link).
   void set_faults(const FaultSpec& spec);
-  /// Checks the spec's link and node names (InputError) and schedules every restart at its
-  /// instant (class kEnvironment) through the hook of its node (`restart_hooks` by name).
+  /// Checks the spec's node names (InputError) and schedules every restart at its instant
+  /// (class kEnvironment) through the hook of its node (`restart_hooks` by name). Link names
+  /// are the study's to check (check_fault_targets() over every link it may build: a
+  /// clause for a link this loop lacks does nothing here).
   void arm_faults(const std::map<std::string, std::function<void()>>& restart_hooks);
   /// Faults injected so far (every link, and the restarts).
   FaultCounters fault_counters() const;
