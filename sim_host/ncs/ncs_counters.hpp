@@ -1,6 +1,6 @@
 /// @file ncs_counters.hpp
 /// @brief The node counters a run of study `ncs` reports (engine and live): refusals and
-///        drops per node, by name ("sensor.stale", …), in a fixed order per loop kind.
+///        drops per node, by name ("sensor.stale", …), in a fixed order per node.
 ///
 /// The one place that reads the nodes' statistics for the fault table and the live
 /// summary: when the nodes get more causes (non-finite, out of range, unexpected source,
@@ -12,34 +12,45 @@
 
 namespace oneshot::ncs {
 
-/// Counter names of the actuation-synchronized loops (A, AK, AKx, AKl).
-inline const std::vector<std::string>& sync_counter_names() {
-  static const std::vector<std::string> names = {
-      "sensor.malformed",   "sensor.stale",    "controller.malformed", "controller.stale",
-      "controller.faults",  "actuator.malformed", "actuator.stale",    "actuator.late"};
-  return names;
+/// Counter names of the synchronized sensor.
+inline std::vector<std::string> sync_sensor_counter_names() { return {"sensor.malformed", "sensor.stale"}; }
+/// Their values, in that order.
+template <typename Sensor>
+std::vector<double> sync_sensor_counters(const Sensor& s) {
+  return {double(s.statistics().malformed), double(s.statistics().stale)};
 }
 
-/// Counter values of a synchronized loop's nodes, in sync_counter_names() order.
-template <typename Sensor, typename Controller, typename Actuator>
-std::vector<double> sync_counters(const Sensor& s, const Controller& c, const Actuator& a) {
-  return {double(s.statistics().malformed), double(s.statistics().stale),    double(c.statistics().malformed),
-          double(c.statistics().stale),     double(c.statistics().faults),   double(a.statistics().malformed),
-          double(a.statistics().stale),     double(a.statistics().late)};
+/// Counter names of the synchronized controller.
+inline std::vector<std::string> sync_controller_counter_names() {
+  return {"controller.malformed", "controller.stale", "controller.faults"};
+}
+/// Their values, in that order.
+template <typename Controller>
+std::vector<double> sync_controller_counters(const Controller& c) {
+  return {double(c.statistics().malformed), double(c.statistics().stale), double(c.statistics().faults)};
 }
 
-/// Counter names of the sampling-synchronized loops (I, S, SK, S+, IK).
-inline const std::vector<std::string>& sampling_counter_names() {
-  static const std::vector<std::string> names = {"controller.malformed", "controller.stale", "actuator.malformed",
-                                                 "actuator.stale"};
-  return names;
+/// Counter names of an actuator (synchronized or not).
+inline std::vector<std::string> actuator_counter_names() { return {"actuator.malformed", "actuator.stale", "actuator.late"}; }
+/// Their values, in that order.
+template <typename Actuator>
+std::vector<double> actuator_counters(const Actuator& a) {
+  return {double(a.statistics().malformed), double(a.statistics().stale), double(a.statistics().late)};
 }
 
-/// Counter values of a sampling loop's nodes, in sampling_counter_names() order.
-template <typename Controller, typename Actuator>
-std::vector<double> sampling_counters(const Controller& c, const Actuator& a) {
-  return {double(c.statistics().malformed), double(c.statistics().stale), double(a.statistics().malformed),
-          double(a.statistics().stale)};
+/// Counter names of a sampling loop's controller.
+inline std::vector<std::string> sampling_controller_counter_names() { return {"controller.malformed", "controller.stale"}; }
+/// Their values, in that order.
+template <typename Controller>
+std::vector<double> sampling_controller_counters(const Controller& c) {
+  return {double(c.statistics().malformed), double(c.statistics().stale)};
+}
+
+/// a followed by b.
+template <typename T>
+std::vector<T> concat(std::vector<T> a, const std::vector<T>& b) {
+  a.insert(a.end(), b.begin(), b.end());
+  return a;
 }
 
 }  // namespace oneshot::ncs

@@ -229,7 +229,7 @@ RunResult run_synchronized(Harness& hs, Estimator est, std::int32_t late_us) {
   r.late = act->statistics().late;
   r.saturated = ctrl->statistics().saturated;
   r.faults = ctrl->statistics().faults;
-  r.counters = sync_counters(*sensor, *ctrl, *act);
+  r.counters = concat(concat(sync_sensor_counters(*sensor), sync_controller_counters(*ctrl)), actuator_counters(*act));
   return r;
 }
 
@@ -278,7 +278,7 @@ RunResult run_sampling(Harness& hs, Law law, Saturated saturated) {
   k.schedule(SimTime{0}, EventClass::kSample, *timer_h, 0);
   RunResult r = hs.finish();
   r.saturated = saturated(ctrl->law());
-  r.counters = sampling_counters(*ctrl, *act);
+  r.counters = concat(sampling_controller_counters(*ctrl), actuator_counters(*act));
   return r;
 }
 
@@ -345,8 +345,11 @@ std::array<double, 3> measurement_cholesky(const Design& d) {
   return c;
 }
 
-const std::vector<std::string>& counter_names(Approach a) {
-  return actuation_synchronized(a) ? sync_counter_names() : sampling_counter_names();
+std::vector<std::string> counter_names(Approach a) {
+  if (actuation_synchronized(a)) {
+    return concat(concat(sync_sensor_counter_names(), sync_controller_counter_names()), actuator_counter_names());
+  }
+  return concat(sampling_controller_counter_names(), actuator_counter_names());
 }
 
 std::vector<std::string> link_names(Approach a) {

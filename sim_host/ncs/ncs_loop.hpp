@@ -71,7 +71,7 @@ engine::LinkConfig leg(const Context& ctx, const Scenario& sc, Approach a, const
 std::array<double, 3> measurement_cholesky(const Design& d);
 
 /// Names of the node counters of approach `a` (RunResult::counters).
-const std::vector<std::string>& counter_names(Approach a);
+std::vector<std::string> counter_names(Approach a);
 /// Names of the links ("as", "sc", "ca"; "sc", "ca" for the sampling loops) and of the
 /// restartable nodes of approach `a`, for checking a fault spec.
 std::vector<std::string> link_names(Approach a);

@@ -10,6 +10,7 @@
 #include <sstream>
 
 #include "ncs_experiments.hpp"
+#include "ncs_faults.hpp"
 #include "ncs_live.hpp"
 #include "oneshot/engine/sweep_registry.hpp"
 #include "oneshot/sim/cli_commands.hpp"
@@ -190,6 +191,7 @@ void register_ncs_study(CLI::App& app) {
     });
   }
   add_ncs_live_commands(study);
+  add_ncs_faults_command(study);
   engine::register_summarizer("ncs", "table", [](const engine::SweepResults& r, const std::string& out, bool plots) {
     return ncs::table_outputs(r, out, plots);
   });
