@@ -64,7 +64,10 @@ LiveRun live_run_from_json(const nlohmann::json& j, const std::string& source) {
     r.scenario = parse_scenarios(scen.dump(), source).at(0);
     r.seed = static_cast<std::uint64_t>(engine::integer_in(j, "run", "seed", 0, std::int64_t{1} << 62));
     r.noise_free = engine::boolean_of(j, "run", "noise_free", false);
-    r.inject = j.contains("inject") ? engine::string_of(j, "run", "inject") : std::string();
+    if (j.contains("inject")) {
+      if (!j.at("inject").is_string()) throw InputError("field 'run.inject': must be a string (empty: no faults)");
+      r.inject = j.at("inject").get<std::string>();
+    }
     engine::check_fault_targets(engine::parse_fault_spec(r.inject), link_names(r.approach), node_names());
     r.t0_ns = engine::integer_in(j, "run", "t0_ns", 0, std::int64_t{1} << 62);
     const nlohmann::json& p = engine::member(j, "run", "ports");

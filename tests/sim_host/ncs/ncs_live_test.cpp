@@ -2,7 +2,9 @@
 /// @brief Live part of study `ncs`: the POSIX UDP port round-trips frames and drives the
 ///        firmware's sensor node; a short five-process run leaves consistent logs, its relay
 ///        applied the engine's delay draws, and its replay reproduces the live cost (and
-///        moves when a recorded noise draw is changed). No assertion on real-time figures.
+///        moves when a recorded noise draw is changed); a faulted run (--inject) completes,
+///        records its injected frames and restarts, and its replay reproduces it. No
+///        assertion on real-time figures.
 #include <gtest/gtest.h>
 #include <sys/socket.h>
 #include <unistd.h>
@@ -215,6 +217,40 @@ TEST(NcsLive, ShortRunLogsAreConsistentAndItsReplayReproducesTheCost) {
   const ReplayResult changed = replay_live(o.out_dir);
   EXPECT_GT(std::fabs(changed.cost / live - 1), 1e-9);
   EXPECT_GT(changed.max_abs_u_difference, 0.0);
+  std::filesystem::remove_all(o.out_dir);
+}
+
+/// A faulted live run: duplicates, bit flips, replays and restarts of two nodes. The run
+/// completes, the relay's injected frames and the restarts are counted, and the replay
+/// (recorded injected bytes, recorded restarts) gives the live cost again.
+TEST(NcsLive, FaultedRunCompletesAndItsReplayReproducesIt) {
+  LiveOptions o;
+  o.approach = Approach::kAK;
+  o.scenario = default_scenarios()[1];
+  o.scenario.duration_s = 2;
+  o.seed = 3;
+  o.inject = "dup:rate=0.1;flip:link=ca,rate=0.05;replay:link=sc,rate=0.1;restart:node=actuator,at_s=1;"
+             "restart:node=controller,at_s=1.5";
+  o.out_dir = test::fresh_dir("ncs_live", "faults");
+  o.executable = ONESHOT_SIM_PATH;
+  const nlohmann::json j = run_live(o);
+  EXPECT_EQ(j.at("inject").get<std::string>(), o.inject);
+  const auto& injected = j.at("faults_injected");
+  EXPECT_GT(injected.at("dup").get<double>(), 0);
+  EXPECT_GT(injected.at("replay").get<double>(), 0);
+  const auto& counters = j.at("node_counters");
+  EXPECT_EQ(counters.at("actuator.restarts").get<double>(), 1);
+  EXPECT_EQ(counters.at("controller.restarts").get<double>(), 1);
+  EXPECT_EQ(counters.at("sensor.restarts").get<double>(), 0);
+  EXPECT_GT(counters.at("sensor.stale").get<double>(), 0);  // duplicated requests
+  std::size_t inject_records = 0;
+  for (const auto& r : read_log(o.out_dir, "relay")) inject_records += r.event == "inject" ? 1u : 0u;
+  EXPECT_GE(inject_records, static_cast<std::size_t>(injected.at("dup").get<double>()));
+  EXPECT_TRUE(std::filesystem::exists(o.out_dir + "/injected.csv"));
+  EXPECT_EQ(j.at("replay_missing_frames").get<unsigned>(), 0u);
+  EXPECT_EQ(j.at("replay_max_abs_u_difference").get<double>(), 0.0);
+  EXPECT_NEAR(j.at("replay_over_live").get<double>(), 1.0, 1e-12);
+  EXPECT_TRUE(std::isfinite(j.at("simulated_cost").get<double>()));
   std::filesystem::remove_all(o.out_dir);
 }
 
