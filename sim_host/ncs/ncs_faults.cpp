@@ -158,7 +158,8 @@ nlohmann::json fault_table(const Context& ctx, const FaultTableOptions& o) {
         live = fmt("%.3g", ratio_live);
       } catch (const std::exception& ex) {
         e["live"] = {{"dir", lo.out_dir}, {"failed", ex.what()}};
-        live = "failed";
+        const bool non_finite_live = std::string(ex.what()).find("not a finite number") != std::string::npos;
+        live = non_finite_live ? "failed: non-finite cost" : "failed (see JSON)";
       }
     }
     md << "| " << cases[c].name << " | `" << cases[c].spec << "` | " << cases[c].node << " | " << what << " | "
