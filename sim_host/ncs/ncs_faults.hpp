@@ -49,12 +49,3 @@ struct FaultTableOptions {
 nlohmann::json fault_table(const Context& ctx, const FaultTableOptions& o);
 
 }  // namespace oneshot::ncs
-
-namespace CLI {
-class App;
-}  // namespace CLI
-
-namespace oneshot::sim {
-/// Registers `ncs faults` under the study command.
-void add_ncs_faults_command(CLI::App* study);
-}  // namespace oneshot::sim

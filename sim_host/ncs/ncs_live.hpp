@@ -119,4 +119,6 @@ class App;
 namespace oneshot::sim {
 /// Registers `ncs live`, `ncs replay` and the hidden `ncs node` under the study command.
 void add_ncs_live_commands(CLI::App* study);
+/// Registers `ncs faults` (ncs_faults.hpp) under the study command.
+void add_ncs_faults_command(CLI::App* study);
 }  // namespace oneshot::sim
