@@ -118,7 +118,8 @@ nlohmann::json fault_table(const Context& ctx, const FaultTableOptions& o) {
     const sim::Summary rs = sim::summarize(ratio);
     nlohmann::json e = {{"name", cases[c].name}, {"node", cases[c].node}, {"spec", cases[c].spec},
                         {"non_finite_runs", non_finite}, {"injected_per_run", mean_of(a, 1)}};
-    e["cost_ratio"] = ratio.empty() ? nlohmann::json(nullptr) : nlohmann::json({{"mean", rs.mean}, {"ci95", rs.ci95}, {"n", rs.n}});
+    e["cost_ratio"] = nullptr;
+    if (!ratio.empty()) e["cost_ratio"] = {{"mean", rs.mean}, {"ci95", rs.ci95}, {"n", rs.n}};
     std::string counter_text;
     for (std::size_t m = 0; m < counters.size(); ++m) {
       const double faulted = mean_of(a, m + 2);

@@ -53,7 +53,8 @@ nlohmann::json to_json(const LiveRun& r) {
 LiveRun live_run_from_json(const nlohmann::json& j, const std::string& source) {
   using engine::InputError;
   try {
-    engine::require_keys(j, "run", {"dir", "plant_file", "approach", "scenario", "seed", "noise_free", "inject", "t0_ns", "ports"});
+    engine::require_keys(j, "run",
+                         {"dir", "plant_file", "approach", "scenario", "seed", "noise_free", "inject", "t0_ns", "ports"});
     LiveRun r;
     r.dir = engine::string_of(j, "run", "dir");
     const nlohmann::json& pf = engine::member(j, "run", "plant_file");
@@ -230,7 +231,8 @@ nlohmann::json analyse_live(const std::string& dir) {
   RunOptions sim_options;
   sim_options.noise_free = run.noise_free;
   sim_options.faults = engine::parse_fault_spec(run.inject);
-  j["simulated_cost"] = ncs::run(*ctx, run.approach, run.scenario, run.seed, sim_options).cost;  // the engine alone, same seed and faults
+  // The engine alone, same seed and faults.
+  j["simulated_cost"] = ncs::run(*ctx, run.approach, run.scenario, run.seed, sim_options).cost;
   return j;
 }
 

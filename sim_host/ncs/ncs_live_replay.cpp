@@ -88,7 +88,9 @@ std::vector<std::vector<std::uint8_t>> read_injected(const std::string& dir) {
   std::string line;
   while (std::getline(in, line)) {
     std::vector<std::uint8_t> b;
-    for (std::size_t i = 0; i + 1 < line.size(); i += 2) b.push_back(static_cast<std::uint8_t>(std::stoul(line.substr(i, 2), nullptr, 16)));
+    for (std::size_t i = 0; i + 1 < line.size(); i += 2) {
+      b.push_back(static_cast<std::uint8_t>(std::stoul(line.substr(i, 2), nullptr, 16)));
+    }
     out.push_back(std::move(b));
   }
   return out;
@@ -149,7 +151,10 @@ ReplayResult replay_live(const std::string& dir, bool ideal_instants) {
       if (v.restart) {
         if (v.node == kLiveSensor) sensor.emplace(kLiveController, late_us);
         if (v.node == kLiveController) ctrl.emplace(kLiveActuator, design.l, u_min, u_max, est, ref);
-        if (v.node == kLiveActuator) act.emplace(kLiveSensor, InputVec{}), fresh = true;
+        if (v.node == kLiveActuator) {
+          act.emplace(kLiveSensor, InputVec{});
+          fresh = true;
+        }
         return;
       }
       for (const auto& [src, k] : v.frames) {

@@ -71,7 +71,8 @@ void drain(int fd) {
 }
 
 /// DIR/counters_<role>.json: {name: value}.
-void write_counters(const LiveRun& r, const char* role, const std::vector<std::string>& names, const std::vector<double>& values) {
+void write_counters(const LiveRun& r, const char* role, const std::vector<std::string>& names,
+                    const std::vector<double>& values) {
   nlohmann::json j = nlohmann::json::object();
   for (std::size_t i = 0; i < names.size() && i < values.size(); ++i) j[names[i]] = values[i];
   std::ofstream(r.dir + "/counters_" + role + ".json") << j.dump(1) << "\n";
@@ -345,7 +346,8 @@ int run_actuator(const LiveRun& r, const std::shared_ptr<const Context>& ctx, in
   }
   const auto& s = act->statistics();
   log.write("stats", c.now(), 0, 0, 0, 0, s.late, act->refused());
-  write_counters(r, "actuator", concat(actuator_counter_names(), {"actuator.restarts"}), concat(actuator_counters(*act), {restarted}));
+  write_counters(r, "actuator", concat(actuator_counter_names(), {"actuator.restarts"}),
+                 concat(actuator_counters(*act), {restarted}));
   return 0;
 }
 

@@ -202,9 +202,21 @@ RunResult run_synchronized(Harness& hs, Estimator est, std::int32_t late_us) {
   net.route(kActuator, kSensor, net.add_link(hs.leg("as")));
   net.route(kSensor, kController, net.add_link(hs.leg("sc")));
   net.route(kController, kActuator, net.add_link(hs.leg("ca")));
-  net.arm_faults({{"sensor", [&]() { sensor.emplace(kController, late_us), hs.lose_inbox(kSensor); }},
-                  {"controller", [&]() { ctrl.emplace(kActuator, l, hs.u_min_, hs.u_max_, est, hs.ref_), hs.lose_inbox(kController); }},
-                  {"actuator", [&]() { act.emplace(kSensor, InputVec{}), hs.lose_inbox(kActuator), act_restarted = true; }}});
+  net.arm_faults({{"sensor",
+                   [&]() {
+                     sensor.emplace(kController, late_us);
+                     hs.lose_inbox(kSensor);
+                   }},
+                  {"controller",
+                   [&]() {
+                     ctrl.emplace(kActuator, l, hs.u_min_, hs.u_max_, est, hs.ref_);
+                     hs.lose_inbox(kController);
+                   }},
+                  {"actuator", [&]() {
+                     act.emplace(kSensor, InputVec{});
+                     hs.lose_inbox(kActuator);
+                     act_restarted = true;
+                   }}});
   auto timer_h = std::make_shared<HandlerId>(0);
   *timer_h = k.add_handler("actuation", [&, timer_h](std::uint64_t n) {
     if (act_restarted) {  // the restarted actuator's first timer is its k = 0
@@ -260,9 +272,20 @@ RunResult run_sampling(Harness& hs, Law law, Saturated saturated) {
   });
   net.route(kSensor, kController, net.add_link(hs.leg("sc")));
   net.route(kController, kActuator, net.add_link(hs.leg("ca")));
-  net.arm_faults({{"sensor", [&]() { sensor.emplace(kController, Trigger(1)), sensor_restarted = true; }},
-                  {"controller", [&]() { ctrl.emplace(kActuator, node::ControllerMode::kOnArrival, law), hs.lose_inbox(kController); }},
-                  {"actuator", [&]() { act.emplace(node::ActuatorMode::kOnArrival, InputVec{}), hs.lose_inbox(kActuator); }}});
+  net.arm_faults({{"sensor",
+                   [&]() {
+                     sensor.emplace(kController, Trigger(1));
+                     sensor_restarted = true;
+                   }},
+                  {"controller",
+                   [&]() {
+                     ctrl.emplace(kActuator, node::ControllerMode::kOnArrival, law);
+                     hs.lose_inbox(kController);
+                   }},
+                  {"actuator", [&]() {
+                     act.emplace(node::ActuatorMode::kOnArrival, InputVec{});
+                     hs.lose_inbox(kActuator);
+                   }}});
   auto timer_h = std::make_shared<HandlerId>(0);
   *timer_h = k.add_handler("sample", [&, timer_h](std::uint64_t n) {
     if (sensor_restarted) {

@@ -125,7 +125,9 @@ void Network::run_node(std::uint8_t address, const std::function<void()>& f) {
       const std::uint8_t src = frame.source;
       const std::uint8_t dst = frame.destination;
       kernel_.schedule(*arrival, EventClass::kDelivery, deliver_id_, park(std::move(frame)));
-      for (auto& bytes : extra) kernel_.schedule(*arrival, EventClass::kDelivery, deliver_id_, park(host::Frame{src, dst, std::move(bytes)}));
+      for (auto& bytes : extra) {
+        kernel_.schedule(*arrival, EventClass::kDelivery, deliver_id_, park(host::Frame{src, dst, std::move(bytes)}));
+      }
     } else {
       // Segmented over CAN frames of ≤ 8 bytes, queued back to back with the route's
       // identifier (FIFO within an identifier): the message arrives with its last frame.
