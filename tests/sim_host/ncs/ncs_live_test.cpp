@@ -18,6 +18,7 @@
 #include "ncs_live.hpp"
 #include "ncs_live_nodes.hpp"
 #include "ncs_loop.hpp"
+#include "oneshot/engine/frame_faults.hpp"
 #include "oneshot/engine/link.hpp"
 #include "oneshot/node/sync_sensor_node.hpp"
 #include "oneshot/posix/udp_network.hpp"
@@ -243,8 +244,32 @@ TEST(NcsLive, FaultedRunCompletesAndItsReplayReproducesIt) {
   EXPECT_EQ(counters.at("controller.restarts").get<double>(), 1);
   EXPECT_EQ(counters.at("sensor.restarts").get<double>(), 0);
   EXPECT_GT(counters.at("sensor.stale").get<double>(), 0);  // duplicated requests
+  // The relay drew the engine's faults: LinkFaults with the run's seed, fed the relay's receipt
+  // instants per link (frames of each link's size), injects the same counts.
+  const auto ctx = Context::load("");
+  const engine::FaultSpec spec = engine::parse_fault_spec(o.inject);
+  std::map<int, std::unique_ptr<engine::LinkFaults>> faults;
+  const char* names[4] = {"", "sc", "ca", "as"};  // by source address
+  const std::size_t sizes[4] = {0, node::report_size<double, kP, kM>(), node::kHeaderBytes + 8 * kM,
+                                node::request_size<double, kM>()};
+  for (int src : {1, 2, 3}) {
+    const engine::LinkConfig cfg = leg(*ctx, o.scenario, o.approach, names[src]);
+    faults[src] = std::make_unique<engine::LinkFaults>(spec, cfg.name, cfg.frame, o.seed);
+  }
   std::size_t inject_records = 0;
-  for (const auto& r : read_log(o.out_dir, "relay")) inject_records += r.event == "inject" ? 1u : 0u;
+  for (const auto& r : read_log(o.out_dir, "relay")) {
+    inject_records += r.event == "inject" ? 1u : 0u;
+    if (r.event != "in") continue;
+    std::vector<std::uint8_t> bytes(sizes[r.src], 0);
+    std::vector<std::vector<std::uint8_t>> extra;
+    faults.at(r.src)->apply(engine::SimTime{r.t_ns}, bytes, extra);
+  }
+  engine::FaultCounters total;
+  for (const auto& [src, f] : faults) total += f->counters();
+  EXPECT_EQ(static_cast<double>(total.dup), injected.at("dup").get<double>());
+  EXPECT_EQ(static_cast<double>(total.flip), injected.at("flip").get<double>());
+  EXPECT_EQ(static_cast<double>(total.replay), injected.at("replay").get<double>());
+  EXPECT_EQ(static_cast<double>(total.skipped), injected.at("skipped").get<double>());
   EXPECT_GE(inject_records, static_cast<std::size_t>(injected.at("dup").get<double>()));
   EXPECT_TRUE(std::filesystem::exists(o.out_dir + "/injected.csv"));
   EXPECT_EQ(j.at("replay_missing_frames").get<unsigned>(), 0u);
