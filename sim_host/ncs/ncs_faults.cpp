@@ -128,13 +128,14 @@ nlohmann::json fault_table(const Context& ctx, const FaultTableOptions& o) {
       if (faulted != base) counter_text += (counter_text.empty() ? "" : ", ") + counters[m] + " " + fmt("%+.3g", faulted - base);
     }
     // What happens, from the figures: a poisoned loop (non-finite cost), a lost one (over 3×
-    // the clean cost of its seed), absorbed (the interval's upper end within 1 %), else degraded.
+    // the clean cost of its seed), absorbed (the interval's upper end within 1 %, or the
+    // interval holding 1), else degraded.
     std::string what;
     if (non_finite > 0) {
       what = "loop poisoned: non-finite cost in " + std::to_string(non_finite) + " runs";
     } else if (lost > 0) {
       what = "loop lost: J > 3× clean in " + std::to_string(lost) + " runs";
-    } else if (rs.mean + rs.ci95 <= 1.01) {
+    } else if (rs.mean + rs.ci95 <= 1.01 || std::fabs(rs.mean - 1) <= rs.ci95) {
       what = "absorbed";
     } else {
       what = "degraded";
