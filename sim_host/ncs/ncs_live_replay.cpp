@@ -14,6 +14,7 @@
 /// intervals (paired, not identical). A faulted run: the frames the relay altered or added
 /// are delivered with their recorded bytes (DIR/injected.csv) in the relay's order for
 /// their (source, destination, k), and the recorded restarts rebuild the node.
+#include <algorithm>
 #include <cmath>
 #include <deque>
 #include <fstream>
@@ -251,8 +252,12 @@ ReplayResult replay_live(const std::string& dir, bool ideal_instants) {
     }
     for (std::size_t i = 0; i < inv.size(); ++i) {
       const bool timer = inv[i].timer;
-      const SimTime at{ideal_instants && timer ? std::int64_t{inv[i].k} * h_ns : inv[i].t_ns};
-      if (at >= SimTime{0} && at < end) kernel.schedule(at, timer ? EventClass::kActuation : EventClass::kCompute, node_h, i);
+      std::int64_t at_ns = ideal_instants && timer ? std::int64_t{inv[i].k} * h_ns : inv[i].t_ns;
+      // An actuator restart comes before the timer it logged (k): kept so at ideal instants.
+      const bool act_restart = inv[i].restart && inv[i].node == kLiveActuator;
+      if (ideal_instants && act_restart) at_ns = std::min(at_ns, std::int64_t{inv[i].k} * h_ns);
+      const EventClass cls = timer ? EventClass::kActuation : act_restart ? EventClass::kEnvironment : EventClass::kCompute;
+      if (at_ns >= 0 && SimTime{at_ns} < end) kernel.schedule(SimTime{at_ns}, cls, node_h, i);
     }
     kernel.run_until(end);
     result.cost = plant.cost().total();
