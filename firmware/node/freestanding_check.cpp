@@ -144,7 +144,7 @@ void exercise_sod() {
   eye(1, 1) = oneshot::ScalarTraits<S>::one();
   HeldMeasurementEstimator<S, 2, 1, 2> est(eye, oneshot::Matrix<S, 2, 1>{}, eye, eye);
   est.reset(V2{}, eye);
-  est.predict(V{});
+  static_cast<void>(est.predict(V{}));
   for (std::size_t i = 0; i < 2; ++i) {
     const HeldMeasurement<S> m = rx.measurement(i, 1);
     if (m.present) static_cast<void>(est.correct(i, m.z, m.r_bar));

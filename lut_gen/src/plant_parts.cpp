@@ -13,6 +13,11 @@ namespace {
 
 using nlohmann::json;
 
+/// Largest |voltage| a board's PWM levels and ADC range may have (V): the boards this
+/// design step targets run on a few volts; ±1 kV leaves room for power stages while every
+/// product of the design (gains × ranges, costs) stays far from overflow.
+constexpr double kMaxBoardVolts = 1000.0;
+
 std::string num(double v) {
   std::ostringstream o;
   o.precision(10);
@@ -219,15 +224,26 @@ void parse_board_or_actuator(const json& root, PlantDescription& p, const Checke
                                            num(bd.pwm_frequency_hz) + " Hz give a duty step of " + num(step_ns) +
                                            " ns, below the 1 ns resolution of the emulated PWM");
   }
-  bd.pwm_low_volts = check.vector_of(board, "pwm_low_volts", "board.", m);
-  bd.pwm_high_volts = check.vector_of(board, "pwm_high_volts", "board.", m);
+  // Each voltage within ±kMaxBoardVolts, the field named (a ±1e308 V range would only show
+  // later as a diverged run).
+  const auto volts = [&](const char* key, std::size_t count) {
+    std::vector<double> v = check.vector_of(board, key, "board.", count);
+    for (std::size_t j = 0; j < v.size(); ++j)
+      if (!(v[j] >= -kMaxBoardVolts && v[j] <= kMaxBoardVolts)) {
+        check.fail("board." + std::string(key) + "[" + std::to_string(j) + "]",
+                   num(v[j]) + " V is outside the supported board range of +-" + num(kMaxBoardVolts) + " V");
+      }
+    return v;
+  };
+  bd.pwm_low_volts = volts("pwm_low_volts", m);
+  bd.pwm_high_volts = volts("pwm_high_volts", m);
   for (std::size_t j = 0; j < m; ++j)
     if (!(bd.pwm_low_volts[j] < bd.pwm_high_volts[j])) {
       check.fail("board.pwm_high_volts[" + std::to_string(j) + "]", "must be above board.pwm_low_volts");
     }
   bd.adc_bits = static_cast<int>(check.integer(board, "adc_bits", "board.", 1, 24));
-  bd.adc_min_volts = check.vector_of(board, "adc_min_volts", "board.", p.p());
-  bd.adc_max_volts = check.vector_of(board, "adc_max_volts", "board.", p.p());
+  bd.adc_min_volts = volts("adc_min_volts", p.p());
+  bd.adc_max_volts = volts("adc_max_volts", p.p());
   for (std::size_t j = 0; j < p.p(); ++j)
     if (!(bd.adc_min_volts[j] < bd.adc_max_volts[j])) {
       check.fail("board.adc_max_volts[" + std::to_string(j) + "]", "must be above board.adc_min_volts");

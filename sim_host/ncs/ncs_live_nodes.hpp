@@ -46,6 +46,52 @@ void with_sync_estimator(const Context& ctx, const Scenario& sc, Approach a, con
   }
 }
 
+/// The actuator's range [u_min, u_max] from the design.
+inline void actuator_range(const Context& ctx, InputVec& u_min, InputVec& u_max) {
+  for (std::size_t j = 0; j < kM; ++j) {
+    u_min[j] = ctx.design().u_min[j];
+    u_max[j] = ctx.design().u_max[j];
+  }
+}
+
+/// Frame checks of the live sensor (docs/node_validation.md), the same in the process and
+/// the replay: requests from the actuator only, echoes in its range, t_k at most four
+/// periods ahead of the sensor's clock.
+template <typename Sensor>
+void check_requests(const Context& ctx, Sensor& sensor) {
+  InputVec u_min, u_max;
+  actuator_range(ctx, u_min, u_max);
+  sensor.expect_source(kLiveActuator);
+  sensor.set_echo_range(u_min, u_max);
+  sensor.set_stamp_window(4 * ctx.period_us());
+}
+
+/// Frame checks of the live controller: reports from the sensor only, echoes in the
+/// actuator's range. Samples are only checked finite (the live plant's output is not
+/// clamped to the ADC range).
+template <typename Controller>
+void check_reports(Controller& ctrl) {
+  ctrl.expect_source(kLiveSensor);
+  ctrl.check_echo_range();
+}
+
+/// Frame checks of the live actuator: commands from the controller only, in its range.
+template <typename Actuator>
+void check_commands(const Context& ctx, Actuator& act) {
+  InputVec u_min, u_max;
+  actuator_range(ctx, u_min, u_max);
+  act.expect_source(kLiveController);
+  act.set_command_range(u_min, u_max);
+}
+
+/// Logs a node's refusal counters as two records: "refused" (non-finite, out of range,
+/// source) and "refused_seq" (sequence, re-acquired, stale).
+template <typename Log, typename Stats>
+void log_refusals(Log& log, std::int64_t t_ns, const Stats& s, std::uint32_t stale) {
+  log.write("refused", t_ns, 0, 0, 0, 0, s.refused_non_finite, s.refused_out_of_range, s.refused_source);
+  log.write("refused_seq", t_ns, 0, 0, 0, 0, s.refused_sequence, s.reacquired, stale);
+}
+
 /// Plant link (direct, not through the relay): sampling request 'S' k clock_us (9 bytes),
 /// its answer 'Y' k y1 y2 (21 bytes), command 'U' k clock_us u (17 bytes); little-endian
 /// integers, doubles in host order (one machine).

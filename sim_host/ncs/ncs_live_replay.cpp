@@ -135,6 +135,9 @@ ReplayResult replay_live(const std::string& dir, bool ideal_instants) {
     std::optional<node::SyncSensorNode<Board, double, kP, kM>> sensor(std::in_place, kLiveController, late_us);
     using Ctrl = node::SyncControllerNode<Board, Est, Ref, double, kN, kP, kM>;
     std::optional<Ctrl> ctrl(std::in_place, kLiveActuator, design.l, u_min, u_max, est, ref);
+    check_requests(*ctx, *sensor);
+    check_reports(*ctrl);
+    check_commands(*ctx, *act);
     std::uint32_t n0 = 0;  // the actuator's power-on timer index (as in the live actuator)
     bool fresh = false;
     std::map<Key, std::vector<std::uint8_t>> sent;
@@ -150,10 +153,17 @@ ReplayResult replay_live(const std::string& dir, bool ideal_instants) {
       const Invocation& v = inv[i];
       host::HostNetworkState& s = net[v.node];
       if (v.restart) {
-        if (v.node == kLiveSensor) sensor.emplace(kLiveController, late_us);
-        if (v.node == kLiveController) ctrl.emplace(kLiveActuator, design.l, u_min, u_max, est, ref);
+        if (v.node == kLiveSensor) {
+          sensor.emplace(kLiveController, late_us);
+          check_requests(*ctx, *sensor);
+        }
+        if (v.node == kLiveController) {
+          ctrl.emplace(kLiveActuator, design.l, u_min, u_max, est, ref);
+          check_reports(*ctrl);
+        }
         if (v.node == kLiveActuator) {
           act.emplace(kLiveSensor, InputVec{});
+          check_commands(*ctx, *act);
           fresh = true;
         }
         return;

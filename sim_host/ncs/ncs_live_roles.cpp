@@ -178,6 +178,7 @@ int run_sensor(const LiveRun& r, const std::shared_ptr<const Context>& ctx, int 
   };
   posix::ScopedUdpNetwork scope(net);
   std::optional<node::SyncSensorNode<Board, double, kP, kM>> sensor(std::in_place, kLiveController, late_us);
+  check_requests(*ctx, *sensor);
   Restarts restarts(r, "sensor");
   double restarted = 0;
   const sockaddr_in plant = posix::loopback(r.plant_port);
@@ -190,6 +191,7 @@ int run_sensor(const LiveRun& r, const std::shared_ptr<const Context>& ctx, int 
     if (restarts.due(c.now())) {
       drain(net_fd);
       sensor.emplace(kLiveController, late_us);
+      check_requests(*ctx, *sensor);
       pending = false;
       ++restarted;
       log.write("restart", c.now(), clock_us(c.now()), 0, kLiveSensor, 0);
@@ -234,6 +236,7 @@ int run_sensor(const LiveRun& r, const std::shared_ptr<const Context>& ctx, int 
   log.write("stats", c.now(), 0, 0, 0, 0, s.requests, s.stale, s.refused);
   write_counters(r, "sensor", concat(sync_sensor_counter_names(), {"sensor.restarts"}),
                  concat(sync_sensor_counters(*sensor), {restarted}));
+  log_refusals(log, c.now(), s, s.stale);
   return 0;
 }
 
@@ -251,6 +254,7 @@ int controller_loop(const LiveRun& r, const Context& ctx, Est est, int net_fd, c
   }
   using Ctrl = node::SyncControllerNode<Board, Est, Ref, double, kN, kP, kM>;
   std::optional<Ctrl> ctrl(std::in_place, kLiveActuator, d.l, u_min, u_max, est, reference(ctx, r.scenario));
+  check_reports(*ctrl);
   Restarts restarts(r, "controller");
   double restarted = 0;
   engine::RandomStream compute = engine::Kernel(r.seed).stream("compute");
@@ -260,6 +264,7 @@ int controller_loop(const LiveRun& r, const Context& ctx, Est est, int net_fd, c
     if (restarts.due(c.now())) {
       drain(net_fd);
       ctrl.emplace(kLiveActuator, d.l, u_min, u_max, est, reference(ctx, r.scenario));
+      check_reports(*ctrl);
       ++restarted;
       log.write("restart", c.now(), clock_us(c.now()), 0, kLiveController, 0);
       continue;
@@ -278,6 +283,8 @@ int controller_loop(const LiveRun& r, const Context& ctx, Est est, int net_fd, c
   log.write("stats", c.now(), 0, 0, 0, 0, s.computations, s.saturated, s.faults);
   write_counters(r, "controller", concat(sync_controller_counter_names(), {"controller.restarts"}),
                  concat(sync_controller_counters(*ctrl), {restarted}));
+  log_refusals(log, c.now(), s, s.stale);
+  log.write("resets", c.now(), 0, 0, 0, 0, s.estimator_resets, s.withheld);
   return 0;
 }
 
@@ -296,6 +303,7 @@ int run_actuator(const LiveRun& r, const std::shared_ptr<const Context>& ctx, in
   attach(net, net_fd, kLiveActuator, r, log, c);
   posix::ScopedUdpNetwork scope(net);
   std::optional<node::SyncActuatorNode<Board, double, kM>> act(std::in_place, kLiveSensor, InputVec{});
+  check_commands(*ctx, *act);
   Restarts restarts(r, "actuator");
   double restarted = 0;
   std::uint32_t n0 = 0;  // timer index of the actuator's power-on: its period index is n − n0
@@ -311,6 +319,7 @@ int run_actuator(const LiveRun& r, const std::shared_ptr<const Context>& ctx, in
       if (restarts.due(c.now())) {
         drain(net_fd);
         act.emplace(kLiveSensor, InputVec{});
+        check_commands(*ctx, *act);
         fresh = true;
         ++restarted;
         log.write("restart", c.now(), clock_us(c.now()), 0, kLiveActuator, n);
@@ -346,6 +355,7 @@ int run_actuator(const LiveRun& r, const std::shared_ptr<const Context>& ctx, in
   }
   const auto& s = act->statistics();
   log.write("stats", c.now(), 0, 0, 0, 0, s.late, act->refused());
+  log_refusals(log, c.now(), s, s.stale);
   write_counters(r, "actuator", concat(actuator_counter_names(), {"actuator.restarts"}),
                  concat(actuator_counters(*act), {restarted}));
   return 0;

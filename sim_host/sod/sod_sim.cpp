@@ -118,11 +118,13 @@ RunResult simulate_run(const SodModel& model, const RunConfig& cfg, std::uint64_
   });
   const engine::HandlerId compute = kernel.add_handler("sod estimator", [&](std::uint64_t kk) {
     const auto k = static_cast<node::SequenceNumber>(kk);
-    if (kk > 0) est.predict(u);
+    if (kk > 0 && est.predict(u) == Status::kNonFinite) ++res.estimator_resets;
     node::HeldMeasurement<double> m[kNodes];
     for (std::size_t i = 0; i < kNodes; ++i) {
       m[i] = rx.measurement(i, k);
-      if (m[i].present && !est.correct(i, m[i].z, m[i].r_bar)) throw std::runtime_error("sod: innovation variance not positive");
+      const Status st = m[i].present ? est.correct(i, m[i].z, m[i].r_bar) : Status::kOk;
+      if (st == Status::kSingular) throw std::runtime_error("sod: innovation variance not positive");
+      if (st == Status::kNonFinite) ++res.estimator_resets;
       if (m[i].dropouts > last_d[i]) res.detected[i] += m[i].dropouts - last_d[i];
       last_d[i] = m[i].arrived ? 0 : m[i].dropouts;
     }

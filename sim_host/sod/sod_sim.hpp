@@ -55,6 +55,7 @@ struct RunResult {
   double time_sends[kNodes] = {}; ///< Of which caused by (2b).
   double lost[kNodes] = {};       ///< Lost on the link.
   double detected[kNodes] = {};   ///< Losses the detector proved (Σ increments of d).
+  double estimator_resets = 0;    ///< Steps whose estimate turned non-finite (reset to x0, P0).
 };
 
 /// Per-step record of a run (E4 and the tests).

@@ -13,7 +13,7 @@ namespace oneshot {
 namespace {
 
 constexpr Status kAll[] = {Status::kOk,        Status::kExtended, Status::kClamped,     Status::kSingular,
-                           Status::kOutOfRange, Status::kOverflow, Status::kNotConverged};
+                           Status::kOutOfRange, Status::kOverflow, Status::kNotConverged, Status::kNonFinite};
 
 TEST(Status, WorstOfIsCommutativeAssociativeAndNeverMilder) {
   for (Status a : kAll)
@@ -36,11 +36,13 @@ TEST(Status, WorstOfIsCommutativeAssociativeAndNeverMilder) {
 
 TEST(Status, SingularIsNeverMasked) {
   // WHEN kSingular appears anywhere in a sequence THEN the result is kSingular or the one
-  // more severe status (kOutOfRange: no result at all), never an exact or approximate one
+  // more severe statuses (kOutOfRange: no result at all; kNonFinite: state reset), never an
+  // exact or approximate one
   for (Status before : kAll)
     for (Status after : kAll) {
       const Status s = first_failure(first_failure(before, Status::kSingular), after);
-      EXPECT_TRUE(s == Status::kSingular || s == Status::kOutOfRange) << to_string(before) << " " << to_string(after);
+      EXPECT_TRUE(s == Status::kSingular || s == Status::kOutOfRange || s == Status::kNonFinite)
+          << to_string(before) << " " << to_string(after);
       EXPECT_FALSE(is_exact(s));
     }
   EXPECT_EQ(first_failure(Status::kExtended, Status::kSingular), Status::kSingular);

@@ -137,7 +137,7 @@ TEST(NcsNodes, GainWithExactQdAndConstantTauEqualsThePeriodicGain) {
   for (std::int32_t tau_as : {500, 7'300, 14'000, 30'000}) {
     HalfEst est(design, disc, NoiseModel::kExact);
     est.reset(Vector<double, kN>{}, design.p0, Vector<double, kM>{});
-    for (int k = 0; k < 400; ++k) est.update(design.period_us - tau_as, Vector<double, kP>{}, Vector<double, kM>{});
+    for (int k = 0; k < 400; ++k) ASSERT_TRUE(is_exact(est.update(design.period_us - tau_as, Vector<double, kP>{}, Vector<double, kM>{})));
     double err = 0;
     for (std::size_t i = 0; i < kN; ++i)
       for (std::size_t j = 0; j < kP; ++j) err = std::fmax(err, std::fabs(est.filter().gain()(i, j) - k_ref(i, j)));
@@ -146,7 +146,7 @@ TEST(NcsNodes, GainWithExactQdAndConstantTauEqualsThePeriodicGain) {
   // With the constant Q of the paper the gain depends on τ_as: the check is not vacuous.
   HalfEst est(design, disc, NoiseModel::kConstant);
   est.reset(Vector<double, kN>{}, design.p0, Vector<double, kM>{});
-  for (int k = 0; k < 400; ++k) est.update(design.period_us - 14'000, Vector<double, kP>{}, Vector<double, kM>{});
+  for (int k = 0; k < 400; ++k) ASSERT_TRUE(is_exact(est.update(design.period_us - 14'000, Vector<double, kP>{}, Vector<double, kM>{})));
   EXPECT_GT(std::fabs(est.filter().gain()(0, 0) - k_ref(0, 0)), 1e-4);
 }
 
@@ -168,7 +168,7 @@ TEST(NcsNodes, MeasurementOffsetMovesThePredictionByPhiKDelta) {
       yk[1] = y(rng);
       Vector<double, kM> u;
       u[0] = y(rng);
-      a.update(tau(rng), yk, u);
+      ASSERT_TRUE(is_exact(a.update(tau(rng), yk, u)));
     }
     HalfEst b = a;
     Vector<double, kP> yk;
@@ -180,8 +180,8 @@ TEST(NcsNodes, MeasurementOffsetMovesThePredictionByPhiKDelta) {
     Vector<double, kM> u;
     u[0] = y(rng);
     const std::int32_t t = tau(rng);
-    a.update(t, yk, u);
-    b.update(t, yk + delta, u);
+    ASSERT_TRUE(is_exact(a.update(t, yk, u)));
+    ASSERT_TRUE(is_exact(b.update(t, yk + delta, u)));
     Disc::Triple d;
     ASSERT_EQ(disc.discretize(t, d, WithQd::kNo), Status::kOk);
     const Vector<double, kN> expect = d.phi * (a.filter().gain() * delta);

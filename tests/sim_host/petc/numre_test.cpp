@@ -98,7 +98,7 @@ TEST_P(NumreTest, NStepUpdateEqualsClosedForm) {
   }
   est.reset(xs, ps);
   for (double v : u) est.predict(v);
-  ASSERT_TRUE(est.correct(y));
+  ASSERT_EQ(est.correct(y), oneshot::Status::kOk);
   EXPECT_EQ(est.last_multiplicity(), kN);
 
   Mat an = Mat::Identity(ix(n), ix(n));

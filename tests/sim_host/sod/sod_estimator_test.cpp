@@ -45,8 +45,8 @@ TEST(SodEstimator, TwoScalarCorrectionsEqualTheJointOne) {
     z[1] = u(rng);
     Est est(Matrix<double, 2, 2>{}, Matrix<double, 2, 1>{}, Matrix<double, 2, 2>{}, c);
     est.reset(x, p);
-    ASSERT_TRUE(est.correct(0, z[0], r(0, 0)));
-    ASSERT_TRUE(est.correct(1, z[1], r(1, 1)));
+    ASSERT_EQ(est.correct(0, z[0], r(0, 0)), oneshot::Status::kOk);
+    ASSERT_EQ(est.correct(1, z[1], r(1, 1)), oneshot::Status::kOk);
     Vector<double, 2> xj = x;
     Matrix<double, 2, 2> pj = p;
     Matrix<double, 2, 2> k;

@@ -3,7 +3,7 @@
 ///
 /// The numeric values are part of the PIL protocol and the C job and never change; the
 /// order of severity is severity() (exact < approximate < a step skipped < no result):
-///   kOk < kExtended < kClamped < kOverflow < kNotConverged < kSingular < kOutOfRange.
+///   kOk < kExtended < kClamped < kOverflow < kNotConverged < kSingular < kOutOfRange < kNonFinite.
 /// A sequence of operations reports worst_of() its statuses, so no failure ever hides
 /// behind a milder one (a kSingular correction after a kExtended prediction is kSingular).
 #pragma once
@@ -21,10 +21,12 @@ enum class Status : std::uint8_t {
   kOutOfRange,        ///< Input outside what the routine supports (e.g. norm too large).
   kOverflow,          ///< Fixed-point saturation occurred during the computation.
   kNotConverged,      ///< An iterative routine hit its iteration bound.
+  kNonFinite,         ///< The result turned NaN or ±∞: discarded, the state reset to its design initial value.
 };
 
 /// Rank of s, 0 for kOk: approximate results (clamped, saturated, not converged) rank
-/// below a skipped step (singular), which ranks below no result at all (out of range).
+/// below a skipped step (singular), which ranks below no result at all (out of range), which
+/// ranks below a non-finite result (state lost and reset).
 constexpr std::uint8_t severity(Status s) {
   switch (s) {
     case Status::kOk: return 0;
@@ -34,8 +36,9 @@ constexpr std::uint8_t severity(Status s) {
     case Status::kNotConverged: return 4;
     case Status::kSingular: return 5;
     case Status::kOutOfRange: return 6;
+    case Status::kNonFinite: return 7;
   }
-  return 7;  // not a Status value: worse than any
+  return 8;  // not a Status value: worse than any
 }
 
 /// The more severe of a and b (a on ties): the status of a and b done in sequence.
@@ -58,6 +61,7 @@ constexpr const char* to_string(Status s) {
     case Status::kOutOfRange: return "out_of_range";
     case Status::kOverflow: return "overflow";
     case Status::kNotConverged: return "not_converged";
+    case Status::kNonFinite: return "non_finite";
   }
   return "unknown";
 }

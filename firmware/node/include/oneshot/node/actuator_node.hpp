@@ -2,11 +2,17 @@
 /// @brief An actuator node: applies commands on arrival, or on its timer from a buffer of
 ///        commands keyed by sequence number, holding the last value when a command is late.
 ///
-/// On arrival: a command newer than the one applied is applied at once; older ones are
-/// counted and dropped. On the timer of period k: the command stamped k is applied when
-/// it is in the buffer; otherwise the previous value is held and the miss counted (the
-/// late-command policy of the networked-actuation brief). The glue writes the value to
-/// the output stage after take_output() reports a new one.
+/// On arrival: a command newer than the one applied (sequence window with re-acquisition,
+/// frame_checks.hpp) is applied at once; older ones are counted and dropped. On the timer
+/// of period k: the command stamped k is applied when it is in the buffer; otherwise the
+/// previous value is held and the miss counted (the late-command policy of the
+/// networked-actuation brief). Timer mode buffers only commands for the next Slots periods
+/// after the last timer (k_t, k_t + Slots], k_t = 0 before the first: the actuator's own
+/// period count is the reference, so a forged or restarted sequence never blocks a slot.
+/// A command that is not finite, outside [u_min, u_max] (once set) or from another node
+/// than the expected controller (once set) is refused and counted: the last good value
+/// stays applied. The glue writes the value to the output stage after take_output()
+/// reports a new one.
 #pragma once
 
 #include <cstddef>
@@ -15,6 +21,7 @@
 #include "oneshot/hal/network_contract.hpp"
 #include "oneshot/matrix.hpp"
 #include "oneshot/node/command_buffer.hpp"
+#include "oneshot/node/frame_checks.hpp"
 #include "oneshot/node/message.hpp"
 
 namespace oneshot::node {
@@ -25,10 +32,10 @@ enum class ActuatorMode : std::uint8_t {
   kOnTimer,    ///< At its timer, the command stamped with the timer's period.
 };
 
-/// Counters of an actuator node.
-struct ActuatorStatistics {
+/// Counters of an actuator node (refusals by cause in the FrameRefusals part).
+struct ActuatorStatistics : FrameRefusals {
   std::uint32_t received = 0;   ///< Commands decoded.
-  std::uint32_t stale = 0;      ///< On arrival: not newer than the applied one (dropped).
+  std::uint32_t stale = 0;      ///< Not newer than the applied one / its period already past (dropped).
   std::uint32_t malformed = 0;  ///< Frames that did not decode.
   std::uint32_t applied = 0;    ///< Commands applied.
   std::uint32_t late = 0;       ///< Timer: no command for the period (previous value held).
@@ -57,14 +64,22 @@ class ActuatorNode {
         continue;
       }
       ++stats_.received;
+      if (!source_.check(source, stats_) || !check_payload(c.payload.value, range_, stats_)) continue;
       if (mode_ == ActuatorMode::kOnTimer) {
-        buffer_.store(c.seq, c.payload.value);
+        // d = seq − k_t: 1 … Slots waits in the buffer; ≤ 0 is late; beyond is refused.
+        const SequenceNumber d = c.seq - timer_k_;
+        if (!seq_newer(c.seq, timer_k_)) {
+          ++stats_.stale;
+        } else if (d > Slots) {
+          ++stats_.refused_sequence;
+        } else {
+          buffer_.replace(c.seq, c.payload.value);
+        }
         continue;
       }
-      if (any_applied_ && !seq_newer(c.seq, applied_seq_)) {
-        ++stats_.stale;
-        continue;
-      }
+      const SequenceVerdict v = gate_.offer(c.seq);
+      if (v == SequenceVerdict::kStale) ++stats_.stale;
+      if (!count_sequence(v, stats_)) continue;
       apply(c.seq, c.payload.value);
     }
   }
@@ -72,12 +87,24 @@ class ActuatorNode {
   /// The timer of period k (timer mode): applies the command stamped k, or holds.
   void on_timer(SequenceNumber k) {
     if (mode_ != ActuatorMode::kOnTimer) return;
+    timer_k_ = k;
     Vector<S, M> u;
     if (buffer_.find(k, u)) {
       apply(k, u);
     } else {
       ++stats_.late;
     }
+  }
+
+  /// Accepts commands from `controller` only.
+  constexpr void expect_source(std::uint8_t controller) { source_.set(controller); }
+  /// Accepts commands in [u_min, u_max] only (the actuator's range from the design).
+  constexpr void set_command_range(const Vector<S, M>& u_min, const Vector<S, M>& u_max) {
+    range_ = ValueRange<S, M>(u_min, u_max);
+  }
+  /// On-arrival mode: sequence window W and re-acquisition count R (frame_checks.hpp).
+  constexpr void set_sequence_window(std::uint32_t window, std::uint32_t reacquire) {
+    gate_ = SequenceGate(window, reacquire);
   }
 
   /// True once after each newly applied command, with the value to output in `u`.
@@ -108,6 +135,10 @@ class ActuatorNode {
   SequenceNumber applied_seq_ = 0;
   bool any_applied_ = false;
   bool new_output_ = false;
+  SequenceNumber timer_k_ = 0;
+  SequenceGate gate_{};
+  ExpectedSource source_{};
+  ValueRange<S, M> range_{};
   CommandBuffer<S, M, Slots> buffer_{};
   ActuatorStatistics stats_{};
 };

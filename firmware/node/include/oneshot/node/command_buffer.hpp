@@ -31,6 +31,14 @@ class CommandBuffer {
     s.u = u;
     return true;
   }
+  /// Stores u for sequence number seq whatever the slot held (the caller has checked that
+  /// seq is one of Slots consecutive numbers it waits for, which map to distinct slots).
+  constexpr void replace(SequenceNumber seq, const Vector<S, M>& u) {
+    Slot& s = slots_[seq % Slots];
+    s.used = true;
+    s.seq = seq;
+    s.u = u;
+  }
   /// The command stamped `seq`, when present.
   constexpr bool find(SequenceNumber seq, Vector<S, M>& u) const {
     const Slot& s = slots_[seq % Slots];

@@ -7,7 +7,10 @@
 /// (fresh: a measurement arrived since the last computation); it returns true to send u.
 /// A command carries the sequence number of the measurement it was computed from, so an
 /// actuator can match it to its period; older or repeated measurements are counted and
-/// dropped (reordering on the network never moves the estimate back in time).
+/// dropped (reordering on the network never moves the estimate back in time). Measurements
+/// that are not finite, outside the sensor's range (once set), from another node than the
+/// expected sensor (once set) or beyond the sequence window are refused and counted; a
+/// restarted sensor is re-acquired on its R-th frame (frame_checks.hpp).
 #pragma once
 
 #include <cstddef>
@@ -15,6 +18,7 @@
 
 #include "oneshot/hal/network_contract.hpp"
 #include "oneshot/matrix.hpp"
+#include "oneshot/node/frame_checks.hpp"
 #include "oneshot/node/message.hpp"
 
 namespace oneshot::node {
@@ -25,12 +29,13 @@ enum class ControllerMode : std::uint8_t {
   kOnTimer,    ///< On its timer (on_timer), with the newest measurement.
 };
 
-/// Counters of a controller node.
-struct ControllerStatistics {
+/// Counters of a controller node (refusals by cause in the FrameRefusals part).
+struct ControllerStatistics : FrameRefusals {
   std::uint32_t received = 0;      ///< Measurements decoded.
   std::uint32_t stale = 0;         ///< Older than or equal to the newest one (dropped).
   std::uint32_t malformed = 0;     ///< Frames that did not decode.
   std::uint32_t computations = 0;  ///< Law runs.
+  std::uint32_t withheld = 0;      ///< Commands not sent: the law gave a non-finite value.
   std::uint32_t sends = 0;         ///< Commands sent.
   std::uint32_t refused = 0;       ///< Sends the interface refused.
 };
@@ -60,10 +65,10 @@ class ControllerNode {
         continue;
       }
       ++stats_.received;
-      if (have_ && !seq_newer(m.seq, latest_.seq)) {
-        ++stats_.stale;
-        continue;
-      }
+      if (!source_.check(source, stats_) || !check_payload(m.payload.value, range_, stats_)) continue;
+      const SequenceVerdict v = gate_.offer(m.seq);
+      if (v == SequenceVerdict::kStale) ++stats_.stale;
+      if (!count_sequence(v, stats_)) continue;
       latest_ = m;
       have_ = true;
       fresh_ = true;
@@ -74,6 +79,17 @@ class ControllerNode {
   /// The controller's timer: timer mode computes with the newest measurement.
   void on_timer(McuInstant now) {
     if (mode_ == ControllerMode::kOnTimer && have_) run(now);
+  }
+
+  /// Accepts measurements from `sensor` only.
+  constexpr void expect_source(std::uint8_t sensor) { source_.set(sensor); }
+  /// Accepts measurements in [y_min, y_max] only (the sensor's range from the design).
+  constexpr void set_measurement_range(const Vector<S, P>& y_min, const Vector<S, P>& y_max) {
+    range_ = ValueRange<S, P>(y_min, y_max);
+  }
+  /// Sequence window W and re-acquisition count R (frame_checks.hpp).
+  constexpr void set_sequence_window(std::uint32_t window, std::uint32_t reacquire) {
+    gate_ = SequenceGate(window, reacquire);
   }
 
   /// The law (its estimator state, …).
@@ -90,6 +106,10 @@ class ControllerNode {
     const bool send = law_.compute(latest_, fresh_, now, c.payload.value);
     fresh_ = false;
     if (!send) return;
+    if (!all_finite(c.payload.value)) {
+      ++stats_.withheld;
+      return;
+    }
     c.seq = latest_.seq;
     c.stamp = now;
     std::uint8_t bytes[kMaxMessageBytes];
@@ -107,6 +127,9 @@ class ControllerNode {
   Measurement latest_{};
   bool have_ = false;
   bool fresh_ = false;
+  SequenceGate gate_{};
+  ExpectedSource source_{};
+  ValueRange<S, P> range_{};
   ControllerStatistics stats_{};
 };
 

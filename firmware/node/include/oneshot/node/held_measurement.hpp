@@ -8,7 +8,8 @@
 /// no packet (kPredictOnly):           no correction for node i
 /// The held value's error Δ_i = y_i − y_rx,i is taken as uniform on ±(d_i + 1) δy,i, hence
 /// the variance ((d_i + 1) δy,i)²/3; d_i comes from the DropoutDetector (0 for plain SOD).
-/// Before a node's first arrival there is nothing to hold: no correction.
+/// Before a node's first arrival there is nothing to hold: no correction. A packet whose
+/// value is not finite is refused and counted (the held value stays the last good one).
 #pragma once
 
 #include <cstddef>
@@ -16,6 +17,7 @@
 
 #include "oneshot/matrix.hpp"
 #include "oneshot/node/dropout_detector.hpp"
+#include "oneshot/node/frame_checks.hpp"
 #include "oneshot/node/message.hpp"
 #include "oneshot/scalar_traits.hpp"
 
@@ -51,11 +53,17 @@ class HeldMeasurementReceiver {
   }
 
   /// Node i's packet of sample k with value y arrived (call before measurement(i, k)).
-  constexpr void on_packet(std::size_t i, SequenceNumber k, S y) {
+  /// False (refused, counted, nothing changed) when y is not finite.
+  constexpr bool on_packet(std::size_t i, SequenceNumber k, S y) {
+    if (!is_finite(y)) {
+      ++refusals_.refused_non_finite;
+      return false;
+    }
     y_rx_[i] = y;
     detector_[i].on_receive(k);
     arrived_k_[i] = k;
     arrived_[i] = true;
+    return true;
   }
   /// Node i's measurement at step k: the packet that arrived at k, else the held value with
   /// R̄_ii = R_ii + ((d + 1) δy)²/3 (kHeld) or nothing (kPredictOnly).
@@ -79,6 +87,8 @@ class HeldMeasurementReceiver {
     m.r_bar = r_[i] + width * width / T::from_int(3);
     return m;
   }
+  /// Packets refused, by cause.
+  constexpr const FrameRefusals& refusals() const { return refusals_; }
   /// Node i's detector.
   constexpr const DropoutDetector& detector(std::size_t i) const { return detector_[i]; }
 
@@ -90,6 +100,7 @@ class HeldMeasurementReceiver {
   Vector<S, P> y_rx_{};
   SequenceNumber arrived_k_[P] = {};
   bool arrived_[P] = {};
+  FrameRefusals refusals_{};
 };
 
 }  // namespace oneshot::node

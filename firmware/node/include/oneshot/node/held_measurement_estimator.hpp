@@ -9,13 +9,17 @@
 /// R̄ is diagonal, so the scalar corrections in sequence equal the joint correction with
 /// K = P⁻Cᵀ(C P⁻Cᵀ + R̄)⁻¹ (the measurements' errors are independent); no matrix inverse,
 /// one division per node. P is updated on its upper triangle and mirrored, so it stays
-/// exactly symmetric.
+/// exactly symmetric. The estimate never stays non-finite: when x̂ or P turns NaN or ±∞
+/// (a huge input or measurement) predict()/correct() reset them to the values of reset()
+/// (the design's x0, P0) and return Status::kNonFinite.
 #pragma once
 
 #include <cstddef>
 
+#include "oneshot/finite.hpp"
 #include "oneshot/matrix.hpp"
 #include "oneshot/scalar_traits.hpp"
+#include "oneshot/status.hpp"
 
 namespace oneshot::node {
 
@@ -34,14 +38,16 @@ class HeldMeasurementEstimator {
                                      const Matrix<S, P, N>& c)
       : a_(a_d), b_(b_d), q_(q_d), c_(c) {}
 
-  /// Estimate x0 with covariance p0.
+  /// Estimate x0 with covariance p0 (also the values a non-finite result resets to).
   constexpr void reset(const StateVec& x0, const Cov& p0) {
+    x0_ = x0;
+    p0_ = p0;
     x_ = x0;
     p_ = p0;
   }
 
-  /// x̂⁻ = A_d x̂ + B_d u,  P⁻ = A_d P A_dᵀ + Q_d.
-  constexpr void predict(const InputVec& u) {
+  /// x̂⁻ = A_d x̂ + B_d u,  P⁻ = A_d P A_dᵀ + Q_d; kNonFinite (reset) when they overflow.
+  [[nodiscard]] constexpr Status predict(const InputVec& u) {
     StateVec x{};
     for (std::size_t i = 0; i < N; ++i) {
       S acc = ScalarTraits<S>::zero();
@@ -64,11 +70,13 @@ class HeldMeasurementEstimator {
         p_(i, j) = acc;
         p_(j, i) = acc;
       }
+    return finite_or_reset();
   }
 
-  /// Scalar correction with measurement `z` of output `i` and variance `r_bar` (R̄_ii);
-  /// false (nothing changed) when the innovation variance is not positive.
-  constexpr bool correct(std::size_t i, S z, S r_bar) {
+  /// Scalar correction with measurement `z` of output `i` and variance `r_bar` (R̄_ii):
+  /// kSingular (nothing changed) when the innovation variance is not positive, kNonFinite
+  /// (reset) when x̂ or P turned NaN or ±∞.
+  [[nodiscard]] constexpr Status correct(std::size_t i, S z, S r_bar) {
     StateVec pc{};  // P cᵀ
     S cx = ScalarTraits<S>::zero();
     for (std::size_t a = 0; a < N; ++a) {
@@ -79,7 +87,7 @@ class HeldMeasurementEstimator {
     }
     S s = r_bar;
     for (std::size_t a = 0; a < N; ++a) s += c_(i, a) * pc[a];
-    if (!(ScalarTraits<S>::zero() < s)) return false;
+    if (!(ScalarTraits<S>::zero() < s)) return is_finite(s) ? Status::kSingular : reset_non_finite();
     const S innovation = z - cx;
     for (std::size_t a = 0; a < N; ++a) {
       gain_[a] = pc[a] / s;
@@ -90,7 +98,7 @@ class HeldMeasurementEstimator {
         p_(a, b) -= gain_[a] * pc[b];
         p_(b, a) = p_(a, b);
       }
-    return true;
+    return finite_or_reset();
   }
 
   /// The corrected estimate x̂ (after the corrections of this step).
@@ -101,10 +109,19 @@ class HeldMeasurementEstimator {
   constexpr const StateVec& gain() const { return gain_; }
 
  private:
+  constexpr Status reset_non_finite() {
+    x_ = x0_;
+    p_ = p0_;
+    return Status::kNonFinite;
+  }
+  constexpr Status finite_or_reset() { return all_finite(x_) && all_finite(p_) ? Status::kOk : reset_non_finite(); }
+
   Cov a_;
   Matrix<S, N, M> b_;
   Cov q_;
   Matrix<S, P, N> c_;
+  StateVec x0_{};
+  Cov p0_{};
   StateVec x_{};
   Cov p_{};
   StateVec gain_{};

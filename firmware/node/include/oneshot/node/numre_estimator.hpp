@@ -13,12 +13,17 @@
 ///     S = C M Cᵀ + V,  K = M Cᵀ / S,  x̂ ← x̂ + K (y − C x̂),
 ///     P = (I − K C) M (I − K C)ᵀ + K V Kᵀ.
 /// Multiply-adds are counted as executed (dense), for the study's cost figures.
+/// The estimate never stays non-finite: a correction that leaves x̂ or P NaN or ±∞ resets
+/// them to the initial values (reset(); x̂ = 0, P = 0 at construction) and reports
+/// Status::kNonFinite.
 #pragma once
 
 #include <cstddef>
 #include <cstdint>
 
+#include "oneshot/finite.hpp"
 #include "oneshot/matrix.hpp"
+#include "oneshot/status.hpp"
 
 namespace oneshot::node {
 
@@ -53,8 +58,10 @@ class NumreEstimator {
       for (std::size_t j = 0; j < N; ++j) q_(i, j) = m_.b_w[i] * m_.w * m_.b_w[j];
   }
 
-  /// Sets x̂ and P (the last arrival's values).
+  /// Sets x̂ and P (the last arrival's values; also what a non-finite result resets to).
   constexpr void reset(const State& x, const Covariance& p) {
+    x0_ = x;
+    p0_ = p;
     x_ = x;
     p_ = p;
     g_ = State{};
@@ -76,8 +83,9 @@ class NumreEstimator {
   }
 
   /// Arrival of y after `multiplicity()` predictions: finishes M_k and corrects (Joseph).
-  /// Returns false (x̂, P untouched apart from M_k) when C M Cᵀ + V is not positive.
-  constexpr bool correct(S y) {
+  /// kSingular (x̂, P untouched apart from M_k) when C M Cᵀ + V is not positive; kNonFinite
+  /// when x̂ or P turned NaN or ±∞ (reset to the initial values); kOk otherwise.
+  [[nodiscard]] constexpr Status correct(S y) {
     if (acc_ == NoiseAccumulation::kFrozen) {
       for (std::size_t i = 0; i < N; ++i)
         for (std::size_t j = 0; j < N; ++j) p_(i, j) = p_(i, j) + g_[i] * m_.w * g_[j];
@@ -92,7 +100,7 @@ class NumreEstimator {
     steps_ = 0;
     if (!(s > S(0))) {
       k_ = State{};
-      return false;
+      return is_finite(s) ? Status::kSingular : reset_non_finite();
     }
     k_ = mct * (S(1) / s);
     S innovation = y;
@@ -103,7 +111,7 @@ class NumreEstimator {
     for (std::size_t i = 0; i < N; ++i)
       for (std::size_t j = 0; j < N; ++j) p_(i, j) = p_(i, j) + k_[i] * m_.v * k_[j];
     macs_ += 3 * N + N * N + 2 * N * N * N + 2 * N * N;
-    return true;
+    return all_finite(x_) && all_finite(p_) ? Status::kOk : reset_non_finite();
   }
 
   /// x̂ (x̂(k|k) after correct(), the prediction before).
@@ -120,9 +128,19 @@ class NumreEstimator {
   constexpr std::uint64_t macs() const { return macs_; }
 
  private:
+  constexpr Status reset_non_finite() {
+    x_ = x0_;
+    p_ = p0_;
+    g_ = State{};
+    k_ = State{};
+    return Status::kNonFinite;
+  }
+
   NumreModel<S, N> m_;
   NoiseAccumulation acc_;
   Covariance q_{};
+  State x0_{};
+  Covariance p0_{};
   State x_{};
   Covariance p_{};
   State g_{};

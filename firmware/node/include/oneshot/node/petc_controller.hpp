@@ -11,6 +11,12 @@
 ///  3. send the packet if (ū − u_k)² > σ_c u_k² + δ_c (ū = first entry of the last packet
 ///     sent), or k − k_sent ≥ k_max (safety), or on the first arrival; otherwise the packet
 ///     in force stays and the estimator keeps propagating its inputs.
+/// Arrivals are untrusted (frame_checks.hpp): a non-finite y, a y outside the sensor's range
+/// (once set) or a k beyond the sequence window is refused and counted (no packet); a
+/// restarted sensor is re-acquired on its R-th arrival (no prediction over the unknown
+/// interval then). A correction that turns the NUMRE non-finite resets it (counted,
+/// last_status() = kNonFinite) and sends nothing; a cascade with a non-finite input is
+/// withheld: the packet in force stays.
 /// Storage: H + 2 law states (the state before each entry and after the last), 2(H + 1)
 /// inputs: about 64 KB for H = 200 with the DOB, DSP-class memory (brief §10).
 #pragma once
@@ -18,12 +24,22 @@
 #include <cstddef>
 #include <cstdint>
 
+#include "oneshot/finite.hpp"
 #include "oneshot/matrix.hpp"
+#include "oneshot/node/frame_checks.hpp"
 #include "oneshot/node/mtm_trigger.hpp"
 #include "oneshot/node/numre_estimator.hpp"
 #include "oneshot/node/send_cause.hpp"
+#include "oneshot/status.hpp"
 
 namespace oneshot::node {
+
+/// Counters of a PETC controller (refusals by cause in the FrameRefusals part).
+struct PetcStatistics : FrameRefusals {
+  std::uint32_t stale = 0;             ///< Arrivals not newer than the last one (dropped).
+  std::uint32_t estimator_resets = 0;  ///< Corrections that turned non-finite (NUMRE reset).
+  std::uint32_t withheld = 0;          ///< Cascades with a non-finite input (not sent).
+};
 
 /// PETC controller with an N-state NUMRE, a packet of H + 1 inputs, a control law `Law`
 /// (u = law.step(k, e), copyable) and a disturbance estimate `Observer`.
@@ -46,12 +62,36 @@ class PetcController {
   /// The reference from now on (a known change: the sensor is told separately).
   constexpr void set_reference(S r) { reference_ = r; }
 
+  /// Accepts y in [y_min, y_max] only (the sensor's range from the design).
+  constexpr void set_measurement_range(S y_min, S y_max) {
+    Vector<S, 1> lo;
+    Vector<S, 1> hi;
+    lo[0] = y_min;
+    hi[0] = y_max;
+    range_ = ValueRange<S, 1>(lo, hi);
+  }
+  /// Sequence window W (the longest silence, periods) and re-acquisition count R.
+  constexpr void set_sequence_window(std::uint32_t window, std::uint32_t reacquire) {
+    gate_ = SequenceGate(window, reacquire);
+  }
+
   /// Arrival of y at period k. Returns the send cause (kNone: no packet).
   constexpr SendCause on_arrival(std::uint32_t k, S y) {
-    if (arrivals_ > 0)
+    Vector<S, 1> yv;
+    yv[0] = y;
+    if (!check_payload(yv, range_, stats_)) return SendCause::kNone;
+    const SequenceVerdict v = gate_.offer(k);
+    if (v == SequenceVerdict::kStale) ++stats_.stale;
+    if (!count_sequence(v, stats_)) return SendCause::kNone;
+    if (arrivals_ > 0 && v == SequenceVerdict::kAccepted)
       for (std::uint32_t j = k_prev_; j != k; ++j) est_.predict(applied(j));
-    est_.correct(y);
+    status_ = est_.correct(y);
     ++arrivals_;
+    if (status_ == Status::kNonFinite) {
+      ++stats_.estimator_resets;
+      k_prev_ = k;
+      return SendCause::kNone;
+    }
     k_prev_ = k;
     // The law state in force at k: stored with the packet in force.
     LawState ls = initial_;
@@ -80,6 +120,11 @@ class PetcController {
     }
     new_states_[H + 1] = ls;
     cascade_macs_ += (ls.law.macs() - new_states_[0].law.macs()) + (ls.obs.macs() - new_states_[0].obs.macs());
+    for (std::size_t l = 0; l < kEntries; ++l)
+      if (!is_finite(new_packet_[l])) {
+        ++stats_.withheld;
+        return SendCause::kNone;
+      }
     // Controller trigger on the first entry.
     Vector<S, 1> u0;
     u0[0] = new_packet_[0];
@@ -119,6 +164,10 @@ class PetcController {
   constexpr const S* last_cascade_d_hat() const { return new_d_hat_; }
   /// The estimator.
   constexpr const NumreEstimator<S, N>& estimator() const { return est_; }
+  /// Status of the last correction (kNonFinite: the NUMRE was reset).
+  constexpr Status last_status() const { return status_; }
+  /// Counters.
+  constexpr const PetcStatistics& statistics() const { return stats_; }
   /// Multiply-adds: estimator + cascades (model, law, observer).
   constexpr std::uint64_t macs() const { return est_.macs() + cascade_macs_; }
 
@@ -138,6 +187,10 @@ class PetcController {
   LawState states_[H + 2]{};
   LawState new_states_[H + 2]{};
   std::uint64_t cascade_macs_ = 0;
+  Status status_ = Status::kOk;
+  SequenceGate gate_{};
+  ValueRange<S, 1> range_{};
+  PetcStatistics stats_{};
 };
 
 }  // namespace oneshot::node

@@ -6,7 +6,9 @@
 /// Commands (msg 3, seq = k) are buffered by the timer-mode ActuatorNode; at t_k the
 /// command for k is applied, or, when it is late, the previous value is held and the miss
 /// counted (late-command policy, brief §2). The request for k + 1 then carries the value
-/// in force, so the controller predicts with the input the plant really got.
+/// in force, so the controller predicts with the input the plant really got. Commands are
+/// checked as in ActuatorNode (source, finite, range, timer window): a refused command is
+/// counted and the last good value held.
 #pragma once
 
 #include <cstddef>
@@ -31,6 +33,13 @@ class SyncActuatorNode {
   /// Frames waiting at the interface: commands are buffered until their instant.
   void on_receive() { inner_.on_receive(); }
 
+  /// Accepts commands from `controller` only.
+  constexpr void expect_source(std::uint8_t controller) { inner_.expect_source(controller); }
+  /// Accepts commands in [u_min, u_max] only (the actuator's range from the design).
+  constexpr void set_command_range(const Vector<S, M>& u_min, const Vector<S, M>& u_max) {
+    inner_.set_command_range(u_min, u_max);
+  }
+
   /// First timer interrupt (k = 0, no command exists yet): asks for sample 1, due at t_1.
   void start(McuInstant t_1) { request(1, t_1); }
 
@@ -45,7 +54,7 @@ class SyncActuatorNode {
   constexpr bool take_output(Vector<S, M>& u) { return inner_.take_output(u); }
   /// The input in force (what the next request echoes).
   constexpr const Vector<S, M>& applied() const { return inner_.applied(); }
-  /// Counters: applied commands, late periods (held value), …
+  /// Counters: applied commands, late periods (held value), refusals by cause, …
   constexpr const ActuatorStatistics& statistics() const { return inner_.statistics(); }
   /// Requests the interface refused.
   constexpr std::uint32_t refused() const { return refused_; }

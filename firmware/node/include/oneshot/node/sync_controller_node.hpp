@@ -5,7 +5,13 @@
 ///     x̂_k = estimator(τ_k, y_s,k, u applied at t_{k−1}),   u_k = u_ref,k − L (x̂_k − x_ref,k),
 /// clamped to the actuator's range (counted). The estimator is a plug-in (sync_estimators.hpp);
 /// the reference gives x_ref,k and u_ref,k for the instant the command targets. Reports
-/// that are not newer than the last one are counted and dropped.
+/// that are not newer than the last one are counted and dropped. Reports are untrusted
+/// (frame_checks.hpp): from another node than the expected sensor (once set), with a
+/// non-finite y or echo, y, echo or τ outside their ranges (once set), or beyond the
+/// sequence window they are refused and counted; a restarted actuator's new k is
+/// re-acquired on the R-th report. The estimator never leaves a non-finite estimate (its
+/// update() resets it and returns Status::kNonFinite, counted): no command is sent then,
+/// and a command that is not finite is never sent (the actuator holds its value).
 #pragma once
 
 #include <cstddef>
@@ -13,18 +19,21 @@
 
 #include "oneshot/hal/network_contract.hpp"
 #include "oneshot/node/actuation_sync_messages.hpp"
+#include "oneshot/node/frame_checks.hpp"
 #include "oneshot/node/square_wave_reference.hpp"
 #include "oneshot/status.hpp"
 
 namespace oneshot::node {
 
-/// Counters of a synchronized controller.
-struct SyncControllerStatistics {
+/// Counters of a synchronized controller (refusals by cause in the FrameRefusals part).
+struct SyncControllerStatistics : FrameRefusals {
   std::uint32_t received = 0;      ///< Reports decoded.
   std::uint32_t stale = 0;         ///< Not newer than the last one (dropped).
   std::uint32_t malformed = 0;     ///< Frames that did not decode.
   std::uint32_t computations = 0;  ///< Estimator runs.
   std::uint32_t faults = 0;        ///< Estimator runs whose status was not exact.
+  std::uint32_t estimator_resets = 0;  ///< Estimator runs that turned non-finite (reset, no command).
+  std::uint32_t withheld = 0;      ///< Commands not sent because they were not finite.
   std::uint32_t saturated = 0;     ///< Commands clamped to the actuator's range.
   std::uint32_t sends = 0;         ///< Commands sent.
   std::uint32_t refused = 0;       ///< Sends the interface refused.
@@ -57,20 +66,42 @@ class SyncControllerNode {
         continue;
       }
       ++stats_.received;
-      if (any_ && !seq_newer(r.k, last_k_)) {
-        ++stats_.stale;
+      if (!source_.check(source, stats_) || !check_payload(r.y, y_range_, stats_) ||
+          !check_payload(r.u_applied, echo_range_, stats_))
+        continue;
+      if (r.tau_us < tau_min_us_ || r.tau_us > tau_max_us_) {
+        ++stats_.refused_out_of_range;
         continue;
       }
-      any_ = true;
-      last_k_ = r.k;
+      const SequenceVerdict v = gate_.offer(r.k);
+      if (v == SequenceVerdict::kStale) ++stats_.stale;
+      if (!count_sequence(v, stats_)) continue;
       compute(r, now);
     }
+  }
+
+  /// Accepts reports from `sensor` only.
+  constexpr void expect_source(std::uint8_t sensor) { source_.set(sensor); }
+  /// Accepts samples y in [y_min, y_max] only (the sensor's range from the design).
+  constexpr void set_measurement_range(const Vector<S, P>& y_min, const Vector<S, P>& y_max) {
+    y_range_ = ValueRange<S, P>(y_min, y_max);
+  }
+  /// Accepts echoes in the actuator's range [u_min, u_max] given at construction.
+  constexpr void check_echo_range() { echo_range_ = ValueRange<S, M>(u_min_, u_max_); }
+  /// Accepts τ_k in [tau_min_us, tau_max_us] only (the horizon the design covers).
+  constexpr void set_tau_range(std::int32_t tau_min_us, std::int32_t tau_max_us) {
+    tau_min_us_ = tau_min_us;
+    tau_max_us_ = tau_max_us;
+  }
+  /// Sequence window W and re-acquisition count R (frame_checks.hpp).
+  constexpr void set_sequence_window(std::uint32_t window, std::uint32_t reacquire) {
+    gate_ = SequenceGate(window, reacquire);
   }
 
   /// The estimator (reset, covariance, …).
   constexpr Estimator& estimator() { return estimator_; }
   /// Period index of the last report used (valid after the first).
-  constexpr SequenceNumber last_k() const { return last_k_; }
+  constexpr SequenceNumber last_k() const { return gate_.last(); }
   /// The last command sent.
   constexpr const Vector<S, M>& last_command() const { return u_; }
   /// Counters.
@@ -79,8 +110,18 @@ class SyncControllerNode {
  private:
   void compute(const Report& r, McuInstant now) {
     ++stats_.computations;
-    if (!is_exact(estimator_.update(r.tau_us, r.y, r.u_applied))) ++stats_.faults;
-    u_ = reference_.input(r.k) - l_ * (estimator_.estimate() - reference_.state(r.k));
+    const Status st = estimator_.update(r.tau_us, r.y, r.u_applied);
+    if (!is_exact(st)) ++stats_.faults;
+    if (st == Status::kNonFinite) {
+      ++stats_.estimator_resets;
+      return;
+    }
+    const Vector<S, M> u = reference_.input(r.k) - l_ * (estimator_.estimate() - reference_.state(r.k));
+    if (!all_finite(u)) {
+      ++stats_.withheld;
+      return;
+    }
+    u_ = u;
     if (saturate(u_, u_min_, u_max_)) ++stats_.saturated;
     Command c;
     c.seq = r.k;
@@ -102,8 +143,12 @@ class SyncControllerNode {
   Estimator estimator_;
   Reference reference_;
   Vector<S, M> u_{};
-  SequenceNumber last_k_ = 0;
-  bool any_ = false;
+  std::int32_t tau_min_us_ = INT32_MIN;
+  std::int32_t tau_max_us_ = INT32_MAX;
+  SequenceGate gate_{};
+  ExpectedSource source_{};
+  ValueRange<S, P> y_range_{};
+  ValueRange<S, M> echo_range_{};
   SyncControllerStatistics stats_{};
 };
 

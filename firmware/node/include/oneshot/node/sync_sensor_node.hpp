@@ -5,6 +5,10 @@
 /// The board samples; the node says when. With late sampling (approach AKl) the sensor
 /// waits until t_k − D, D the worst τ_sc + τ_c + τ_ca, so the prediction horizon is D
 /// instead of h − τ_as; a request arriving after t_k − D is sampled at once.
+/// Requests are untrusted (frame_checks.hpp): from another node than the expected actuator
+/// (once set), with a non-finite or out-of-range echo, beyond the sequence window, or with
+/// t_k more than the stamp window ahead of the sensor's clock (once set) they are refused
+/// and counted; a restarted actuator (k from 0 again) is re-acquired on its R-th request.
 #pragma once
 
 #include <cstddef>
@@ -12,11 +16,12 @@
 
 #include "oneshot/hal/network_contract.hpp"
 #include "oneshot/node/actuation_sync_messages.hpp"
+#include "oneshot/node/frame_checks.hpp"
 
 namespace oneshot::node {
 
-/// Counters of a synchronized sensor.
-struct SyncSensorStatistics {
+/// Counters of a synchronized sensor (refusals by cause in the FrameRefusals part).
+struct SyncSensorStatistics : FrameRefusals {
   std::uint32_t requests = 0;   ///< Requests decoded.
   std::uint32_t stale = 0;      ///< Requests not newer than the pending or last one (dropped).
   std::uint32_t malformed = 0;  ///< Frames that did not decode.
@@ -47,13 +52,15 @@ class SyncSensorNode {
         continue;
       }
       ++stats_.requests;
-      if (any_ && !seq_newer(r.k, last_k_)) {
-        ++stats_.stale;
+      if (!source_.check(source, stats_) || !check_payload(r.u_applied, echo_range_, stats_)) continue;
+      if (lead_us_ >= 0 && r.t_k - now > lead_us_) {  // t_k too far ahead of the sensor's clock
+        ++stats_.refused_sequence;
         continue;
       }
+      const SequenceVerdict v = gate_.offer(r.k);
+      if (v == SequenceVerdict::kStale) ++stats_.stale;
+      if (!count_sequence(v, stats_)) continue;
       pending_ = r;
-      last_k_ = r.k;
-      any_ = true;
       have_pending_ = true;
       due = true;
     }
@@ -86,6 +93,20 @@ class SyncSensorNode {
     return true;
   }
 
+  /// Accepts requests from `actuator` only.
+  constexpr void expect_source(std::uint8_t actuator) { source_.set(actuator); }
+  /// Accepts echoes in [u_min, u_max] only (the actuator's range from the design).
+  constexpr void set_echo_range(const Vector<S, M>& u_min, const Vector<S, M>& u_max) {
+    echo_range_ = ValueRange<S, M>(u_min, u_max);
+  }
+  /// Refuses requests whose t_k is more than `lead_us` ≥ 0 ahead of the sensor's clock
+  /// (a request is sent one period h before its t_k: a few h is the documented window).
+  constexpr void set_stamp_window(std::int32_t lead_us) { lead_us_ = lead_us; }
+  /// Sequence window W and re-acquisition count R (frame_checks.hpp).
+  constexpr void set_sequence_window(std::uint32_t window, std::uint32_t reacquire) {
+    gate_ = SequenceGate(window, reacquire);
+  }
+
   /// Counters.
   constexpr const SyncSensorStatistics& statistics() const { return stats_; }
 
@@ -93,9 +114,11 @@ class SyncSensorNode {
   std::uint8_t controller_;
   std::int32_t late_us_;
   ActuationRequest<S, M> pending_{};
-  SequenceNumber last_k_ = 0;
-  bool any_ = false;
   bool have_pending_ = false;
+  std::int32_t lead_us_ = -1;  // < 0: t_k unchecked
+  SequenceGate gate_{};
+  ExpectedSource source_{};
+  ValueRange<S, M> echo_range_{};
   SyncSensorStatistics stats_{};
 };
 

@@ -8,11 +8,16 @@
 /// held is a duplicate (the first copy stays). Packets may arrive in any order. Step k
 /// takes stamp n = k − T_hold out of the ring (γ_n = whether it was there) and frees its
 /// slot for stamp k. Stamps are 32-bit sequence numbers compared as serial numbers, so the
-/// step counter may wrap. No heap, no exceptions: it runs on an MCU.
+/// step counter may wrap. A value that is not finite is refused and counted (the buffer
+/// never hands the filter NaN or ±∞); the stamp window itself is the sequence check (the
+/// buffer's own step count is the reference, so no sender can move it). No heap, no
+/// exceptions: it runs on an MCU.
 #pragma once
 
 #include <cstddef>
 #include <cstdint>
+
+#include "oneshot/finite.hpp"
 
 namespace oneshot::node {
 
@@ -22,6 +27,7 @@ enum class ArrivalVerdict : std::uint8_t {
   kDuplicate,    ///< Its stamp is already held: ignored.
   kOverDelayed,  ///< Older than the window (j < k − T_hold): dropped, γ_j = 0.
   kFuture,       ///< Stamp not yet sampled (j ≥ k): refused.
+  kNonFinite,    ///< A value is NaN or ±∞: refused.
 };
 
 /// Counters of a ThresholdBuffer.
@@ -30,6 +36,7 @@ struct ThresholdBufferCounts {
   std::uint32_t duplicates = 0;    ///< Second copies ignored.
   std::uint32_t over_delayed = 0;  ///< Packets older than the window.
   std::uint32_t future = 0;        ///< Packets stamped in the future.
+  std::uint32_t refused_non_finite = 0;  ///< Packets with a NaN or ±∞ value.
   std::uint32_t taken = 0;         ///< Stamps the anchor consumed present (γ = 1).
   std::uint32_t missed = 0;        ///< Stamps the anchor consumed absent (γ = 0).
 };
@@ -48,6 +55,10 @@ class ThresholdBuffer {
 
   /// Offers the packet stamped `stamp` with value `y` (between steps).
   constexpr ArrivalVerdict receive(std::uint32_t stamp, const Y& y) {
+    if (!all_finite(y)) {
+      ++counts_.refused_non_finite;
+      return ArrivalVerdict::kNonFinite;
+    }
     // age = k − j as a serial-number difference: 1 … T_hold is the window.
     const auto age = static_cast<std::int32_t>(next_ - stamp);
     if (age <= 0) {

@@ -1,0 +1,103 @@
+/// @file petc_validation_test.cpp
+/// @brief The PETC controller node refuses NaN and out-of-window arrivals (issue 24): the
+///        NUMRE estimate stays finite, a forged far-future period neither stalls the node
+///        (no 2^31-period prediction) nor stops later arrivals, a restarted sensor is
+///        re-acquired on its R-th arrival, and a non-finite correction resets the NUMRE.
+#include <gtest/gtest.h>
+
+#include <cstdint>
+#include <limits>
+
+#include "oneshot/node/disturbance_observer.hpp"
+#include "oneshot/node/interlaced_controller.hpp"
+#include "oneshot/node/petc_controller.hpp"
+
+namespace oneshot::node {
+namespace {
+
+using Law = InterlacedController<double, 1, 2>;
+using Petc = PetcController<double, 2, 8, Law, ModelDisturbance<double>>;
+
+NumreModel<double, 2> model() {
+  NumreModel<double, 2> m{};
+  m.a(0, 0) = 0.9;
+  m.a(0, 1) = 0.1;
+  m.a(1, 1) = 0.8;
+  m.b[1] = 0.1;
+  m.b_w[1] = 1;
+  m.c[0] = 1;
+  m.w = 1e-4;
+  m.v = 1e-3;
+  return m;
+}
+
+Petc make() {
+  InterlacedConfig<double, 1, 2> c{};
+  c.feedthrough = 0.5;
+  c.ratio = 2;
+  return Petc(model(), NoiseAccumulation::kSum, Law(c), ModelDisturbance<double>{},
+              MtmTrigger<double, 1>(0.01, 1e-4, 4, 0), 0.3);
+}
+
+bool finite_state(const Petc& p) {
+  for (std::size_t l = 0; l < Petc::kEntries; ++l)
+    if (!is_finite(p.packet()[l])) return false;
+  return all_finite(p.estimator().state()) && all_finite(p.estimator().covariance());
+}
+
+TEST(PetcValidation, NanArrivalsRefusedEstimateFinite) {
+  Petc p = make();
+  for (std::uint32_t k = 0; k < 20; ++k) static_cast<void>(p.on_arrival(k, 0.01 * k));
+  const std::uint32_t sent_at = p.packet_start();
+  for (std::uint32_t k = 20; k < 80; ++k) EXPECT_EQ(p.on_arrival(k, std::numeric_limits<double>::quiet_NaN()), SendCause::kNone);
+  EXPECT_TRUE(finite_state(p));
+  EXPECT_EQ(p.packet_start(), sent_at);
+  // Genuine arrivals after the NaN burst are used (the MTM safety k_max = 4 sends).
+  for (std::uint32_t k = 80; k < 90; ++k) static_cast<void>(p.on_arrival(k, 0.1));
+  EXPECT_TRUE(finite_state(p));
+  EXPECT_GE(p.packet_start(), 85U);
+  EXPECT_EQ(p.statistics().refused_non_finite, 60U);
+}
+
+TEST(PetcValidation, ForgedFuturePeriodAndRestartedSensor) {
+  Petc p = make();
+  for (std::uint32_t k = 0; k < 20; ++k) static_cast<void>(p.on_arrival(k, 0.05));
+  // One arrival 2^31 − 2^16 periods ahead: refused at once (no prediction over it).
+  EXPECT_EQ(p.on_arrival(20U + (1U << 31) - (1U << 16), 0.05), SendCause::kNone);
+  for (std::uint32_t k = 20; k < 30; ++k) static_cast<void>(p.on_arrival(k, 0.05));
+  EXPECT_GE(p.packet_start(), 25U);
+  EXPECT_EQ(p.estimator().last_multiplicity(), 1U);  // the last arrival predicted one period
+  // The sensor restarts: periods from 0 again, re-acquired on the R-th arrival.
+  const std::uint32_t before = p.packet_start();
+  for (std::uint32_t k = 0; k + 1 < kDefaultReacquireFrames; ++k) EXPECT_EQ(p.on_arrival(k, 0.05), SendCause::kNone);
+  static_cast<void>(p.on_arrival(kDefaultReacquireFrames - 1, 0.05));
+  for (std::uint32_t k = kDefaultReacquireFrames; k < 12; ++k) static_cast<void>(p.on_arrival(k, 0.05));
+  EXPECT_NE(p.packet_start(), before);
+  EXPECT_LT(p.packet_start(), 12U);
+  EXPECT_TRUE(finite_state(p));
+  const auto& s = p.statistics();
+  EXPECT_EQ(s.refused_sequence, 1U);
+  EXPECT_EQ(s.reacquired, 1U);
+  EXPECT_EQ(s.stale, kDefaultReacquireFrames - 1);
+}
+
+TEST(PetcValidation, NonFiniteCorrectionResetsTheNumre) {
+  // GIVEN a NUMRE whose gain turns a huge (finite) measurement into an overflow
+  NumreModel<double, 2> m = model();
+  m.c[0] = 1e-3;  // K ≈ 1/c = 1000: K (y − C x̂) overflows for y ≈ 1.7e308
+  m.v = 1e-12;
+  NumreEstimator<double, 2> est(m, NoiseAccumulation::kSum);
+  Matrix<double, 2, 2> p0 = Matrix<double, 2, 2>::identity();
+  Vector<double, 2> x0;
+  x0[0] = 0.5;
+  est.reset(x0, p0);
+  EXPECT_EQ(est.correct(0.6), Status::kOk);
+  est.predict(0.0);
+  // WHEN y = 1.7e308 THEN the innovation overflows: reset to (x0, P0), kNonFinite
+  EXPECT_EQ(est.correct(1.7e308), Status::kNonFinite);
+  EXPECT_EQ(est.state()[0], 0.5);
+  EXPECT_EQ(est.covariance()(1, 1), 1.0);
+}
+
+}  // namespace
+}  // namespace oneshot::node
