@@ -172,6 +172,23 @@ RunResult run_synchronized(Harness& hs, Estimator est, std::int32_t late_us) {
   std::optional<Act> act(std::in_place, kSensor, InputVec{});
   std::optional<Sensor> sensor(std::in_place, kController, late_us);
   std::optional<Ctrl> ctrl(std::in_place, kActuator, l, hs.u_min_, hs.u_max_, est, hs.ref_);
+  // Frame checks as in the live run (ncs_live_nodes.hpp), again after every restart.
+  const auto check_sensor = [&]() {
+    sensor->expect_source(kActuator);
+    sensor->set_echo_range(hs.u_min_, hs.u_max_);
+    sensor->set_stamp_window(4 * hs.ctx_.period_us());
+  };
+  const auto check_ctrl = [&]() {
+    ctrl->expect_source(kSensor);
+    ctrl->check_echo_range();
+  };
+  const auto check_act = [&]() {
+    act->expect_source(kController);
+    act->set_command_range(hs.u_min_, hs.u_max_);
+  };
+  check_sensor();
+  check_ctrl();
+  check_act();
   std::uint64_t act_n0 = 0;  // timer index of the actuator's power-on (its k = n − n0)
   bool act_restarted = false;
   engine::Network& net = hs.net_;
@@ -205,15 +222,18 @@ RunResult run_synchronized(Harness& hs, Estimator est, std::int32_t late_us) {
   net.arm_faults({{"sensor",
                    [&]() {
                      sensor.emplace(kController, late_us);
+                     check_sensor();
                      hs.lose_inbox(kSensor);
                    }},
                   {"controller",
                    [&]() {
                      ctrl.emplace(kActuator, l, hs.u_min_, hs.u_max_, est, hs.ref_);
+                     check_ctrl();
                      hs.lose_inbox(kController);
                    }},
                   {"actuator", [&]() {
                      act.emplace(kSensor, InputVec{});
+                     check_act();
                      hs.lose_inbox(kActuator);
                      act_restarted = true;
                    }}});
@@ -255,6 +275,13 @@ RunResult run_sampling(Harness& hs, Law law, Saturated saturated) {
   std::optional<Sensor> sensor(std::in_place, kController, Trigger(1));
   std::optional<Ctrl> ctrl(std::in_place, kActuator, node::ControllerMode::kOnArrival, law);
   std::optional<Act> act(std::in_place, node::ActuatorMode::kOnArrival, InputVec{});
+  const auto check_ctrl = [&]() { ctrl->expect_source(kSensor); };  // samples: finite (the plant is not clamped)
+  const auto check_act = [&]() {
+    act->expect_source(kController);
+    act->set_command_range(hs.u_min_, hs.u_max_);
+  };
+  check_ctrl();
+  check_act();
   std::uint64_t sensor_n0 = 0;  // sample index of the sensor's power-on (its sequence = n − n0)
   bool sensor_restarted = false;
   engine::Network& net = hs.net_;
@@ -280,10 +307,12 @@ RunResult run_sampling(Harness& hs, Law law, Saturated saturated) {
                   {"controller",
                    [&]() {
                      ctrl.emplace(kActuator, node::ControllerMode::kOnArrival, law);
+                     check_ctrl();
                      hs.lose_inbox(kController);
                    }},
                   {"actuator", [&]() {
                      act.emplace(node::ActuatorMode::kOnArrival, InputVec{});
+                     check_act();
                      hs.lose_inbox(kActuator);
                    }}});
   auto timer_h = std::make_shared<HandlerId>(0);
