@@ -44,10 +44,11 @@ std::vector<double> sync_sensor_counters(const Sensor& s) {
 }
 
 /// Counter names of the synchronized controller (estimator resets: the estimate turned
-/// non-finite and was reset; withheld: a non-finite command was not sent).
+/// non-finite and was reset; withheld: a non-finite command was not sent; filled: periods
+/// without a report predicted over).
 inline std::vector<std::string> sync_controller_counter_names() {
   std::vector<std::string> n{"controller.malformed", "controller.stale", "controller.faults",
-                             "controller.estimator_resets", "controller.withheld"};
+                             "controller.estimator_resets", "controller.withheld", "controller.filled"};
   const auto r = refusal_counter_names("controller");
   n.insert(n.end(), r.begin(), r.end());
   return n;
@@ -57,7 +58,7 @@ template <typename Controller>
 std::vector<double> sync_controller_counters(const Controller& c) {
   const auto& st = c.statistics();
   std::vector<double> v{double(st.malformed), double(st.stale), double(st.faults), double(st.estimator_resets),
-                        double(st.withheld)};
+                        double(st.withheld), double(st.filled)};
   const auto r = refusal_counters(st);
   v.insert(v.end(), r.begin(), r.end());
   return v;

@@ -136,7 +136,7 @@ ReplayResult replay_live(const std::string& dir, bool ideal_instants) {
     using Ctrl = node::SyncControllerNode<Board, Est, Ref, double, kN, kP, kM>;
     std::optional<Ctrl> ctrl(std::in_place, kLiveActuator, design.l, u_min, u_max, est, ref);
     check_requests(*ctx, *sensor);
-    check_reports(*ctrl);
+    check_reports(*ctx, *ctrl);
     check_commands(*ctx, *act);
     std::uint32_t n0 = 0;  // the actuator's power-on timer index (as in the live actuator)
     bool fresh = false;
@@ -159,7 +159,7 @@ ReplayResult replay_live(const std::string& dir, bool ideal_instants) {
         }
         if (v.node == kLiveController) {
           ctrl.emplace(kLiveActuator, design.l, u_min, u_max, est, ref);
-          check_reports(*ctrl);
+          check_reports(*ctx, *ctrl);
         }
         if (v.node == kLiveActuator) {
           act.emplace(kLiveSensor, InputVec{});

@@ -254,7 +254,7 @@ int controller_loop(const LiveRun& r, const Context& ctx, Est est, int net_fd, c
   }
   using Ctrl = node::SyncControllerNode<Board, Est, Ref, double, kN, kP, kM>;
   std::optional<Ctrl> ctrl(std::in_place, kLiveActuator, d.l, u_min, u_max, est, reference(ctx, r.scenario));
-  check_reports(*ctrl);
+  check_reports(ctx, *ctrl);
   Restarts restarts(r, "controller");
   double restarted = 0;
   engine::RandomStream compute = engine::Kernel(r.seed).stream("compute");
@@ -264,7 +264,7 @@ int controller_loop(const LiveRun& r, const Context& ctx, Est est, int net_fd, c
     if (restarts.due(c.now())) {
       drain(net_fd);
       ctrl.emplace(kLiveActuator, d.l, u_min, u_max, est, reference(ctx, r.scenario));
-      check_reports(*ctrl);
+      check_reports(ctx, *ctrl);
       ++restarted;
       log.write("restart", c.now(), clock_us(c.now()), 0, kLiveController, 0);
       continue;

@@ -181,6 +181,8 @@ RunResult run_synchronized(Harness& hs, Estimator est, std::int32_t late_us) {
   const auto check_ctrl = [&]() {
     ctrl->expect_source(kSensor);
     ctrl->check_echo_range();
+    ctrl->set_tau_range(0, hs.ctx_.period_us());
+    ctrl->set_period_us(hs.ctx_.period_us());
   };
   const auto check_act = [&]() {
     act->expect_source(kController);

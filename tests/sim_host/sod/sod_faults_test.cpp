@@ -68,10 +68,15 @@ TEST(SodFaults, FaultedFramesAreRefusedCountedAndTheEstimateStaysFinite) {
     }
     EXPECT_TRUE(std::isfinite(r.nees)) << c.spec;
     EXPECT_EQ(r.estimator_resets, 0) << c.spec;
-    if (c.nan_refused) EXPECT_EQ(r.refused_non_finite, static_cast<double>(r.injected.nan)) << c.spec;
-    if (c.seq_refused)
+    if (c.nan_refused) {
+      EXPECT_EQ(r.refused_non_finite, static_cast<double>(r.injected.nan)) << c.spec;
+    }
+    if (c.seq_refused) {
       EXPECT_EQ(r.refused_sequence, static_cast<double>(r.injected.replay + r.injected.forge_seq)) << c.spec;
-    if (!c.nan_refused && !c.seq_refused) EXPECT_EQ(r.refused_sequence + r.refused_non_finite, 0) << c.spec;
+    }
+    if (!c.nan_refused && !c.seq_refused) {
+      EXPECT_EQ(r.refused_sequence + r.refused_non_finite, 0) << c.spec;
+    }
   }
 }
 
