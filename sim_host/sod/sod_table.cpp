@@ -77,15 +77,15 @@ nlohmann::json run_table(const SodModel& model, const StudyOptions& opt) {
   spec.first_seed = opt.seed;
   spec.seeds = opt.seeds;
   spec.metrics = kMetrics;
-  if (!opt.faults.empty()) {  // only then: the clean table's spec (and its shards) stay as they were
-    spec.config["inject"] = opt.faults.text;
-    for (const auto& m : kFaultMetrics) spec.metrics.push_back(m);
-  }
   spec.config = {{"plant", model.plant_name},
                  {"delta_y", opt.delta_y}, {"mu", opt.mu}, {"amplitude", opt.amplitude}, {"steps", opt.steps},
                  {"period_s", model.period_s()},
                  {"mean_gap_s", {g.mean_s[0], g.mean_s[1]}},
                  {"scenarios", scen}};
+  if (!opt.faults.empty()) {  // only then: the clean table's spec (and its shards) stay as they were
+    spec.config["inject"] = opt.faults.text;
+    for (const auto& m : kFaultMetrics) spec.metrics.push_back(m);
+  }
   const engine::SweepResults r = engine::run_sweep(spec, opt.shard, opt.threads,
       [&](std::size_t a, std::size_t s, std::uint64_t seed) {
         RunConfig cfg;
