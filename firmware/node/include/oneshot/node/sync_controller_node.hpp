@@ -19,11 +19,13 @@
 /// is n = round((t_k − t_last)/h) ≥ 2 periods after the last one first runs
 /// estimator.skip(u) for the n − 1 periods between (none when more than kMaxFilledPeriods:
 /// a long silence), u the report's echo: the input the actuator held at t_k − h (its last
-/// command that arrived, or what a restarted actuator applies; never a lost command).
-/// Without this the filter would take the new sample as one period after the last and carry
-/// a period's drift for many periods. The reference is read on the same time base (x_ref,
-/// u_ref at an index that moves by n per report from the first report's k), not at the
-/// report's k: a restarted actuator's k from 0 does not move the reference back to its start.
+/// command that arrived, or what a restarted actuator applies; never a lost command). The
+/// controller's own clock checks n: when the count of its receive instants differs by more
+/// than one, the stamp is wrong and that count is taken. Without this the filter would take
+/// the new sample as one period after the last and carry a period's drift for many periods.
+/// The reference is read on the same time base (x_ref, u_ref at an index that moves by n
+/// per report from the first report's k), not at the report's k: a restarted actuator's k
+/// from 0 does not move the reference back to its start.
 #pragma once
 
 #include <cstddef>
@@ -54,8 +56,6 @@ struct SyncControllerStatistics : FrameRefusals {
 
 /// Most periods without a report one report fills in (more: none, the estimator's correction alone).
 inline constexpr std::int32_t kMaxFilledPeriods = 64;
-/// Most periods between two reports the reference index follows (more: a wrong stamp, one period).
-inline constexpr std::int32_t kMaxReferencePeriods = 1 << 20;
 
 /// Controller of N states, P outputs, M inputs in scalar S on board `Board`.
 template <typename Board, typename Estimator, typename Reference, typename S, std::size_t N, std::size_t P,
@@ -128,23 +128,32 @@ class SyncControllerNode {
   constexpr const SyncControllerStatistics& statistics() const { return stats_; }
 
  private:
+  // round(dt / h) (µs; in 64 bits: no overflow at any dt).
+  constexpr std::int32_t periods(std::int32_t dt) const {
+    const std::int64_t h = period_us_;
+    const std::int64_t d = dt;
+    return static_cast<std::int32_t>(d >= 0 ? (d + h / 2) / h : -((-d + h / 2) / h));
+  }
+
   // Periods between the last report's t_k and this one's: predicts the estimator over the
   // missing ones and moves the reference index by as many (false: the estimator was reset).
-  [[nodiscard]] bool fill_gap(const Report& r) {
+  [[nodiscard]] bool fill_gap(const Report& r, McuInstant now) {
     const McuInstant t_k = r.t_s.plus(r.tau_us);
     const bool had = have_t_k_;
     const std::int32_t dt = t_k - last_t_k_;
+    const std::int32_t dt_own = now - last_now_;
     last_t_k_ = t_k;
+    last_now_ = now;
     have_t_k_ = true;
     if (period_us_ == 0 || !had) {
       ref_k_ = r.k;
       return true;
     }
-    const std::int32_t n = dt / period_us_ + ((dt % period_us_) * 2 >= period_us_ ? 1 : 0);
-    if (n < 1 || n > kMaxReferencePeriods) {  // a wrong stamp: one period
-      ++ref_k_;
-      return true;
-    }
+    // The stamps give n exactly; the controller's own clock (jittered by the delays) checks
+    // them: a stamp more than one period off its count is wrong, the own count is taken.
+    std::int32_t n = periods(dt);
+    const std::int32_t n_own = periods(dt_own);
+    if (n < 1 || n - n_own > 1 || n_own - n > 1) n = n_own < 1 ? 1 : n_own;
     ref_k_ += static_cast<SequenceNumber>(n);
     if (n - 1 > kMaxFilledPeriods) return true;  // a long silence: the correction alone
     for (std::int32_t i = 1; i < n; ++i) {
@@ -158,7 +167,7 @@ class SyncControllerNode {
   }
 
   void compute(const Report& r, McuInstant now) {
-    if (!fill_gap(r)) return;
+    if (!fill_gap(r, now)) return;
     ++stats_.computations;
     const Status st = estimator_.update(r.tau_us, r.y, r.u_applied);
     if (!is_exact(st)) ++stats_.faults;
@@ -195,6 +204,7 @@ class SyncControllerNode {
   Vector<S, M> u_{};
   std::int32_t period_us_ = 0;
   McuInstant last_t_k_{};
+  McuInstant last_now_{};
   SequenceNumber ref_k_ = 0;
   bool have_t_k_ = false;
   std::int32_t tau_min_us_ = INT32_MIN;
