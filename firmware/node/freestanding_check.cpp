@@ -62,6 +62,10 @@ void exercise() {
   ControllerNode<NullBoard, ProportionalLaw<S>, S, 1, 1> ctrl(3, ControllerMode::kOnArrival,
                                                             ProportionalLaw<S>{oneshot::ScalarTraits<S>::one()});
   ActuatorNode<NullBoard, S, 1> act(ActuatorMode::kOnTimer, V{});
+  ctrl.expect_source(1);
+  ctrl.set_measurement_range(V{}, V{});
+  ctrl.set_sequence_window(64, 3);
+  act.set_sequence_window(64, 3);
   const oneshot::McuInstant now(7);
   sod.on_sample(0, now, delta);
   periodic.on_sample(0, now, delta);
@@ -100,14 +104,24 @@ void exercise_sync() {
   const Vector<S, 1> hi{};
   const McuInstant now(7);
   SyncActuatorNode<NullBoard, S, 1> act(1, lo);
+  act.expect_source(3);
+  act.set_command_range(lo, hi);
   act.start(now);
   act.on_receive();
   act.on_timer(1, now);
   SyncSensorNode<NullBoard, S, 2, 1> sensor(2, 5000);
+  sensor.expect_source(1);
+  sensor.set_echo_range(lo, hi);
+  sensor.set_stamp_window(200000);
+  sensor.set_sequence_window(64, 3);
   McuInstant at;
   if (sensor.on_receive(now, at)) sensor.on_sample(at, Vector<S, 2>{});
   SyncControllerNode<NullBoard, HalfKalmanEstimator<Fmt, Structure, Disc>, Ref, S, 2, 2, 1> ak(
       3, design.l, lo, hi, HalfKalmanEstimator<Fmt, Structure, Disc>(design, disc, NoiseModel::kExact), ref);
+  ak.expect_source(2);
+  ak.set_measurement_range(Vector<S, 2>{}, Vector<S, 2>{});
+  ak.check_echo_range();
+  ak.set_tau_range(0, 50000);
   ak.on_receive(now);
   SyncControllerNode<NullBoard, SampledStatePredictor<Fmt, Structure, Disc>, Ref, S, 2, 2, 1> a(
       3, design.l, lo, hi, SampledStatePredictor<Fmt, Structure, Disc>(disc), ref);

@@ -185,7 +185,8 @@ struct Nodes {
       }
       case 3: {
         const host::ScopedHostNetwork cur(a_net);
-        act.on_timer(++timer_k, McuInstant(timer_k * 50'000U));
+        ++timer_k;
+        act.on_timer(timer_k, McuInstant(timer_k * 50'000U));
         break;
       }
       case 4: {

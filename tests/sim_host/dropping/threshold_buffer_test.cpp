@@ -2,10 +2,25 @@
 /// @brief The threshold ring: window, over-delay, duplicates, reordering, future stamps, wrap.
 #include <gtest/gtest.h>
 
+#include <limits>
+
 #include "oneshot/node/threshold_buffer.hpp"
 
 namespace oneshot::node {
 namespace {
+
+TEST(ThresholdBuffer, NonFiniteValuesAreRefusedAndCounted) {
+  // A NaN in the window never reaches the filter: refused, the slot stays free for the genuine copy.
+  ThresholdBuffer<double, 3> b;
+  double y = 0;
+  for (int i = 0; i < 3; ++i) static_cast<void>(b.advance(false, y));
+  EXPECT_EQ(b.receive(1, std::numeric_limits<double>::quiet_NaN()), ArrivalVerdict::kNonFinite);
+  EXPECT_EQ(b.receive(1, std::numeric_limits<double>::infinity()), ArrivalVerdict::kNonFinite);
+  EXPECT_EQ(b.receive(1, 0.5), ArrivalVerdict::kStored);
+  EXPECT_TRUE(b.holds(1, y));
+  EXPECT_EQ(y, 0.5);
+  EXPECT_EQ(b.counts().refused_non_finite, 2U);
+}
 
 TEST(ThresholdBuffer, WindowReorderDuplicatesOverDelayFuture) {
   ThresholdBuffer<int, 3> b;  // before step 0: window empty, everything is future

@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <limits>
 
 #include "oneshot/engine/loss_model.hpp"
 #include "oneshot/engine/random_stream.hpp"
@@ -88,8 +89,11 @@ TEST(SodDetector, ReceiverBuildsHeldVarianceInClosedForm) {
   const std::uint32_t n_t[2] = {10, 0};
   oneshot::node::HeldMeasurementReceiver<double, 2> rx(dy, r, n_t, oneshot::node::SilencePolicy::kHeld);
   EXPECT_FALSE(rx.measurement(0, 0).present);  // nothing to hold yet
-  rx.on_packet(0, 3, 1.5);
-  rx.on_packet(1, 3, -2.0);
+  EXPECT_FALSE(rx.on_packet(0, 3, std::numeric_limits<double>::quiet_NaN()));  // refused, counted
+  EXPECT_FALSE(rx.measurement(0, 3).present);
+  EXPECT_EQ(rx.refusals().refused_non_finite, 1U);
+  EXPECT_TRUE(rx.on_packet(0, 3, 1.5));
+  EXPECT_TRUE(rx.on_packet(1, 3, -2.0));
   auto m = rx.measurement(0, 3);
   EXPECT_TRUE(m.present && m.arrived);
   EXPECT_EQ(m.z, 1.5);

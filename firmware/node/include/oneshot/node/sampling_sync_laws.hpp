@@ -15,6 +15,7 @@
 #include <cstddef>
 #include <cstdint>
 
+#include "oneshot/finite.hpp"
 #include "oneshot/node/message.hpp"
 #include "oneshot/node/square_wave_reference.hpp"
 #include "oneshot/standard_kalman.hpp"
@@ -57,9 +58,16 @@ class PeriodicKalmanLaw {
   /// Commands clamped.
   constexpr std::uint32_t saturated() const { return saturated_; }
   /// Corrects with y_k (after predicting over h with the last command), u_k from x̂_k.
+  /// A non-finite x̂ or P resets the filter to x̂ = 0, the design's P0, u = 0 (counted in
+  /// resets()) and sends nothing for this sample.
   bool compute(const Message<VectorPayload<S, kP>>& m, bool fresh, McuInstant, Vector<S, kM>& u) {
     if (!fresh) return false;
     if (!is_exact(filter_.update(0, m.payload.value))) ++faults_;
+    if (!all_finite(filter_.prediction()) || !all_finite(filter_.covariance())) {
+      filter_.reset(Vector<S, kN>{}, design_->p0, Vector<S, kM>{});
+      ++resets_;
+      return false;
+    }
     u = reference_.input(m.seq) - design_->l * (filter_.prediction() - reference_.state(m.seq));
     if (saturate(u, u_min_, u_max_)) ++saturated_;
     filter_.set_applied_input(u);
@@ -67,6 +75,8 @@ class PeriodicKalmanLaw {
   }
   /// Filter runs whose status was not exact.
   constexpr std::uint32_t faults() const { return faults_; }
+  /// Filter runs that turned non-finite (reset).
+  constexpr std::uint32_t resets() const { return resets_; }
 
  private:
   const typename Filter::Design* design_;
@@ -76,6 +86,7 @@ class PeriodicKalmanLaw {
   Reference reference_;
   std::uint32_t saturated_ = 0;
   std::uint32_t faults_ = 0;
+  std::uint32_t resets_ = 0;
 };
 
 /// State feedback with the previous command as an extra state (eq. 8's delay model).
