@@ -279,5 +279,40 @@ TEST(NcsLive, FaultedRunCompletesAndItsReplayReproducesIt) {
   std::filesystem::remove_all(o.out_dir);
 }
 
+/// Issue 24's live symptoms: NaN frames on every link and forged sequence numbers on the
+/// request and report links. Before the nodes refused them the run ended with "field
+/// 'live_cost' is not a finite number" (NaN) or a loop that stopped commanding (forged k).
+/// The run completes with a finite cost, every fault is refused and counted by the node it
+/// reaches, commands keep coming, and the replay reproduces the live cost.
+TEST(NcsLive, NanAndForgedSequenceFramesAreRefusedAndTheLoopGoesOn) {
+  LiveOptions o;
+  o.approach = Approach::kAK;
+  o.scenario = default_scenarios()[1];
+  o.scenario.duration_s = 2;
+  o.seed = 4;
+  o.inject = "nan:link=as,rate=0.05;nan:link=sc,rate=0.05;nan:link=ca,rate=0.05;forge_seq:link=as,at_s=0.5;"
+             "forge_seq:link=sc,at_s=1";
+  o.out_dir = test::fresh_dir("ncs_live", "nan_forged");
+  o.executable = ONESHOT_SIM_PATH;
+  const nlohmann::json j = run_live(o);
+  const double live = j.at("live_cost").get<double>();
+  EXPECT_TRUE(std::isfinite(live));
+  EXPECT_TRUE(std::isfinite(j.at("simulated_cost").get<double>()));
+  const auto& injected = j.at("faults_injected");
+  const auto& c = j.at("node_counters");
+  const double refused_nan = c.at("sensor.refused_non_finite").get<double>() +
+                             c.at("controller.refused_non_finite").get<double>() +
+                             c.at("actuator.refused_non_finite").get<double>();
+  EXPECT_GT(injected.at("nan").get<double>(), 0);
+  EXPECT_EQ(refused_nan, injected.at("nan").get<double>());  // every NaN refused where it arrives
+  EXPECT_EQ(injected.at("forge_seq").get<double>(), 2);
+  EXPECT_EQ(c.at("sensor.refused_sequence").get<double>() + c.at("controller.refused_sequence").get<double>(), 2);
+  EXPECT_EQ(c.at("controller.estimator_resets").get<double>(), 0);
+  // Commands go on: at most the refused frames' periods (and the timing's) held.
+  EXPECT_LT(j.at("late_commands").get<double>(), 0.25 * j.at("actuation_instants_expected").get<double>());
+  EXPECT_NEAR(j.at("replay_over_live").get<double>(), 1.0, 1e-12);
+  std::filesystem::remove_all(o.out_dir);
+}
+
 }  // namespace
 }  // namespace oneshot::ncs
