@@ -10,24 +10,16 @@
 #include <cstdint>
 #include <vector>
 
-#include "oneshot/generated/plant_tables.hpp"
 #include "oneshot/host/host_network.hpp"
 #include "oneshot/node/sync_controller_node.hpp"
 #include "oneshot/node/sync_estimators.hpp"
 #include "oneshot/table_discretizer.hpp"
+#include "sync_test_loop.hpp"
 
 namespace oneshot::node {
 namespace {
 
-using K = generated::PlantConstants<double>;
-using Structure = generated::PlantStructure;
-using Disc = TableDiscretizer<K::Format, Structure, double>;
-using Est = HalfKalmanEstimator<K::Format, Structure, Disc>;
-using Ref = SquareWaveReference<double, 2, 1>;
-using Ctrl = SyncControllerNode<host::HostNetwork, Est, Ref, double, 2, 1, 1>;
-constexpr std::uint8_t kSensor = 1;
-constexpr std::uint8_t kController = 2;
-constexpr std::uint8_t kActuator = 3;
+using namespace sync_test;  // NOLINT(google-build-using-namespace): the shared test loop
 constexpr std::uint32_t kH = 50'000;  // the generated plant's period (µs)
 constexpr std::int32_t kTau = 20'000;
 
@@ -55,15 +47,7 @@ struct GapLoop {
     return Ctrl(kActuator, K::kDesign.l, lo, hi, estimator(disc), Ref(0.5, 8, nx, nu));
   }
   void report(SequenceNumber k, std::uint32_t n, double y, double u) {
-    SampleReport<double, 1, 1> r;
-    r.k = k;
-    r.t_s = McuInstant(n * kH - static_cast<std::uint32_t>(kTau));
-    r.tau_us = kTau;
-    r.y[0] = y;
-    r.u_applied[0] = u;
-    std::uint8_t bytes[kMaxMessageBytes];
-    const std::size_t len = encode(r, bytes);
-    net.deliver(host::Frame{kSensor, kController, std::vector<std::uint8_t>(bytes, bytes + len)});
+    deliver_report(net, kSensor, k, McuInstant(n * kH - static_cast<std::uint32_t>(kTau)), kTau, y, u);
     const host::ScopedHostNetwork cur(net);
     ctrl.on_receive(McuInstant(n * kH - 5'000U));
   }

@@ -221,19 +221,26 @@ TEST(NcsLive, ShortRunLogsAreConsistentAndItsReplayReproducesTheCost) {
   std::filesystem::remove_all(o.out_dir);
 }
 
-/// A faulted live run: duplicates, bit flips, replays and restarts of two nodes. The run
-/// completes, the relay's injected frames and the restarts are counted, and the replay
-/// (recorded injected bytes, recorded restarts) gives the live cost again.
-TEST(NcsLive, FaultedRunCompletesAndItsReplayReproducesIt) {
+/// A 2 s live run of AK on scenario a0.2-T2-d14-s1 with seed `seed` and faults `inject`.
+LiveOptions faulted_run(std::uint64_t seed, const char* dir, const char* inject) {
   LiveOptions o;
   o.approach = Approach::kAK;
   o.scenario = default_scenarios()[1];
   o.scenario.duration_s = 2;
-  o.seed = 3;
-  o.inject = "dup:rate=0.1;flip:link=ca,rate=0.05;replay:link=sc,rate=0.1;restart:node=actuator,at_s=1;"
-             "restart:node=controller,at_s=1.5";
-  o.out_dir = test::fresh_dir("ncs_live", "faults");
+  o.seed = seed;
+  o.inject = inject;
+  o.out_dir = test::fresh_dir("ncs_live", dir);
   o.executable = ONESHOT_SIM_PATH;
+  return o;
+}
+
+/// A faulted live run: duplicates, bit flips, replays and restarts of two nodes. The run
+/// completes, the relay's injected frames and the restarts are counted, and the replay
+/// (recorded injected bytes, recorded restarts) gives the live cost again.
+TEST(NcsLive, FaultedRunCompletesAndItsReplayReproducesIt) {
+  const LiveOptions o = faulted_run(3, "faults",
+                                    "dup:rate=0.1;flip:link=ca,rate=0.05;replay:link=sc,rate=0.1;"
+                                    "restart:node=actuator,at_s=1;restart:node=controller,at_s=1.5");
   const nlohmann::json j = run_live(o);
   EXPECT_EQ(j.at("inject").get<std::string>(), o.inject);
   const auto& injected = j.at("faults_injected");
@@ -285,15 +292,9 @@ TEST(NcsLive, FaultedRunCompletesAndItsReplayReproducesIt) {
 /// The run completes with a finite cost, every fault is refused and counted by the node it
 /// reaches, commands keep coming, and the replay reproduces the live cost.
 TEST(NcsLive, NanAndForgedSequenceFramesAreRefusedAndTheLoopGoesOn) {
-  LiveOptions o;
-  o.approach = Approach::kAK;
-  o.scenario = default_scenarios()[1];
-  o.scenario.duration_s = 2;
-  o.seed = 4;
-  o.inject = "nan:link=as,rate=0.05;nan:link=sc,rate=0.05;nan:link=ca,rate=0.05;forge_seq:link=as,at_s=0.5;"
-             "forge_seq:link=sc,at_s=1";
-  o.out_dir = test::fresh_dir("ncs_live", "nan_forged");
-  o.executable = ONESHOT_SIM_PATH;
+  const LiveOptions o = faulted_run(4, "nan_forged",
+                                    "nan:link=as,rate=0.05;nan:link=sc,rate=0.05;nan:link=ca,rate=0.05;"
+                                    "forge_seq:link=as,at_s=0.5;forge_seq:link=sc,at_s=1");
   const nlohmann::json j = run_live(o);
   const double live = j.at("live_cost").get<double>();
   EXPECT_TRUE(std::isfinite(live));
