@@ -11,6 +11,7 @@
 #include <nlohmann/json.hpp>
 
 #include "ncs_model.hpp"
+#include "oneshot/engine/fault_spec.hpp"
 #include "oneshot/engine/sweep.hpp"
 
 namespace oneshot::ncs {
@@ -24,6 +25,7 @@ struct TableOptions {
   std::vector<Approach> approaches{kAllApproaches.begin(), kAllApproaches.end()};  ///< I must be first.
   std::vector<Scenario> scenarios;  ///< Scenarios (empty: the ten defaults, with duration_s).
   double duration_s = 20;          ///< Run length per default scenario.
+  engine::FaultSpec faults;        ///< Faults injected in every run (empty: clean).
 };
 
 /// Runs the table's sweep (or one shard of it).

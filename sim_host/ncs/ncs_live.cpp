@@ -40,6 +40,7 @@ nlohmann::json to_json(const LiveRun& r) {
             {"duration_s", s.duration_s}}},
           {"seed", r.seed},
           {"noise_free", r.noise_free},
+          {"inject", r.inject},
           {"t0_ns", r.t0_ns},
           {"ports",
            {{"relay", r.relay_port},
@@ -52,7 +53,8 @@ nlohmann::json to_json(const LiveRun& r) {
 LiveRun live_run_from_json(const nlohmann::json& j, const std::string& source) {
   using engine::InputError;
   try {
-    engine::require_keys(j, "run", {"dir", "plant_file", "approach", "scenario", "seed", "noise_free", "t0_ns", "ports"});
+    engine::require_keys(j, "run",
+                         {"dir", "plant_file", "approach", "scenario", "seed", "noise_free", "inject", "t0_ns", "ports"});
     LiveRun r;
     r.dir = engine::string_of(j, "run", "dir");
     const nlohmann::json& pf = engine::member(j, "run", "plant_file");
@@ -63,6 +65,11 @@ LiveRun live_run_from_json(const nlohmann::json& j, const std::string& source) {
     r.scenario = parse_scenarios(scen.dump(), source).at(0);
     r.seed = static_cast<std::uint64_t>(engine::integer_in(j, "run", "seed", 0, std::int64_t{1} << 62));
     r.noise_free = engine::boolean_of(j, "run", "noise_free", false);
+    if (j.contains("inject")) {
+      if (!j.at("inject").is_string()) throw InputError("field 'run.inject': must be a string (empty: no faults)");
+      r.inject = j.at("inject").get<std::string>();
+    }
+    engine::check_fault_targets(engine::parse_fault_spec(r.inject), link_names(r.approach), node_names());
     r.t0_ns = engine::integer_in(j, "run", "t0_ns", 0, std::int64_t{1} << 62);
     const nlohmann::json& p = engine::member(j, "run", "ports");
     engine::require_keys(p, "ports", {"relay", "plant", "sensor", "controller", "actuator"});
@@ -211,9 +218,21 @@ nlohmann::json analyse_live(const std::string& dir) {
   j["ideal_instants_cost"] = ideal.cost;
   j["live_over_ideal_instants"] = live_cost / ideal.cost;
   j["ideal_instants_late"] = ideal.late;
+  j["inject"] = run.inject;
+  j["node_counters"] = nlohmann::json::object();
+  for (const char* role : {"sensor", "controller", "actuator", "relay"}) {
+    std::ifstream in(dir + "/counters_" + role + ".json");
+    if (!in) continue;
+    std::ostringstream text;
+    text << in.rdbuf();
+    const nlohmann::json c = engine::parse_json_strict(text.str(), dir + "/counters_" + role + ".json");
+    for (const auto& [k, v] : c.items()) j[std::string(role) == "relay" ? "faults_injected" : "node_counters"][k] = v;
+  }
   RunOptions sim_options;
   sim_options.noise_free = run.noise_free;
-  j["simulated_cost"] = ncs::run(*ctx, run.approach, run.scenario, run.seed, sim_options).cost;  // the engine alone, same seed
+  sim_options.faults = engine::parse_fault_spec(run.inject);
+  // The engine alone, same seed and faults.
+  j["simulated_cost"] = ncs::run(*ctx, run.approach, run.scenario, run.seed, sim_options).cost;
   return j;
 }
 
@@ -223,10 +242,13 @@ nlohmann::json run_live(const LiveOptions& o) {
     throw std::invalid_argument(std::string("ncs live: approach ") + name(o.approach) + " is not actuation-synchronized (A, AK, AKx, AKl)");
   }
   (void)half_wave_periods(*ctx, o.scenario);
+  engine::check_fault_targets(engine::parse_fault_spec(o.inject), link_names(o.approach), node_names());
   sim::make_directory(o.out_dir);
   for (const char* role : {"plant", "sensor", "controller", "actuator", "relay"}) {
     std::filesystem::remove(std::filesystem::path(o.out_dir) / (std::string(role) + ".csv"));
+    std::filesystem::remove(std::filesystem::path(o.out_dir) / ("counters_" + std::string(role) + ".json"));
   }
+  std::filesystem::remove(std::filesystem::path(o.out_dir) / "injected.csv");
   LiveRun r;
   r.dir = o.out_dir;
   r.plant_file = o.plant_file;
@@ -234,6 +256,7 @@ nlohmann::json run_live(const LiveOptions& o) {
   r.scenario = o.scenario;
   r.seed = o.seed;
   r.noise_free = o.noise_free;
+  r.inject = o.inject;
   struct Sock {
     int fd;
     ~Sock() { if (fd >= 0) ::close(fd); }
@@ -319,7 +342,11 @@ void print_summary(const nlohmann::json& j) {
   std::printf("same draws at ideal instants (actuation at t_k, samples at t_s): cost %.9g, live/ideal %.6f (late %u)\n",
               j.at("ideal_instants_cost").get<double>(), j.at("live_over_ideal_instants").get<double>(),
               j.at("ideal_instants_late").get<unsigned>());
-  std::printf("the engine alone (same approach, scenario, seed, duration): cost %.9g\n", j.at("simulated_cost").get<double>());
+  std::printf("the engine alone (same approach, scenario, seed, duration, faults): cost %.9g\n", j.at("simulated_cost").get<double>());
+  if (!j.value("inject", std::string()).empty()) {
+    std::printf("faults injected (%s): %s\nnode counters: %s\n", j.at("inject").get<std::string>().c_str(),
+                j.value("faults_injected", nlohmann::json::object()).dump().c_str(), j.at("node_counters").dump().c_str());
+  }
 }
 
 std::string self_executable() {
@@ -350,6 +377,7 @@ void add_ncs_live_commands(CLI::App* study) {
     cmd->add_option("--seed", o->seed, "seed of the delay, noise and computation streams")->capture_default_str();
     cmd->add_option("--plant", o->plant_file, "plant file (default: lut_gen/plants/networked_board.json)")->check(CLI::ExistingFile);
     cmd->add_flag("--noise-free", o->noise_free, "no process or measurement noise");
+    cmd->add_option("--inject", o->inject, "faults, e.g. 'dup:link=sc,rate=0.05;restart:node=actuator,at_s=2' (docs/faults.md)");
     cmd->add_option("--out", o->out_dir, "output directory (logs, run.json, summary.json)")->capture_default_str();
     cmd->add_option("--json", *json, "write the summary as JSON to PATH, or '-' for standard output");
     cmd->callback([o, approach, scenario, scenario_file, duration, json]() {

@@ -15,6 +15,13 @@
 /// (t_ns since the common start t0, clock_us the node clock, doubles in %.17g).
 /// `replay` feeds the recorded instants, frames and noise draws back into the engine with
 /// the same node code and recomputes the cost.
+/// With `--inject SPEC` (docs/faults.md) the relay applies the engine's frame faults
+/// (LinkFaults, the run's seed) to every frame it receives, before its delay, and logs
+/// each frame it altered or added as `inject` (v0: its line in DIR/injected.csv, which
+/// holds its bytes) just before its `out`; a node named by `restart` rebuilds itself at
+/// that instant (logged `restart`), losing what its socket held. Every node process
+/// writes its counters (ncs_counters.hpp) to DIR/counters_<role>.json, the relay the
+/// faults it injected; the summary gathers them.
 #pragma once
 
 #include <cstdint>
@@ -39,6 +46,7 @@ struct LiveRun {
   Scenario scenario;              ///< Delays, noise, set-point; duration_s is the run length.
   std::uint64_t seed = 1;         ///< Streams: process, measurement, compute, link/*/delay.
   bool noise_free = false;        ///< No process or measurement noise.
+  std::string inject;             ///< Fault spec (empty: none).
   std::int64_t t0_ns = 0;         ///< CLOCK_MONOTONIC instant of t = 0.
   std::uint16_t relay_port = 0;   ///< Ports on 127.0.0.1.
   std::uint16_t plant_port = 0;
@@ -76,6 +84,7 @@ struct LiveOptions {
   Scenario scenario;
   std::uint64_t seed = 1;
   bool noise_free = false;
+  std::string inject;          ///< Fault spec (empty: none).
   std::string out_dir;
   std::string executable;      ///< oneshot-sim (the processes are its hidden sub-command).
   std::int64_t startup_ms = 400;  ///< Time the processes get to start before t0.
@@ -110,4 +119,6 @@ class App;
 namespace oneshot::sim {
 /// Registers `ncs live`, `ncs replay` and the hidden `ncs node` under the study command.
 void add_ncs_live_commands(CLI::App* study);
+/// Registers `ncs faults` (ncs_faults.hpp) under the study command.
+void add_ncs_faults_command(CLI::App* study);
 }  // namespace oneshot::sim

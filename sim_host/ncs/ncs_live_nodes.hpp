@@ -67,12 +67,14 @@ void check_requests(const Context& ctx, Sensor& sensor) {
 }
 
 /// Frame checks of the live controller: reports from the sensor only, echoes in the
-/// actuator's range. Samples are only checked finite (the live plant's output is not
-/// clamped to the ADC range).
+/// actuator's range, τ in [0, h]. Samples are only checked finite (the live plant's output
+/// is not clamped to the ADC range). Periods without a report are predicted over (h set).
 template <typename Controller>
-void check_reports(Controller& ctrl) {
+void check_reports(const Context& ctx, Controller& ctrl) {
   ctrl.expect_source(kLiveSensor);
   ctrl.check_echo_range();
+  ctrl.set_tau_range(0, ctx.period_us());
+  ctrl.set_period_us(ctx.period_us());
 }
 
 /// Frame checks of the live actuator: commands from the controller only, in its range.

@@ -4,13 +4,18 @@
 #include <sys/prctl.h>
 #include <sys/socket.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <cstring>
+#include <fstream>
 #include <map>
 #include <memory>
+#include <optional>
 #include <stdexcept>
 
+#include "ncs_counters.hpp"
 #include "ncs_live_nodes.hpp"
+#include "oneshot/engine/frame_faults.hpp"
 #include "oneshot/engine/kernel.hpp"
 #include "oneshot/engine/link.hpp"
 #include "oneshot/node/sync_actuator_node.hpp"
@@ -39,6 +44,39 @@ struct Clock {
 };
 
 std::int64_t end_ns(const LiveRun& r) { return engine::from_seconds(r.scenario.duration_s, "live duration").count(); }
+
+/// The restart instants of one node (ns since t0) from the run's fault spec.
+struct Restarts {
+  std::vector<std::int64_t> at;
+  std::size_t next = 0;
+  Restarts(const LiveRun& r, const char* node) {
+    for (engine::SimTime t : engine::restart_instants(engine::parse_fault_spec(r.inject), node)) at.push_back(t.count());
+    std::sort(at.begin(), at.end());
+  }
+  /// `other`, or the next restart when it comes first.
+  std::int64_t deadline(std::int64_t other) const { return next < at.size() ? std::min(other, at[next]) : other; }
+  /// True (once) when the next restart is due at `now`.
+  bool due(std::int64_t now) {
+    if (next >= at.size() || now < at[next]) return false;
+    ++next;
+    return true;
+  }
+};
+
+/// A restarting node loses what its socket holds.
+void drain(int fd) {
+  std::uint8_t buf[posix::kUdpHeaderBytes + posix::kUdpMaxPayloadBytes + 1];
+  while (::recv(fd, buf, sizeof buf, MSG_DONTWAIT) >= 0) {
+  }
+}
+
+/// DIR/counters_<role>.json: {name: value}.
+void write_counters(const LiveRun& r, const char* role, const std::vector<std::string>& names,
+                    const std::vector<double>& values) {
+  nlohmann::json j = nlohmann::json::object();
+  for (std::size_t i = 0; i < names.size() && i < values.size(); ++i) j[names[i]] = values[i];
+  std::ofstream(r.dir + "/counters_" + role + ".json") << j.dump(1) << "\n";
+}
 
 /// The node's UDP interface, logging every frame as send/recv with its k (bytes 0–3).
 void attach(posix::UdpNetworkState& net, int fd, std::uint8_t address, const LiveRun& r, LogWriter& log, const Clock& c) {
@@ -139,19 +177,31 @@ int run_sensor(const LiveRun& r, const std::shared_ptr<const Context>& ctx, int 
     logged(send, peer, d, n);
   };
   posix::ScopedUdpNetwork scope(net);
-  node::SyncSensorNode<Board, double, kP, kM> sensor(kLiveController, late_us);
-  check_requests(*ctx, sensor);
+  std::optional<node::SyncSensorNode<Board, double, kP, kM>> sensor(std::in_place, kLiveController, late_us);
+  check_requests(*ctx, *sensor);
+  Restarts restarts(r, "sensor");
+  double restarted = 0;
   const sockaddr_in plant = posix::loopback(r.plant_port);
   const std::int64_t stop = end_ns(r) + kTailNs;
   bool pending = false;
   std::int64_t at_ns = 0;
   std::uint32_t pending_k = 0;
   while (c.now() < stop) {
-    if (wait_readable(net_fd, c.t0 + (pending ? at_ns : stop))) {
+    const bool readable = wait_readable(net_fd, c.t0 + restarts.deadline(pending ? at_ns : stop));
+    if (restarts.due(c.now())) {
+      drain(net_fd);
+      sensor.emplace(kLiveController, late_us);
+      check_requests(*ctx, *sensor);
+      pending = false;
+      ++restarted;
+      log.write("restart", c.now(), clock_us(c.now()), 0, kLiveSensor, 0);
+      continue;
+    }
+    if (readable) {
       const std::int64_t t = c.now();
       log.write("invoke", t, clock_us(t), 0, kLiveSensor, 0);
       McuInstant at;
-      if (sensor.on_receive(McuInstant(clock_us(t)), at)) {
+      if (sensor->on_receive(McuInstant(clock_us(t)), at)) {
         pending = true;
         pending_k = request_k;
         at_ns = t + (at - McuInstant(clock_us(t))) * 1000;
@@ -180,10 +230,12 @@ int run_sensor(const LiveRun& r, const std::shared_ptr<const Context>& ctx, int 
       log.write("sample_timeout", c.now(), clk, 0, 0, pending_k);
       continue;
     }
-    sensor.on_sample(McuInstant(clk), y);
+    sensor->on_sample(McuInstant(clk), y);
   }
-  const auto& s = sensor.statistics();
+  const auto& s = sensor->statistics();
   log.write("stats", c.now(), 0, 0, 0, 0, s.requests, s.stale, s.refused);
+  write_counters(r, "sensor", concat(sync_sensor_counter_names(), {"sensor.restarts"}),
+                 concat(sync_sensor_counters(*sensor), {restarted}));
   log_refusals(log, c.now(), s, s.stale);
   return 0;
 }
@@ -200,24 +252,37 @@ int controller_loop(const LiveRun& r, const Context& ctx, Est est, int net_fd, c
     u_min[j] = ctx.design().u_min[j];
     u_max[j] = ctx.design().u_max[j];
   }
-  node::SyncControllerNode<Board, Est, Ref, double, kN, kP, kM> ctrl(kLiveActuator, d.l, u_min, u_max, est,
-                                                                    reference(ctx, r.scenario));
-  check_reports(ctrl);
+  using Ctrl = node::SyncControllerNode<Board, Est, Ref, double, kN, kP, kM>;
+  std::optional<Ctrl> ctrl(std::in_place, kLiveActuator, d.l, u_min, u_max, est, reference(ctx, r.scenario));
+  check_reports(ctx, *ctrl);
+  Restarts restarts(r, "controller");
+  double restarted = 0;
   engine::RandomStream compute = engine::Kernel(r.seed).stream("compute");
   const std::int64_t stop = end_ns(r) + kTailNs;
   while (c.now() < stop) {
-    if (!wait_readable(net_fd, c.t0 + stop)) continue;
+    const bool readable = wait_readable(net_fd, c.t0 + restarts.deadline(stop));
+    if (restarts.due(c.now())) {
+      drain(net_fd);
+      ctrl.emplace(kLiveActuator, d.l, u_min, u_max, est, reference(ctx, r.scenario));
+      check_reports(ctx, *ctrl);
+      ++restarted;
+      log.write("restart", c.now(), clock_us(c.now()), 0, kLiveController, 0);
+      continue;
+    }
+    if (!readable) continue;
     // τ_c ~ U[1, 5] ms between the arrival and the computation (brief §3).
     const std::int64_t tau_c = compute.uniform_int(ctx.timing().compute_min_us, ctx.timing().compute_max_us) * 1000;
     wait_readable(-1, c.t0 + c.now() + tau_c);
     const std::int64_t t = c.now();
     log.write("invoke", t, clock_us(t), 0, kLiveController, 0);
-    ctrl.on_receive(McuInstant(clock_us(t)));
-    const auto x = ctrl.estimator().estimate();
-    log.write("estimate", c.now(), 0, 0, 0, ctrl.last_k(), x[0], x[1], ctrl.last_command()[0]);
+    ctrl->on_receive(McuInstant(clock_us(t)));
+    const auto x = ctrl->estimator().estimate();
+    log.write("estimate", c.now(), 0, 0, 0, ctrl->last_k(), x[0], x[1], ctrl->last_command()[0]);
   }
-  const auto& s = ctrl.statistics();
+  const auto& s = ctrl->statistics();
   log.write("stats", c.now(), 0, 0, 0, 0, s.computations, s.saturated, s.faults);
+  write_counters(r, "controller", concat(sync_controller_counter_names(), {"controller.restarts"}),
+                 concat(sync_controller_counters(*ctrl), {restarted}));
   log_refusals(log, c.now(), s, s.stale);
   log.write("resets", c.now(), 0, 0, 0, 0, s.estimator_resets, s.withheld);
   return 0;
@@ -237,30 +302,49 @@ int run_actuator(const LiveRun& r, const std::shared_ptr<const Context>& ctx, in
   posix::UdpNetworkState net;
   attach(net, net_fd, kLiveActuator, r, log, c);
   posix::ScopedUdpNetwork scope(net);
-  node::SyncActuatorNode<Board, double, kM> act(kLiveSensor, InputVec{});
-  check_commands(*ctx, act);
+  std::optional<node::SyncActuatorNode<Board, double, kM>> act(std::in_place, kLiveSensor, InputVec{});
+  check_commands(*ctx, *act);
+  Restarts restarts(r, "actuator");
+  double restarted = 0;
+  std::uint32_t n0 = 0;  // timer index of the actuator's power-on: its period index is n − n0
+  bool fresh = false;
   const sockaddr_in plant = posix::loopback(r.plant_port);
   const std::int64_t h_ns = std::int64_t{ctx->period_us()} * 1000;
   const auto h_us = static_cast<std::uint32_t>(ctx->period_us());
   const std::int64_t end = end_ns(r);
   for (std::uint32_t n = 0; std::int64_t{n} * h_ns < end; ++n) {
     const std::int64_t due = std::int64_t{n} * h_ns;
-    while (wait_readable(net_fd, c.t0 + due)) {
+    for (;;) {
+      const bool readable = wait_readable(net_fd, c.t0 + restarts.deadline(due));
+      if (restarts.due(c.now())) {
+        drain(net_fd);
+        act.emplace(kLiveSensor, InputVec{});
+        check_commands(*ctx, *act);
+        fresh = true;
+        ++restarted;
+        log.write("restart", c.now(), clock_us(c.now()), 0, kLiveActuator, n);
+        continue;
+      }
+      if (!readable) break;
       const std::int64_t t = c.now();
       log.write("invoke", t, clock_us(t), 0, kLiveActuator, 0);
-      act.on_receive();
+      act->on_receive();
     }
     const std::int64_t t = c.now();
     const std::uint32_t clk = clock_us(t);
     log.write("timer", t, clk, 0, 0, n);
+    if (fresh) {  // the restarted actuator's first timer is its k = 0
+      fresh = false;
+      n0 = n;
+    }
     // The timer is periodic: t_{k+1} = (k + 1) h on the shared clock, whatever the wake-up jitter.
-    if (n == 0) {
-      act.start(McuInstant(h_us));
+    if (n == n0) {
+      act->start(McuInstant((n + 1) * h_us));
     } else {
-      act.on_timer(n, McuInstant((n + 1) * h_us));
+      act->on_timer(n - n0, McuInstant((n + 1) * h_us));
     }
     InputVec u;
-    if (act.take_output(u)) {
+    if (act->take_output(u)) {
       std::uint8_t cmd[kCommandBytes] = {'U'};
       put_u32(cmd + 1, n);
       put_u32(cmd + 5, clk);
@@ -269,9 +353,11 @@ int run_actuator(const LiveRun& r, const std::shared_ptr<const Context>& ctx, in
       log.write("command", c.now(), clk, 0, 0, n, u[0]);
     }
   }
-  const auto& s = act.statistics();
-  log.write("stats", c.now(), 0, 0, 0, 0, s.late, act.refused());
+  const auto& s = act->statistics();
+  log.write("stats", c.now(), 0, 0, 0, 0, s.late, act->refused());
   log_refusals(log, c.now(), s, s.stale);
+  write_counters(r, "actuator", concat(actuator_counter_names(), {"actuator.restarts"}),
+                 concat(actuator_counters(*act), {restarted}));
   return 0;
 }
 
@@ -285,14 +371,29 @@ int run_relay(const LiveRun& r, const std::shared_ptr<const Context>& ctx, int f
                            {kLiveSensor, kLiveController, "sc", r.controller_port},
                            {kLiveController, kLiveActuator, "ca", r.actuator_port}};
   std::vector<std::unique_ptr<engine::Link>> links;
-  for (const Route& rt : routes) links.push_back(std::make_unique<engine::Link>(leg(*ctx, r.scenario, r.approach, rt.name), r.seed));
+  std::vector<std::unique_ptr<engine::LinkFaults>> faults;  // the engine's frame faults, same seed and streams
+  const engine::FaultSpec spec = engine::parse_fault_spec(r.inject);
+  for (const Route& rt : routes) {
+    const engine::LinkConfig cfg = leg(*ctx, r.scenario, r.approach, rt.name);
+    links.push_back(std::make_unique<engine::Link>(cfg, r.seed));
+    faults.push_back(std::make_unique<engine::LinkFaults>(spec, cfg.name, cfg.frame, r.seed));
+  }
   struct Held {
     std::size_t route;
     std::vector<std::uint8_t> bytes;
     std::int64_t arrival;
+    long injected;  ///< Line of injected.csv (−1: the frame as sent).
   };
   std::multimap<std::int64_t, Held> queue;  // by release instant; FIFO among equal instants
   LogWriter log(r.dir, "relay");
+  std::FILE* injected = spec.empty() ? nullptr : std::fopen((r.dir + "/injected.csv").c_str(), "w");
+  if (!spec.empty() && injected == nullptr) throw std::runtime_error(r.dir + "/injected.csv: cannot write");
+  long injected_lines = 0;
+  const auto record = [&](const std::vector<std::uint8_t>& payload) {  // one line: the payload in hex
+    for (std::uint8_t b : payload) std::fprintf(injected, "%02x", b);
+    std::fputc('\n', injected);
+    return injected_lines++;
+  };
   const std::int64_t stop = end_ns(r) + kTailNs;
   std::uint8_t buf[posix::kUdpHeaderBytes + posix::kUdpMaxPayloadBytes + 1];
   while (c.now() < stop) {
@@ -310,6 +411,10 @@ int run_relay(const LiveRun& r, const std::shared_ptr<const Context>& ctx, int f
           log.write("drop", t, 0, size > 0 ? buf[0] : 0, size > 1 ? buf[1] : 0, 0, static_cast<double>(size));
           continue;
         }
+        const std::vector<std::uint8_t> sent(buf + posix::kUdpHeaderBytes, buf + size);
+        std::vector<std::uint8_t> payload = sent;
+        std::vector<std::vector<std::uint8_t>> extra;
+        faults[route]->apply(engine::SimTime{t}, payload, extra);  // as Network::run_node: faults, then the link
         const auto arrival = links[route]->transmit(engine::SimTime{t});  // the engine's link: delay model, FIFO
         const std::uint32_t k = get_u32(buf + posix::kUdpHeaderBytes);
         if (!arrival) {
@@ -317,21 +422,34 @@ int run_relay(const LiveRun& r, const std::shared_ptr<const Context>& ctx, int f
           continue;
         }
         log.write("in", t, 0, buf[0], buf[1], k, static_cast<double>(arrival->count() - t));
-        queue.emplace(arrival->count(), Held{route, std::vector<std::uint8_t>(buf, buf + size), t});
+        const auto hold = [&](const std::vector<std::uint8_t>& p, long line) {
+          std::vector<std::uint8_t> bytes(buf, buf + posix::kUdpHeaderBytes);
+          bytes.insert(bytes.end(), p.begin(), p.end());
+          queue.emplace(arrival->count(), Held{route, std::move(bytes), t, line});
+        };
+        hold(payload, payload == sent ? -1 : record(payload));
+        for (const auto& e : extra) hold(e, record(e));
       }
     }
     for (std::int64_t t = c.now(); !queue.empty() && queue.begin()->first <= t; t = c.now()) {
       const auto it = queue.begin();
       const Route& rt = routes[it->second.route];
       const sockaddr_in to = posix::loopback(rt.port);
+      const std::uint32_t k = get_u32(it->second.bytes.data() + posix::kUdpHeaderBytes);
+      if (it->second.injected >= 0) log.write("inject", t, 0, rt.src, rt.dst, k, static_cast<double>(it->second.injected));
       ::sendto(fd, it->second.bytes.data(), it->second.bytes.size(), MSG_DONTWAIT, reinterpret_cast<const sockaddr*>(&to),
                sizeof to);
-      log.write("out", t, 0, rt.src, rt.dst, get_u32(it->second.bytes.data() + posix::kUdpHeaderBytes),
-                static_cast<double>(it->first - it->second.arrival), static_cast<double>(it->first),
-                static_cast<double>(it->second.arrival));
+      log.write("out", t, 0, rt.src, rt.dst, k, static_cast<double>(it->first - it->second.arrival),
+                static_cast<double>(it->first), static_cast<double>(it->second.arrival));
       queue.erase(it);
     }
   }
+  if (injected != nullptr) std::fclose(injected);
+  engine::FaultCounters total;
+  for (const auto& f : faults) total += f->counters();
+  write_counters(r, "relay", {"nan", "flip", "dup", "replay", "forge_seq", "skipped"},
+                 {double(total.nan), double(total.flip), double(total.dup), double(total.replay), double(total.forge_seq),
+                  double(total.skipped)});
   return 0;
 }
 

@@ -5,14 +5,17 @@
 #include <cmath>
 #include <functional>
 #include <memory>
+#include <optional>
 #include <stdexcept>
 
+#include "ncs_counters.hpp"
 #include "oneshot/engine/continuous_plant.hpp"
 #include "oneshot/engine/kernel.hpp"
 #include "oneshot/engine/network.hpp"
 #include "oneshot/host/host_network.hpp"
 #include "oneshot/node/actuator_node.hpp"
 #include "oneshot/node/controller_node.hpp"
+#include "oneshot/node/message.hpp"
 #include "oneshot/node/periodic_trigger.hpp"
 #include "oneshot/node/sampling_sync_laws.hpp"
 #include "oneshot/node/sensor_node.hpp"
@@ -58,6 +61,7 @@ class Harness {
         noisy_(noisy(a, opt)),
         h_(engine::from_us(ctx.period_us())),
         end_(engine::from_seconds(sc.duration_s, "ncs scenario duration")) {
+    net_.set_faults(opt.faults);
     if (!(sc.max_delay_ms * 1000 >= static_cast<double>(ctx.timing().leg_min_us))) {
       throw std::invalid_argument("ncs scenario " + sc.name + ": d must be at least 0.5 ms");
     }
@@ -121,9 +125,13 @@ class Harness {
     result_.estimates.push_back(Point{static_cast<double>(k) * engine::to_seconds(h_), {x[0], x[1]}});
   }
 
-  /// Runs the kernel to the end and collects the cost and trace.
+  /// Node `address` restarts: whatever its interface held is lost.
+  void lose_inbox(std::uint8_t address) { net_.node(address).interface.inbox.clear(); }
+
+  /// Runs the kernel to the end and collects the cost, trace and injected faults.
   RunResult finish() {
     kernel_.run_until(end_);
+    result_.injected = net_.fault_counters();
     result_.cost = plant_.cost().total();
     for (const auto& s : plant_.trace()) {
       const double t = engine::to_seconds(s.t);
@@ -156,94 +164,175 @@ class Harness {
 /// The actuation-synchronized loop with estimator `est` (brief §1).
 template <typename Estimator>
 RunResult run_synchronized(Harness& hs, Estimator est, std::int32_t late_us) {
+  using Act = node::SyncActuatorNode<Board, double, kM>;
+  using Sensor = node::SyncSensorNode<Board, double, kP, kM>;
+  using Ctrl = node::SyncControllerNode<Board, Estimator, Ref, double, kN, kP, kM>;
   Matrix<double, kM, kN> l = hs.design_.l;
-  node::SyncActuatorNode<Board, double, kM> act(kSensor, InputVec{});
-  node::SyncSensorNode<Board, double, kP, kM> sensor(kController, late_us);
-  node::SyncControllerNode<Board, Estimator, Ref, double, kN, kP, kM> ctrl(kActuator, l, hs.u_min_, hs.u_max_, est,
-                                                                          hs.ref_);
+  // Optional: a restart rebuilds the node as at power-on.
+  std::optional<Act> act(std::in_place, kSensor, InputVec{});
+  std::optional<Sensor> sensor(std::in_place, kController, late_us);
+  std::optional<Ctrl> ctrl(std::in_place, kActuator, l, hs.u_min_, hs.u_max_, est, hs.ref_);
+  // Frame checks as in the live run (ncs_live_nodes.hpp), again after every restart.
+  const auto check_sensor = [&]() {
+    sensor->expect_source(kActuator);
+    sensor->set_echo_range(hs.u_min_, hs.u_max_);
+    sensor->set_stamp_window(4 * hs.ctx_.period_us());
+  };
+  const auto check_ctrl = [&]() {
+    ctrl->expect_source(kSensor);
+    ctrl->check_echo_range();
+    ctrl->set_tau_range(0, hs.ctx_.period_us());
+    ctrl->set_period_us(hs.ctx_.period_us());
+  };
+  const auto check_act = [&]() {
+    act->expect_source(kController);
+    act->set_command_range(hs.u_min_, hs.u_max_);
+  };
+  check_sensor();
+  check_ctrl();
+  check_act();
+  std::uint64_t act_n0 = 0;  // timer index of the actuator's power-on (its k = n − n0)
+  bool act_restarted = false;
   engine::Network& net = hs.net_;
   engine::Kernel& k = hs.kernel_;
   const HandlerId sample_h = k.add_handler("sample", [&](std::uint64_t) {
     const OutputVec y = hs.sample();
-    net.run_node(kSensor, [&]() { sensor.on_sample(net.node_clock(kSensor), y); });
+    net.run_node(kSensor, [&]() { sensor->on_sample(net.node_clock(kSensor), y); });
   });
   const HandlerId compute_h = k.add_handler("compute", [&](std::uint64_t) {
-    net.run_node(kController, [&]() { ctrl.on_receive(net.node_clock(kController)); });
-    hs.estimate(ctrl.last_k(), ctrl.estimator().estimate());
+    net.run_node(kController, [&]() { ctrl->on_receive(net.node_clock(kController)); });
+    hs.estimate(ctrl->last_k(), ctrl->estimator().estimate());
   });
   net.add_node(kSensor, "sensor", Duration{0}, [&]() {
     const McuInstant now = net.node_clock(kSensor);
     McuInstant at;
-    if (!sensor.on_receive(now, at)) return;
+    if (!sensor->on_receive(now, at)) return;
     const std::int64_t wait_us = at - now;
     if (wait_us <= 0) {
       const OutputVec y = hs.sample();
-      sensor.on_sample(now, y);  // inside the sensor's run_node: routed afterwards
+      sensor->on_sample(now, y);  // inside the sensor's run_node: routed afterwards
     } else {
       k.schedule_in(engine::from_us(wait_us), EventClass::kSample, sample_h);
     }
   });
   net.add_node(kController, "controller", Duration{0},
                [&]() { k.schedule_in(hs.compute_time(), EventClass::kCompute, compute_h); });
-  net.add_node(kActuator, "actuator", Duration{0}, [&]() { act.on_receive(); });
+  net.add_node(kActuator, "actuator", Duration{0}, [&]() { act->on_receive(); });
   net.route(kActuator, kSensor, net.add_link(hs.leg("as")));
   net.route(kSensor, kController, net.add_link(hs.leg("sc")));
   net.route(kController, kActuator, net.add_link(hs.leg("ca")));
+  net.arm_faults({{"sensor",
+                   [&]() {
+                     sensor.emplace(kController, late_us);
+                     check_sensor();
+                     hs.lose_inbox(kSensor);
+                   }},
+                  {"controller",
+                   [&]() {
+                     ctrl.emplace(kActuator, l, hs.u_min_, hs.u_max_, est, hs.ref_);
+                     check_ctrl();
+                     hs.lose_inbox(kController);
+                   }},
+                  {"actuator", [&]() {
+                     act.emplace(kSensor, InputVec{});
+                     check_act();
+                     hs.lose_inbox(kActuator);
+                     act_restarted = true;
+                   }}});
   auto timer_h = std::make_shared<HandlerId>(0);
   *timer_h = k.add_handler("actuation", [&, timer_h](std::uint64_t n) {
+    if (act_restarted) {  // the restarted actuator's first timer is its k = 0
+      act_restarted = false;
+      act_n0 = n;
+    }
     net.run_node(kActuator, [&]() {
       const McuInstant next = net.node_clock(kActuator).plus(hs.ctx_.period_us());
-      if (n == 0) {
-        act.start(next);
+      if (n == act_n0) {
+        act->start(next);
       } else {
-        act.on_timer(static_cast<node::SequenceNumber>(n), next);
+        act->on_timer(static_cast<node::SequenceNumber>(n - act_n0), next);
       }
       InputVec u;
-      if (act.take_output(u)) hs.apply(u);
+      if (act->take_output(u)) hs.apply(u);
     });
     const SimTime t_next = k.now() + hs.h_;
     if (t_next < hs.end_) k.schedule(t_next, EventClass::kActuation, *timer_h, n + 1);
   });
   k.schedule(SimTime{0}, EventClass::kActuation, *timer_h, 0);
   RunResult r = hs.finish();
-  r.late = act.statistics().late;
-  r.saturated = ctrl.statistics().saturated;
-  r.faults = ctrl.statistics().faults;
+  r.late = act->statistics().late;
+  r.saturated = ctrl->statistics().saturated;
+  r.faults = ctrl->statistics().faults;
+  r.counters = concat(concat(sync_sensor_counters(*sensor), sync_controller_counters(*ctrl)), actuator_counters(*act));
   return r;
 }
 
 /// The sampling-synchronized baseline with law `law`; `saturated(law)` reads its count.
 template <typename Law, typename Saturated>
 RunResult run_sampling(Harness& hs, Law law, Saturated saturated) {
-  node::SensorNode<Board, node::PeriodicTrigger<double, kP>, double, kP> sensor(kController,
-                                                                               node::PeriodicTrigger<double, kP>(1));
-  node::ControllerNode<Board, Law, double, kP, kM> ctrl(kActuator, node::ControllerMode::kOnArrival, law);
-  node::ActuatorNode<Board, double, kM> act(node::ActuatorMode::kOnArrival, InputVec{});
+  using Trigger = node::PeriodicTrigger<double, kP>;
+  using Sensor = node::SensorNode<Board, Trigger, double, kP>;
+  using Ctrl = node::ControllerNode<Board, Law, double, kP, kM>;
+  using Act = node::ActuatorNode<Board, double, kM>;
+  std::optional<Sensor> sensor(std::in_place, kController, Trigger(1));
+  std::optional<Ctrl> ctrl(std::in_place, kActuator, node::ControllerMode::kOnArrival, law);
+  std::optional<Act> act(std::in_place, node::ActuatorMode::kOnArrival, InputVec{});
+  const auto check_ctrl = [&]() { ctrl->expect_source(kSensor); };  // samples: finite (the plant is not clamped)
+  const auto check_act = [&]() {
+    act->expect_source(kController);
+    act->set_command_range(hs.u_min_, hs.u_max_);
+  };
+  check_ctrl();
+  check_act();
+  std::uint64_t sensor_n0 = 0;  // sample index of the sensor's power-on (its sequence = n − n0)
+  bool sensor_restarted = false;
   engine::Network& net = hs.net_;
   engine::Kernel& k = hs.kernel_;
   const HandlerId compute_h = k.add_handler("compute", [&](std::uint64_t) {
-    net.run_node(kController, [&]() { ctrl.on_receive(net.node_clock(kController)); });
+    net.run_node(kController, [&]() { ctrl->on_receive(net.node_clock(kController)); });
   });
   net.add_node(kSensor, "sensor", Duration{0}, nullptr);
   net.add_node(kController, "controller", Duration{0},
                [&]() { k.schedule_in(hs.compute_time(), EventClass::kCompute, compute_h); });
   net.add_node(kActuator, "actuator", Duration{0}, [&]() {
-    act.on_receive();
+    act->on_receive();
     InputVec u;
-    if (act.take_output(u)) hs.apply(u);
+    if (act->take_output(u)) hs.apply(u);
   });
   net.route(kSensor, kController, net.add_link(hs.leg("sc")));
   net.route(kController, kActuator, net.add_link(hs.leg("ca")));
+  net.arm_faults({{"sensor",
+                   [&]() {
+                     sensor.emplace(kController, Trigger(1));
+                     sensor_restarted = true;
+                   }},
+                  {"controller",
+                   [&]() {
+                     ctrl.emplace(kActuator, node::ControllerMode::kOnArrival, law);
+                     check_ctrl();
+                     hs.lose_inbox(kController);
+                   }},
+                  {"actuator", [&]() {
+                     act.emplace(node::ActuatorMode::kOnArrival, InputVec{});
+                     check_act();
+                     hs.lose_inbox(kActuator);
+                   }}});
   auto timer_h = std::make_shared<HandlerId>(0);
   *timer_h = k.add_handler("sample", [&, timer_h](std::uint64_t n) {
+    if (sensor_restarted) {
+      sensor_restarted = false;
+      sensor_n0 = n;
+    }
     const OutputVec y = hs.sample();
-    net.run_node(kSensor, [&]() { sensor.on_sample(static_cast<node::SequenceNumber>(n), net.node_clock(kSensor), y); });
+    const auto seq = static_cast<node::SequenceNumber>(n - sensor_n0);
+    net.run_node(kSensor, [&]() { sensor->on_sample(seq, net.node_clock(kSensor), y); });
     const SimTime t_next = k.now() + hs.h_;
     if (t_next < hs.end_) k.schedule(t_next, EventClass::kSample, *timer_h, n + 1);
   });
   k.schedule(SimTime{0}, EventClass::kSample, *timer_h, 0);
   RunResult r = hs.finish();
-  r.saturated = saturated(ctrl.law());
+  r.saturated = saturated(ctrl->law());
+  r.counters = concat(sampling_controller_counters(*ctrl), actuator_counters(*act));
   return r;
 }
 
@@ -290,6 +379,9 @@ engine::LinkConfig leg(const Context& ctx, const Scenario& sc, Approach a, const
   engine::LinkConfig c;
   c.name = name;
   c.fifo = true;
+  // Frames: k (4) | instant (4) | [τ (4)] | doubles (actuation_sync_messages.hpp, message.hpp).
+  const bool report = std::string(name) == "sc" && actuation_synchronized(a);
+  c.frame = engine::FrameLayout{0, 4, report ? node::kHeaderBytes + 4 : node::kHeaderBytes, 8};
   if (delay_free(a)) return c;  // constant 0
   c.delay.kind = engine::DelayModel::Kind::kUniform;
   c.delay.min = engine::from_us(ctx.timing().leg_min_us);
@@ -306,6 +398,20 @@ std::array<double, 3> measurement_cholesky(const Design& d) {
   c[2] = std::sqrt(std::fmax(0.0, d.r(1, 1) - c[1] * c[1]));
   return c;
 }
+
+std::vector<std::string> counter_names(Approach a) {
+  if (actuation_synchronized(a)) {
+    return concat(concat(sync_sensor_counter_names(), sync_controller_counter_names()), actuator_counter_names());
+  }
+  return concat(sampling_controller_counter_names(), actuator_counter_names());
+}
+
+std::vector<std::string> link_names(Approach a) {
+  if (actuation_synchronized(a)) return {"as", "sc", "ca"};
+  return {"sc", "ca"};
+}
+
+std::vector<std::string> node_names() { return {"sensor", "controller", "actuator"}; }
 
 RunResult run(const Context& ctx, Approach a, const Scenario& sc, std::uint64_t seed, const RunOptions& options) {
   Harness hs(ctx, a, sc, seed, options);

@@ -9,15 +9,22 @@
 /// the sensor samples at kh, the controller computes τ_c after arrival, the actuator applies
 /// on arrival. Links: uniform delays U[0.5, d] ms in whole µs; τ_c ~ U[1, 5] ms (stream
 /// "compute"); I and IK have none. Streams per source (common random numbers): process,
-/// measurement, compute, link/<as|sc|ca>/delay.
+/// measurement, compute, link/<as|sc|ca>/delay. With a fault spec (RunOptions::faults)
+/// the links carry the engine's frame faults and the nodes "sensor", "controller",
+/// "actuator" restart at the spec's instants: a restarted node is rebuilt as at power-on
+/// (its interface emptied; the actuator's period index starts again from 0 at its next
+/// timer, the plant keeping the last applied input until a new command is applied).
 #pragma once
 
 #include <array>
 #include <cstdint>
+#include <string>
 #include <vector>
 
 #include "ncs_model.hpp"
 #include "oneshot/engine/continuous_plant.hpp"
+#include "oneshot/engine/fault_spec.hpp"
+#include "oneshot/engine/frame_faults.hpp"
 #include "oneshot/engine/link.hpp"
 #include "oneshot/node/square_wave_reference.hpp"
 
@@ -27,6 +34,7 @@ namespace oneshot::ncs {
 struct RunOptions {
   bool noise_free = false;  ///< No process or measurement noise (delays stay).
   double trace_step_s = 0;  ///< > 0: record the true state every step (bridged, never changes the run).
+  engine::FaultSpec faults;  ///< Faults injected (empty: a clean run, bit-identical to none).
 };
 
 /// One row of a recorded sample or estimate.
@@ -42,6 +50,8 @@ struct RunResult {
   std::uint32_t saturated = 0; ///< Commands clamped to the actuator's range.
   std::uint32_t faults = 0;    ///< Estimator runs whose status was not exact.
   std::uint32_t commands = 0;  ///< Commands applied.
+  engine::FaultCounters injected;  ///< Faults injected.
+  std::vector<double> counters;    ///< Node counters (ncs_counters.hpp, order of counter_names()).
   std::vector<Point> truth;      ///< True state every trace step (x1, x2).
   std::vector<Point> samples;    ///< Samples y at their instants.
   std::vector<Point> sample_truth;  ///< C x at the same instants (noise-free output).
@@ -59,6 +69,14 @@ node::SquareWaveReference<double, kN, kM> reference(const Context& ctx, const Sc
 engine::LinkConfig leg(const Context& ctx, const Scenario& sc, Approach a, const char* name);
 /// Lower Cholesky factor of R = s·R_n: y = C x + [[c0, 0], [c1, c2]] n, n ~ N(0, I).
 std::array<double, 3> measurement_cholesky(const Design& d);
+
+/// Names of the node counters of approach `a` (RunResult::counters).
+std::vector<std::string> counter_names(Approach a);
+/// Names of the links ("as", "sc", "ca"; "sc", "ca" for the sampling loops) and of the
+/// restartable nodes of approach `a`, for checking a fault spec.
+std::vector<std::string> link_names(Approach a);
+/// The restartable nodes: "sensor", "controller", "actuator".
+std::vector<std::string> node_names();
 
 /// Runs approach `a` on `scenario` with `seed`.
 RunResult run(const Context& ctx, Approach a, const Scenario& scenario, std::uint64_t seed, const RunOptions& options);

@@ -10,6 +10,7 @@
 #include <sstream>
 
 #include "ncs_experiments.hpp"
+#include "ncs_faults.hpp"
 #include "ncs_live.hpp"
 #include "oneshot/engine/sweep_registry.hpp"
 #include "oneshot/sim/cli_commands.hpp"
@@ -115,6 +116,7 @@ void register_ncs_study(CLI::App& app) {
     auto shard = std::make_shared<std::string>("0/1");
     auto approaches = std::make_shared<std::vector<std::string>>();
     auto scenario_file = std::make_shared<std::string>();
+    auto inject = std::make_shared<std::string>();
     CLI::App* cmd = study->add_subcommand("table", "E4: every approach on the ten scenarios (95 % CI, paired differences)");
     add_common(cmd, *c, "out/ncs");
     cmd->add_option("--seeds", t->seeds, "seeds per scenario")->check(CLI::Range(2, 100000))->capture_default_str();
@@ -124,9 +126,11 @@ void register_ncs_study(CLI::App& app) {
         ->check(CLI::ExistingFile);
     cmd->add_option("--threads", t->threads, "worker threads (0: every core)")->capture_default_str();
     cmd->add_option("--approaches", *approaches, "approaches, I first (default: I S A AK AKx AKl SK S+ IK)");
+    cmd->add_option("--inject", *inject, "faults in every run, e.g. 'dup:link=sc,rate=0.02;restart:node=sensor,at_s=5' (docs/faults.md)");
     cmd->add_option("--shard", *shard, "run part i/N of the sweep and write OUT/table.shard-i-of-N.json (`oneshot-sim merge`)")
         ->capture_default_str();
-    cmd->callback([c, t, shard, approaches, scenario_file]() {
+    cmd->callback([c, t, shard, approaches, scenario_file, inject]() {
+      t->faults = engine::parse_fault_spec(*inject);
       const auto ctx = ncs::Context::load(c->plant);
       if (!scenario_file->empty()) t->scenarios = ncs::load_scenarios(*scenario_file);
       if (!approaches->empty()) {
@@ -187,6 +191,7 @@ void register_ncs_study(CLI::App& app) {
     });
   }
   add_ncs_live_commands(study);
+  add_ncs_faults_command(study);
   engine::register_summarizer("ncs", "table", [](const engine::SweepResults& r, const std::string& out, bool plots) {
     return ncs::table_outputs(r, out, plots);
   });

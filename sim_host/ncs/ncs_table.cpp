@@ -63,9 +63,14 @@ engine::SweepResults table_sweep(const Context& ctx, const TableOptions& opt, co
                  {"leg_delay_min_us", ctx.timing().leg_min_us},
                  {"compute_us", {ctx.timing().compute_min_us, ctx.timing().compute_max_us}},
                  {"scenarios", sc}};
+  if (!opt.faults.empty()) {  // only then: the clean table's spec (and its shards) stay as they were
+    engine::check_fault_targets(opt.faults, {"as", "sc", "ca"}, node_names());
+    spec.config["inject"] = opt.faults.text;
+  }
   const std::vector<Approach> approaches = opt.approaches;
   RunOptions ro;
   ro.noise_free = opt.noise_free;
+  ro.faults = opt.faults;
   return engine::run_sweep(
       spec, shard, opt.threads,
       [&](std::size_t a, std::size_t s, std::uint64_t seed) {
@@ -97,6 +102,7 @@ nlohmann::json table_outputs(const engine::SweepResults& results, const std::str
   j["seeds"] = seeds;
   j["scenarios"] = spec.config.at("scenarios");
   j["runs"] = spec.runs();
+  if (spec.config.contains("inject")) j["inject"] = spec.config.at("inject");
   std::ostringstream md;
   md << "| approach | description | mean cost J | 95 % CI | ratio to I (95 % CI) | scenario-weighted ratio (95 % CI) | late | saturated |\n"
         "|---|---|---|---|---|---|---|---|\n";

@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "oneshot/engine/fault_spec.hpp"
 #include "oneshot/engine/sweep.hpp"
 #include "sod_design.hpp"
 #include "sod_model.hpp"
@@ -29,6 +30,7 @@ struct StudyOptions {
   std::vector<double> losses = {0, 0.05, 0.1, 0.2}; ///< ξ of the table.
   std::vector<double> design_losses = {0.05, 0.1, 0.15, 0.2};  ///< ξ of the design command.
   engine::Shard shard;                              ///< Part of the table sweep.
+  engine::FaultSpec faults;                         ///< Table: frame faults in every run (docs/faults.md).
 };
 
 /// ΔT_i (E1): mean time between packets of lossless plain SOD, per seed N·T/sends_i.

@@ -3,6 +3,7 @@
 #include "sod_sim.hpp"
 
 #include <cmath>
+#include <cstring>
 #include <limits>
 #include <optional>
 #include <stdexcept>
@@ -44,6 +45,22 @@ NodeRule make_rule(const RunConfig& cfg, std::size_t i) {
                   node::PeriodicTrigger<double, 1>(cfg.every[i])};
 }
 
+/// A packet on the wire under faults: k (u32, little-endian) then y (IEEE 754 double).
+constexpr engine::FrameLayout kFrameLayout{0, 4, 4, 8};
+
+std::vector<std::uint8_t> encode_frame(node::SequenceNumber k, double y) {
+  std::vector<std::uint8_t> b(12);
+  for (std::size_t j = 0; j < 4; ++j) b[j] = static_cast<std::uint8_t>(k >> (8 * j));
+  std::memcpy(b.data() + 4, &y, sizeof y);
+  return b;
+}
+
+void decode_frame(const std::vector<std::uint8_t>& b, node::SequenceNumber& k, double& y) {
+  k = 0;
+  for (std::size_t j = 0; j < 4; ++j) k |= static_cast<node::SequenceNumber>(b[j]) << (8 * j);
+  std::memcpy(&y, b.data() + 4, sizeof y);
+}
+
 void check(const RunConfig& cfg) {
   if (!(cfg.loss >= 0 && cfg.loss <= 1)) throw std::invalid_argument("sod: loss rate must lie in [0, 1]");
   if (cfg.steps < 1 || cfg.steps > (std::int64_t{1} << 31)) throw std::invalid_argument("sod: steps must lie in [1, 2^31]");
@@ -52,6 +69,7 @@ void check(const RunConfig& cfg) {
     if (cfg.every[i] == 0) throw std::invalid_argument("sod: periodic sender needs every >= 1");
   }
   if (!(cfg.p0 > 0)) throw std::invalid_argument("sod: P(0) must be positive");
+  engine::check_fault_targets(cfg.faults, sod_link_names(), {});  // frame faults only: no node restarts
 }
 
 }  // namespace
@@ -88,6 +106,13 @@ RunResult simulate_run(const SodModel& model, const RunConfig& cfg, std::uint64_
     link[i].emplace(lc, seed);
   }
 
+  // Frame faults (faulted runs only: the clean run registers nothing more, bit-identical).
+  const bool faulted = !cfg.faults.empty();
+  std::optional<engine::LinkFaults> faults[kNodes];
+  if (faulted)
+    for (std::size_t i = 0; i < kNodes; ++i) faults[i].emplace(cfg.faults, kNodeNames[i], kFrameLayout, seed);
+  std::vector<std::vector<std::uint8_t>> frames;  // delivered by "sod frame" (arg: index << 1 | node)
+
   Vector<double, kNodes> dy, r;
   for (std::size_t i = 0; i < kNodes; ++i) {
     dy[i] = cfg.delta_y[i];
@@ -116,6 +141,25 @@ RunResult simulate_run(const SodModel& model, const RunConfig& cfg, std::uint64_
     rx.on_packet(i, static_cast<node::SequenceNumber>(arg >> 1), pending_y[i]);
     lost_run[i] = 0;
   });
+  std::int64_t step_now = 0;
+  engine::HandlerId deliver_frame{};
+  if (faulted) {
+    deliver_frame = kernel.add_handler("sod frame", [&](std::uint64_t arg) {
+      const std::size_t i = arg & 1u;
+      node::SequenceNumber k = 0;
+      double y = 0;
+      decode_frame(frames[arg >> 1], k, y);
+      if (std::int64_t{k} != step_now) {  // no delay on the link: only the current sample is genuine
+        res.refused_sequence += 1;
+        return;
+      }
+      if (!rx.on_packet(i, k, y)) {
+        res.refused_non_finite += 1;
+        return;
+      }
+      lost_run[i] = 0;
+    });
+  }
   const engine::HandlerId compute = kernel.add_handler("sod estimator", [&](std::uint64_t kk) {
     const auto k = static_cast<node::SequenceNumber>(kk);
     if (kk > 0 && est.predict(u) == Status::kNonFinite) ++res.estimator_resets;
@@ -162,6 +206,7 @@ RunResult simulate_run(const SodModel& model, const RunConfig& cfg, std::uint64_
   engine::HandlerId sample_handler{};
   sample_handler = kernel.add_handler("sod sample", [&](std::uint64_t kk) {
     const auto k = static_cast<node::SequenceNumber>(kk);
+    step_now = static_cast<std::int64_t>(kk);
     const auto& x = plant.state();
     for (std::size_t i = 0; i < kNodes; ++i) {
       double y = 0;
@@ -177,6 +222,23 @@ RunResult simulate_run(const SodModel& model, const RunConfig& cfg, std::uint64_
       rule[i].on_sent(k, yv);  // no acknowledgement
       res.sends[i] += 1;
       if (cause == node::SendCause::kTime) res.time_sends[i] += 1;
+      if (faulted) {
+        std::vector<std::uint8_t> bytes = encode_frame(k, y);
+        std::vector<std::vector<std::uint8_t>> extra;
+        faults[i]->apply(kernel.now(), bytes, extra);
+        const std::optional<engine::SimTime> at = link[i]->transmit(kernel.now());
+        if (!at) {
+          res.lost[i] += 1;
+          ++lost_run[i];
+          continue;
+        }
+        extra.insert(extra.begin(), std::move(bytes));
+        for (auto& f : extra) {
+          kernel.schedule(*at, engine::EventClass::kDelivery, deliver_frame, (frames.size() << 1) | i);
+          frames.push_back(std::move(f));
+        }
+        continue;
+      }
       const std::optional<engine::SimTime> arrival = link[i]->transmit(kernel.now());
       if (!arrival) {
         res.lost[i] += 1;
@@ -192,6 +254,8 @@ RunResult simulate_run(const SodModel& model, const RunConfig& cfg, std::uint64_
   kernel.schedule(engine::SimTime{0}, engine::EventClass::kSample, sample_handler, 0);
   kernel.run_until(end);
 
+  for (std::size_t i = 0; i < kNodes; ++i)
+    if (faults[i]) res.injected += faults[i]->counters();
   const double n = static_cast<double>(cfg.steps);
   res.nees /= n;
   for (std::size_t i = 0; i < kNodes; ++i) {

@@ -9,11 +9,19 @@
 /// event, and the estimator runs in kCompute: predict (k ≥ 1), then one scalar correction
 /// per node with what the receiver gives. The senders' decisions depend only on the plant
 /// and measurement streams, so plain SOD sends the same packets at every ξ for a seed.
+///
+/// With a fault spec (RunConfig::faults, frame faults on links "node1", "node2" only) each
+/// packet travels as a frame [k: u32 LE][y: f64] through the link's engine::LinkFaults
+/// before the loss draw; the receiver takes a frame only when its k is the current sample
+/// (the links have no delay: another k is a replay or forged, refused_sequence) and its y is
+/// finite (refused_non_finite). An empty spec is the clean run, bit for bit.
 #pragma once
 
 #include <cstdint>
 #include <vector>
 
+#include "oneshot/engine/fault_spec.hpp"
+#include "oneshot/engine/frame_faults.hpp"
 #include "sod_model.hpp"
 
 namespace oneshot::sod {
@@ -44,6 +52,7 @@ struct RunConfig {
   double tail_from_s = 20;                 ///< Start of the "slow tail" error window.
   double p0 = 0.01;                        ///< P(0) = p0·I, x̂(0) = x(0) = 0.
   bool noise = true;                       ///< Process and measurement noise (false: noise-free).
+  engine::FaultSpec faults;                ///< Frame faults on links node1, node2 (empty: clean).
 };
 
 /// Figures of one run.
@@ -56,7 +65,13 @@ struct RunResult {
   double lost[kNodes] = {};       ///< Lost on the link.
   double detected[kNodes] = {};   ///< Losses the detector proved (Σ increments of d).
   double estimator_resets = 0;    ///< Steps whose estimate turned non-finite (reset to x0, P0).
+  double refused_non_finite = 0;  ///< Frames the receiver refused: y not finite (faults only).
+  double refused_sequence = 0;    ///< Frames the receiver refused: k not the current sample (faults only).
+  engine::FaultCounters injected; ///< Faults injected on both links.
 };
+
+/// The link names a fault spec of the study may name.
+inline std::vector<std::string> sod_link_names() { return {"node1", "node2"}; }
 
 /// Per-step record of a run (E4 and the tests).
 struct RunTrace {

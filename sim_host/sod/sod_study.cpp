@@ -59,9 +59,13 @@ void register_sod_study(CLI::App& app) {
     common_options(cmd, *c);
     cmd->add_option("--loss", c->opt.losses, "loss rates xi")->check(CLI::Range(0.0, 0.99))->capture_default_str();
     cmd->add_option("--shard", c->shard, "run part i/N of the sweep (merge with `oneshot-sim merge`)");
-    cmd->callback([c] {
+    auto inject = std::make_shared<std::string>();
+    cmd->add_option("--inject", *inject, "frame faults in every run on links node1/node2, e.g. 'nan:link=node1,rate=0.05' (docs/faults.md)");
+    cmd->callback([c, inject] {
       const sod::SodModel m = model_of(*c);
       if (!c->shard.empty()) c->opt.shard = engine::parse_shard(c->shard);
+      c->opt.faults = engine::parse_fault_spec(*inject);
+      engine::check_fault_targets(c->opt.faults, sod::sod_link_names(), {});
       sod::emit_json(sod::run_table(m, c->opt), c->json);
     });
   }

@@ -34,6 +34,9 @@ constexpr Configuration kConfigurations[] = {
 const std::vector<std::string> kMetrics = {"e1", "e2", "e1_tail", "e2_tail", "nees", "sends1", "sends2",
                                            "time_sends1", "time_sends2", "lost1", "lost2", "detected1", "detected2"};
 
+/// Per-run counters of a faulted table (RunResult): faults injected, frames refused, estimator resets.
+const std::vector<std::string> kFaultMetrics = {"injected", "refused_non_finite", "refused_sequence", "estimator_resets"};
+
 std::string path_in(const std::string& dir, const std::string& name) { return (std::filesystem::path(dir) / name).string(); }
 std::string f4(double v) {
   char b[48];
@@ -79,6 +82,10 @@ nlohmann::json run_table(const SodModel& model, const StudyOptions& opt) {
                  {"period_s", model.period_s()},
                  {"mean_gap_s", {g.mean_s[0], g.mean_s[1]}},
                  {"scenarios", scen}};
+  if (!opt.faults.empty()) {  // only then: the clean table's spec (and its shards) stay as they were
+    spec.config["inject"] = opt.faults.text;
+    for (const auto& m : kFaultMetrics) spec.metrics.push_back(m);
+  }
   const engine::SweepResults r = engine::run_sweep(spec, opt.shard, opt.threads,
       [&](std::size_t a, std::size_t s, std::uint64_t seed) {
         RunConfig cfg;
@@ -90,9 +97,14 @@ nlohmann::json run_table(const SodModel& model, const StudyOptions& opt) {
         cfg.loss = opt.losses[s];
         cfg.amplitude = opt.amplitude;
         cfg.steps = opt.steps;
+        cfg.faults = opt.faults;
         const RunResult x = simulate_run(model, cfg, seed);
-        return std::vector<double>{x.e[0], x.e[1], x.e_tail[0], x.e_tail[1], x.nees, x.sends[0], x.sends[1],
-                                   x.time_sends[0], x.time_sends[1], x.lost[0], x.lost[1], x.detected[0], x.detected[1]};
+        std::vector<double> v{x.e[0], x.e[1], x.e_tail[0], x.e_tail[1], x.nees, x.sends[0], x.sends[1],
+                              x.time_sends[0], x.time_sends[1], x.lost[0], x.lost[1], x.detected[0], x.detected[1]};
+        if (!opt.faults.empty())
+          v.insert(v.end(), {static_cast<double>(x.injected.injected()), x.refused_non_finite, x.refused_sequence,
+                             x.estimator_resets});
+        return v;
       }, "sod table");
   if (!opt.shard.whole()) {
     sim::make_directory(opt.out_dir);
@@ -115,6 +127,7 @@ nlohmann::json table_outputs(const engine::SweepResults& results, const std::str
   };
   auto stat = [&](std::size_t a, std::size_t s, const std::string& m) { return sim::summarize(series(a, s, m)); };
   nlohmann::json j = {{"experiment", "E3 table"}, {"config", spec.config}, {"seeds", seeds}, {"first_seed", spec.first_seed}};
+  if (spec.config.contains("inject")) j["inject"] = spec.config.at("inject");
   std::ostringstream md;
   md << "| configuration | xi | packets 1 | packets 2 | (2b) 1 | (2b) 2 | lost 1 | lost 2 | e1 (95 % CI) | e2 (95 % CI) | e1 20-50 s | NEES (2 = consistent) |\n"
         "|---|---|---|---|---|---|---|---|---|---|---|---|\n";
@@ -134,6 +147,8 @@ nlohmann::json table_outputs(const engine::SweepResults& results, const std::str
         row["e_tail_20_50s"].push_back(ci(stat(a, s, "e" + n + "_tail")));
       }
       row["nees"] = ci(stat(a, s, "nees"));
+      if (spec.config.contains("inject"))
+        for (const auto& m : kFaultMetrics) row["faults"][m] = ci(stat(a, s, m));
       j["rows"].push_back(row);
       const auto e1 = stat(a, s, "e1"), e2 = stat(a, s, "e2"), t1 = stat(a, s, "e1_tail"), nees = stat(a, s, "nees");
       md << "| " << spec.approaches[a] << " | " << xi << " | " << f4(stat(a, s, "sends1").mean) << " | "

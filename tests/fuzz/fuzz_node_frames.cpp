@@ -71,6 +71,7 @@ struct Nodes {
   Disc disc{K::kTable};
   host::HostNetworkState c_net, s_net, a_net, g_net, o_net;
   SyncControllerNode<Net, Est, Ref, double, 2, 1, 1> ctrl;
+  std::uint32_t ctrl_clock_us = 0;  ///< The controller's receive clock (µs).
   SyncSensorNode<Net, double, 1, 1> sensor{kController, 0};
   SyncActuatorNode<Net, double, 1> act{kSensor, V1{}};
   struct Echo {
@@ -133,6 +134,7 @@ struct Nodes {
     ctrl.set_measurement_range(v1(-kU), v1(kU));
     ctrl.check_echo_range();
     ctrl.set_tau_range(0, 50'000);
+    ctrl.set_period_us(50'000);  // periods without a report predicted over (skip())
     sensor.expect_source(kActuator);
     sensor.set_echo_range(v1(-kU), v1(kU));
     sensor.set_stamp_window(150'000);
@@ -167,7 +169,8 @@ struct Nodes {
       case 0: {
         deliver(c_net, src, b, n);
         const host::ScopedHostNetwork cur(c_net);
-        ctrl.on_receive(McuInstant(0));
+        ctrl_clock_us += 50'000U;  // one period per invocation: any stamp may open a gap
+        ctrl.on_receive(McuInstant(ctrl_clock_us));
         break;
       }
       case 1: {
@@ -238,7 +241,8 @@ struct Nodes {
       deliver(c_net, kSensor, bytes, encode(r, bytes));
       {
         const host::ScopedHostNetwork cur(c_net);
-        ctrl.on_receive(McuInstant(0));
+        ctrl_clock_us += 50'000U;
+        ctrl.on_receive(McuInstant(ctrl_clock_us));
       }
       require(!must || (c_net.outbox.size() == 1 && u32(c_net.outbox[0].bytes.data()) == k),
               "sync controller: no command within R valid reports");

@@ -26,7 +26,40 @@ NodePort& Network::add_node(std::uint8_t address, const std::string& name, Durat
 
 Link& Network::add_link(const LinkConfig& config) {
   links_.push_back(std::make_unique<Link>(config, kernel_.seed()));
+  auto f = std::make_unique<LinkFaults>(faults_, config.name, config.frame, kernel_.seed());
+  link_faults_.push_back(f->empty() ? nullptr : std::move(f));
   return *links_.back();
+}
+
+void Network::set_faults(const FaultSpec& spec) {
+  if (!links_.empty()) throw std::logic_error("network: set_faults() after the first link");
+  faults_ = spec;
+}
+
+void Network::arm_faults(const std::map<std::string, std::function<void()>>& restart_hooks) {
+  std::vector<std::string> nodes;
+  for (const auto& [name, hook] : restart_hooks) nodes.push_back(name);
+  FaultSpec restarts;
+  for (const FaultClause& c : faults_.clauses)
+    if (!is_frame_fault(c.kind)) restarts.clauses.push_back(c);
+  check_fault_targets(restarts, {}, nodes);
+  for (const auto& [name, hook] : restart_hooks) {
+    const std::vector<SimTime> at = restart_instants(faults_, name);
+    if (at.empty()) continue;
+    const HandlerId h = kernel_.add_handler("restart " + name, [this, hook = hook](std::uint64_t) {
+      ++restarts_;
+      hook();
+    });
+    for (SimTime t : at) kernel_.schedule(t, EventClass::kEnvironment, h);
+  }
+}
+
+FaultCounters Network::fault_counters() const {
+  FaultCounters c;
+  for (const auto& f : link_faults_)
+    if (f) c += f->counters();
+  c.restart += restarts_;
+  return c;
 }
 
 CanBus& Network::add_can_bus(const CanBusConfig& config) {
@@ -35,11 +68,14 @@ CanBus& Network::add_can_bus(const CanBusConfig& config) {
 }
 
 void Network::route(std::uint8_t source, std::uint8_t destination, Link& link) {
-  routes_[{source, destination}] = Route{&link, nullptr, 0};
+  LinkFaults* faults = nullptr;
+  for (std::size_t i = 0; i < links_.size(); ++i)
+    if (links_[i].get() == &link) faults = link_faults_[i].get();
+  routes_[{source, destination}] = Route{&link, faults, nullptr, 0};
 }
 
 void Network::route(std::uint8_t source, std::uint8_t destination, CanBus& bus, std::uint32_t id) {
-  routes_[{source, destination}] = Route{nullptr, &bus, id};
+  routes_[{source, destination}] = Route{nullptr, nullptr, &bus, id};
 }
 
 NodePort& Network::node(std::uint8_t address) {
@@ -82,8 +118,16 @@ void Network::run_node(std::uint8_t address, const std::function<void()>& f) {
     }
     const Route& r = it->second;
     if (r.link != nullptr) {
+      std::vector<std::vector<std::uint8_t>> extra;
+      if (r.faults != nullptr) r.faults->apply(kernel_.now(), frame.bytes, extra);
       const auto arrival = r.link->transmit(kernel_.now());
-      if (arrival) kernel_.schedule(*arrival, EventClass::kDelivery, deliver_id_, park(std::move(frame)));
+      if (!arrival) continue;
+      const std::uint8_t src = frame.source;
+      const std::uint8_t dst = frame.destination;
+      kernel_.schedule(*arrival, EventClass::kDelivery, deliver_id_, park(std::move(frame)));
+      for (auto& bytes : extra) {
+        kernel_.schedule(*arrival, EventClass::kDelivery, deliver_id_, park(host::Frame{src, dst, std::move(bytes)}));
+      }
     } else {
       // Segmented over CAN frames of ≤ 8 bytes, queued back to back with the route's
       // identifier (FIFO within an identifier): the message arrives with its last frame.

@@ -8,26 +8,18 @@
 #include <cstdint>
 #include <limits>
 
-#include "oneshot/generated/plant_tables.hpp"
 #include "oneshot/host/host_network.hpp"
 #include "oneshot/node/sync_controller_node.hpp"
 #include "oneshot/node/sync_estimators.hpp"
 #include "oneshot/node/sync_sensor_node.hpp"
 #include "oneshot/table_discretizer.hpp"
+#include "sync_test_loop.hpp"
 
 namespace oneshot::node {
 namespace {
 
-using K = generated::PlantConstants<double>;
-using Structure = generated::PlantStructure;
-using Disc = TableDiscretizer<K::Format, Structure, double>;
-using Est = HalfKalmanEstimator<K::Format, Structure, Disc>;
-using Ref = SquareWaveReference<double, 2, 1>;
-using Ctrl = SyncControllerNode<host::HostNetwork, Est, Ref, double, 2, 1, 1>;
+using namespace sync_test;  // NOLINT(google-build-using-namespace): the shared test loop
 using Report = SampleReport<double, 1, 1>;
-constexpr std::uint8_t kSensor = 1;
-constexpr std::uint8_t kController = 2;
-constexpr std::uint8_t kActuator = 3;
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
 /// A controller on the generated reference plant, its interface, and a report sender.
@@ -48,15 +40,7 @@ struct Loop {
   }
   /// The sensor's report of period k with sample y (τ = 20 ms, echo u), handled at once.
   void report(SequenceNumber k, double y, double u = 0.0, std::uint8_t from = kSensor) {
-    Report r;
-    r.k = k;
-    r.t_s = McuInstant(k * 50'000U);
-    r.tau_us = 20'000;
-    r.y[0] = y;
-    r.u_applied[0] = u;
-    std::uint8_t bytes[kMaxMessageBytes];
-    const std::size_t n = encode(r, bytes);
-    net.deliver(host::Frame{from, kController, std::vector<std::uint8_t>(bytes, bytes + n)});
+    deliver_report(net, from, k, McuInstant(k * 50'000U), 20'000, y, u);
     const host::ScopedHostNetwork cur(net);
     ctrl.on_receive(McuInstant(k * 50'000U + 25'000U));
   }

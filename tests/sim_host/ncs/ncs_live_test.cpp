@@ -2,7 +2,9 @@
 /// @brief Live part of study `ncs`: the POSIX UDP port round-trips frames and drives the
 ///        firmware's sensor node; a short five-process run leaves consistent logs, its relay
 ///        applied the engine's delay draws, and its replay reproduces the live cost (and
-///        moves when a recorded noise draw is changed). No assertion on real-time figures.
+///        moves when a recorded noise draw is changed); a faulted run (--inject) completes,
+///        records its injected frames and restarts, and its replay reproduces it. No
+///        assertion on real-time figures.
 #include <gtest/gtest.h>
 #include <sys/socket.h>
 #include <unistd.h>
@@ -16,6 +18,7 @@
 #include "ncs_live.hpp"
 #include "ncs_live_nodes.hpp"
 #include "ncs_loop.hpp"
+#include "oneshot/engine/frame_faults.hpp"
 #include "oneshot/engine/link.hpp"
 #include "oneshot/node/sync_sensor_node.hpp"
 #include "oneshot/posix/udp_network.hpp"
@@ -215,6 +218,100 @@ TEST(NcsLive, ShortRunLogsAreConsistentAndItsReplayReproducesTheCost) {
   const ReplayResult changed = replay_live(o.out_dir);
   EXPECT_GT(std::fabs(changed.cost / live - 1), 1e-9);
   EXPECT_GT(changed.max_abs_u_difference, 0.0);
+  std::filesystem::remove_all(o.out_dir);
+}
+
+/// A 2 s live run of AK on scenario a0.2-T2-d14-s1 with seed `seed` and faults `inject`.
+LiveOptions faulted_run(std::uint64_t seed, const char* dir, const char* inject) {
+  LiveOptions o;
+  o.approach = Approach::kAK;
+  o.scenario = default_scenarios()[1];
+  o.scenario.duration_s = 2;
+  o.seed = seed;
+  o.inject = inject;
+  o.out_dir = test::fresh_dir("ncs_live", dir);
+  o.executable = ONESHOT_SIM_PATH;
+  return o;
+}
+
+/// A faulted live run: duplicates, bit flips, replays and restarts of two nodes. The run
+/// completes, the relay's injected frames and the restarts are counted, and the replay
+/// (recorded injected bytes, recorded restarts) gives the live cost again.
+TEST(NcsLive, FaultedRunCompletesAndItsReplayReproducesIt) {
+  const LiveOptions o = faulted_run(3, "faults",
+                                    "dup:rate=0.1;flip:link=ca,rate=0.05;replay:link=sc,rate=0.1;"
+                                    "restart:node=actuator,at_s=1;restart:node=controller,at_s=1.5");
+  const nlohmann::json j = run_live(o);
+  EXPECT_EQ(j.at("inject").get<std::string>(), o.inject);
+  const auto& injected = j.at("faults_injected");
+  EXPECT_GT(injected.at("dup").get<double>(), 0);
+  EXPECT_GT(injected.at("replay").get<double>(), 0);
+  const auto& counters = j.at("node_counters");
+  EXPECT_EQ(counters.at("actuator.restarts").get<double>(), 1);
+  EXPECT_EQ(counters.at("controller.restarts").get<double>(), 1);
+  EXPECT_EQ(counters.at("sensor.restarts").get<double>(), 0);
+  EXPECT_GT(counters.at("sensor.stale").get<double>(), 0);  // duplicated requests
+  // The relay drew the engine's faults: LinkFaults with the run's seed, fed the relay's receipt
+  // instants per link (frames of each link's size), injects the same counts.
+  const auto ctx = Context::load("");
+  const engine::FaultSpec spec = engine::parse_fault_spec(o.inject);
+  std::map<int, std::unique_ptr<engine::LinkFaults>> faults;
+  const char* names[4] = {"", "sc", "ca", "as"};  // by source address
+  const std::size_t sizes[4] = {0, node::report_size<double, kP, kM>(), node::kHeaderBytes + 8 * kM,
+                                node::request_size<double, kM>()};
+  for (int src : {1, 2, 3}) {
+    const engine::LinkConfig cfg = leg(*ctx, o.scenario, o.approach, names[src]);
+    faults[src] = std::make_unique<engine::LinkFaults>(spec, cfg.name, cfg.frame, o.seed);
+  }
+  std::size_t inject_records = 0;
+  for (const auto& r : read_log(o.out_dir, "relay")) {
+    inject_records += r.event == "inject" ? 1u : 0u;
+    if (r.event != "in") continue;
+    std::vector<std::uint8_t> bytes(sizes[r.src], 0);
+    std::vector<std::vector<std::uint8_t>> extra;
+    faults.at(r.src)->apply(engine::SimTime{r.t_ns}, bytes, extra);
+  }
+  engine::FaultCounters total;
+  for (const auto& [src, f] : faults) total += f->counters();
+  EXPECT_EQ(static_cast<double>(total.dup), injected.at("dup").get<double>());
+  EXPECT_EQ(static_cast<double>(total.flip), injected.at("flip").get<double>());
+  EXPECT_EQ(static_cast<double>(total.replay), injected.at("replay").get<double>());
+  EXPECT_EQ(static_cast<double>(total.skipped), injected.at("skipped").get<double>());
+  EXPECT_GE(inject_records, static_cast<std::size_t>(injected.at("dup").get<double>()));
+  EXPECT_TRUE(std::filesystem::exists(o.out_dir + "/injected.csv"));
+  EXPECT_EQ(j.at("replay_missing_frames").get<unsigned>(), 0u);
+  EXPECT_EQ(j.at("replay_max_abs_u_difference").get<double>(), 0.0);
+  EXPECT_NEAR(j.at("replay_over_live").get<double>(), 1.0, 1e-12);
+  EXPECT_TRUE(std::isfinite(j.at("simulated_cost").get<double>()));
+  std::filesystem::remove_all(o.out_dir);
+}
+
+/// Issue 24's live symptoms: NaN frames on every link and forged sequence numbers on the
+/// request and report links. Before the nodes refused them the run ended with "field
+/// 'live_cost' is not a finite number" (NaN) or a loop that stopped commanding (forged k).
+/// The run completes with a finite cost, every fault is refused and counted by the node it
+/// reaches, commands keep coming, and the replay reproduces the live cost.
+TEST(NcsLive, NanAndForgedSequenceFramesAreRefusedAndTheLoopGoesOn) {
+  const LiveOptions o = faulted_run(4, "nan_forged",
+                                    "nan:link=as,rate=0.05;nan:link=sc,rate=0.05;nan:link=ca,rate=0.05;"
+                                    "forge_seq:link=as,at_s=0.5;forge_seq:link=sc,at_s=1");
+  const nlohmann::json j = run_live(o);
+  const double live = j.at("live_cost").get<double>();
+  EXPECT_TRUE(std::isfinite(live));
+  EXPECT_TRUE(std::isfinite(j.at("simulated_cost").get<double>()));
+  const auto& injected = j.at("faults_injected");
+  const auto& c = j.at("node_counters");
+  const double refused_nan = c.at("sensor.refused_non_finite").get<double>() +
+                             c.at("controller.refused_non_finite").get<double>() +
+                             c.at("actuator.refused_non_finite").get<double>();
+  EXPECT_GT(injected.at("nan").get<double>(), 0);
+  EXPECT_EQ(refused_nan, injected.at("nan").get<double>());  // every NaN refused where it arrives
+  EXPECT_EQ(injected.at("forge_seq").get<double>(), 2);
+  EXPECT_EQ(c.at("sensor.refused_sequence").get<double>() + c.at("controller.refused_sequence").get<double>(), 2);
+  EXPECT_EQ(c.at("controller.estimator_resets").get<double>(), 0);
+  // Commands go on: at most the refused frames' periods (and the timing's) held.
+  EXPECT_LT(j.at("late_commands").get<double>(), 0.25 * j.at("actuation_instants_expected").get<double>());
+  EXPECT_NEAR(j.at("replay_over_live").get<double>(), 1.0, 1e-12);
   std::filesystem::remove_all(o.out_dir);
 }
 

@@ -54,6 +54,12 @@ class HalfKalman : public KalmanFilterBase<Fmt, Structure, kForm> {
     return status;
   }
 
+  /// A period without a job (its sample lost or refused): from the last actuation instant
+  /// to the next one, x̂⁻ ← Φ(h) x̂⁻ + Γ(h) u, P⁻ ← Φ(h) P⁻ Φ(h)ᵀ + Q, u the input applied
+  /// there (set_applied_input()).
+  constexpr Status skip_period() {
+    return core_.predict(*disc_, design_->period_us, u_, noise_, design_->q_constant);
+  }
   /// The input applied at the actuation instant the last update predicted to.
   constexpr void set_applied_input(const InputVec& u) { u_ = u; }
   /// x̂⁻_k: the estimate at the next actuation instant.

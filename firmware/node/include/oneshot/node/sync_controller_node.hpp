@@ -12,6 +12,20 @@
 /// re-acquired on the R-th report. The estimator never leaves a non-finite estimate (its
 /// update() resets it and returns Status::kNonFinite, counted): no command is sent then,
 /// and a command that is not finite is never sent (the actuator holds its value).
+///
+/// Periods without a report (lost, refused, or while a restarted peer is re-acquired) are
+/// predicted over once the period h is set (set_period_us()): with t_k = t_s,k + τ_k the
+/// actuation instant a report targets (sensor clock, independent of k), a report whose t_k
+/// is n = round((t_k − t_last)/h) ≥ 2 periods after the last one first runs
+/// estimator.skip(u) for the n − 1 periods between (none when more than kMaxFilledPeriods:
+/// a long silence), u the report's echo: the input the actuator held at t_k − h (its last
+/// command that arrived, or what a restarted actuator applies; never a lost command). The
+/// controller's own clock checks n: when the count of its receive instants differs by more
+/// than one, the stamp is wrong and that count is taken. Without this the filter would take
+/// the new sample as one period after the last and carry a period's drift for many periods.
+/// The reference is read on the same time base (x_ref, u_ref at an index that moves by n
+/// per report from the first report's k), not at the report's k: a restarted actuator's k
+/// from 0 does not move the reference back to its start.
 #pragma once
 
 #include <cstddef>
@@ -34,10 +48,14 @@ struct SyncControllerStatistics : FrameRefusals {
   std::uint32_t faults = 0;        ///< Estimator runs whose status was not exact.
   std::uint32_t estimator_resets = 0;  ///< Estimator runs that turned non-finite (reset, no command).
   std::uint32_t withheld = 0;      ///< Commands not sent because they were not finite.
+  std::uint32_t filled = 0;        ///< Periods without a report the estimator predicted over.
   std::uint32_t saturated = 0;     ///< Commands clamped to the actuator's range.
   std::uint32_t sends = 0;         ///< Commands sent.
   std::uint32_t refused = 0;       ///< Sends the interface refused.
 };
+
+/// Most periods without a report one report fills in (more: none, the estimator's correction alone).
+inline constexpr std::int32_t kMaxFilledPeriods = 64;
 
 /// Controller of N states, P outputs, M inputs in scalar S on board `Board`.
 template <typename Board, typename Estimator, typename Reference, typename S, std::size_t N, std::size_t P,
@@ -93,6 +111,8 @@ class SyncControllerNode {
     tau_min_us_ = tau_min_us;
     tau_max_us_ = tau_max_us;
   }
+  /// The loop's period h (µs): periods without a report are predicted over (0: off).
+  constexpr void set_period_us(std::int32_t period_us) { period_us_ = period_us > 0 ? period_us : 0; }
   /// Sequence window W and re-acquisition count R (frame_checks.hpp).
   constexpr void set_sequence_window(std::uint32_t window, std::uint32_t reacquire) {
     gate_ = SequenceGate(window, reacquire);
@@ -108,7 +128,46 @@ class SyncControllerNode {
   constexpr const SyncControllerStatistics& statistics() const { return stats_; }
 
  private:
+  // round(dt / h) (µs; in 64 bits: no overflow at any dt).
+  constexpr std::int32_t periods(std::int32_t dt) const {
+    const std::int64_t h = period_us_;
+    const std::int64_t d = dt;
+    return static_cast<std::int32_t>(d >= 0 ? (d + h / 2) / h : -((-d + h / 2) / h));
+  }
+
+  // Periods between the last report's t_k and this one's: predicts the estimator over the
+  // missing ones and moves the reference index by as many (false: the estimator was reset).
+  [[nodiscard]] bool fill_gap(const Report& r, McuInstant now) {
+    const McuInstant t_k = r.t_s.plus(r.tau_us);
+    const bool had = have_t_k_;
+    const std::int32_t dt = t_k - last_t_k_;
+    const std::int32_t dt_own = now - last_now_;
+    last_t_k_ = t_k;
+    last_now_ = now;
+    have_t_k_ = true;
+    if (period_us_ == 0 || !had) {
+      ref_k_ = r.k;
+      return true;
+    }
+    // The stamps give n exactly; the controller's own clock (jittered by the delays) checks
+    // them: a stamp more than one period off its count is wrong, the own count is taken.
+    std::int32_t n = periods(dt);
+    const std::int32_t n_own = periods(dt_own);
+    if (n < 1 || n - n_own > 1 || n_own - n > 1) n = n_own < 1 ? 1 : n_own;
+    ref_k_ += static_cast<SequenceNumber>(n);
+    if (n - 1 > kMaxFilledPeriods) return true;  // a long silence: the correction alone
+    for (std::int32_t i = 1; i < n; ++i) {
+      if (estimator_.skip(r.u_applied) == Status::kNonFinite) {
+        ++stats_.estimator_resets;
+        return false;
+      }
+      ++stats_.filled;
+    }
+    return true;
+  }
+
   void compute(const Report& r, McuInstant now) {
+    if (!fill_gap(r, now)) return;
     ++stats_.computations;
     const Status st = estimator_.update(r.tau_us, r.y, r.u_applied);
     if (!is_exact(st)) ++stats_.faults;
@@ -116,7 +175,7 @@ class SyncControllerNode {
       ++stats_.estimator_resets;
       return;
     }
-    const Vector<S, M> u = reference_.input(r.k) - l_ * (estimator_.estimate() - reference_.state(r.k));
+    const Vector<S, M> u = reference_.input(ref_k_) - l_ * (estimator_.estimate() - reference_.state(ref_k_));
     if (!all_finite(u)) {
       ++stats_.withheld;
       return;
@@ -143,6 +202,11 @@ class SyncControllerNode {
   Estimator estimator_;
   Reference reference_;
   Vector<S, M> u_{};
+  std::int32_t period_us_ = 0;
+  McuInstant last_t_k_{};
+  McuInstant last_now_{};
+  SequenceNumber ref_k_ = 0;
+  bool have_t_k_ = false;
   std::int32_t tau_min_us_ = INT32_MIN;
   std::int32_t tau_max_us_ = INT32_MAX;
   SequenceGate gate_{};

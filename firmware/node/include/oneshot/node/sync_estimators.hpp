@@ -2,7 +2,8 @@
 /// @brief Estimators of the actuation-synchronized controller: each turns the report of
 ///        period k (τ_k, y_s,k, the input applied at t_{k−1}) into x̂ at t_k.
 ///
-/// Plug-in interface: update(τ_us, y, u_applied) → Status, estimate() → x̂ at t_k.
+/// Plug-in interface: update(τ_us, y, u_applied) → Status, skip(u_held) → Status (a period
+/// without a report, predicted over h), estimate() → x̂ at t_k.
 /// update() never leaves a non-finite estimate: when x̂ (or P) turns NaN or ±∞ it resets to
 /// the initial values it was given (reset(); the design's x0, P0) and returns
 /// Status::kNonFinite.
@@ -52,6 +53,15 @@ class HalfKalmanEstimator {
     filter_.reset(x0_, p0_, u0_);
     return Status::kNonFinite;
   }
+  /// A period without a report: predicts over h from t_k with the input held there (the
+  /// last command). Reset and Status::kNonFinite as update().
+  [[nodiscard]] constexpr Status skip(const InputVec& u_held) {
+    filter_.set_applied_input(u_held);
+    const Status s = filter_.skip_period();
+    if (all_finite(filter_.prediction()) && all_finite(filter_.covariance())) return s;
+    filter_.reset(x0_, p0_, u0_);
+    return Status::kNonFinite;
+  }
   /// x̂⁻_k: the estimate at t_k.
   constexpr const StateVec& estimate() const { return filter_.prediction(); }
   /// The core filter (covariance, gain).
@@ -87,6 +97,8 @@ class SampledStatePredictor {
     x_ = StateVec{};
     return Status::kNonFinite;
   }
+  /// A period without a report: nothing to do (no memory across reports).
+  [[nodiscard]] constexpr Status skip(const InputVec&) { return Status::kOk; }
   /// x̂_k.
   constexpr const StateVec& estimate() const { return x_; }
 

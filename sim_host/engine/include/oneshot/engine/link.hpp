@@ -14,6 +14,7 @@
 #include <string>
 
 #include "oneshot/engine/delay_model.hpp"
+#include "oneshot/engine/frame_layout.hpp"
 #include "oneshot/engine/loss_model.hpp"
 #include "oneshot/engine/sim_time.hpp"
 
@@ -25,6 +26,7 @@ struct LinkConfig {
   DelayModel delay;   ///< Delay distribution.
   LossModel loss;     ///< Loss process.
   bool fifo = false;  ///< Never deliver out of order.
+  FrameLayout frame{};  ///< What its frames look like (for the fault models, frame_faults.hpp).
 };
 
 /// Counters of a link.

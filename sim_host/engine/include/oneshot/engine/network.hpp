@@ -9,7 +9,9 @@
 /// with the route's identifier (a message longer than 8 bytes goes as consecutive frames
 /// of ≤ 8 bytes with that identifier and arrives with its last one). An arrival is a kDelivery event that puts the frame into
 /// the destination's inbox and calls its receive handler inside run_node(). A node's
-/// clock reads t + its offset (node_clock()).
+/// clock reads t + its offset (node_clock()). With a fault spec (set_faults(), before the
+/// links are added) every link's frames pass through its LinkFaults (frame_faults.hpp) when
+/// sent, and arm_faults() schedules the node restarts through the study's hooks.
 #pragma once
 
 #include <cstdint>
@@ -21,6 +23,8 @@
 #include <vector>
 
 #include "oneshot/engine/can_bus.hpp"
+#include "oneshot/engine/fault_spec.hpp"
+#include "oneshot/engine/frame_faults.hpp"
 #include "oneshot/engine/kernel.hpp"
 #include "oneshot/engine/link.hpp"
 #include "oneshot/host/host_network.hpp"
@@ -62,6 +66,16 @@ class Network {
   /// The node's port.
   NodePort& node(std::uint8_t address);
 
+  /// Faults of `spec` on the links added from now on (std::logic_error after the first link).
+  void set_faults(const FaultSpec& spec);
+  /// Checks the spec's node names (InputError) and schedules every restart at its instant
+  /// (class kEnvironment) through the hook of its node (`restart_hooks` by name). Link names
+  /// are the study's to check (check_fault_targets() over every link it may build: a
+  /// clause for a link this loop lacks does nothing here).
+  void arm_faults(const std::map<std::string, std::function<void()>>& restart_hooks);
+  /// Faults injected so far (every link, and the restarts).
+  FaultCounters fault_counters() const;
+
   /// Frames sent, frames refused because no route exists (a configuration error: counted,
   /// and run_node() throws on the first).
   std::uint64_t frames_sent() const { return frames_sent_; }
@@ -69,6 +83,7 @@ class Network {
  private:
   struct Route {
     Link* link = nullptr;
+    LinkFaults* faults = nullptr;
     CanBus* bus = nullptr;
     std::uint32_t id = 0;
   };
@@ -78,6 +93,9 @@ class Network {
   Kernel& kernel_;
   std::map<std::uint8_t, std::unique_ptr<NodePort>> nodes_;
   std::vector<std::unique_ptr<Link>> links_;
+  std::vector<std::unique_ptr<LinkFaults>> link_faults_;  ///< Beside links_ (null: no clause).
+  FaultSpec faults_;
+  std::uint64_t restarts_ = 0;
   std::vector<std::unique_ptr<CanBus>> buses_;
   std::map<std::pair<std::uint8_t, std::uint8_t>, Route> routes_;
   std::vector<host::Frame> in_flight_;
