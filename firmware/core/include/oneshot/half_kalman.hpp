@@ -58,7 +58,7 @@ class HalfKalman : public KalmanFilterBase<Fmt, Structure, kForm> {
   /// to the next one, x̂⁻ ← Φ(h) x̂⁻ + Γ(h) u, P⁻ ← Φ(h) P⁻ Φ(h)ᵀ + Q, u the input applied
   /// there (set_applied_input()).
   constexpr Status skip_period() {
-    return core_.predict(*disc_, design_->period_us, u_, noise_, design_->q_constant);
+    return this->core_.predict(*disc_, this->design_->period_us, u_, this->noise_, this->design_->q_constant);
   }
   /// The input applied at the actuation instant the last update predicted to.
   constexpr void set_applied_input(const InputVec& u) { u_ = u; }
