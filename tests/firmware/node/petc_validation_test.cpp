@@ -99,16 +99,22 @@ TEST(PetcValidation, NonFiniteCorrectionResetsTheNumre) {
   EXPECT_EQ(est.covariance()(1, 1), 1.0);
 }
 
-TEST(PetcValidation, OverflowingCascadeWithheldPacketInForceRegenerated) {
-  // GIVEN an unstable model (a_11 = 10: ×10 per period over H = 200 periods) and a packet in
-  // force sent with r = 0.3 (finite: about 1e198 at its end)
-  using Petc200 = PetcController<double, 2, 200, Law, ModelDisturbance<double>>;
+using Petc200 = PetcController<double, 2, 200, Law, ModelDisturbance<double>>;
+
+/// The overflow fixture: model() with a_11 = 10 (×10 per period over H = 200 periods), reference r.
+Petc200 unstable(double r) {
   NumreModel<double, 2> m = model();
   m.a(1, 1) = 10.0;
   InterlacedConfig<double, 1, 2> c{};
   c.feedthrough = 0.5;
   c.ratio = 2;
-  Petc200 p(m, NoiseAccumulation::kSum, Law(c), ModelDisturbance<double>{}, MtmTrigger<double, 1>(0.01, 1e-4, 0, 0), 0.3);
+  return Petc200(m, NoiseAccumulation::kSum, Law(c), ModelDisturbance<double>{}, MtmTrigger<double, 1>(0.01, 1e-4, 0, 0), r);
+}
+
+TEST(PetcValidation, OverflowingCascadeWithheldPacketInForceRegenerated) {
+  // GIVEN an unstable model (a_11 = 10: ×10 per period over H = 200 periods) and a packet in
+  // force sent with r = 0.3 (finite: about 1e198 at its end)
+  Petc200 p = unstable(0.3);
   EXPECT_EQ(p.on_arrival(0, 0.05), SendCause::kFirst);
   static double before[Petc200::kEntries];
   static double d_before[Petc200::kEntries];
@@ -142,13 +148,7 @@ TEST(PetcValidation, OverflowingCascadeWithheldPacketInForceRegenerated) {
 
 TEST(PetcValidation, OverflowingFirstCascadeLeavesNoPacket) {
   // GIVEN the unstable model and r = 1e150 from the start (no packet in force yet)
-  using Petc200 = PetcController<double, 2, 200, Law, ModelDisturbance<double>>;
-  NumreModel<double, 2> m = model();
-  m.a(1, 1) = 10.0;
-  InterlacedConfig<double, 1, 2> c{};
-  c.feedthrough = 0.5;
-  c.ratio = 2;
-  Petc200 p(m, NoiseAccumulation::kSum, Law(c), ModelDisturbance<double>{}, MtmTrigger<double, 1>(0.01, 1e-4, 0, 0), 1e150);
+  Petc200 p = unstable(1e150);
   // WHEN the first cascade overflows THEN nothing is sent, no packet is in force (all zero)
   EXPECT_EQ(p.on_arrival(0, 0.05), SendCause::kNone);
   EXPECT_EQ(p.statistics().withheld, 1U);
