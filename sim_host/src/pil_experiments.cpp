@@ -50,6 +50,18 @@ std::pair<std::size_t, std::size_t> image_memory(const std::string& path) {
 
 namespace {
 
+/// The PIL sample request of a recorded job: sample and actuation instants (µs), ADC and
+/// set-point codes.
+app::pil::Frame sample_frame(const JobRecord& r) {
+  app::pil::Frame f;
+  app::pil::Writer w(f);
+  w.u(static_cast<std::uint32_t>(std::llround(r.t_sample_s * 1e6)), 4);
+  w.u(static_cast<std::uint32_t>(std::llround(r.t_apply_s * 1e6)), 4);
+  w.s(r.y_code, 2);
+  w.s(r.setpoint_code, 2);
+  return f;
+}
+
 /// Host run options that record every job, for the comparison with the MCU.
 RunOptions options_for(const CommonOptions& opt, Approach a) {
   RunOptions r = run_options(opt, a);
@@ -158,13 +170,7 @@ nlohmann::json soft_float_calls(const PilOptions& image, std::uint32_t approach,
     cw.u(pwm0, 2);
     link.request(app::pil::Type::kConfig, cfg);
     for (const JobRecord& r : jobs) {
-      app::pil::Frame f;
-      app::pil::Writer w(f);
-      w.u(static_cast<std::uint32_t>(std::llround(r.t_sample_s * 1e6)), 4);
-      w.u(static_cast<std::uint32_t>(std::llround(r.t_apply_s * 1e6)), 4);
-      w.s(r.y_code, 2);
-      w.s(r.setpoint_code, 2);
-      link.request(app::pil::Type::kSample, f);
+      link.request(app::pil::Type::kSample, sample_frame(r));
     }
   }  // QEMU ends: the plugin writes the profile
   std::map<std::uint32_t, std::string> entries;
@@ -349,13 +355,7 @@ nlohmann::json run_exectime_target(const SimContext& ctx, const CommonOptions& o
               static_cast<std::uint16_t>(std::lround(-ctx.design().u_min[0] * ctx.design().steps_per_volt[0])));
         }
         for (const JobRecord& r : jobs) {
-          app::pil::Frame f;
-          app::pil::Writer w(f);
-          w.u(static_cast<std::uint32_t>(std::llround(r.t_sample_s * 1e6)), 4);
-          w.u(static_cast<std::uint32_t>(std::llround(r.t_apply_s * 1e6)), 4);
-          w.s(r.y_code, 2);
-          w.s(r.setpoint_code, 2);
-          const app::pil::Frame reply = link.request(app::pil::Type::kSample, f);
+          const app::pil::Frame reply = link.request(app::pil::Type::kSample, sample_frame(r));
           const std::vector<std::uint8_t> bytes(reply.payload, reply.payload + reply.length);
           if (a == static_cast<std::uint32_t>(Approach::kB)) replies_b.push_back(bytes);
           // Same inputs, same job: status, τ, saturation, estimate, gain and applied input byte for byte.
