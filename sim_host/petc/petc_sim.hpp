@@ -12,6 +12,7 @@
 
 #include "oneshot/node/numre_estimator.hpp"
 #include "petc_design.hpp"
+#include "petc_modal.hpp"
 
 namespace oneshot::sim::petc {
 
@@ -68,6 +69,7 @@ struct PetcSetup {
   PlantFacts plant;                 ///< Plant (with σ_w, σ_v applied to its model).
   MrciDesign mrci;                  ///< Controller split.
   DobDesign dob;                    ///< DOB substitute.
+  BlockDiagonalModel node_model;    ///< Cases 3–5 NUMRE model: the augmented one in its block-diagonal basis.
   EstimatorModel plant_only;        ///< Case 6 NUMRE model.
   EstimatorModel eso;               ///< Case 6′ NUMRE model.
   std::vector<double> var_d;        ///< E[d_k²], k = 0 … K.

@@ -145,7 +145,7 @@ TEST(NumreClosedLoop, MultiplicityOneEqualsStandardKalman) {
   ASSERT_EQ(t.x_hat.size(), o.steps);
   EXPECT_EQ(v[5], static_cast<double>(o.steps));  // every sample sent
   for (std::size_t k = 1; k < t.multiplicity.size(); ++k) ASSERT_EQ(t.multiplicity[k], 1U) << k;
-  const EstimatorModel& e = s.plant.augmented;
+  const EstimatorModel& e = s.node_model.model;  // the basis the node runs in
   const Mat a = eig(e.a), b = eig(e.b), bw = eig(e.b_w), cm = eig(e.c);
   const Mat q = bw * e.w * bw.transpose();
   Vec x = Vec::Zero(12);
