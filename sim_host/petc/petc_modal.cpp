@@ -37,24 +37,30 @@ DenseMatrix sylvester(const DenseMatrix& a_oo, const DenseMatrix& d, const Dense
 
 }  // namespace
 
-BlockDiagonalModel block_diagonal_model(const EstimatorModel& m, std::size_t block) {
+BlockDiagonalModel block_diagonal_model(const EstimatorModel& m, std::size_t block, std::size_t leading) {
   const std::size_t n = m.a.rows;
-  if (block == 0 || n == 0 || n % block != 0 || m.a.cols != n)
-    throw std::invalid_argument("petc modal form: " + std::to_string(n) + " states do not split into blocks of " +
-                                std::to_string(block));
+  if (leading == 0) leading = n;
+  if (block == 0 || n == 0 || leading > n || leading % block != 0 || m.a.cols != n)
+    throw std::invalid_argument("petc modal form: " + std::to_string(leading) + " of " + std::to_string(n) +
+                                " states do not split into blocks of " + std::to_string(block));
+  // A's leading part (the plant) is block-diagonalized; the rest (the disturbance) keeps its
+  // coupling column into it: A' = [[D, T_p⁻¹ A_pd], [0, A_dd]].
+  const DenseMatrix a_pp = design::block(m.a, 0, 0, leading, leading);
   DenseMatrix t = design::identity(n);
-  DenseMatrix d = DenseMatrix::zeros(n, n);
-  for (std::size_t s = 0; s < n; s += block) {
+  DenseMatrix d = m.a;
+  for (std::size_t i = 0; i < leading; ++i)
+    for (std::size_t j = 0; j < leading; ++j) d(i, j) = 0.0;
+  for (std::size_t s = 0; s < leading; s += block) {
     std::vector<std::size_t> other;
-    for (std::size_t i = 0; i < n; ++i)
+    for (std::size_t i = 0; i < leading; ++i)
       if (i < s || i >= s + block) other.push_back(i);
     const std::size_t o = other.size();
     DenseMatrix a_oo = DenseMatrix::zeros(o, o), r = DenseMatrix::zeros(o, block);
     for (std::size_t i = 0; i < o; ++i) {
-      for (std::size_t j = 0; j < o; ++j) a_oo(i, j) = m.a(other[i], other[j]);
-      for (std::size_t c = 0; c < block; ++c) r(i, c) = -m.a(other[i], s + c);
+      for (std::size_t j = 0; j < o; ++j) a_oo(i, j) = a_pp(other[i], other[j]);
+      for (std::size_t c = 0; c < block; ++c) r(i, c) = -a_pp(other[i], s + c);
     }
-    const DenseMatrix d_j = design::block(m.a, s, s, block, block);
+    const DenseMatrix d_j = design::block(a_pp, s, s, block, block);
     design::set_block(d, s, s, d_j);
     const DenseMatrix x = o == 0 ? DenseMatrix::zeros(0, block) : sylvester(a_oo, d_j, r);
     for (std::size_t i = 0; i < o; ++i)
@@ -64,6 +70,10 @@ BlockDiagonalModel block_diagonal_model(const EstimatorModel& m, std::size_t blo
   design::flush_tiny(t, 1e-14);
   const design::SolveResult inv = design::solve(t, design::identity(n));
   if (!inv.ok) throw std::invalid_argument("petc modal form: T is singular");
+  // The coupling column of the rest: T_p⁻¹ A_pd (rows of the leading part).
+  const DenseMatrix coupled = inv.x * m.a;
+  for (std::size_t i = 0; i < leading; ++i)
+    for (std::size_t j = leading; j < n; ++j) d(i, j) = coupled(i, j);
   BlockDiagonalModel out;
   out.t = t;
   out.t_max = design::max_abs(t);
@@ -72,6 +82,7 @@ BlockDiagonalModel block_diagonal_model(const EstimatorModel& m, std::size_t blo
   if (!(out.residual <= 1e-10))
     throw std::invalid_argument("petc modal form: T^-1 A T is not block diagonal (residual " +
                                 std::to_string(out.residual) + "): A is not block triangular");
+  design::flush_tiny(d, 1e-15);
   out.model = m;
   out.model.a = d;
   out.model.b = inv.x * m.b;

@@ -355,7 +355,7 @@ PetcSetup make_setup(const PetcOptions& opt) {
   if (opt.sigma_v >= 0) s.plant.augmented.v = opt.sigma_v * opt.sigma_v;
   if (s.plant.augmented.a.rows != kPlantStates || s.plant.phi_p.rows != kPlantOnly)
     throw std::invalid_argument("petc: the study is compiled for a 10-state plant with 2 disturbance states");
-  s.node_model = block_diagonal_model(s.plant.augmented);
+  s.node_model = block_diagonal_model(s.plant.augmented, 2, kPlantOnly);
   if (opt.steps == 0 || opt.steps > 1000000) throw std::invalid_argument("petc: --steps must lie in 1 … 1000000");
   s.mrci = brief_mrci(opt.ratio);
   if (s.mrci.fast_count != 1 || s.mrci.slow_count != 2)

@@ -36,19 +36,20 @@ inline constexpr std::size_t kHorizon = 200;  ///< H: packets of H + 1 inputs (t
 /// The MRCI law of the brief: 1 fast and 2 slow first-order modes.
 template <typename S>
 using Law = node::InterlacedController<S, 1, 2>;
-/// Nonzero structure of the augmented HDD model in the block-diagonal basis the design gives
-/// the node (sim_host/petc/petc_modal.hpp: z = T⁻¹x, A' = blockdiag of A's 2 × 2 sections,
-/// B' = T⁻¹B, C' = C T, C̄' = C̄ T): 22 of A's 144 entries, its powers keep the same blocks;
-/// B' in the ten plant and notch rows but row 1, C' over nine states, C̄' the disturbance
-/// output state. kPetcReset refuses a model outside it (Node::fits).
+/// Nonzero structure of the augmented HDD model in the basis the design gives the node
+/// (sim_host/petc/petc_modal.hpp: the plant's ten states block-diagonalized, z_p = T_p⁻¹x_p,
+/// the disturbance states kept): A' = the plant's five 2 × 2 sections, their coupling column
+/// 11 from the disturbance, and the disturbance block; 32 of A's 144 entries, 44 in the
+/// closure of its powers. B' in the plant rows but row 1, C' over seven states, C̄' the
+/// disturbance output state. kPetcReset refuses a model outside it (Node::fits).
 struct HddStructure {
-  /// Row masks of A (bit j: A_ij may be nonzero): six 2 × 2 diagonal blocks.
-  static constexpr std::uint32_t kRows[kStates] = {0x003, 0x001, 0x00C, 0x004, 0x030, 0x030,
-                                                   0x0C0, 0x0C0, 0x300, 0x300, 0xC00, 0xC00};
+  /// Row masks of A (bit j: A_ij may be nonzero).
+  static constexpr std::uint32_t kRows[kStates] = {0x803, 0x001, 0x80C, 0x804, 0x830, 0x830,
+                                                   0x8C0, 0x8C0, 0xB00, 0xB00, 0xC00, 0xC00};
   /// Row mask i of A.
   static constexpr std::uint32_t row(std::size_t i) { return kRows[i]; }
-  static constexpr std::uint32_t kB = 0x3FD;     ///< B': plant and notch rows but row 1.
-  static constexpr std::uint32_t kC = 0xDF3;     ///< C': every state but the dead notch block (2, 3) and 9.
+  static constexpr std::uint32_t kB = 0x3FD;     ///< B': plant rows but row 1.
+  static constexpr std::uint32_t kC = 0x1F3;     ///< C': the sections the output sees (not notch 2's, nor 9).
   static constexpr std::uint32_t kCbar = 0x800;  ///< C̄': the disturbance output state.
 };
 
