@@ -7,6 +7,7 @@
 #include <memory>
 #include <stdexcept>
 
+#include "oneshot/app/petc_pil.hpp"
 #include "oneshot/engine/discrete_plant.hpp"
 #include "oneshot/engine/kernel.hpp"
 #include "oneshot/node/disturbance_observer.hpp"
@@ -122,15 +123,16 @@ class HoldController {
   double packet_[kHorizon + 1]{};
 };
 
-/// NUMRE controller node wrapped for the loop.
-template <std::size_t N, typename Observer>
+/// NUMRE controller node wrapped for the loop, compiled for the model's `Structure` (the
+/// augmented model: the M4F image's HddStructure, so the multiply-adds are the image's).
+template <std::size_t N, typename Observer, typename Structure = node::DenseModelStructure<N>>
 class NumreController {
  public:
-  using Node = node::PetcController<double, N, kHorizon, Law, Observer>;
+  using Node = node::PetcController<double, N, kHorizon, Law, Observer, Structure>;
   NumreController(const EstimatorModel& m, bool frozen, const Law& law, const Observer& obs, const Trigger& trig,
                   double r)
-      : node_(std::make_unique<Node>(numre_model<N>(m), frozen ? node::NoiseAccumulation::kFrozen
-                                                               : node::NoiseAccumulation::kSum,
+      : node_(std::make_unique<Node>(fitting(numre_model<N>(m)), frozen ? node::NoiseAccumulation::kFrozen
+                                                                        : node::NoiseAccumulation::kSum,
                                      law, obs, trig, r)) {}
   SendCause arrive(std::uint32_t k, double y) {
     const std::uint64_t before = node_->macs();
@@ -151,6 +153,12 @@ class NumreController {
  private:
   std::unique_ptr<Node> node_;
   std::uint64_t last_macs_ = 0;
+
+  /// The model, refused when it has a nonzero outside Structure.
+  static const node::NumreModel<double, N>& fitting(const node::NumreModel<double, N>& m) {
+    if (!Node::fits(m)) throw std::invalid_argument("petc: the NUMRE model has a nonzero outside its compiled structure");
+    return m;
+  }
 };
 
 Vector<double, 1> scalar(double x) {
@@ -331,8 +339,8 @@ std::vector<double> run_case(const PetcSetup& s, const CaseSpec& c, std::uint64_
   }
   switch (c.observer) {
     case ObserverKind::kAugmented: {
-      NumreController<kPlantStates, node::ModelDisturbance<double>> n(s.node_model.model, s.opt.frozen_noise, law,
-                                                                      {}, trig, r);
+      NumreController<kPlantStates, node::ModelDisturbance<double>, app::petc::HddStructure> n(
+          s.node_model.model, s.opt.frozen_noise, law, {}, trig, r);
       return simulate(s, c, seed, n, trace);
     }
     case ObserverKind::kDob: {
