@@ -66,6 +66,7 @@ void emit(const DroppingCli& c, const nlohmann::json& j, double wall) {
   if (!c.json.empty()) write_json(c.json, j);
   if (c.json != "-") {
     if (j.contains("markdown")) std::cout << j.at("markdown").get<std::string>();
+    if (j.contains("markdown_faults")) std::cout << "\n" << j.at("markdown_faults").get<std::string>();
     std::cout << j.value("experiment", std::string("result")) << ": written to " << c.opt.out_dir << std::endl;
   }
   std::cerr << "wall time " << wall << " s\n";

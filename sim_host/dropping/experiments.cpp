@@ -319,6 +319,7 @@ nlohmann::json closed_loop_outputs(const engine::SweepResults& r, const std::str
   }
   j["markdown_e5"] = m5.str();
   j["markdown"] = md.str();
+  if (cfg.contains("inject")) j["markdown_faults"] = sim::fault_markdown(r);
   sim::write_csv(path_in(out_dir, "closed_loop.csv"),
                  {"lambda", "approach", "err_median", "err_p10", "err_p90", "err_mean", "err_ci95", "trp_median", "trp_p10",
                   "trp_p90", "trp_mean", "trp_ci95"},
@@ -433,6 +434,7 @@ nlohmann::json hold_outputs(const engine::SweepResults& r, const std::string& ou
                    tc.mean.mean});
   }
   j["markdown"] = md.str();
+  if (cfg.contains("inject")) j["markdown_faults"] = sim::fault_markdown(r);
   sim::write_csv(path_in(out_dir, "hold.csv"),
                  {"D", "T_hold", "err_median", "err_p10", "err_p90", "anchor_median", "anchor_p10", "anchor_p90",
                   "corrections"},

@@ -126,7 +126,10 @@ nlohmann::json table_outputs(const engine::SweepResults& r, const std::string& o
   nlohmann::json j = {{"study", "petc"},        {"experiment", "table"},     {"seeds", spec.seeds},
                       {"first_seed", spec.first_seed}, {"n_tts", spec.config.value("steps", 0)},
                       {"config", spec.config},  {"cases", cases},          {"paired_differences_consecutive", paired}};
-  if (spec.config.contains("inject")) j["inject"] = spec.config.at("inject");
+  if (spec.config.contains("inject")) {
+    j["inject"] = spec.config.at("inject");
+    j["markdown_faults"] = sim::fault_markdown(r);
+  }
   write_json(join(out_dir, "table.json"), j);
   return j;
 }

@@ -154,6 +154,7 @@ void register_petc_study(CLI::App& app) {
     cli->sweep.shard = engine::parse_shard(cli->shard);
     const nlohmann::json j = run_table(make_setup(cli->design), cli->sweep);
     if (cli->json != "-" && cli->sweep.shard.whole()) std::cout << table_markdown(j);
+    if (cli->json != "-" && j.contains("markdown_faults")) std::cout << "\n" << j.at("markdown_faults").get<std::string>();
     emit(*cli, j);
   });
 

@@ -45,4 +45,8 @@ void append_fault_values(std::vector<double>& values, const RunFaultCounts& c);
 /// ratio of two diverged runs: null); null for a clean table.
 nlohmann::json fault_row(const engine::SweepResults& r, std::size_t a, std::size_t s);
 
+/// Markdown table of a faulted table's rows (every approach × scenario): the spec, the
+/// counters per run and ratio_to_clean (mean ± 95 % CI, finite runs of all); "" for a clean table.
+std::string fault_markdown(const engine::SweepResults& r);
+
 }  // namespace oneshot::sim
