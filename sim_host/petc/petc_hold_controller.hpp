@@ -21,8 +21,11 @@ using Trigger = node::MtmTrigger<double, 1>;
 /// TTS and PETC without NUMRE: hold the last y, run the law every period on arrival.
 class HoldController {
  public:
+  /// Law, controller trigger, `always` (TTS: send every period), reference r.
   HoldController(const Law& law, const Trigger& trig, bool always, double r)
       : law_(law), trig_(trig), always_(always), r_(r) {}
+  /// y_k arrived: the law catches up over the periods since the last arrival with the held
+  /// y, then e_k = r − y_k gives u_k; the packet is u_k held (H + 1 entries) when sent.
   node::SendCause arrive(std::uint32_t k, double y) {
     const std::uint64_t before = law_.macs();
     if (any_)
@@ -42,11 +45,17 @@ class HoldController {
     }
     return cause;
   }
+  /// The packet in force (H + 1 entries).
   const double* packet() const { return packet_; }
+  /// Multiply-adds of the law so far.
   std::uint64_t macs() const { return law_.macs(); }
+  /// Multiply-adds of the last arrival.
   std::uint64_t last_macs() const { return last_macs_; }
+  /// Periods since the previous arrival (0 on the first).
   std::uint32_t multiplicity() const { return multiplicity_; }
+  /// No disturbance estimate: 0.
   double d_hat(std::uint32_t) const { return 0; }
+  /// No estimator state to record.
   void record_state(RunTrace&) const {}
   /// Restart: the power-on controller `p` again.
   void restart_as(const HoldController& p) { *this = p; }
@@ -65,6 +74,5 @@ class HoldController {
   std::uint64_t last_macs_ = 0;
   double packet_[kHorizon + 1]{};
 };
-
 
 }  // namespace oneshot::sim::petc

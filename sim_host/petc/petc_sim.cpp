@@ -91,6 +91,7 @@ class NumreController {
       : node_(std::make_unique<Node>(numre_model<N>(m), frozen ? node::NoiseAccumulation::kFrozen
                                                                : node::NoiseAccumulation::kSum,
                                      law, obs, trig, r)) {}
+  /// A deep copy (the power-on node kept for a restart).
   NumreController(const NumreController& o) : node_(std::make_unique<Node>(*o.node_)), last_macs_(o.last_macs_) {}
   NumreController& operator=(const NumreController&) = delete;
   /// Restart: the power-on node `p` again (its estimator resets so far are kept in the count).
