@@ -9,6 +9,7 @@
 #include "c_job/c_arith.hpp"
 #include "c_job/c_job_variant.hpp"
 #include "c_job/c_writer.hpp"
+#include "c_job/float_grid.hpp"
 #include "c_job/q15_arith.hpp"
 
 namespace oneshot::design {
@@ -202,7 +203,9 @@ CJobSources emit_c_job(const PlantDescription& plant, const DesignResult& design
     specs.push_back({"q15_nearest", false, q15_arith.get(), fixed_text(*table_fixed)});
   }
   specs.push_back({"float_table", true, &float_arith, float_text(table_float)});
-  specs.push_back({"float_nearest", false, &float_arith, float_text(table_float)});
+  cjob::TableText nearest_text = float_text(table_float);
+  for (float v : cjob::composed_float_grid(table_float)) nearest_text.grid_values.push_back(cjob::float_literal(v));
+  specs.push_back({"float_nearest", false, &float_arith, nearest_text});
 
   CodeWriter h;
   CodeWriter variants_h;
