@@ -254,6 +254,14 @@ CJobSources emit_c_job(const PlantDescription& plant, const DesignResult& design
       if (v.rfind("fixed_", 0) == 0 || v.rfind("q15_", 0) == 0) guard += (guard.empty() ? "" : " || ") + std::string("!defined(ONESHOT_JOB_WITHOUT_") + upper_identifier(v) + ")";
     helpers = "#if " + guard + "\n" + fixed_helpers(body) + "#endif\n\n";
   }
+  std::string float_guard;
+  for (const std::string& v : out.variants)
+    if (v.rfind("float_", 0) == 0) float_guard += (float_guard.empty() ? "" : " || ") + std::string("!defined(ONESHOT_JOB_WITHOUT_") + upper_identifier(v) + ")";
+  if (!float_guard.empty()) {
+    CodeWriter fh;
+    cjob::FloatArith::emit_helpers(fh);
+    helpers += "#if " + float_guard + "\n" + fh.str() + "#endif\n\n";
+  }
   out.source = c.str() + helpers + body;
   return out;
 }

@@ -350,8 +350,44 @@ void FixedArith::emit_division_helpers(CodeWriter& w) {
 // Float.
 
 namespace {
-std::string float_operand(const Val& v) { return v.count ? "(float)(" + v.expr + ")" : v.expr; }
+// A count in [0, 65535] converts exactly; os_f32_of_u16 does it in integers (no __aeabi_ui2f).
+std::string float_operand(const Val& v) { return v.count ? "os_f32_of_u16((uint32_t)(" + v.expr + "))" : v.expr; }
 }  // namespace
+
+void FloatArith::emit_helpers(CodeWriter& w) {
+  w.line("/* IEEE single precision read and written as its bits (C99 union punning): comparisons and");
+  w.line("   exact conversions in integers, the results those of the float operations they replace. */");
+  w.open("static inline uint32_t os_f32_bits(float v) {")
+      .line("union { float f; uint32_t u; } x;")
+      .line("x.f = v;")
+      .line("return x.u;")
+      .close();
+  w.open("static inline float os_f32_of_bits(uint32_t u) {")
+      .line("union { float f; uint32_t u; } x;")
+      .line("x.u = u;")
+      .line("return x.f;")
+      .close();
+  w.line("/* 0 < v: bits 1 .. 0x7F800000 (+subnormal .. +inf); false for +-0, negatives and NaN. */");
+  w.open("static inline int os_f32_positive(float v) {")
+      .line("return os_f32_bits(v) - 1u < UINT32_C(0x7F800000);")
+      .close();
+  w.line("/* (float)v for 0 <= v < 2^16, exact: the leading one at bit p gives the exponent 127 + p. */");
+  w.open("static inline float os_f32_of_u16(uint32_t v) {")
+      .line("uint32_t p = 0u;")
+      .open("if (v == 0u) {").line("return " + float_literal(0.0F) + ";").close()
+      .open("if (v >= UINT32_C(0x100)) {").line("p = 8u;").close()
+      .open("if ((v >> p) >= UINT32_C(0x10)) {").line("p += 4u;").close()
+      .open("if ((v >> p) >= UINT32_C(0x4)) {").line("p += 2u;").close()
+      .open("if ((v >> p) >= UINT32_C(0x2)) {").line("p += 1u;").close()
+      .line("return os_f32_of_bits(((UINT32_C(127) + p) << 23) | ((v << (23u - p)) & UINT32_C(0x7FFFFF)));")
+      .close();
+  w.line("/* (int32_t)v, truncation, for +0 <= v < 2^23 (no __aeabi_f2iz). */");
+  w.open("static inline int32_t os_f32_trunc(float v) {")
+      .line("const uint32_t b = os_f32_bits(v);")
+      .open("if (b < UINT32_C(0x3F800000)) {").line("return 0;").close()
+      .line("return (int32_t)(((b & UINT32_C(0x7FFFFF)) | UINT32_C(0x800000)) >> (150u - (b >> 23)));")
+      .close();
+}
 
 void FloatArith::accumulate(CodeWriter& w, const std::string& dest, Qty, const std::vector<Term>& terms) const {
   if (terms.empty()) {

@@ -132,6 +132,8 @@ class FloatArith final : public Arith {
   }
   std::string zero(Qty) const override { return float_literal(0.0F); }
   std::string slot_to(Qty, const std::string& raw, int, int) const override { return raw; }
+  /// Integer forms of comparisons and exact conversions the float code uses (emitted once).
+  static void emit_helpers(CodeWriter& w);
 };
 
 }  // namespace oneshot::design::cjob

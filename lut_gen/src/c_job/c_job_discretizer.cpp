@@ -194,7 +194,11 @@ void VariantEmitter::emit_residual(CodeWriter& w) const {
     }
   } else {
     const float scale = 1.0F / static_cast<float>(g);  // ScalarTraits<float>::fraction_scale
-    w.line("const float r = (float)residual_us * " + float_literal(scale) + ";");
+    if (g <= 65536) {  // 0 < residual_us < g: an exact integer conversion
+      w.line("const float r = os_f32_of_u16((uint32_t)residual_us) * " + float_literal(scale) + ";");
+    } else {
+      w.line("const float r = (float)residual_us * " + float_literal(scale) + ";");
+    }
     for (std::size_t s = 0; s < t.slots; ++s) {
       const auto& c = t.coeff_float[s];
       const std::string v = "v" + std::to_string(s);
