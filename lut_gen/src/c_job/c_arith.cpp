@@ -354,6 +354,60 @@ namespace {
 std::string float_operand(const Val& v) { return v.count ? "os_f32_of_u16((uint32_t)(" + v.expr + "))" : v.expr; }
 }  // namespace
 
+void FloatArith::emit_fmul(CodeWriter& w) {
+  w.line("/* a * b. With ONESHOT_JOB_INTEGER_FMUL (default on a Cortex-M0, which has no 32x32->64");
+  w.line("   multiply and whose library multiplication costs about 115 instructions) in integers: the");
+  w.line("   48-bit product of the 24-bit significands from four 16x16->32 products, rounded to nearest,");
+  w.line("   ties to even. IEEE rounding is unique, so the result is a * b bit for bit; zeros,");
+  w.line("   subnormals, infinities, NaNs and results outside the normal range take a * b itself. */");
+  w.line("#if !defined(ONESHOT_JOB_INTEGER_FMUL) && defined(__ARM_ARCH_6M__)");
+  w.line("#define ONESHOT_JOB_INTEGER_FMUL 1");
+  w.line("#endif");
+  w.line("#if defined(ONESHOT_JOB_INTEGER_FMUL) && ONESHOT_JOB_INTEGER_FMUL");
+  w.open("static float os_fmul(float a, float b) {")
+      .line("const uint32_t ua = os_f32_bits(a);")
+      .line("const uint32_t ub = os_f32_bits(b);")
+      .line("const uint32_t ea = (ua >> 23) & UINT32_C(0xFF);")
+      .line("const uint32_t eb = (ub >> 23) & UINT32_C(0xFF);")
+      .line("uint32_t ma, mb, lo, mid, hi, m, half, rest;")
+      .line("int32_t e;")
+      .open("if (ea - 1u >= UINT32_C(0xFE) || eb - 1u >= UINT32_C(0xFE)) {").line("return a * b;").close()
+      .line("ma = (ua & UINT32_C(0x7FFFFF)) | UINT32_C(0x800000);")
+      .line("mb = (ub & UINT32_C(0x7FFFFF)) | UINT32_C(0x800000);")
+      .line("/* ma mb = hi 2^32 + lo = (ah bh) 2^32 + (ah bl + al bh) 2^16 + al bl, a = ah 2^16 + al. */")
+      .line("lo = (ma & UINT32_C(0xFFFF)) * (mb & UINT32_C(0xFFFF));")
+      .line("mid = (ma >> 16) * (mb & UINT32_C(0xFFFF)) + (ma & UINT32_C(0xFFFF)) * (mb >> 16);  /* < 2^25 */")
+      .line("hi = (ma >> 16) * (mb >> 16) + (mid >> 16);")
+      .line("mid <<= 16;")
+      .line("lo += mid;")
+      .open("if (lo < mid) {").line("++hi;").close()
+      .line("/* ma mb in [2^46, 2^48): keep 24 bits, the next one (half) and whether any below is set. */")
+      .line("e = (int32_t)(ea + eb) - 127;")
+      .open("if (hi >= UINT32_C(0x8000)) {")
+      .line("m = (hi << 8) | (lo >> 24);")
+      .line("half = lo & UINT32_C(0x800000);")
+      .line("rest = lo & UINT32_C(0x7FFFFF);")
+      .line("++e;")
+      .middle("} else {")
+      .line("m = (hi << 9) | (lo >> 23);")
+      .line("half = lo & UINT32_C(0x400000);")
+      .line("rest = lo & UINT32_C(0x3FFFFF);")
+      .close()
+      .open("if (e < 1 || e > 254) {").line("return a * b;  /* subnormal or overflowing: the library rounds */").close()
+      .open("if (half != 0u && (rest != 0u || (m & 1u) != 0u)) {")
+      .line("++m;")
+      .open("if (m == UINT32_C(0x1000000)) {")
+      .line("m >>= 1;")
+      .open("if (++e > 254) {").line("return a * b;").close()
+      .close()
+      .close()
+      .line("return os_f32_of_bits(((ua ^ ub) & UINT32_C(0x80000000)) | ((uint32_t)e << 23) | (m & UINT32_C(0x7FFFFF)));")
+      .close();
+  w.line("#else");
+  w.open("static inline float os_fmul(float a, float b) {").line("return a * b;").close();
+  w.line("#endif");
+}
+
 void FloatArith::emit_helpers(CodeWriter& w) {
   w.line("/* IEEE single precision read and written as its bits (C99 union punning): comparisons and");
   w.line("   exact conversions in integers, the results those of the float operations they replace. */");
@@ -381,6 +435,7 @@ void FloatArith::emit_helpers(CodeWriter& w) {
       .open("if ((v >> p) >= UINT32_C(0x2)) {").line("p += 1u;").close()
       .line("return os_f32_of_bits(((UINT32_C(127) + p) << 23) | ((v << (23u - p)) & UINT32_C(0x7FFFFF)));")
       .close();
+  emit_fmul(w);
   w.line("/* (int32_t)v, truncation, for +0 <= v < 2^23 (no __aeabi_f2iz). */");
   w.open("static inline int32_t os_f32_trunc(float v) {")
       .line("const uint32_t b = os_f32_bits(v);")
@@ -403,7 +458,7 @@ void FloatArith::accumulate(CodeWriter& w, const std::string& dest, Qty, const s
     } else if (t.kind == Term::Kind::kValue) {
       e = float_operand(t.a);
     } else {
-      e = "(" + float_operand(t.a) + " * " + float_operand(t.b) + ")";
+      e = "os_fmul(" + float_operand(t.a) + ", " + float_operand(t.b) + ")";
     }
     if (i == 0) {
       sum = t.negative ? "-" + e : e;  // the empty accumulator takes ±the first term
@@ -415,7 +470,7 @@ void FloatArith::accumulate(CodeWriter& w, const std::string& dest, Qty, const s
 }
 
 void FloatArith::mul(CodeWriter& w, const std::string& dest, Qty, const Val& a, const Val& b) const {
-  w.line(dest + " = " + float_operand(a) + " * " + float_operand(b) + ";");
+  w.line(dest + " = os_fmul(" + float_operand(a) + ", " + float_operand(b) + ");");
 }
 
 Val FloatArith::constant(Qty, double v, const std::string&) const {

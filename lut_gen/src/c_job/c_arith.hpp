@@ -134,6 +134,9 @@ class FloatArith final : public Arith {
   std::string slot_to(Qty, const std::string& raw, int, int) const override { return raw; }
   /// Integer forms of comparisons and exact conversions the float code uses (emitted once).
   static void emit_helpers(CodeWriter& w);
+
+ private:
+  static void emit_fmul(CodeWriter& w);
 };
 
 }  // namespace oneshot::design::cjob

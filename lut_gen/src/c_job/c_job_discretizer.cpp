@@ -195,19 +195,19 @@ void VariantEmitter::emit_residual(CodeWriter& w) const {
   } else {
     const float scale = 1.0F / static_cast<float>(g);  // ScalarTraits<float>::fraction_scale
     if (g <= 65536) {  // 0 < residual_us < g: an exact integer conversion
-      w.line("const float r = os_f32_of_u16((uint32_t)residual_us) * " + float_literal(scale) + ";");
+      w.line("const float r = os_fmul(os_f32_of_u16((uint32_t)residual_us), " + float_literal(scale) + ");");
     } else {
-      w.line("const float r = (float)residual_us * " + float_literal(scale) + ";");
+      w.line("const float r = os_fmul((float)residual_us, " + float_literal(scale) + ");");
     }
     for (std::size_t s = 0; s < t.slots; ++s) {
       const auto& c = t.coeff_float[s];
       const std::string v = "v" + std::to_string(s);
       w.line("float " + v + " = " + float_literal(c.back()) + ";");
       for (std::size_t k = c.size() - 1; k > 0; --k) {
-        w.line(v + " = " + v + " * r;");
+        w.line(v + " = os_fmul(" + v + ", r);");
         w.line(v + " = " + v + " + " + float_literal(c[k - 1]) + ";");
       }
-      for (std::uint8_t k = 0; k < t.low[s]; ++k) w.line(v + " = " + v + " * r;");
+      for (std::uint8_t k = 0; k < t.low[s]; ++k) w.line(v + " = os_fmul(" + v + ", r);");
     }
   }
   for (std::size_t k = 0; k < phi_free_.size(); ++k) {

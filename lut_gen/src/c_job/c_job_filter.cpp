@@ -181,7 +181,7 @@ void VariantEmitter::emit_quantize(CodeWriter& w, std::size_t j, const std::stri
                      ar().constant(Qty::kInput, design_.u_min[j], "u_min").expr + ";");
     w.open("if (!os_f32_positive(offset)) {  /* !(0 < offset) */").line(code + " = 0;").middle("} else {");
     const float spv = static_cast<float>(design_.steps_per_volt[j]);
-    w.line("const float steps = offset * " + ar().constant(Qty::kInverseInput, design_.steps_per_volt[j], "").expr + ";");
+    w.line("const float steps = os_fmul(offset, " + ar().constant(Qty::kInverseInput, design_.steps_per_volt[j], "").expr + ");");
     if (spv > 0.0F && std::isfinite(spv)) {
       // offset > 0 and steps/volt > 0: steps is +0 … +inf, never NaN; on non-negative floats the
       // order of the values is the order of the bits, and steps + 1/2 < 2^23 truncates exactly.
