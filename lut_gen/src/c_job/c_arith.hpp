@@ -137,7 +137,6 @@ class FloatArith final : public Arith {
 
  private:
   static void emit_fmul(CodeWriter& w);
-  static void emit_fadd(CodeWriter& w);
 };
 
 }  // namespace oneshot::design::cjob

@@ -205,7 +205,7 @@ void VariantEmitter::emit_residual(CodeWriter& w) const {
       w.line("float " + v + " = " + float_literal(c.back()) + ";");
       for (std::size_t k = c.size() - 1; k > 0; --k) {
         w.line(v + " = os_fmul(" + v + ", r);");
-        w.line(v + " = os_fadd(" + v + ", " + float_literal(c[k - 1]) + ");");
+        w.line(v + " = " + v + " + " + float_literal(c[k - 1]) + ";");
       }
       for (std::uint8_t k = 0; k < t.low[s]; ++k) w.line(v + " = os_fmul(" + v + ", r);");
     }

@@ -122,7 +122,7 @@ void VariantEmitter::emit_correct(CodeWriter& w) const {
     w.open("if (sv <= 0) {").line("return ONESHOT_JOB_STATUS_SINGULAR;").close();
     w.open("{").line("const " + inv_t + " inv = " + fn("reciprocal") + "(sv, sat);");
   } else {
-    w.line("sv = os_fadd(sv, " + r.expr + ");");
+    w.line("sv = sv + " + r.expr + ";");
     w.open("if (!os_f32_positive(sv)) {  /* !(0 < sv) */").line("return ONESHOT_JOB_STATUS_SINGULAR;").close();
     w.open("{").line("const float inv = " + float_literal(1.0F) + " / sv;");
   }
@@ -177,8 +177,8 @@ void VariantEmitter::emit_quantize(CodeWriter& w, std::size_t j, const std::stri
   const std::string n = int_literal(steps, 32);
   w.line("/* quantize_input: code = clamp(round((u - u_min) steps_per_volt), 0, " + std::to_string(steps) + "). */");
   if (!fixed()) {
-    w.open("{").line("const float offset = os_fadd(" + u + ", -" +
-                     ar().constant(Qty::kInput, design_.u_min[j], "u_min").expr + ");  /* u - u_min */");
+    w.open("{").line("const float offset = " + u + " - " +
+                     ar().constant(Qty::kInput, design_.u_min[j], "u_min").expr + ";");
     w.open("if (!os_f32_positive(offset)) {  /* !(0 < offset) */").line(code + " = 0;").middle("} else {");
     const float spv = static_cast<float>(design_.steps_per_volt[j]);
     w.line("const float steps = os_fmul(offset, " + ar().constant(Qty::kInverseInput, design_.steps_per_volt[j], "").expr + ");");
@@ -189,7 +189,7 @@ void VariantEmitter::emit_quantize(CodeWriter& w, std::size_t j, const std::stri
       w.open("if (os_f32_bits(steps) >= " + u32_literal(float_bits(top)) + ") {  /* !(steps < " + float_literal(top) + ") */")
           .line(code + " = " + n + ";");
       w.middle("} else {");
-      w.line(code + " = os_f32_trunc(os_fadd(steps, " + float_literal(0.5F) + "));  /* (int32_t)(steps + 1/2), steps >= 0 */");
+      w.line(code + " = os_f32_trunc(steps + " + float_literal(0.5F) + ");  /* (int32_t)(steps + 1/2), steps >= 0 */");
     } else {
       w.open("if (!(steps < " + float_literal(static_cast<float>(steps)) + ")) {").line(code + " = " + n + ";");
       w.middle("} else {");

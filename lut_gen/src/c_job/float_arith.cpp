@@ -16,15 +16,15 @@ std::string float_operand(const Val& v) { return v.count ? "os_f32_of_u16((uint3
 }  // namespace
 
 void FloatArith::emit_fmul(CodeWriter& w) {
-  w.line("/* a * b and a + b. With ONESHOT_JOB_INTEGER_FLOAT (default on a Cortex-M0, which has no 32x32->64");
+  w.line("/* a * b. With ONESHOT_JOB_INTEGER_FMUL (default on a Cortex-M0, which has no 32x32->64");
   w.line("   multiply and whose library multiplication costs about 115 instructions) in integers: the");
   w.line("   48-bit product of the 24-bit significands from four 16x16->32 products, rounded to nearest,");
   w.line("   ties to even. IEEE rounding is unique, so the result is a * b bit for bit; zeros,");
   w.line("   subnormals, infinities, NaNs and results outside the normal range take a * b itself. */");
-  w.line("#if !defined(ONESHOT_JOB_INTEGER_FLOAT) && defined(__ARM_ARCH_6M__)");
-  w.line("#define ONESHOT_JOB_INTEGER_FLOAT 1");
+  w.line("#if !defined(ONESHOT_JOB_INTEGER_FMUL) && defined(__ARM_ARCH_6M__)");
+  w.line("#define ONESHOT_JOB_INTEGER_FMUL 1");
   w.line("#endif");
-  w.line("#if defined(ONESHOT_JOB_INTEGER_FLOAT) && ONESHOT_JOB_INTEGER_FLOAT");
+  w.line("#if defined(ONESHOT_JOB_INTEGER_FMUL) && ONESHOT_JOB_INTEGER_FMUL");
   w.open("static float os_fmul(float a, float b) {")
       .line("const uint32_t ua = os_f32_bits(a);")
       .line("const uint32_t ub = os_f32_bits(b);")
@@ -69,65 +69,9 @@ void FloatArith::emit_fmul(CodeWriter& w) {
       .close()
       .line("return os_f32_of_bits(((ua ^ ub) & UINT32_C(0x80000000)) | ((uint32_t)e << 23) | (m & UINT32_C(0x7FFFFF)));")
       .close();
-  emit_fadd(w);
   w.line("#else");
   w.open("static inline float os_fmul(float a, float b) {").line("return a * b;").close();
-  w.open("static inline float os_fadd(float a, float b) {").line("return a + b;").close();
   w.line("#endif");
-}
-
-void FloatArith::emit_fadd(CodeWriter& w) {
-  w.line("/* a + b in integers (ONESHOT_JOB_INTEGER_FLOAT): significands with 6 extra low bits, the");
-  w.line("   smaller one shifted right with the bits it loses kept as one sticky bit, added or");
-  w.line("   subtracted, normalized, rounded to nearest, ties to even: a + b bit for bit. Zeros,");
-  w.line("   subnormals, infinities, NaNs, an exact zero sum and results outside the normal range");
-  w.line("   take a + b itself. */");
-  w.open("static float os_fadd(float a, float b) {")
-      .line("uint32_t ua = os_f32_bits(a), ub = os_f32_bits(b), m, mb;")
-      .line("int32_t e, d;")
-      .open("if ((ua & UINT32_C(0x7FFFFFFF)) < (ub & UINT32_C(0x7FFFFFFF))) {  /* |a| >= |b| */")
-      .line("m = ua;")
-      .line("ua = ub;")
-      .line("ub = m;")
-      .close()
-      .line("e = (int32_t)((ua >> 23) & UINT32_C(0xFF));")
-      .line("d = (int32_t)((ub >> 23) & UINT32_C(0xFF));")
-      .open("if ((uint32_t)(e - 1) >= UINT32_C(0xFE) || (uint32_t)(d - 1) >= UINT32_C(0xFE)) {")
-      .line("return a + b;")
-      .close()
-      .line("d = e - d;")
-      .line("m = ((ua & UINT32_C(0x7FFFFF)) | UINT32_C(0x800000)) << 6;")
-      .line("mb = ((ub & UINT32_C(0x7FFFFF)) | UINT32_C(0x800000)) << 6;")
-      .open("if (d > 31) {")
-      .line("mb = 1u;")
-      .middle("} else if (d > 0) {")
-      .line("mb = (mb >> d) | (uint32_t)((mb << (32 - d)) != 0u);")
-      .close()
-      .open("if ((ua ^ ub) < UINT32_C(0x80000000)) {  /* same signs */")
-      .line("m += mb;")
-      .open("if (m >= UINT32_C(0x40000000)) {")
-      .line("m = (m >> 1) | (m & 1u);")
-      .line("++e;")
-      .close()
-      .middle("} else {")
-      .line("m -= mb;")
-      .open("if (m == 0u) {").line("return a + b;").close()
-      .open("while (m < UINT32_C(0x20000000)) {").line("m <<= 1;").line("--e;").close()
-      .close()
-      .open("if ((uint32_t)(e - 1) >= UINT32_C(0xFE)) {")
-      .line("return a + b;  /* subnormal or overflowing: the library rounds */")
-      .close()
-      .open("if ((m & UINT32_C(0x20)) != 0u && (m & UINT32_C(0x5F)) != 0u) {  /* to nearest, ties to even */")
-      .line("m = (m >> 6) + 1u;")
-      .open("if (m == UINT32_C(0x1000000)) {")
-      .line("m >>= 1;")
-      .open("if (++e > 254) {").line("return a + b;").close()
-      .close()
-      .middle("} else {")
-      .line("m >>= 6;")
-      .close()
-      .line("return os_f32_of_bits((ua & UINT32_C(0x80000000)) | ((uint32_t)e << 23) | (m & UINT32_C(0x7FFFFF)));")
-      .close();
 }
 
 void FloatArith::emit_helpers(CodeWriter& w) {
@@ -185,7 +129,7 @@ void FloatArith::accumulate(CodeWriter& w, const std::string& dest, Qty, const s
     if (i == 0) {
       sum = t.negative ? "-" + e : e;  // the empty accumulator takes ±the first term
     } else {
-      sum = "os_fadd(" + sum + ", " + (t.negative ? "-" : "") + e + ")";  // a - b = a + (-b) exactly
+      sum = "(" + sum + (t.negative ? " - " : " + ") + e + ")";
     }
   }
   w.line(dest + " = " + sum + ";");
