@@ -205,6 +205,10 @@ void VariantEmitter::emit_residual(CodeWriter& w) const {
       w.line("float " + v + " = " + float_literal(c.back()) + ";");
       for (std::size_t k = c.size() - 1; k > 0; --k) {
         w.line(v + " = os_fmul(" + v + ", r);");
+        // v + 0 only turns -0 into +0, which a later v·r + c (c != 0) makes irrelevant: skip it then.
+        bool later = false;
+        for (std::size_t j = 0; j + 1 < k; ++j) later = later || c[j] != 0.0F;
+        if (c[k - 1] == 0.0F && later) continue;
         w.line(v + " = " + v + " + " + float_literal(c[k - 1]) + ";");
       }
       for (std::uint8_t k = 0; k < t.low[s]; ++k) w.line(v + " = os_fmul(" + v + ", r);");
