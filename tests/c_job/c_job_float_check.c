@@ -1,11 +1,11 @@
 /* The float variants' integer helpers against the host's IEEE single arithmetic, bit for bit:
- * os_fmul with ONESHOT_JOB_INTEGER_FMUL (the Cortex-M0 path) against a * b on random operand
+ * os_fmul with ONESHOT_JOB_INTEGER_FLOAT (the Cortex-M0 path) against a * b on random operand
  * pairs (every class: zeros, subnormals, infinities, NaNs) and on pairs built to hit the
  * rounding ties and the edges of the normal range; os_f32_of_u16 against (float) on every
  * 16-bit value; os_f32_trunc against (int32_t) on every k and k + 1/2 and on a sweep of
  * [0, 2^23); os_f32_positive against 0 < v on a sweep of all bit patterns and the special
  * values. Random streams: xorshift32, one fixed seed per stream. Usage: c_job_float_check */
-#define ONESHOT_JOB_INTEGER_FMUL 1
+#define ONESHOT_JOB_INTEGER_FLOAT 1
 #include "oneshot_job.c"
 
 #include <stdio.h>

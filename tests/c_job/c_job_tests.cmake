@@ -7,8 +7,8 @@
 #   CJob.Q15Arithmetic             the q15 variant's saturation, reciprocal and rounding rules
 #   CJob.FloatIntegerHelpers       the float variants' integer multiply, conversions and comparison
 #                                  against the host's IEEE single arithmetic
-#   CJob.HostGccBitIdenticalIntegerFmul  CJob.HostGccBitIdentical with the Cortex-M0's integer
-#                                  multiply (ONESHOT_JOB_INTEGER_FMUL) compiled in
+#   CJob.HostGccBitIdenticalIntegerFloat  CJob.HostGccBitIdentical with the Cortex-M0's integer
+#                                  helpers (ONESHOT_JOB_INTEGER_FLOAT) compiled in
 #   CJob.AvrSimavrBitIdentical     the job compiled by avr-gcc (16-bit int) and run in simavr,
 #                                  with the cycles per job
 set(c_job_dir ${ONESHOT_GENERATED_DIR}/oneshot_c)
@@ -24,9 +24,9 @@ add_executable(c_job_check c_job/c_job_check.c ${c_job_dir}/oneshot_job.c)
 add_executable(c_job_division_check c_job/c_job_division_check.c)
 add_executable(c_job_q15_check c_job/c_job_q15_check.c)
 add_executable(c_job_float_check c_job/c_job_float_check.c)
-add_executable(c_job_check_integer_fmul c_job/c_job_check.c ${c_job_dir}/oneshot_job.c)
-target_compile_definitions(c_job_check_integer_fmul PRIVATE ONESHOT_JOB_INTEGER_FMUL=1)
-foreach(t c_job_check c_job_division_check c_job_q15_check c_job_float_check c_job_check_integer_fmul)
+add_executable(c_job_check_integer_float c_job/c_job_check.c ${c_job_dir}/oneshot_job.c)
+target_compile_definitions(c_job_check_integer_float PRIVATE ONESHOT_JOB_INTEGER_FLOAT=1)
+foreach(t c_job_check c_job_division_check c_job_q15_check c_job_float_check c_job_check_integer_float)
   set_target_properties(${t} PROPERTIES C_STANDARD 99 C_STANDARD_REQUIRED ON C_EXTENSIONS OFF)
   target_include_directories(${t} PRIVATE ${c_job_dir} ${CMAKE_CURRENT_SOURCE_DIR}/c_job)
   target_compile_options(${t} PRIVATE ${c_job_strict})
@@ -40,8 +40,8 @@ set_tests_properties(CJob.HostGccBitIdentical PROPERTIES FIXTURES_REQUIRED c_job
 add_test(NAME CJob.DivisionFreeReciprocal COMMAND c_job_division_check)
 add_test(NAME CJob.FloatIntegerHelpers COMMAND c_job_float_check)
 set_tests_properties(CJob.FloatIntegerHelpers PROPERTIES TIMEOUT 120)
-add_test(NAME CJob.HostGccBitIdenticalIntegerFmul COMMAND c_job_check_integer_fmul ${c_job_ref})
-set_tests_properties(CJob.HostGccBitIdenticalIntegerFmul PROPERTIES FIXTURES_REQUIRED c_job_reference TIMEOUT 120)
+add_test(NAME CJob.HostGccBitIdenticalIntegerFloat COMMAND c_job_check_integer_float ${c_job_ref})
+set_tests_properties(CJob.HostGccBitIdenticalIntegerFloat PROPERTIES FIXTURES_REQUIRED c_job_reference TIMEOUT 120)
 add_test(NAME CJob.Q15Arithmetic COMMAND c_job_q15_check)
 set_tests_properties(CJob.Q15Arithmetic PROPERTIES TIMEOUT 60)
 set_tests_properties(CJob.DivisionFreeReciprocal PROPERTIES TIMEOUT 120)

@@ -186,7 +186,7 @@ void VariantEmitter::emit_quantize(CodeWriter& w, std::size_t j, const std::stri
       // offset > 0 and steps/volt > 0: steps is +0 … +inf, never NaN; on non-negative floats the
       // order of the values is the order of the bits, and steps + 1/2 < 2^23 truncates exactly.
       const float top = static_cast<float>(steps);
-      w.open("if (os_f32_bits(steps) >= " + u32_literal(float_bits(top)) + ") {  /* !(steps < " + float_literal(top) + ") */")
+      w.open("if (!os_f32_below(steps, " + u32_literal(float_bits(top)) + ", " + float_literal(top) + ")) {")
           .line(code + " = " + n + ";");
       w.middle("} else {");
       w.line(code + " = os_f32_trunc(steps + " + float_literal(0.5F) + ");  /* (int32_t)(steps + 1/2), steps >= 0 */");

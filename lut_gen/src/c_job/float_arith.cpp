@@ -16,15 +16,11 @@ std::string float_operand(const Val& v) { return v.count ? "os_f32_of_u16((uint3
 }  // namespace
 
 void FloatArith::emit_fmul(CodeWriter& w) {
-  w.line("/* a * b. With ONESHOT_JOB_INTEGER_FMUL (default on a Cortex-M0, which has no 32x32->64");
-  w.line("   multiply and whose library multiplication costs about 115 instructions) in integers: the");
-  w.line("   48-bit product of the 24-bit significands from four 16x16->32 products, rounded to nearest,");
-  w.line("   ties to even. IEEE rounding is unique, so the result is a * b bit for bit; zeros,");
+  w.line("/* a * b in integers (a Cortex-M0 has no 32x32->64 multiply; libgcc's multiplication costs");
+  w.line("   about 115 instructions there): the 48-bit product of the 24-bit significands from four");
+  w.line("   16x16->32 products, rounded to nearest, ties to even. IEEE rounding is unique, so the");
+  w.line("   result is a * b bit for bit; zeros,");
   w.line("   subnormals, infinities, NaNs and results outside the normal range take a * b itself. */");
-  w.line("#if !defined(ONESHOT_JOB_INTEGER_FMUL) && defined(__ARM_ARCH_6M__)");
-  w.line("#define ONESHOT_JOB_INTEGER_FMUL 1");
-  w.line("#endif");
-  w.line("#if defined(ONESHOT_JOB_INTEGER_FMUL) && ONESHOT_JOB_INTEGER_FMUL");
   w.open("static float os_fmul(float a, float b) {")
       .line("const uint32_t ua = os_f32_bits(a);")
       .line("const uint32_t ub = os_f32_bits(b);")
@@ -69,14 +65,17 @@ void FloatArith::emit_fmul(CodeWriter& w) {
       .close()
       .line("return os_f32_of_bits(((ua ^ ub) & UINT32_C(0x80000000)) | ((uint32_t)e << 23) | (m & UINT32_C(0x7FFFFF)));")
       .close();
-  w.line("#else");
-  w.open("static inline float os_fmul(float a, float b) {").line("return a * b;").close();
-  w.line("#endif");
 }
 
 void FloatArith::emit_helpers(CodeWriter& w) {
-  w.line("/* IEEE single precision read and written as its bits (C99 union punning): comparisons and");
-  w.line("   exact conversions in integers, the results those of the float operations they replace. */");
+  w.line("/* ONESHOT_JOB_INTEGER_FLOAT (default on a Cortex-M0): comparisons, exact conversions and the");
+  w.line("   multiplication in integers on the IEEE single bits, each with the result of the float");
+  w.line("   operation it replaces; elsewhere (FPU, or a library in assembly as on AVR) the plain C. */");
+  w.line("#if !defined(ONESHOT_JOB_INTEGER_FLOAT) && defined(__ARM_ARCH_6M__)");
+  w.line("#define ONESHOT_JOB_INTEGER_FLOAT 1");
+  w.line("#endif");
+  w.line("#if defined(ONESHOT_JOB_INTEGER_FLOAT) && ONESHOT_JOB_INTEGER_FLOAT");
+  w.line("/* The bits of v and back (C99 union punning). */");
   w.open("static inline uint32_t os_f32_bits(float v) {")
       .line("union { float f; uint32_t u; } x;")
       .line("x.f = v;")
@@ -91,6 +90,12 @@ void FloatArith::emit_helpers(CodeWriter& w) {
   w.open("static inline int os_f32_positive(float v) {")
       .line("return os_f32_bits(v) - 1u < UINT32_C(0x7F800000);")
       .close();
+  w.line("/* v < top for v in +0 .. +inf and top > 0 (top_bits its bits): non-negative floats order as");
+  w.line("   their bits. */");
+  w.open("static inline int os_f32_below(float v, uint32_t top_bits, float top) {")
+      .line("(void)top;")
+      .line("return os_f32_bits(v) < top_bits;")
+      .close();
   w.line("/* (float)v for 0 <= v < 2^16, exact: the leading one at bit p gives the exponent 127 + p. */");
   w.open("static inline float os_f32_of_u16(uint32_t v) {")
       .line("uint32_t p = 0u;")
@@ -101,13 +106,23 @@ void FloatArith::emit_helpers(CodeWriter& w) {
       .open("if ((v >> p) >= UINT32_C(0x2)) {").line("p += 1u;").close()
       .line("return os_f32_of_bits(((UINT32_C(127) + p) << 23) | ((v << (23u - p)) & UINT32_C(0x7FFFFF)));")
       .close();
-  emit_fmul(w);
   w.line("/* (int32_t)v, truncation, for +0 <= v < 2^23 (no __aeabi_f2iz). */");
   w.open("static inline int32_t os_f32_trunc(float v) {")
       .line("const uint32_t b = os_f32_bits(v);")
       .open("if (b < UINT32_C(0x3F800000)) {").line("return 0;").close()
       .line("return (int32_t)(((b & UINT32_C(0x7FFFFF)) | UINT32_C(0x800000)) >> (150u - (b >> 23)));")
       .close();
+  emit_fmul(w);
+  w.line("#else");
+  w.open("static inline int os_f32_positive(float v) {").line("return " + float_literal(0.0F) + " < v;").close();
+  w.open("static inline int os_f32_below(float v, uint32_t top_bits, float top) {")
+      .line("(void)top_bits;")
+      .line("return v < top;")
+      .close();
+  w.open("static inline float os_f32_of_u16(uint32_t v) {").line("return (float)v;").close();
+  w.open("static inline int32_t os_f32_trunc(float v) {").line("return (int32_t)v;").close();
+  w.open("static inline float os_fmul(float a, float b) {").line("return a * b;").close();
+  w.line("#endif");
 }
 
 void FloatArith::accumulate(CodeWriter& w, const std::string& dest, Qty, const std::vector<Term>& terms) const {
