@@ -9,6 +9,7 @@
 #include "c_job/c_arith.hpp"
 #include "c_job/c_job_variant.hpp"
 #include "c_job/c_writer.hpp"
+#include "c_job/float_grid.hpp"
 #include "c_job/q15_arith.hpp"
 
 namespace oneshot::design {
@@ -202,7 +203,9 @@ CJobSources emit_c_job(const PlantDescription& plant, const DesignResult& design
     specs.push_back({"q15_nearest", false, q15_arith.get(), fixed_text(*table_fixed)});
   }
   specs.push_back({"float_table", true, &float_arith, float_text(table_float)});
-  specs.push_back({"float_nearest", false, &float_arith, float_text(table_float)});
+  cjob::TableText nearest_text = float_text(table_float);
+  for (float v : cjob::composed_float_grid(table_float)) nearest_text.grid_values.push_back(cjob::float_literal(v));
+  specs.push_back({"float_nearest", false, &float_arith, nearest_text});
 
   CodeWriter h;
   CodeWriter variants_h;
@@ -250,6 +253,14 @@ CJobSources emit_c_job(const PlantDescription& plant, const DesignResult& design
     for (const std::string& v : out.variants)
       if (v.rfind("fixed_", 0) == 0 || v.rfind("q15_", 0) == 0) guard += (guard.empty() ? "" : " || ") + std::string("!defined(ONESHOT_JOB_WITHOUT_") + upper_identifier(v) + ")";
     helpers = "#if " + guard + "\n" + fixed_helpers(body) + "#endif\n\n";
+  }
+  std::string float_guard;
+  for (const std::string& v : out.variants)
+    if (v.rfind("float_", 0) == 0) float_guard += (float_guard.empty() ? "" : " || ") + std::string("!defined(ONESHOT_JOB_WITHOUT_") + upper_identifier(v) + ")";
+  if (!float_guard.empty()) {
+    CodeWriter fh;
+    cjob::FloatArith::emit_helpers(fh);
+    helpers += "#if " + float_guard + "\n" + fh.str() + "#endif\n\n";
   }
   out.source = c.str() + helpers + body;
   return out;

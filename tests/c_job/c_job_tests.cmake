@@ -5,6 +5,10 @@
 #   CJob.HostGccBitIdentical       the job compiled by the host C compiler as strict C99
 #   CJob.DivisionFreeReciprocal    the reciprocal without division against the core's algorithm
 #   CJob.Q15Arithmetic             the q15 variant's saturation, reciprocal and rounding rules
+#   CJob.FloatIntegerHelpers       the float variants' integer multiply, conversions and comparison
+#                                  against the host's IEEE single arithmetic
+#   CJob.HostGccBitIdenticalIntegerFloat  CJob.HostGccBitIdentical with the Cortex-M0's integer
+#                                  helpers (ONESHOT_JOB_INTEGER_FLOAT) compiled in
 #   CJob.AvrSimavrBitIdentical     the job compiled by avr-gcc (16-bit int) and run in simavr,
 #                                  with the cycles per job
 set(c_job_dir ${ONESHOT_GENERATED_DIR}/oneshot_c)
@@ -19,7 +23,10 @@ oneshot_warnings(c_job_reference)
 add_executable(c_job_check c_job/c_job_check.c ${c_job_dir}/oneshot_job.c)
 add_executable(c_job_division_check c_job/c_job_division_check.c)
 add_executable(c_job_q15_check c_job/c_job_q15_check.c)
-foreach(t c_job_check c_job_division_check c_job_q15_check)
+add_executable(c_job_float_check c_job/c_job_float_check.c)
+add_executable(c_job_check_integer_float c_job/c_job_check.c ${c_job_dir}/oneshot_job.c)
+target_compile_definitions(c_job_check_integer_float PRIVATE ONESHOT_JOB_INTEGER_FLOAT=1)
+foreach(t c_job_check c_job_division_check c_job_q15_check c_job_float_check c_job_check_integer_float)
   set_target_properties(${t} PROPERTIES C_STANDARD 99 C_STANDARD_REQUIRED ON C_EXTENSIONS OFF)
   target_include_directories(${t} PRIVATE ${c_job_dir} ${CMAKE_CURRENT_SOURCE_DIR}/c_job)
   target_compile_options(${t} PRIVATE ${c_job_strict})
@@ -31,6 +38,10 @@ set_tests_properties(CJob.Reference PROPERTIES FIXTURES_SETUP c_job_reference TI
 add_test(NAME CJob.HostGccBitIdentical COMMAND c_job_check ${c_job_ref})
 set_tests_properties(CJob.HostGccBitIdentical PROPERTIES FIXTURES_REQUIRED c_job_reference TIMEOUT 120)
 add_test(NAME CJob.DivisionFreeReciprocal COMMAND c_job_division_check)
+add_test(NAME CJob.FloatIntegerHelpers COMMAND c_job_float_check)
+set_tests_properties(CJob.FloatIntegerHelpers PROPERTIES TIMEOUT 120)
+add_test(NAME CJob.HostGccBitIdenticalIntegerFloat COMMAND c_job_check_integer_float ${c_job_ref})
+set_tests_properties(CJob.HostGccBitIdenticalIntegerFloat PROPERTIES FIXTURES_REQUIRED c_job_reference TIMEOUT 120)
 add_test(NAME CJob.Q15Arithmetic COMMAND c_job_q15_check)
 set_tests_properties(CJob.Q15Arithmetic PROPERTIES TIMEOUT 60)
 set_tests_properties(CJob.DivisionFreeReciprocal PROPERTIES TIMEOUT 120)

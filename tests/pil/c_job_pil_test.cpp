@@ -37,9 +37,16 @@ TEST(CJobOnMcu, SameRepliesAsTheCppJobAndFewerInstructions) {
         EXPECT_LE(image["flash_bytes"].get<int>(), 12 * 1024) << c;
         EXPECT_LE(image["ram_total_bound_bytes"].get<int>(), 1024) << c;
         if (std::string(fmt) == "float" && target == "cortex-m0") {
-          // libgcc soft-float calls per job, counted from the instruction profile
+          // soft-float calls per job, counted from the instruction profile: the multiplications
+          // go to the job's integer os_fmul (bit-identical, checked above), libgcc's
+          // __aeabi_fmul only takes its rare special cases
           EXPECT_GT(v["soft_float_calls"]["per_job"].get<double>(), 50.0) << c;
-          EXPECT_GT(v["soft_float_calls"]["by_routine"]["__aeabi_fmul"].get<double>(), 20.0) << c;
+          EXPECT_GT(v["soft_float_calls"]["by_routine"]["os_fmul"].get<double>(), 20.0) << c;
+          EXPECT_LT(v["soft_float_calls"]["by_routine"]["__aeabi_fmul"].get<double>(), 3.0) << c;
+          if (std::string(disc) == "nearest") {
+            // issue 25: the float job at <= 6000 Cortex-M0 instructions (stable QEMU counts)
+            EXPECT_LE(v["instructions_per_job"].get<double>(), 6000.0) << c;
+          }
         }
       }
     }

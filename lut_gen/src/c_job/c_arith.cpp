@@ -1,5 +1,5 @@
 /// @file c_arith.cpp
-/// @brief Fixed-point and float arithmetic of the generated C job (see c_arith.hpp).
+/// @brief Fixed-point arithmetic of the generated C job (see c_arith.hpp; float: float_arith.cpp).
 #include "c_job/c_arith.hpp"
 
 #include <algorithm>
@@ -344,46 +344,6 @@ void FixedArith::emit_division_helpers(CodeWriter& w) {
       .open("while (t >= m) {").line("++y;").line("t -= m;").close()
       .line("return y;")
       .close();
-}
-
-// ---------------------------------------------------------------------------------------
-// Float.
-
-namespace {
-std::string float_operand(const Val& v) { return v.count ? "(float)(" + v.expr + ")" : v.expr; }
-}  // namespace
-
-void FloatArith::accumulate(CodeWriter& w, const std::string& dest, Qty, const std::vector<Term>& terms) const {
-  if (terms.empty()) {
-    w.line(dest + " = " + zero(Qty::kState) + ";");
-    return;
-  }
-  std::string sum;
-  for (std::size_t i = 0; i < terms.size(); ++i) {
-    const Term& t = terms[i];
-    std::string e;
-    if (t.kind == Term::Kind::kOne) {
-      e = float_literal(1.0F);
-    } else if (t.kind == Term::Kind::kValue) {
-      e = float_operand(t.a);
-    } else {
-      e = "(" + float_operand(t.a) + " * " + float_operand(t.b) + ")";
-    }
-    if (i == 0) {
-      sum = t.negative ? "-" + e : e;  // the empty accumulator takes ±the first term
-    } else {
-      sum = "(" + sum + (t.negative ? " - " : " + ") + e + ")";
-    }
-  }
-  w.line(dest + " = " + sum + ";");
-}
-
-void FloatArith::mul(CodeWriter& w, const std::string& dest, Qty, const Val& a, const Val& b) const {
-  w.line(dest + " = " + float_operand(a) + " * " + float_operand(b) + ";");
-}
-
-Val FloatArith::constant(Qty, double v, const std::string&) const {
-  return Val::of(float_literal(static_cast<float>(v)), QFormat{32, 0});
 }
 
 }  // namespace oneshot::design::cjob

@@ -132,6 +132,13 @@ class FloatArith final : public Arith {
   }
   std::string zero(Qty) const override { return float_literal(0.0F); }
   std::string slot_to(Qty, const std::string& raw, int, int) const override { return raw; }
+  /// The comparisons, exact conversions and multiply the float code calls (os_f32_*, os_fmul):
+  /// integer forms under ONESHOT_JOB_INTEGER_FLOAT (default on a Cortex-M0), plain C otherwise.
+  static void emit_helpers(CodeWriter& w);
+
+ private:
+  /// The correctly rounded integer multiply os_fmul (inside the ONESHOT_JOB_INTEGER_FLOAT block).
+  static void emit_fmul(CodeWriter& w);
 };
 
 }  // namespace oneshot::design::cjob

@@ -89,7 +89,7 @@ void VariantEmitter::source(CodeWriter& w) {
     emit_triple(w);
     emit_load(w);
     if (spec_.exact_subgrid) emit_residual(w);
-    emit_identity(w);
+    if (!grid()) emit_identity(w);  // grid point 0 is the identity
     emit_compose(w);
     emit_in_range(w);
     emit_discretize(w);

@@ -71,6 +71,10 @@ Val VariantEmitter::qd(const std::string& p, std::size_t i, std::size_t j) const
 
 void VariantEmitter::emit_table(CodeWriter& w) const {
   const TableText& t = spec_.table;
+  if (grid()) {
+    emit_grid(w);
+    return;
+  }
   std::string times;
   std::uint32_t spacing = 1;
   for (std::size_t l = 0; l < t.radix.size(); ++l) {
@@ -86,6 +90,23 @@ void VariantEmitter::emit_table(CodeWriter& w) const {
     std::string row = "{";
     for (std::size_t s = 0; s < t.slots; ++s) row += (s ? ", " : "") + t.values[e * t.slots + s];
     w.line(row + (e + 1 < t.entries ? "}," : "}"));
+  }
+  w.close("};");
+}
+
+void VariantEmitter::emit_grid(CodeWriter& w) const {
+  const TableText& t = spec_.table;
+  const std::size_t points = t.grid_values.size() / t.slots;
+  w.line("/* The grid table: Phi, Gamma, Q_d at every grid point k x " + std::to_string(t.granularity_us) +
+         " us, k = 0.." + std::to_string(points - 1) + ", " + std::to_string(t.slots) + " free values each,");
+  w.line("   composed at generation time in float exactly as the " + std::to_string(t.entries) +
+         " stored mixed-radix entries compose (TableDiscretizer::in_range). */");
+  w.open("static ONESHOT_CONST_TABLE const float " + fn("grid") + "[" + std::to_string(points) + "][" +
+         std::to_string(t.slots) + "] = {");
+  for (std::size_t e = 0; e < points; ++e) {
+    std::string row = "{";
+    for (std::size_t s = 0; s < t.slots; ++s) row += (s ? ", " : "") + t.grid_values[e * t.slots + s];
+    w.line(row + (e + 1 < points ? "}," : "}"));
   }
   w.close("};");
 }
@@ -124,9 +145,12 @@ void VariantEmitter::emit_pick(CodeWriter& w, const std::string& dest, Qty q, st
 
 void VariantEmitter::emit_load(CodeWriter& w) const {
   const TableText& t = spec_.table;
-  const std::string raw = fn("values") + "[entry][";
-  w.line("/* d = stored entry `entry` (TableDiscretizer::load_entry). */");
-  w.open("static void " + fn("load") + "(uint8_t entry, " + triple_type() + " *d" + sat_param() + ") {");
+  const std::string raw = fn(grid() ? "grid" : "values") + "[entry][";
+  const bool wide = grid() && t.grid_values.size() / t.slots > 256;
+  w.line(grid() ? "/* d = grid point `entry` of the grid table. */"
+                : "/* d = stored entry `entry` (TableDiscretizer::load_entry). */");
+  w.open("static void " + fn("load") + "(" + (wide ? "uint16_t" : "uint8_t") + " entry, " + triple_type() + " *d" +
+         sat_param() + ") {");
   if (fixed()) w.line("(void)sat;");
   for (std::size_t k = 0; k < phi_free_.size(); ++k) {
     const auto [i, j] = phi_free_[k];
@@ -170,16 +194,24 @@ void VariantEmitter::emit_residual(CodeWriter& w) const {
     }
   } else {
     const float scale = 1.0F / static_cast<float>(g);  // ScalarTraits<float>::fraction_scale
-    w.line("const float r = (float)residual_us * " + float_literal(scale) + ";");
+    if (g <= 65536) {  // 0 < residual_us < g: an exact integer conversion
+      w.line("const float r = os_fmul(os_f32_of_u16((uint32_t)residual_us), " + float_literal(scale) + ");");
+    } else {
+      w.line("const float r = os_fmul((float)residual_us, " + float_literal(scale) + ");");
+    }
     for (std::size_t s = 0; s < t.slots; ++s) {
       const auto& c = t.coeff_float[s];
       const std::string v = "v" + std::to_string(s);
       w.line("float " + v + " = " + float_literal(c.back()) + ";");
       for (std::size_t k = c.size() - 1; k > 0; --k) {
-        w.line(v + " = " + v + " * r;");
+        w.line(v + " = os_fmul(" + v + ", r);");
+        // v + 0 only turns -0 into +0, which a later v·r + c (c != 0) makes irrelevant: skip it then.
+        bool later = false;
+        for (std::size_t j = 0; j + 1 < k; ++j) later = later || c[j] != 0.0F;
+        if (c[k - 1] == 0.0F && later) continue;
         w.line(v + " = " + v + " + " + float_literal(c[k - 1]) + ";");
       }
-      for (std::uint8_t k = 0; k < t.low[s]; ++k) w.line(v + " = " + v + " * r;");
+      for (std::uint8_t k = 0; k < t.low[s]; ++k) w.line(v + " = os_fmul(" + v + ", r);");
     }
   }
   for (std::size_t k = 0; k < phi_free_.size(); ++k) {
@@ -287,6 +319,17 @@ void VariantEmitter::emit_in_range(CodeWriter& w) {
   const TableText& t = spec_.table;
   const std::int32_t g = t.granularity_us;
   const auto max_index = static_cast<std::uint32_t>(t.range_us / g);
+  if (grid()) {
+    const bool wide = t.grid_values.size() / t.slots > 256;
+    w.line("/* d over 0 <= tau_us <= range, tau_us a multiple of g (the job rounds tau to the grid first):");
+    w.line("   one grid point (TableDiscretizer::in_range, its compositions done at generation time). */");
+    w.open("static void " + fn("in_range") + "(int32_t tau_us, " + triple_type() + " *d" + sat_param() + ") {");
+    w.line(fn("load") + "((" + (wide ? "uint16_t" : "uint8_t") + ")" +
+           divide_by_constant("tau_us", static_cast<std::uint32_t>(g), static_cast<std::uint32_t>(t.range_us), divisions_) +
+           ", d" + sat_arg() + ");");
+    w.close();
+    return;
+  }
   w.line("/* d over 0 <= tau_us <= range (TableDiscretizer::in_range): the residual, then one stored");
   w.line("   entry per non-zero mixed-radix digit of tau/g, finest level first. */");
   w.open("static void " + fn("in_range") + "(int32_t tau_us, " + triple_type() + " *d" + sat_param() + ") {");

@@ -2,10 +2,20 @@
 /// @brief The generated job's filter and control law: HalfKalman::update, correct(),
 ///        control_law(), quantize_input() and the converters, unrolled over the structure.
 #include <cmath>
+#include <cstdint>
+#include <cstring>
 
 #include "c_job/c_job_variant.hpp"
 
 namespace oneshot::design::cjob {
+namespace {
+/// The IEEE single bits of v.
+std::uint32_t float_bits(float v) {
+  std::uint32_t b = 0;
+  std::memcpy(&b, &v, sizeof b);
+  return b;
+}
+}  // namespace
 
 Val VariantEmitter::cov(std::size_t i, std::size_t j) const {
   return ar().val(Qty::kCovariance, "s->p[" + std::to_string(upper_index(n_, i, j)) + "]");
@@ -113,7 +123,7 @@ void VariantEmitter::emit_correct(CodeWriter& w) const {
     w.open("{").line("const " + inv_t + " inv = " + fn("reciprocal") + "(sv, sat);");
   } else {
     w.line("sv = sv + " + r.expr + ";");
-    w.open("if (!(" + ar().zero(Qty::kCovariance) + " < sv)) {").line("return ONESHOT_JOB_STATUS_SINGULAR;").close();
+    w.open("if (!os_f32_positive(sv)) {  /* !(0 < sv) */").line("return ONESHOT_JOB_STATUS_SINGULAR;").close();
     w.open("{").line("const float inv = " + float_literal(1.0F) + " / sv;");
   }
   const Val inv = ar().val(Qty::kInverseCovariance, "inv");
@@ -169,12 +179,23 @@ void VariantEmitter::emit_quantize(CodeWriter& w, std::size_t j, const std::stri
   if (!fixed()) {
     w.open("{").line("const float offset = " + u + " - " +
                      ar().constant(Qty::kInput, design_.u_min[j], "u_min").expr + ";");
-    w.open("if (!(" + ar().zero(Qty::kInput) + " < offset)) {").line(code + " = 0;").middle("} else {");
-    w.line("const float steps = offset * " + ar().constant(Qty::kInverseInput, design_.steps_per_volt[j], "").expr + ";");
-    w.open("if (!(steps < " + float_literal(static_cast<float>(steps)) + ")) {").line(code + " = " + n + ";");
-    w.middle("} else {");
-    w.line(code + " = steps < " + float_literal(0.0F) + " ? -(int32_t)(-steps + " + float_literal(0.5F) +
-           ") : (int32_t)(steps + " + float_literal(0.5F) + ");");
+    w.open("if (!os_f32_positive(offset)) {  /* !(0 < offset) */").line(code + " = 0;").middle("} else {");
+    const float spv = static_cast<float>(design_.steps_per_volt[j]);
+    w.line("const float steps = os_fmul(offset, " + ar().constant(Qty::kInverseInput, design_.steps_per_volt[j], "").expr + ");");
+    if (spv > 0.0F && std::isfinite(spv)) {
+      // offset > 0 and steps/volt > 0: steps is +0 … +inf, never NaN; on non-negative floats the
+      // order of the values is the order of the bits, and steps + 1/2 < 2^23 truncates exactly.
+      const float top = static_cast<float>(steps);
+      w.open("if (!os_f32_below(steps, " + u32_literal(float_bits(top)) + ", " + float_literal(top) + ")) {")
+          .line(code + " = " + n + ";");
+      w.middle("} else {");
+      w.line(code + " = os_f32_trunc(steps + " + float_literal(0.5F) + ");  /* (int32_t)(steps + 1/2), steps >= 0 */");
+    } else {
+      w.open("if (!(steps < " + float_literal(static_cast<float>(steps)) + ")) {").line(code + " = " + n + ";");
+      w.middle("} else {");
+      w.line(code + " = steps < " + float_literal(0.0F) + " ? -(int32_t)(-steps + " + float_literal(0.5F) +
+             ") : (int32_t)(steps + " + float_literal(0.5F) + ");");
+    }
     w.open("if (" + code + " > " + n + ") {").line(code + " = " + n + ";").close();
     w.close().close().close();
     return;

@@ -37,6 +37,9 @@ struct TableText {
   std::vector<std::vector<long long>> coeff_raw;      ///< Fixed: coefficients low … high.
   std::vector<std::vector<float>> coeff_float;        ///< Float: coefficients low … high.
   std::vector<int> residual_frac;           ///< Fixed: scale of each slot's coefficients.
+  /// Float nearest: (range/g + 1) × slots literals, the triple at every grid point as the
+  /// stored entries compose (float_grid.hpp); empty: compose at run time.
+  std::vector<std::string> grid_values;
 };
 
 /// Everything one variant needs.
@@ -89,6 +92,8 @@ class VariantEmitter {
   void emit_pick(CodeWriter& w, const std::string& dest, Qty q, std::int16_t slot, const std::string& raw_prefix,
                  bool residual) const;
   void emit_load(CodeWriter& w) const;
+  void emit_grid(CodeWriter& w) const;
+  bool grid() const { return !spec_.table.grid_values.empty(); }
   void emit_residual(CodeWriter& w) const;
   void emit_identity(CodeWriter& w) const;
   void emit_compose(CodeWriter& w) const;
