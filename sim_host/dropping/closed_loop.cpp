@@ -8,9 +8,12 @@
 #include <stdexcept>
 
 #include "oneshot/engine/discrete_plant.hpp"
+#include "oneshot/engine/json_fields.hpp"
 #include "oneshot/engine/kernel.hpp"
 #include "oneshot/engine/link.hpp"
 #include "oneshot/engine/psd_math.hpp"
+#include "oneshot/engine/sequenced_frame.hpp"
+#include "oneshot/finite.hpp"
 #include "oneshot/kalman_correction.hpp"
 #include "oneshot/node/buffered_kalman.hpp"
 #include "oneshot/number_format.hpp"
@@ -137,6 +140,12 @@ RunMetrics run_impl(const DroppingPlant& plant, const RunConfig& cfg, std::uint6
   std::vector<double> ys(steps, 0.0);
   std::vector<StateVec> xs(steps);
   std::optional<std::uint32_t> newest;  // newest stamp arrived this period (unaware KF)
+  double newest_y = 0;                  // its value
+  // Frame faults (faulted runs only: the clean run draws and registers nothing more).
+  const bool faulted = !cfg.faults.empty();
+  std::optional<engine::LinkFaults> faults;
+  if (faulted) faults.emplace(cfg.faults, "sensor", engine::kSequencedFrameLayout, seed);
+  std::vector<std::vector<std::uint8_t>> frames;  // delivered by "deliver frame" (arg: index)
 
   RunMetrics out;
   double sum_tr = 0, sum_err = 0, sum_tr_a = 0, sum_err_a = 0, sum_corr = 0, sum_gamma = 0;
@@ -154,14 +163,67 @@ RunMetrics run_impl(const DroppingPlant& plant, const RunConfig& cfg, std::uint6
       if (v == node::ArrivalVerdict::kOverDelayed) out.over_delayed += 1;
       if (v == node::ArrivalVerdict::kDuplicate) out.duplicates += 1;
     }
-    if (!newest || j > *newest) newest = static_cast<std::uint32_t>(j);
+    if (!newest || j > *newest) {
+      newest = static_cast<std::uint32_t>(j);
+      newest_y = ys[j];
+    }
   });
+  // The controller's frame checks: y finite, stamp not after the period it arrives in (a
+  // genuine sample arrives at least half a period after it was taken), then the buffer's
+  // window (over-delayed, duplicate) or, for the unaware KF, newer than the period's newest.
+  engine::HandlerId deliver_frame{};
+  if (faulted) {
+    deliver_frame = kernel.add_handler("deliver frame", [&](std::uint64_t i) {
+      std::uint32_t j = 0;
+      double yj = 0;
+      if (!engine::decode_sequenced_frame(frames[i], j, &yj, 1)) return;  // every fault keeps the size
+      if (!std::isfinite(yj)) {
+        out.refused_non_finite += 1;
+        return;
+      }
+      const auto period_now = static_cast<std::uint32_t>(kernel.now().count() / period.count());
+      if (static_cast<std::int32_t>(period_now - j) < 0) {
+        out.refused_sequence += 1;
+        return;
+      }
+      OutputVec y;
+      y[0] = yj;
+      if (buffered) {
+        const node::ArrivalVerdict v = filter.receive(j, y);
+        if (v == node::ArrivalVerdict::kOverDelayed) out.over_delayed += 1;
+        if (v == node::ArrivalVerdict::kDuplicate) out.duplicates += 1;
+      }
+      if (!newest || static_cast<std::int32_t>(j - *newest) > 0) {
+        newest = j;
+        newest_y = yj;
+      } else {
+        out.stale += 1;
+      }
+    });
+  }
   const engine::HandlerId sample = kernel.add_handler("sample", [&](std::uint64_t k) {
     xs[k] = sys.state();
     const double cx = (plant.c * sys.state())[0];
     ys[k] = cx + sd_v * meas.normal();
     const engine::SimTime now = kernel.now();
-    if (cfg.channel == ChannelKind::kNetwork) {
+    if (faulted) {
+      std::vector<std::uint8_t> bytes = engine::encode_sequenced_frame(static_cast<std::uint32_t>(k), &ys[k], 1);
+      std::vector<std::vector<std::uint8_t>> extra;
+      faults->apply(now, bytes, extra);  // before the channel's draws: they never move
+      std::optional<engine::SimTime> at;
+      if (cfg.channel == ChannelKind::kNetwork) {
+        at = link.transmit(now);
+      } else if (gamma_rng.bernoulli(cfg.bernoulli_lambda)) {
+        at = now + period / 2;
+      }
+      if (at) {
+        extra.insert(extra.begin(), std::move(bytes));
+        for (auto& f : extra) {  // copies travel with the frame, right after it
+          kernel.schedule(*at, engine::EventClass::kDelivery, deliver_frame, frames.size());
+          frames.push_back(std::move(f));
+        }
+      }
+    } else if (cfg.channel == ChannelKind::kNetwork) {
       if (const auto at = link.transmit(now)) kernel.schedule(*at, engine::EventClass::kDelivery, deliver, k);
     } else if (gamma_rng.bernoulli(cfg.bernoulli_lambda)) {
       kernel.schedule(now + period / 2, engine::EventClass::kDelivery, deliver, k);
@@ -179,7 +241,7 @@ RunMetrics run_impl(const DroppingPlant& plant, const RunConfig& cfg, std::uint6
     std::optional<OutputVec> y_newest;
     if (newest) {
       OutputVec v;
-      v[0] = ys[*newest];
+      v[0] = newest_y;
       y_newest = v;
     }
     newest.reset();
@@ -205,6 +267,7 @@ RunMetrics run_impl(const DroppingPlant& plant, const RunConfig& cfg, std::uint6
       corr = unaware.last_corrections();
     }
     if (st != Status::kOk) out.failed = true;
+    if (faulted && !all_finite(xhat)) out.estimate_non_finite += 1;
     const double r_k = ((static_cast<std::int64_t>(k) / half_wave) % 2 == 0) ? 1.0 : -1.0;
     InputVec u = -(plant.l * xhat);
     u[0] += r_k;
@@ -244,6 +307,7 @@ RunMetrics run_impl(const DroppingPlant& plant, const RunConfig& cfg, std::uint6
   out.err_shadow_small_r = buffered ? sum_shadow_small / n : nan;
   out.err_shadow_nominal_r = buffered ? sum_shadow_nominal / n : nan;
   out.gamma = buffered && anchors > 0 ? sum_gamma / static_cast<double>(anchors) : nan;
+  if (faults) out.injected = faults->counters();
   return out;
 }
 
@@ -280,7 +344,20 @@ double gamma_impl(double mean_delay_periods, double loss, std::size_t steps, std
 
 }  // namespace
 
+void check_dropping_faults(const engine::FaultSpec& spec) {
+  for (std::size_t i = 0; i < spec.clauses.size(); ++i) {
+    const engine::FaultClause& c = spec.clauses[i];
+    if (c.kind == engine::FaultClause::Kind::kRestart)
+      throw engine::InputError("fault clause " + std::to_string(i + 1) + " (restart): node '" + c.node +
+                               "' cannot restart in study dropping (no restartable node: the sensor stamps its samples "
+                               "with the synchronized step index, and the buffered filter's step count, its sequence "
+                               "reference, cannot be re-based)");
+  }
+  engine::check_fault_targets(spec, dropping_link_names(), {});
+}
+
 RunMetrics run_closed_loop(const DroppingPlant& plant, const RunConfig& cfg, std::uint64_t seed) {
+  check_dropping_faults(cfg.faults);
   if (cfg.steps < 2) throw std::invalid_argument("a run needs at least 2 steps");
   if (!(cfg.square_wave_period_s > 0)) throw std::invalid_argument("square-wave period must be positive");
   switch (cfg.t_hold) {

@@ -9,6 +9,17 @@
 /// (kDelivery) enter the buffer; the estimator runs step k and the controller applies
 /// u_k = −L x̂(k|Y_k) + r_k (kCompute), which the plant latches for step k (kLatch).
 /// r_k: ±1 square wave, 4 s period. x₀ ~ N(0, P₀), x̂₀ = 0.
+///
+/// With a fault spec (RunConfig::faults; docs/faults.md, "Study dropping") each sample
+/// travels as a frame [j: u32][y: f64] (engine/sequenced_frame.hpp) through the link
+/// "sensor"'s engine::LinkFaults before the link's delay and loss draws (or the Bernoulli
+/// channel's draw); the controller decodes it and refuses a non-finite y
+/// (refused_non_finite) and a stamp not yet sampled, j > the period it arrives in
+/// (refused_sequence: a forged or corrupted stamp), before the threshold buffer (which drops
+/// over-delayed stamps and duplicates) or the delay-unaware KF (which takes only a stamp
+/// newer than the period's newest; older ones are `stale`). Node restarts are refused (no
+/// restartable node: the sensor's stamps are the synchronized step index, the buffered
+/// filter's step count cannot be re-based). An empty spec is the clean run, bit for bit.
 #pragma once
 
 #include <cstddef>
@@ -17,6 +28,8 @@
 #include <vector>
 
 #include "dropping_plant.hpp"
+#include "oneshot/engine/fault_spec.hpp"
+#include "oneshot/engine/frame_faults.hpp"
 
 namespace oneshot::dropping {
 
@@ -44,6 +57,7 @@ struct RunConfig {
   std::size_t steps = 1000;            ///< Steps simulated.
   double square_wave_period_s = 4;     ///< Period of r_k.
   bool trace = false;                  ///< Keep per-step traces.
+  engine::FaultSpec faults;            ///< Frame faults on link "sensor" (empty: clean run).
 };
 
 /// Per-step trace of a run (when RunConfig::trace).
@@ -70,11 +84,23 @@ struct RunMetrics {
   double duplicates = 0;       ///< Duplicate packets ignored.
   double reordered = 0;        ///< Packets the link delivered out of order.
   bool failed = false;         ///< An estimator step reported a failure (innovation variance).
+  double refused_non_finite = 0;  ///< Frames refused by the controller: y not finite (faults only).
+  double refused_sequence = 0;    ///< Frames refused: stamp j after the arrival's period (faults only).
+  double stale = 0;               ///< Unaware KF: frames not newer than the period's newest (faults only).
+  double estimate_non_finite = 0; ///< Steps whose loop estimate x̂(k|Y_k) was not finite (faults only).
+  engine::FaultCounters injected; ///< Faults injected on the link.
   RunTrace trace;              ///< Traces (when asked).
 };
 
 /// Runs one closed loop with `seed`; std::invalid_argument for T_hold outside 1 … 8.
 RunMetrics run_closed_loop(const DroppingPlant& plant, const RunConfig& cfg, std::uint64_t seed);
+
+/// The link names a fault spec of the study may name ("sensor").
+inline std::vector<std::string> dropping_link_names() { return {"sensor"}; }
+
+/// Checks a spec against the study: links as dropping_link_names(); a restart clause is an
+/// engine::InputError naming the node (the study has no restartable node).
+void check_dropping_faults(const engine::FaultSpec& spec);
 
 /// γ frequency of the pipeline alone (network + ThresholdBuffer, no plant): the fraction of
 /// stamps n = 0 … steps − 1 − T_hold found in the buffer at step n + T_hold.

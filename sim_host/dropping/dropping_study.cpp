@@ -23,6 +23,7 @@ using dropping::StudyOptions;
 
 struct DroppingCli {
   StudyOptions opt;
+  std::string inject;
   std::string plant;
   std::string json;
   std::string shard = "0/1";
@@ -46,8 +47,16 @@ void add_common(CLI::App* cmd, DroppingCli& c, const std::string& out, bool swee
       ->capture_default_str();
 }
 
+/// `--inject SPEC` (closed-loop, hold): frame faults on link "sensor" in every run.
+void add_inject(CLI::App* cmd, DroppingCli& c) {
+  cmd->add_option("--inject", c.inject,
+                  "frame faults in every run on link 'sensor', e.g. 'nan:rate=0.02; forge_seq:at_s=2' (docs/faults.md)");
+}
+
 StudyOptions resolve(const DroppingCli& c) {
   StudyOptions o = c.opt;
+  o.faults = engine::parse_fault_spec(c.inject);
+  dropping::check_dropping_faults(o.faults);
   o.plots = !c.no_plots;
   o.shard = engine::parse_shard(c.shard);
   return o;
@@ -57,6 +66,7 @@ void emit(const DroppingCli& c, const nlohmann::json& j, double wall) {
   if (!c.json.empty()) util::write_json(c.json, j);
   if (c.json != "-") {
     if (j.contains("markdown")) std::cout << j.at("markdown").get<std::string>();
+    if (j.contains("markdown_faults")) std::cout << "\n" << j.at("markdown_faults").get<std::string>();
     std::cout << j.value("experiment", std::string("result")) << ": written to " << c.opt.out_dir << std::endl;
   }
   std::cerr << "wall time " << wall << " s\n";
@@ -123,6 +133,7 @@ void register_dropping_study(CLI::App& app) {
     CLI::App* cmd = study->add_subcommand(
         "closed-loop", "E4/E5: closed loop at lambda through the pipeline (T_hold = 1), Bernoulli check, delay-unaware KF");
     add_common(cmd, *c, "out/dropping", true);
+    add_inject(cmd, *c);
     cmd->add_option("--lambda", *lambdas, "arrival probabilities (D = -ln(lambda/(1-loss)))")->capture_default_str();
     cmd->callback([c, lambdas]() {
       const auto t0 = std::chrono::steady_clock::now();
@@ -137,6 +148,7 @@ void register_dropping_study(CLI::App& app) {
     auto delays = std::make_shared<std::vector<double>>(std::vector<double>{1, 2});
     CLI::App* cmd = study->add_subcommand("hold", "E6: T_hold = 1 ... max at D = 1, 2: anchor and current error against cost");
     add_common(cmd, *c, "out/dropping", true);
+    add_inject(cmd, *c);
     cmd->add_option("--max-hold", *max_hold, "largest T_hold (<= 8)")->check(CLI::Range(1, 8))->capture_default_str();
     cmd->add_option("--delay", *delays, "mean delays D (periods)")->capture_default_str();
     cmd->callback([c, max_hold, delays]() {

@@ -12,6 +12,7 @@
 #include "oneshot/engine/quantiles.hpp"
 #include "oneshot/engine/random_stream.hpp"
 #include "oneshot/engine/sweep_statistics.hpp"
+#include "oneshot/sim/sweep_faults.hpp"
 #include "oneshot/node/buffered_kalman.hpp"
 #include "oneshot/number_format.hpp"
 #include "oneshot/plant_structure.hpp"
@@ -47,6 +48,23 @@ std::string plant_digest(const DroppingPlant& p) {
                                                                       ? dropping_plant_json()
                                                                       : p.plant.name + p.plant.source)));
   return b;
+}
+
+/// A faulted run's counters, with its cost over the clean run's of the same seed (run here).
+std::vector<double> with_faults(std::vector<double> v, const DroppingPlant& plant, RunConfig c, const RunMetrics& m,
+                                std::uint64_t seed) {
+  if (c.faults.empty()) return v;
+  sim::RunFaultCounts f;
+  f.injected = static_cast<double>(m.injected.injected());
+  f.refused_non_finite = m.refused_non_finite;
+  f.refused_sequence = m.refused_sequence;
+  f.stale = m.stale;
+  f.estimator_resets = m.estimate_non_finite;
+  c.faults = engine::FaultSpec{};
+  c.trace = false;
+  f.ratio_to_clean = m.cost / run_closed_loop(plant, c, seed).cost;
+  sim::append_fault_values(v, f);
+  return v;
 }
 
 const char* const kClosedLoopApproaches[] = {"buffered", "buffered-bernoulli", "unaware-R0.05", "unaware-R2.5"};
@@ -159,6 +177,7 @@ nlohmann::json run_closed_loop_experiment(const DroppingPlant& plant, const Stud
                   "err_shadow_R0.05", "err_shadow_R2.5"};
   spec.config = {{"plant", plant.plant.name}, {"plant_digest", plant_digest(plant)}, {"loss", opt.loss},
                  {"steps", opt.steps}, {"t_hold", 1}, {"scenarios", sc}};
+  sim::add_fault_metrics(spec, opt.faults, "cost");
   const engine::SweepResults r = engine::run_sweep(
       spec, opt.shard, opt.threads,
       [&](std::size_t a, std::size_t s, std::uint64_t seed) {
@@ -171,10 +190,11 @@ nlohmann::json run_closed_loop_experiment(const DroppingPlant& plant, const Stud
         c.channel = a == 1 ? ChannelKind::kBernoulli : ChannelKind::kNetwork;
         c.estimator = a >= 2 ? EstimatorKind::kUnaware : EstimatorKind::kBuffered;
         c.unaware_r = a == 2 ? 0.05 : 2.5;
+        c.faults = opt.faults;
         const RunMetrics m = run_closed_loop(plant, c, seed);
-        return std::vector<double>{m.err,       m.err_anchor, m.trace_p,       m.trace_p_anchor,
-                                   m.gamma,     m.cost,       m.reordered,     m.failed ? 1.0 : 0.0,
-                                   m.err_shadow_small_r,  m.err_shadow_nominal_r};
+        return with_faults({m.err, m.err_anchor, m.trace_p, m.trace_p_anchor, m.gamma, m.cost, m.reordered,
+                            m.failed ? 1.0 : 0.0, m.err_shadow_small_r, m.err_shadow_nominal_r},
+                           plant, c, m, seed);
       },
       "dropping closed-loop");
   nlohmann::json j = finish(r, opt, "closed-loop", closed_loop_outputs);
@@ -187,6 +207,7 @@ nlohmann::json run_closed_loop_experiment(const DroppingPlant& plant, const Stud
       c.loss = opt.loss;
       c.mean_delay_periods = delay_for_lambda(lambdas[s], opt.loss);
       c.trace = true;
+      c.faults = opt.faults;
       const RunMetrics m = run_closed_loop(plant, c, opt.seed);
       for (std::size_t k = 0; k < opt.steps; ++k)
         rows.push_back({static_cast<double>(s), static_cast<double>(k) * plant.plant.period_us * 1e-6, m.trace.y[k],
@@ -226,6 +247,7 @@ nlohmann::json closed_loop_outputs(const engine::SweepResults& r, const std::str
   j["seeds"] = r.spec.seeds;
   j["first_seed"] = r.spec.first_seed;
   j["loss"] = cfg.at("loss");
+  if (cfg.contains("inject")) j["inject"] = cfg.at("inject");
   std::ostringstream md;
   md << "| λ | estimator | \\|x − x̂(k\\|Y_k)\\|² median [10–90 %] | mean ± 95 % CI | tr P_k median [10–90 %] | mean ± CI | "
         "anchor \\|x_n − x̂(n\\|n)\\|² median | γ freq | paired Δ err vs buffered (median of per-seed ratio) |\n"
@@ -251,6 +273,7 @@ nlohmann::json closed_loop_outputs(const engine::SweepResults& r, const std::str
       ja["paired_err_ratio_to_buffered"] = tail_json(tr);
       // Null where the differences overflow (a diverging baseline): the median ratio beside it stays defined.
       ja["paired_err_difference_to_buffered"] = {{"mean", num(dd.mean)}, {"ci95", num(dd.ci95)}};
+      if (cfg.contains("inject")) ja["faults"] = sim::fault_row(r, a, s);
       js["approaches"][r.spec.approaches[a]] = ja;
       const engine::TailSummary te = engine::tail_summary(e);
       const engine::TailSummary tp = engine::tail_summary(cell(r, a, s, r.metric("trace_p")));
@@ -296,6 +319,7 @@ nlohmann::json closed_loop_outputs(const engine::SweepResults& r, const std::str
   }
   j["markdown_e5"] = m5.str();
   j["markdown"] = md.str();
+  if (cfg.contains("inject")) j["markdown_faults"] = sim::fault_markdown(r);
   util::write_csv(path_in(out_dir, "closed_loop.csv"),
                  {"lambda", "approach", "err_median", "err_p10", "err_p90", "err_mean", "err_ci95", "trp_median", "trp_p10",
                   "trp_p90", "trp_mean", "trp_ci95"},
@@ -354,6 +378,7 @@ nlohmann::json run_hold(const DroppingPlant& plant, const StudyOptions& opt, int
   spec.metrics = {"err", "err_anchor", "trace_p", "trace_p_anchor", "gamma", "corrections", "cost", "over_delayed"};
   spec.config = {{"plant", plant.plant.name}, {"plant_digest", plant_digest(plant)}, {"loss", opt.loss},
                  {"steps", opt.steps}, {"scenarios", sc}};
+  sim::add_fault_metrics(spec, opt.faults, "cost");
   const engine::SweepResults r = engine::run_sweep(
       spec, opt.shard, opt.threads,
       [&](std::size_t, std::size_t s, std::uint64_t seed) {
@@ -363,9 +388,11 @@ nlohmann::json run_hold(const DroppingPlant& plant, const StudyOptions& opt, int
         rc.mean_delay_periods = c.at("D").get<double>();
         rc.loss = opt.loss;
         rc.steps = opt.steps;
+        rc.faults = opt.faults;
         const RunMetrics m = run_closed_loop(plant, rc, seed);
-        return std::vector<double>{m.err, m.err_anchor, m.trace_p, m.trace_p_anchor, m.gamma, m.corrections, m.cost,
-                                   m.over_delayed};
+        return with_faults({m.err, m.err_anchor, m.trace_p, m.trace_p_anchor, m.gamma, m.corrections, m.cost,
+                            m.over_delayed},
+                           plant, rc, m, seed);
       },
       "dropping hold");
   return finish(r, opt, "hold", hold_outputs);
@@ -379,6 +406,7 @@ nlohmann::json hold_outputs(const engine::SweepResults& r, const std::string& ou
   j["steps"] = cfg.at("steps");
   j["seeds"] = r.spec.seeds;
   j["first_seed"] = r.spec.first_seed;
+  if (cfg.contains("inject")) j["inject"] = cfg.at("inject");
   std::ostringstream md;
   md << "| D | T_hold | λ(T_hold) | γ freq | current \\|x − x̂(k\\|Y_k)\\|² median [10–90 %] | mean ± CI | anchor "
         "\\|x_n − x̂(n\\|n)\\|² median [10–90 %] | tr P_k median | predictions / corrections per step | filter bytes "
@@ -396,6 +424,7 @@ nlohmann::json hold_outputs(const engine::SweepResults& r, const std::string& ou
     const engine::TailSummary tg = engine::tail_summary(cell(r, 0, s, r.metric("gamma")));
     const engine::TailSummary tc = engine::tail_summary(cell(r, 0, s, r.metric("corrections")));
     js["predictions_per_step"] = t + 1;
+    if (cfg.contains("inject")) js["faults"] = sim::fault_row(r, 0, s);
     j["per_cell"].push_back(js);
     md << "| " << fmt_g(c.at("D").get<double>()) << " | " << t << " | " << fmt_f(c.at("lambda").get<double>(), 4) << " | "
        << fmt_f(tg.mean.mean, 4) << " | " << band_md(te) << " | " << mean_md(te) << " | " << band_md(ta) << " | "
@@ -405,6 +434,7 @@ nlohmann::json hold_outputs(const engine::SweepResults& r, const std::string& ou
                    tc.mean.mean});
   }
   j["markdown"] = md.str();
+  if (cfg.contains("inject")) j["markdown_faults"] = sim::fault_markdown(r);
   util::write_csv(path_in(out_dir, "hold.csv"),
                  {"D", "T_hold", "err_median", "err_p10", "err_p90", "anchor_median", "anchor_p10", "anchor_p90",
                   "corrections"},

@@ -18,6 +18,7 @@
 
 #include "dropping_plant.hpp"
 #include "lambda_c.hpp"
+#include "oneshot/engine/fault_spec.hpp"
 #include "oneshot/engine/sweep.hpp"
 
 namespace oneshot::dropping {
@@ -32,6 +33,7 @@ struct StudyOptions {
   bool plots = true;                     ///< gnuplot PNGs.
   engine::Shard shard;                   ///< Part of the sweep to run.
   double loss = 0.01;                    ///< ε.
+  engine::FaultSpec faults;              ///< closed-loop, hold: frame faults in every run (docs/faults.md).
 };
 
 /// E1: the sweep (or its shard file) and, for a whole sweep, the summary JSON (+ files).

@@ -25,7 +25,7 @@ static_assert(pp::kHorizon == kHorizon, "the image's horizon is the study's");
 
 /// The node's constants in double (the design's values), petc_pil.hpp layout.
 void design_words(const PetcSetup& s, double (&w)[pp::kWordCount]) {
-  const EstimatorModel& m = s.plant.augmented;
+  const EstimatorModel& m = s.node_model.model;  // the block-diagonal basis the node runs in
   if (m.a.rows != pp::kStates) throw std::invalid_argument("petc exectime: the image is built for the 12-state model");
   for (std::size_t i = 0; i < pp::kStates; ++i) {
     for (std::size_t j = 0; j < pp::kStates; ++j) w[pp::kA + i * pp::kStates + j] = m.a(i, j);

@@ -9,6 +9,7 @@
 
 #include "oneshot/engine/sweep_statistics.hpp"
 #include "oneshot/util/output_files.hpp"
+#include "oneshot/sim/sweep_faults.hpp"
 
 namespace oneshot::sim::petc {
 
@@ -75,9 +76,20 @@ nlohmann::json run_table(const PetcSetup& setup, const SweepOptions& opt) {
     labels[c.name] = {{"label", c.label}, {"sigma_s", c.sigma_s}, {"delta_s", c.delta_s}, {"sigma_c", c.sigma_c},
                       {"delta_c", c.delta_c}, {"noise", c.noise}};
   spec.config["cases"] = labels;
+  sim::add_fault_metrics(spec, opt.faults, "tracking error sqrt(sum_k (r - y_k)^2)");
   util::make_directory(opt.out_dir);
   const engine::SweepResults r = finish(
-      spec, opt, [&](std::size_t a, std::size_t, std::uint64_t seed) { return run_case(setup, cases[a], seed); },
+      spec, opt,
+      [&](std::size_t a, std::size_t, std::uint64_t seed) {
+        if (opt.faults.empty()) return run_case(setup, cases[a], seed);
+        FaultRun f, clean;
+        f.spec = opt.faults;
+        std::vector<double> v = run_case(setup, cases[a], seed, nullptr, &f);
+        static_cast<void>(run_case(setup, cases[a], seed, nullptr, &clean));  // the same seed without faults
+        f.counts.ratio_to_clean = f.tracking_error / clean.tracking_error;
+        sim::append_fault_values(v, f.counts);
+        return v;
+      },
       "petc table");
   if (!opt.shard.whole()) {
     const nlohmann::json j = engine::shard_to_json(r);
@@ -98,6 +110,7 @@ nlohmann::json table_outputs(const engine::SweepResults& r, const std::string& o
     for (std::size_t m = 0; m < spec.metrics.size(); ++m) metrics[spec.metrics[m]] = mean_ci(sums[m].value[a]);
     nlohmann::json c = {{"case", spec.approaches[a]}, {"metrics", metrics}};
     if (spec.config.contains("cases")) c["setting"] = spec.config["cases"].at(spec.approaches[a]);
+    if (spec.config.contains("inject")) c["faults"] = sim::fault_row(r, a, 0);
     cases.push_back(c);
   }
   // Paired differences (same seeds) between consecutive cases for the headline metrics.
@@ -113,6 +126,10 @@ nlohmann::json table_outputs(const engine::SweepResults& r, const std::string& o
   nlohmann::json j = {{"study", "petc"},        {"experiment", "table"},     {"seeds", spec.seeds},
                       {"first_seed", spec.first_seed}, {"n_tts", spec.config.value("steps", 0)},
                       {"config", spec.config},  {"cases", cases},          {"paired_differences_consecutive", paired}};
+  if (spec.config.contains("inject")) {
+    j["inject"] = spec.config.at("inject");
+    j["markdown_faults"] = sim::fault_markdown(r);
+  }
   util::write_json(join(out_dir, "table.json"), j);
   return j;
 }

@@ -9,6 +9,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "oneshot/engine/fault_spec.hpp"
 #include "oneshot/engine/sweep.hpp"
 #include "petc_sim.hpp"
 
@@ -22,6 +23,7 @@ struct SweepOptions {
   std::string out_dir = "out/petc";  ///< Output folder.
   bool plots = true;              ///< Draw PNGs with gnuplot.
   engine::Shard shard;            ///< Part of the sweep to run.
+  engine::FaultSpec faults;       ///< table: frame faults and restarts in every run (docs/faults.md).
 };
 
 /// The options and design digest that fix a sweep's numbers (its spec config).

@@ -5,15 +5,21 @@
 #include <algorithm>
 #include <cmath>
 #include <memory>
+#include <optional>
 #include <stdexcept>
 
+#include "oneshot/app/petc_pil.hpp"
 #include "oneshot/engine/discrete_plant.hpp"
+#include "oneshot/engine/frame_faults.hpp"
 #include "oneshot/engine/kernel.hpp"
+#include "oneshot/engine/sequenced_frame.hpp"
 #include "oneshot/node/disturbance_observer.hpp"
 #include "oneshot/node/interlaced_controller.hpp"
 #include "oneshot/node/mtm_trigger.hpp"
 #include "oneshot/node/packet_buffer.hpp"
 #include "oneshot/node/petc_controller.hpp"
+#include "petc_frames.hpp"
+#include "petc_hold_controller.hpp"
 
 namespace oneshot::sim::petc {
 
@@ -21,9 +27,7 @@ namespace {
 
 constexpr std::size_t kPlantStates = 12;
 constexpr std::size_t kPlantOnly = 10;
-using Law = node::InterlacedController<double, 1, 2>;
 using Dob = node::DisturbanceObserver<double, kDobSections, kDobMaxDelay>;
-using Trigger = node::MtmTrigger<double, 1>;
 using node::SendCause;
 
 template <std::size_t R, std::size_t C>
@@ -78,60 +82,27 @@ Dob make_dob(const PetcSetup& s) {
   return Dob(cfg);
 }
 
-/// TTS and PETC without NUMRE: hold the last y, run the law every period on arrival.
-class HoldController {
- public:
-  HoldController(const Law& law, const Trigger& trig, bool always, double r)
-      : law_(law), trig_(trig), always_(always), r_(r) {}
-  SendCause arrive(std::uint32_t k, double y) {
-    const std::uint64_t before = law_.macs();
-    if (any_)
-      for (std::uint32_t j = k_prev_ + 1; j != k; ++j) static_cast<void>(law_.step(j, r_ - y_held_));
-    const double u = law_.step(k, r_ - y);
-    multiplicity_ = any_ ? k - k_prev_ : 0;
-    y_held_ = y;
-    k_prev_ = k;
-    any_ = true;
-    last_macs_ = law_.macs() - before;
-    Vector<double, 1> uv;
-    uv[0] = u;
-    const SendCause cause = always_ ? SendCause::kPeriodic : trig_.evaluate(k, uv);
-    if (cause != SendCause::kNone) {
-      trig_.on_sent(k, uv);
-      std::fill(packet_, packet_ + kHorizon + 1, u);
-    }
-    return cause;
-  }
-  const double* packet() const { return packet_; }
-  std::uint64_t macs() const { return law_.macs(); }
-  std::uint64_t last_macs() const { return last_macs_; }
-  std::uint32_t multiplicity() const { return multiplicity_; }
-  double d_hat(std::uint32_t) const { return 0; }
-  void record_state(RunTrace&) const {}
-
- private:
-  Law law_;
-  Trigger trig_;
-  bool always_;
-  double r_;
-  std::uint32_t k_prev_ = 0;
-  bool any_ = false;
-  double y_held_ = 0;
-  std::uint32_t multiplicity_ = 0;
-  std::uint64_t last_macs_ = 0;
-  double packet_[kHorizon + 1]{};
-};
-
-/// NUMRE controller node wrapped for the loop.
-template <std::size_t N, typename Observer>
+/// NUMRE controller node wrapped for the loop, compiled for the model's `Structure` (the
+/// augmented model: the M4F image's HddStructure, so the multiply-adds are the image's).
+template <std::size_t N, typename Observer, typename Structure = node::DenseModelStructure<N>>
 class NumreController {
  public:
-  using Node = node::PetcController<double, N, kHorizon, Law, Observer>;
+  using Node = node::PetcController<double, N, kHorizon, Law, Observer, Structure>;
   NumreController(const EstimatorModel& m, bool frozen, const Law& law, const Observer& obs, const Trigger& trig,
                   double r)
-      : node_(std::make_unique<Node>(numre_model<N>(m), frozen ? node::NoiseAccumulation::kFrozen
-                                                               : node::NoiseAccumulation::kSum,
+      : node_(std::make_unique<Node>(fitting(numre_model<N>(m)), frozen ? node::NoiseAccumulation::kFrozen
+                                                                        : node::NoiseAccumulation::kSum,
                                      law, obs, trig, r)) {}
+  /// A deep copy (the power-on node kept for a restart).
+  NumreController(const NumreController& o) : node_(std::make_unique<Node>(*o.node_)), last_macs_(o.last_macs_) {}
+  NumreController& operator=(const NumreController&) = delete;
+  /// Restart: the power-on node `p` again (its estimator resets so far are kept in the count).
+  void restart_as(const NumreController& p) {
+    resets_ += node_->statistics().estimator_resets;
+    *node_ = *p.node_;
+  }
+  /// Estimates that turned non-finite (reset by the node), restarts included.
+  std::uint32_t estimator_resets() const { return resets_ + node_->statistics().estimator_resets; }
   SendCause arrive(std::uint32_t k, double y) {
     const std::uint64_t before = node_->macs();
     const SendCause c = node_->on_arrival(k, y);
@@ -151,6 +122,13 @@ class NumreController {
  private:
   std::unique_ptr<Node> node_;
   std::uint64_t last_macs_ = 0;
+  std::uint32_t resets_ = 0;
+
+  /// The model, refused when it has a nonzero outside Structure.
+  static const node::NumreModel<double, N>& fitting(const node::NumreModel<double, N>& m) {
+    if (!Node::fits(m)) throw std::invalid_argument("petc: the NUMRE model has a nonzero outside its compiled structure");
+    return m;
+  }
 };
 
 Vector<double, 1> scalar(double x) {
@@ -168,7 +146,8 @@ std::size_t longest_silence(const std::vector<std::uint32_t>& sends, std::size_t
 }
 
 template <typename Ctrl>
-std::vector<double> simulate(const PetcSetup& s, const CaseSpec& c, std::uint64_t seed, Ctrl& ctrl, RunTrace* tr) {
+std::vector<double> simulate(const PetcSetup& s, const CaseSpec& c, std::uint64_t seed, Ctrl& ctrl, RunTrace* tr,
+                             FaultRun* fr) {
   const std::size_t steps = s.opt.steps;
   const EstimatorModel& m = s.plant.augmented;
   engine::DiscretePlantConfig<kPlantStates, 1, 1, 1> pc;
@@ -201,13 +180,47 @@ std::vector<double> simulate(const PetcSetup& s, const CaseSpec& c, std::uint64_
   std::vector<double> y_true(steps, 0.0), d(steps, 0.0), d_hat(steps, 0.0);
   if (tr) *tr = RunTrace{};
 
+  // Frame faults (faulted runs only: the clean run registers and draws nothing more).
+  const bool faulted = fr != nullptr && !fr->spec.empty();
+  std::optional<engine::LinkFaults> sc_faults, ca_faults;
+  std::vector<std::vector<std::uint8_t>> sc_frames, ca_frames;  // delivered by index
+  FrameReceiver ctrl_rx(s.y_range), act_rx(s.u_range);
+  std::optional<Ctrl> ctrl_power_on;
+  engine::FaultCounters restarts;
+  if (faulted) {
+    sc_faults.emplace(fr->spec, "sc", engine::kSequencedFrameLayout, seed);
+    ca_faults.emplace(fr->spec, "ca", engine::kSequencedFrameLayout, seed);
+    if (!engine::restart_instants(fr->spec, "controller").empty()) ctrl_power_on.emplace(ctrl);
+  }
+  const auto period_now = [&] { return static_cast<std::uint32_t>(kernel.now().count() / pc.period.count()); };
+  // Sends `bytes` through `faults`: the frame and the copies it gains, all at `now` (no delay, no loss).
+  const auto send = [&](engine::LinkFaults& faults, std::vector<std::uint8_t> bytes, engine::EventClass cls,
+                        engine::HandlerId h, std::vector<std::vector<std::uint8_t>>& frames) {
+    std::vector<std::vector<std::uint8_t>> extra;
+    faults.apply(kernel.now(), bytes, extra);
+    extra.insert(extra.begin(), std::move(bytes));
+    for (auto& f : extra) {
+      kernel.schedule(kernel.now(), cls, h, frames.size());
+      frames.push_back(std::move(f));
+    }
+  };
+
   engine::HandlerId on_rx = kernel.add_handler("actuator receive", [&](std::uint64_t k) {
     actuator.accept(static_cast<std::uint32_t>(k), ctrl.packet());
     plant.set_input(scalar(actuator.value(static_cast<std::uint32_t>(k))));
   });
-  engine::HandlerId on_arrival = kernel.add_handler("controller arrival", [&](std::uint64_t k) {
-    const auto kk = static_cast<std::uint32_t>(k);
-    const SendCause cause = ctrl.arrive(kk, inbox_y);
+  engine::HandlerId on_rx_frame{};
+  if (faulted)
+    on_rx_frame = kernel.add_handler("actuator frame", [&](std::uint64_t i) {
+      std::uint32_t k = 0;
+      double u[kHorizon + 1];
+      if (!engine::decode_sequenced_frame(ca_frames[i], k, u, kHorizon + 1)) return;  // every fault keeps the size
+      if (!act_rx.accept(k, u, kHorizon + 1, period_now())) return;
+      actuator.accept(k, u);
+      plant.set_input(scalar(actuator.value(k)));
+    });
+  const auto arrive = [&](std::uint32_t kk, double y) {
+    const SendCause cause = ctrl.arrive(kk, y);
     n_max = std::max(n_max, ctrl.multiplicity());
     macs_max = std::max(macs_max, ctrl.last_macs());
     if (tr) {
@@ -217,8 +230,23 @@ std::vector<double> simulate(const PetcSetup& s, const CaseSpec& c, std::uint64_
     if (cause == SendCause::kNone) return;
     if (cause == SendCause::kTime) ++controller_safety;
     actuator_sends.push_back(kk);
-    kernel.schedule(kernel.now(), engine::EventClass::kActuation, on_rx, k);
+    if (faulted)
+      send(*ca_faults, engine::encode_sequenced_frame(kk, ctrl.packet(), kHorizon + 1), engine::EventClass::kActuation,
+           on_rx_frame, ca_frames);
+    else
+      kernel.schedule(kernel.now(), engine::EventClass::kActuation, on_rx, kk);
+  };
+  engine::HandlerId on_arrival = kernel.add_handler("controller arrival", [&](std::uint64_t k) {
+    arrive(static_cast<std::uint32_t>(k), inbox_y);
   });
+  engine::HandlerId on_arrival_frame{};
+  if (faulted)
+    on_arrival_frame = kernel.add_handler("controller frame", [&](std::uint64_t i) {
+      std::uint32_t k = 0;
+      double y = 0;
+      if (!engine::decode_sequenced_frame(sc_frames[i], k, &y, 1)) return;
+      if (ctrl_rx.accept(k, &y, 1, period_now())) arrive(k, y);
+    });
   engine::HandlerId on_sample = kernel.add_handler("sensor sample", [&](std::uint64_t k) {
     const auto kk = static_cast<std::uint32_t>(k);
     const double y = plant.output()[0];
@@ -238,6 +266,11 @@ std::vector<double> simulate(const PetcSetup& s, const CaseSpec& c, std::uint64_
     if (cause == SendCause::kTime) ++sensor_safety;
     if (cause == SendCause::kReference) ++reference_sends;
     sensor_sends.push_back(kk);
+    if (faulted) {
+      send(*sc_faults, engine::encode_sequenced_frame(kk, &ym, 1), engine::EventClass::kDelivery, on_arrival_frame,
+           sc_frames);
+      return;
+    }
     inbox_y = ym;
     kernel.schedule(kernel.now(), engine::EventClass::kDelivery, on_arrival, k);
   });
@@ -255,7 +288,45 @@ std::vector<double> simulate(const PetcSetup& s, const CaseSpec& c, std::uint64_
     if (k + 1 < steps) kernel.schedule(kernel.now() + pc.period, engine::EventClass::kActuation, *period_id, k + 1);
   });
   kernel.schedule(engine::SimTime{0}, engine::EventClass::kActuation, *period_id, 0);
+  if (faulted) {  // restarts: the node rebuilt as at power-on (the receivers forget their last frame)
+    const engine::HandlerId restart = kernel.add_handler("restart", [&](std::uint64_t node) {
+      restarts.count(engine::FaultClause::Kind::kRestart);
+      if (node == 0) {
+        sensor = Trigger(c.sigma_s, c.delta_s, static_cast<std::uint32_t>(kHorizon), 0);
+      } else if (node == 1) {
+        ctrl.restart_as(*ctrl_power_on);
+        ctrl_rx.forget();
+      } else {
+        actuator = node::PacketBuffer<double, kHorizon>(0.0);
+        act_rx.forget();
+      }
+    });
+    const std::vector<std::string> nodes = petc_node_names();
+    for (std::size_t i = 0; i < nodes.size(); ++i)
+      for (const engine::SimTime t : engine::restart_instants(fr->spec, nodes[i]))
+        if (t < end) kernel.schedule(t, engine::EventClass::kEnvironment, restart, i);
+  }
   kernel.run_until(end);
+  if (fr != nullptr) {
+    double e2 = 0;
+    for (double y : y_true) e2 += (s.opt.reference - y) * (s.opt.reference - y);
+    fr->tracking_error = std::sqrt(e2);
+    sim::RunFaultCounts& n = fr->counts;
+    n = sim::RunFaultCounts{};
+    if (faulted) {
+      engine::FaultCounters inj = restarts;
+      inj += sc_faults->counters();
+      inj += ca_faults->counters();
+      n.injected = static_cast<double>(inj.injected());
+      for (const FrameCounts& rc : {ctrl_rx.counts(), act_rx.counts()}) {
+        n.refused_non_finite += rc.refused_non_finite;
+        n.refused_out_of_range += rc.refused_out_of_range;
+        n.refused_sequence += rc.refused_sequence;
+        n.stale += rc.stale;
+      }
+      n.estimator_resets = ctrl.estimator_resets();
+    }
+  }
 
   if (tr) {
     tr->d = d;
@@ -321,27 +392,32 @@ std::vector<CaseSpec> default_cases() {
   };
 }
 
-std::vector<double> run_case(const PetcSetup& s, const CaseSpec& c, std::uint64_t seed, RunTrace* trace) {
+std::vector<std::string> petc_link_names() { return {"sc", "ca"}; }
+std::vector<std::string> petc_node_names() { return {"sensor", "controller", "actuator"}; }
+
+std::vector<double> run_case(const PetcSetup& s, const CaseSpec& c, std::uint64_t seed, RunTrace* trace,
+                             FaultRun* faults) {
+  if (faults != nullptr) engine::check_fault_targets(faults->spec, petc_link_names(), petc_node_names());
   const Law law = make_law(s);
   const Trigger trig(c.sigma_c, c.delta_c, static_cast<std::uint32_t>(kHorizon), 0);
   const double r = s.opt.reference;
   if (c.controller != ControllerKind::kNumre) {
     HoldController h(law, trig, c.controller == ControllerKind::kTts, r);
-    return simulate(s, c, seed, h, trace);
+    return simulate(s, c, seed, h, trace, faults);
   }
   switch (c.observer) {
     case ObserverKind::kAugmented: {
-      NumreController<kPlantStates, node::ModelDisturbance<double>> n(s.plant.augmented, s.opt.frozen_noise, law, {},
-                                                                      trig, r);
-      return simulate(s, c, seed, n, trace);
+      NumreController<kPlantStates, node::ModelDisturbance<double>, app::petc::HddStructure> n(
+          s.node_model.model, s.opt.frozen_noise, law, {}, trig, r);
+      return simulate(s, c, seed, n, trace, faults);
     }
     case ObserverKind::kDob: {
       NumreController<kPlantOnly, Dob> n(s.plant_only, s.opt.frozen_noise, law, make_dob(s), trig, r);
-      return simulate(s, c, seed, n, trace);
+      return simulate(s, c, seed, n, trace, faults);
     }
     case ObserverKind::kEso: {
       NumreController<kPlantOnly + 1, node::ModelDisturbance<double>> n(s.eso, s.opt.frozen_noise, law, {}, trig, r);
-      return simulate(s, c, seed, n, trace);
+      return simulate(s, c, seed, n, trace, faults);
     }
   }
   throw std::logic_error("petc: unknown observer");
@@ -355,6 +431,7 @@ PetcSetup make_setup(const PetcOptions& opt) {
   if (opt.sigma_v >= 0) s.plant.augmented.v = opt.sigma_v * opt.sigma_v;
   if (s.plant.augmented.a.rows != kPlantStates || s.plant.phi_p.rows != kPlantOnly)
     throw std::invalid_argument("petc: the study is compiled for a 10-state plant with 2 disturbance states");
+  s.node_model = block_diagonal_model(s.plant.augmented, 2, kPlantOnly);
   if (opt.steps == 0 || opt.steps > 1000000) throw std::invalid_argument("petc: --steps must lie in 1 … 1000000");
   s.mrci = brief_mrci(opt.ratio);
   if (s.mrci.fast_count != 1 || s.mrci.slow_count != 2)
@@ -377,6 +454,11 @@ PetcSetup make_setup(const PetcOptions& opt) {
   double ise2 = 0;
   for (double y : s.y_tts) ise2 += (opt.reference - y) * (opt.reference - y);
   s.ise = std::sqrt(ise2);
+  double y_peak = std::fabs(opt.reference), u_peak = 0;
+  for (double y : s.y_tts) y_peak = std::max(y_peak, std::fabs(y));
+  for (double u : t.u) u_peak = std::max(u_peak, std::fabs(u));
+  s.y_range = 10 * y_peak;
+  s.u_range = 10 * u_peak;
   return s;
 }
 

@@ -3,6 +3,11 @@
 ///        (engine DiscretePlant, 12 states), the sensor's MTM trigger, the controller node
 ///        (TTS, hold-and-catch-up, or NUMRE + cascade with one of three disturbance
 ///        estimates), zero-delay links and the actuator's packet buffer; per-run metrics.
+///
+/// Under a fault spec (FaultRun) the sample and the packet travel as frames through the
+/// links "sc" and "ca" and their engine::LinkFaults, and the controller and the actuator check
+/// them (petc_frames.hpp); nodes "sensor", "controller", "actuator" may restart (rebuilt as
+/// at power-on). Without one (or with an empty spec) the run is the clean run, bit for bit.
 #pragma once
 
 #include <cstddef>
@@ -10,8 +15,11 @@
 #include <string>
 #include <vector>
 
+#include "oneshot/engine/fault_spec.hpp"
 #include "oneshot/node/numre_estimator.hpp"
+#include "oneshot/sim/sweep_faults.hpp"
 #include "petc_design.hpp"
+#include "petc_modal.hpp"
 
 namespace oneshot::sim::petc {
 
@@ -68,11 +76,26 @@ struct PetcSetup {
   PlantFacts plant;                 ///< Plant (with σ_w, σ_v applied to its model).
   MrciDesign mrci;                  ///< Controller split.
   DobDesign dob;                    ///< DOB substitute.
+  BlockDiagonalModel node_model;    ///< Cases 3–5 NUMRE model: the augmented one in its block-diagonal basis.
   EstimatorModel plant_only;        ///< Case 6 NUMRE model.
   EstimatorModel eso;               ///< Case 6′ NUMRE model.
   std::vector<double> var_d;        ///< E[d_k²], k = 0 … K.
   std::vector<double> y_tts;        ///< Case 1's noise-free output (ISE, ISEP reference).
   double ise = 0;                   ///< √Σ (r − y^TTS)².
+  double y_range = 0;               ///< Frame checks: |y| ≤ 10 × the peak |y| of case 1 (TTS), or of r.
+  double u_range = 0;               ///< Frame checks: |u| ≤ 10 × the peak |u| of case 1 (TTS).
+};
+
+/// The link and node names a fault spec of the study may name.
+std::vector<std::string> petc_link_names();
+/// The nodes that may restart (all three).
+std::vector<std::string> petc_node_names();
+
+/// A run under frame faults: the spec in, what happened out.
+struct FaultRun {
+  engine::FaultSpec spec;       ///< Faults (empty: the clean run, bit for bit).
+  sim::RunFaultCounts counts;   ///< Out: injected, refused by cause, stale, estimator resets (ratio_to_clean unset).
+  double tracking_error = 0;    ///< Out: √Σ_k (r − y_k)² of the true output (also for a clean run).
 };
 
 /// Designs everything; std::invalid_argument naming what does not fit the compiled sizes.
@@ -90,6 +113,8 @@ struct RunTrace {
 const std::vector<std::string>& metric_names();
 
 /// One run of `c` with `seed`; one value per metric_names() entry.
-std::vector<double> run_case(const PetcSetup& setup, const CaseSpec& c, std::uint64_t seed, RunTrace* trace = nullptr);
+/// `faults` (optional): the run's frame faults and their counters.
+std::vector<double> run_case(const PetcSetup& setup, const CaseSpec& c, std::uint64_t seed, RunTrace* trace = nullptr,
+                             FaultRun* faults = nullptr);
 
 }  // namespace oneshot::sim::petc

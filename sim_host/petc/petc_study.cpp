@@ -5,6 +5,7 @@
 #include <memory>
 #include <sstream>
 
+#include "oneshot/engine/frame_faults.hpp"
 #include "oneshot/engine/sweep_registry.hpp"
 #include "oneshot/sim/cli_commands.hpp"
 #include "oneshot/util/output_files.hpp"
@@ -27,6 +28,7 @@ struct Cli {
   std::size_t grid = 7;
   std::uint64_t seed = 1;
   bool no_plots = false;
+  std::string inject;
   ExectimeOptions exectime;
 };
 
@@ -142,11 +144,17 @@ void register_petc_study(CLI::App& app) {
 
   CLI::App* table = study->add_subcommand("table", "cases 1-6 and 6' over seeds: U_c, U_a, C_c, N_E with 95 % intervals and counts");
   add_sweep_options(table, *cli);
+  table->add_option("--inject", cli->inject,
+                    "frame faults on links sc/ca and restarts of nodes sensor/controller/actuator in every run, e.g. "
+                    "'nan:link=sc,rate=0.02; restart:node=controller,at_s=0.004' (docs/faults.md)");
   table->callback([cli] {
     cli->sweep.plots = !cli->no_plots;
+    cli->sweep.faults = engine::parse_fault_spec(cli->inject);
+    engine::check_fault_targets(cli->sweep.faults, petc_link_names(), petc_node_names());
     cli->sweep.shard = engine::parse_shard(cli->shard);
     const nlohmann::json j = run_table(make_setup(cli->design), cli->sweep);
     if (cli->json != "-" && cli->sweep.shard.whole()) std::cout << table_markdown(j);
+    if (cli->json != "-" && j.contains("markdown_faults")) std::cout << "\n" << j.at("markdown_faults").get<std::string>();
     emit(*cli, j);
   });
 

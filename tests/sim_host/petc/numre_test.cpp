@@ -145,7 +145,10 @@ TEST(NumreClosedLoop, MultiplicityOneEqualsStandardKalman) {
   ASSERT_EQ(t.x_hat.size(), o.steps);
   EXPECT_EQ(v[5], static_cast<double>(o.steps));  // every sample sent
   for (std::size_t k = 1; k < t.multiplicity.size(); ++k) ASSERT_EQ(t.multiplicity[k], 1U) << k;
+  // The node runs in the block-diagonal basis z = T⁻¹x (petc_modal.hpp): x̂ = T ẑ against
+  // the standard Kalman filter on the augmented model.
   const EstimatorModel& e = s.plant.augmented;
+  const Mat tm = eig(s.node_model.t);
   const Mat a = eig(e.a), b = eig(e.b), bw = eig(e.b_w), cm = eig(e.c);
   const Mat q = bw * e.w * bw.transpose();
   Vec x = Vec::Zero(12);
@@ -159,12 +162,13 @@ TEST(NumreClosedLoop, MultiplicityOneEqualsStandardKalman) {
     const Joseph j = joseph(x, p, cm, e.v, t.y_meas[k]);
     x = j.x;
     p = j.p;
-    Vec got(12);
-    for (std::size_t i = 0; i < 12; ++i) got(ix(i)) = t.x_hat[k][i];
+    Vec z(12);
+    for (std::size_t i = 0; i < 12; ++i) z(ix(i)) = t.x_hat[k][i];
+    const Vec got = tm * z;
     worst = std::max(worst, (got - x).cwiseAbs().maxCoeff() / std::max(1e-300, x.cwiseAbs().maxCoeff()));
   }
   RecordProperty("worst_rel_err", sci(worst));
-  EXPECT_LT(worst, 1e-12);
+  EXPECT_LT(worst, 5e-13);  // measured 1.2e-13 (node in the block-diagonal basis, mapped back)
 }
 
 }  // namespace

@@ -36,19 +36,21 @@ inline constexpr std::size_t kHorizon = 200;  ///< H: packets of H + 1 inputs (t
 /// The MRCI law of the brief: 1 fast and 2 slow first-order modes.
 template <typename S>
 using Law = node::InterlacedController<S, 1, 2>;
-/// Nonzero structure of the augmented HDD model as the design realizes it
-/// (lut_gen/plants/hdd_numre.json: 2nd-order sections as [position, velocity/ω], notches in
-/// series at the input, the disturbance entering through column 11; 56 of A's 144 entries,
-/// 72 in the closure of its powers). kPetcReset refuses a model outside it (Node::fits).
+/// Nonzero structure of the augmented HDD model in the basis the design gives the node
+/// (sim_host/petc/petc_modal.hpp: the plant's ten states block-diagonalized, z_p = T_p⁻¹x_p,
+/// the disturbance states kept): A' = the plant's five 2 × 2 sections, their coupling column
+/// 11 from the disturbance, and the disturbance block; 32 of A's 144 entries, 44 in the
+/// closure of its powers. B' in the plant rows but row 1, C' over seven states, C̄' the
+/// disturbance output state. kPetcReset refuses a model outside it (Node::fits).
 struct HddStructure {
   /// Row masks of A (bit j: A_ij may be nonzero).
-  static constexpr std::uint32_t kRows[kStates] = {0x803, 0x001, 0x80F, 0x004, 0x833, 0x833,
-                                                   0x8F3, 0x8F3, 0xBF3, 0xBF3, 0xC00, 0xC00};
+  static constexpr std::uint32_t kRows[kStates] = {0x803, 0x001, 0x80C, 0x804, 0x830, 0x830,
+                                                   0x8C0, 0x8C0, 0xB00, 0xB00, 0xC00, 0xC00};
   /// Row mask i of A.
   static constexpr std::uint32_t row(std::size_t i) { return kRows[i]; }
-  static constexpr std::uint32_t kB = 0x3F5;     ///< B: plant and notch rows.
-  static constexpr std::uint32_t kC = 0x100;     ///< C: the position state.
-  static constexpr std::uint32_t kCbar = 0x800;  ///< C̄: the disturbance output state.
+  static constexpr std::uint32_t kB = 0x3FD;     ///< B': plant rows but row 1.
+  static constexpr std::uint32_t kC = 0x1F3;     ///< C': the sections the output sees (not notch 2's, nor 9).
+  static constexpr std::uint32_t kCbar = 0x800;  ///< C̄': the disturbance output state.
 };
 
 /// The node of cases 3–5: NUMRE on the augmented model, d̂ = C̄ x̂, the HDD structure.

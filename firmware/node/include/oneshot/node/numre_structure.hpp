@@ -107,16 +107,21 @@ constexpr std::uint64_t masked_product(const Matrix<S, N, N>& a, const Vector<S,
   return structure_size<Structure, N>();
 }
 
-/// x ← A x + B u over Structure's rows and kB, unrolled; returns the multiply-adds.
+/// y = A x + B u over Structure's rows and kB, unrolled, each row summed as (Σ_j A_ij x_j) + B_i u
+/// (y must not alias x); returns the multiply-adds.
 template <typename Structure, typename S, std::size_t N>
-constexpr std::uint64_t masked_step(const Matrix<S, N, N>& a, const Vector<S, N>& b, Vector<S, N>& x, S u) {
-  Vector<S, N> y;
-  static_cast<void>(masked_product<Structure>(a, x, y));
+constexpr std::uint64_t masked_step(const Matrix<S, N, N>& a, const Vector<S, N>& b, const Vector<S, N>& x, S u,
+                                    Vector<S, N>& y) {
   Unrolled<0, N>::run([&](auto ic) {
     constexpr std::size_t i = decltype(ic)::value;
-    if constexpr (((Structure::kB >> i) & 1U) != 0) y[i] = y[i] + b[i] * u;
+    S acc = S(0);
+    Unrolled<0, N>::run([&](auto jc) {
+      constexpr std::size_t j = decltype(jc)::value;
+      if constexpr (((Structure::row(i) >> j) & 1U) != 0) acc = acc + a(i, j) * x[j];
+    });
+    if constexpr (((Structure::kB >> i) & 1U) != 0) acc = acc + b[i] * u;
+    y[i] = acc;
   });
-  x = y;
   return structure_size<Structure, N>() + mask_count(Structure::kB);
 }
 
