@@ -1,6 +1,6 @@
 # Fails when a C, C++ or CMake source of the project starts a program through a shell (the
 # C library's pipe-open or command-string call, or the shell's own path). Programs are
-# spawned with an argument vector (hal/host_sim's child_process.hpp; tests/support/
+# spawned with an argument vector (host_util's child_process.hpp; tests/support/
 # run_command.hpp in tests; execute_process and add_custom_command in CMake).
 # The pattern is written with bracket classes so that this file does not match itself.
 # Usage: cmake -DSOURCE_DIR=<project> -P no_shell.cmake

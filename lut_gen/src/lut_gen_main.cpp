@@ -13,8 +13,8 @@
 #include "oneshot/design/plant_description.hpp"
 #include "oneshot/design/structure_analysis.hpp"
 #include "oneshot/design/table_builder.hpp"
-#include "oneshot/host/file_io.hpp"
-#include "oneshot/host/strict_json.hpp"
+#include "oneshot/util/file_io.hpp"
+#include "oneshot/util/strict_json.hpp"
 
 namespace {
 
@@ -44,7 +44,7 @@ nlohmann::json table_json(const oneshot::design::TableData<S>& t, const oneshot:
 }
 
 /// Atomic, checked write (temporary file, fsync, rename): the build never sees half a header.
-void write_file(const std::string& path, const std::string& text) { oneshot::host::write_file_atomic(path, text); }
+void write_file(const std::string& path, const std::string& text) { oneshot::util::write_file_atomic(path, text); }
 
 }  // namespace
 
@@ -134,7 +134,7 @@ int main(int argc, char** argv) {
     }
     report["formats"]["fixed"] = fixed;
     report["design"] = d::design_json(plant, design);
-    write_file(report_path, oneshot::host::dump_finite(report) + "\n");
+    write_file(report_path, oneshot::util::dump_finite(report) + "\n");
     std::cout << "lut_gen: " << plant.name << ": float table " << table_f.bytes() << " bytes (" << table_f.radix.size()
               << " levels, " << table_f.entry_time_us.size() << " entries x " << static_cast<int>(table_f.slots)
               << " slots), max abs error " << acc_f.max_abs_error;

@@ -12,7 +12,7 @@
 #include "lambda_c.hpp"
 #include "oneshot/engine/sweep_registry.hpp"
 #include "oneshot/sim/cli_commands.hpp"
-#include "oneshot/sim/output_files.hpp"
+#include "oneshot/util/output_files.hpp"
 #include "oneshot/sim/study_report.hpp"
 #include "study_format.hpp"
 
@@ -63,7 +63,7 @@ StudyOptions resolve(const DroppingCli& c) {
 }
 
 void emit(const DroppingCli& c, const nlohmann::json& j, double wall) {
-  if (!c.json.empty()) write_json(c.json, j);
+  if (!c.json.empty()) util::write_json(c.json, j);
   if (c.json != "-") {
     if (j.contains("markdown")) std::cout << j.at("markdown").get<std::string>();
     if (j.contains("markdown_faults")) std::cout << "\n" << j.at("markdown_faults").get<std::string>();
@@ -101,7 +101,7 @@ void register_dropping_study(CLI::App& app) {
       nlohmann::json j = dropping::lambda_c_report(plant, *lc);
       j["experiment"] = "lambda-c";
       if (c->json != "-") std::cout << j.dump(2) << "\n";
-      if (!c->json.empty()) write_json(c->json, j);
+      if (!c->json.empty()) util::write_json(c->json, j);
       std::cerr << "wall time " << seconds_since(t0) << " s\n";
     });
   }
@@ -187,11 +187,11 @@ void register_dropping_study(CLI::App& app) {
         r.bernoulli_lambda = *lambda;
       }
       const dropping::RunMetrics m = dropping::run_closed_loop(plant, r, o.seed);
-      make_directory(o.out_dir);
+      util::make_directory(o.out_dir);
       std::vector<std::vector<double>> rows;
       for (std::size_t k = 0; k < m.trace.y.size(); ++k)
         rows.push_back({static_cast<double>(k), m.trace.y[k], m.trace.cx[k], m.trace.cxhat[k], m.trace.trace_p[k], m.trace.err[k]});
-      write_csv(o.out_dir + "/run_trace.csv", {"k", "y", "Cx", "Cxhat", "trace_p", "err"}, rows, NonFinite::kMissing);
+      util::write_csv(o.out_dir + "/run_trace.csv", {"k", "y", "Cx", "Cxhat", "trace_p", "err"}, rows, util::NonFinite::kMissing);
       const nlohmann::json j = {{"experiment", "run"}, {"err", dropping::num(m.err)}, {"err_anchor", dropping::num(m.err_anchor)},
                                 {"trace_p", dropping::num(m.trace_p)}, {"trace_p_anchor", dropping::num(m.trace_p_anchor)},
                                 {"gamma", dropping::num(m.gamma)}, {"cost", dropping::num(m.cost)},
@@ -199,7 +199,7 @@ void register_dropping_study(CLI::App& app) {
                                 {"duplicates", m.duplicates}, {"reordered", m.reordered}, {"failed", m.failed},
                                 {"D", r.mean_delay_periods}, {"files", {"run_trace.csv"}}};
       if (c->json != "-") std::cout << j.dump(2) << std::endl;
-      if (!c->json.empty()) write_json(c->json, j);
+      if (!c->json.empty()) util::write_json(c->json, j);
     });
   }
   engine::register_summarizer("dropping", "arrival", [](const engine::SweepResults& r, const std::string& out, bool plots) {

@@ -16,7 +16,7 @@
 #include "oneshot/node/buffered_kalman.hpp"
 #include "oneshot/number_format.hpp"
 #include "oneshot/plant_structure.hpp"
-#include "oneshot/sim/output_files.hpp"
+#include "oneshot/util/output_files.hpp"
 #include "study_format.hpp"
 
 namespace oneshot::dropping {
@@ -26,10 +26,10 @@ std::string path_in(const std::string& dir, const std::string& name) { return (s
 
 nlohmann::json finish(const engine::SweepResults& r, const StudyOptions& opt, const std::string& experiment,
                       nlohmann::json (*outputs)(const engine::SweepResults&, const std::string&, bool)) {
-  sim::make_directory(opt.out_dir);
+  util::make_directory(opt.out_dir);
   if (!opt.shard.whole()) {
     nlohmann::json j = engine::shard_to_json(r);
-    sim::write_json(path_in(opt.out_dir, engine::shard_file_name(experiment, opt.shard)), j);
+    util::write_json(path_in(opt.out_dir, engine::shard_file_name(experiment, opt.shard)), j);
     return j;
   }
   return outputs(r, opt.out_dir, opt.plots);
@@ -101,7 +101,7 @@ nlohmann::json run_arrival(const StudyOptions& opt) {
 }
 
 nlohmann::json arrival_outputs(const engine::SweepResults& r, const std::string& out_dir, bool plots) {
-  sim::make_directory(out_dir);
+  util::make_directory(out_dir);
   const nlohmann::json& cfg = r.spec.config;
   const double loss = cfg.at("loss").get<double>();
   const engine::SweepSummary sm = engine::summarize_metric(r, 0, 0);
@@ -115,7 +115,7 @@ nlohmann::json arrival_outputs(const engine::SweepResults& r, const std::string&
     const double d = c.at("D").get<double>();
     const int t = c.at("T_hold").get<int>();
     const double lam = arrival_probability(t, d, loss);
-    const sim::Summary& v = sm.per_scenario[0][s];
+    const util::Summary& v = sm.per_scenario[0][s];
     const bool in = std::fabs(v.mean - lam) <= v.ci95;
     inside += in ? 1 : 0;
     rows.push_back({{"D", d}, {"T_hold", t}, {"lambda", lam}, {"simulated", v.mean}, {"ci95", v.ci95}, {"inside_ci", in}});
@@ -133,13 +133,13 @@ nlohmann::json arrival_outputs(const engine::SweepResults& r, const std::string&
   j["inside_ci"] = inside;
   j["cells"] = r.spec.scenarios.size();
   j["markdown"] = md.str();
-  sim::write_csv(path_in(out_dir, "arrival.csv"), {"D", "T_hold", "lambda", "simulated", "ci95"}, csv);
+  util::write_csv(path_in(out_dir, "arrival.csv"), {"D", "T_hold", "lambda", "simulated", "ci95"}, csv);
   // Poisson pmf with the loss factor (Fig 2a).
   std::vector<std::vector<double>> pmf;
   for (int t = 0; t <= 10; ++t)
     pmf.push_back({static_cast<double>(t), (1 - loss) * poisson_pmf(t, 0.5), (1 - loss) * poisson_pmf(t, 1),
                    (1 - loss) * poisson_pmf(t, 2), (1 - loss) * poisson_pmf(t, 3)});
-  sim::write_csv(path_in(out_dir, "arrival_pmf.csv"), {"t", "D0.5", "D1", "D2", "D3"}, pmf);
+  util::write_csv(path_in(out_dir, "arrival_pmf.csv"), {"t", "D0.5", "D1", "D2", "D3"}, pmf);
   if (plots) {
     std::ostringstream g;
     g << "set terminal pngcairo size 1200,500 font 'Sans,11' noenhanced\nset output 'arrival.png'\n"
@@ -152,7 +152,7 @@ nlohmann::json arrival_outputs(const engine::SweepResults& r, const std::string&
          "plot for [i=0:3] 'arrival.csv' skip 1 every ::(8*i)::(8*i+7) using 2:3 with lines lw 2 title sprintf('D = %s', word('0.5 1 2 3', i+1)), "
          "for [i=0:3] 'arrival.csv' skip 1 every ::(8*i)::(8*i+7) using 2:4:5 with yerrorbars pt 7 ps 0.6 lc rgb 'black' notitle\n"
          "unset multiplot\n";
-    sim::run_gnuplot(out_dir, "arrival.gp", g.str());
+    util::run_gnuplot(out_dir, "arrival.gp", g.str());
   }
   j["files"] = {"arrival.csv", "arrival_pmf.csv", "arrival.png"};
   return j;
@@ -213,8 +213,8 @@ nlohmann::json run_closed_loop_experiment(const DroppingPlant& plant, const Stud
         rows.push_back({static_cast<double>(s), static_cast<double>(k) * plant.plant.period_us * 1e-6, m.trace.y[k],
                         m.trace.cx[k], m.trace.cxhat[k], m.trace.trace_p[k], m.trace.err[k]});
     }
-    sim::write_csv(path_in(opt.out_dir, "closed_loop_trace.csv"), {"scenario", "t_s", "y", "Cx", "Cxhat", "trace_p", "err"},
-                   rows, sim::NonFinite::kMissing);
+    util::write_csv(path_in(opt.out_dir, "closed_loop_trace.csv"), {"scenario", "t_s", "y", "Cx", "Cxhat", "trace_p", "err"},
+                   rows, util::NonFinite::kMissing);
     if (opt.plots) {
       std::ostringstream g;
       g << "set terminal pngcairo size 1200," << 300 * lambdas.size() << " font 'Sans,10' noenhanced\n"
@@ -228,7 +228,7 @@ nlohmann::json run_closed_loop_experiment(const DroppingPlant& plant, const Stud
           << " using 2:4 with lines lc rgb '#1f77b4' title 'C x', '' skip 1 every ::" << s * opt.steps
           << "::" << (s + 1) * opt.steps - 1 << " using 2:5 with lines lc rgb '#d62728' title 'C xhat'\n";
       g << "unset multiplot\n";
-      sim::run_gnuplot(opt.out_dir, "closed_loop_trace.gp", g.str());
+      util::run_gnuplot(opt.out_dir, "closed_loop_trace.gp", g.str());
     }
     j["files"].push_back("closed_loop_trace.csv");
     j["files"].push_back("closed_loop_trace.png");
@@ -237,7 +237,7 @@ nlohmann::json run_closed_loop_experiment(const DroppingPlant& plant, const Stud
 }
 
 nlohmann::json closed_loop_outputs(const engine::SweepResults& r, const std::string& out_dir, bool plots) {
-  sim::make_directory(out_dir);
+  util::make_directory(out_dir);
   const nlohmann::json& cfg = r.spec.config;
   const std::size_t na = r.spec.approaches.size(), ns = r.spec.scenarios.size();
   const std::vector<std::string> shown{"err", "err_anchor", "trace_p", "trace_p_anchor", "gamma", "cost"};
@@ -269,7 +269,7 @@ nlohmann::json closed_loop_outputs(const engine::SweepResults& r, const std::str
         diff[k] = e[k] - ref[k];
       }
       const engine::TailSummary tr = engine::tail_summary(ratio);
-      const sim::Summary dd = sim::summarize(diff);
+      const util::Summary dd = util::summarize(diff);
       ja["paired_err_ratio_to_buffered"] = tail_json(tr);
       // Null where the differences overflow (a diverging baseline): the median ratio beside it stays defined.
       ja["paired_err_difference_to_buffered"] = {{"mean", num(dd.mean)}, {"ci95", num(dd.ci95)}};
@@ -320,11 +320,11 @@ nlohmann::json closed_loop_outputs(const engine::SweepResults& r, const std::str
   j["markdown_e5"] = m5.str();
   j["markdown"] = md.str();
   if (cfg.contains("inject")) j["markdown_faults"] = sim::fault_markdown(r);
-  sim::write_csv(path_in(out_dir, "closed_loop.csv"),
+  util::write_csv(path_in(out_dir, "closed_loop.csv"),
                  {"lambda", "approach", "err_median", "err_p10", "err_p90", "err_mean", "err_ci95", "trp_median", "trp_p10",
                   "trp_p90", "trp_mean", "trp_ci95"},
-                 csv, sim::NonFinite::kMissing);
-  engine::write_runs_csv(r, path_in(out_dir, "closed_loop_runs.csv"), sim::NonFinite::kMissing);
+                 csv, util::NonFinite::kMissing);
+  engine::write_runs_csv(r, path_in(out_dir, "closed_loop_runs.csv"), util::NonFinite::kMissing);
   if (plots) {
     std::ostringstream g;
     g << "set terminal pngcairo size 1200,500 font 'Sans,11' noenhanced\nset output 'closed_loop.png'\n"
@@ -336,7 +336,7 @@ nlohmann::json closed_loop_outputs(const engine::SweepResults& r, const std::str
          "set title 'time-mean tr P_k: median and 10-90 % band'\n"
          "plot for [a=0:" << na - 1 << "] 'closed_loop.csv' skip 1 using ($1+0.004*a):($2==a?$8:1/0):9:10 with yerrorlines "
          "title word('buffered buffered-bernoulli unaware-R0.05 unaware-R2.5', a+1)\nunset multiplot\n";
-    sim::run_gnuplot(out_dir, "closed_loop.gp", g.str());
+    util::run_gnuplot(out_dir, "closed_loop.gp", g.str());
   }
   j["files"] = {"closed_loop.csv", "closed_loop_runs.csv", "closed_loop.png"};
   return j;
@@ -399,7 +399,7 @@ nlohmann::json run_hold(const DroppingPlant& plant, const StudyOptions& opt, int
 }
 
 nlohmann::json hold_outputs(const engine::SweepResults& r, const std::string& out_dir, bool plots) {
-  sim::make_directory(out_dir);
+  util::make_directory(out_dir);
   const nlohmann::json& cfg = r.spec.config;
   nlohmann::json j;
   j["experiment"] = "hold";
@@ -435,11 +435,11 @@ nlohmann::json hold_outputs(const engine::SweepResults& r, const std::string& ou
   }
   j["markdown"] = md.str();
   if (cfg.contains("inject")) j["markdown_faults"] = sim::fault_markdown(r);
-  sim::write_csv(path_in(out_dir, "hold.csv"),
+  util::write_csv(path_in(out_dir, "hold.csv"),
                  {"D", "T_hold", "err_median", "err_p10", "err_p90", "anchor_median", "anchor_p10", "anchor_p90",
                   "corrections"},
-                 csv, sim::NonFinite::kMissing);
-  engine::write_runs_csv(r, path_in(out_dir, "hold_runs.csv"), sim::NonFinite::kMissing);
+                 csv, util::NonFinite::kMissing);
+  engine::write_runs_csv(r, path_in(out_dir, "hold_runs.csv"), util::NonFinite::kMissing);
   if (plots) {
     std::ostringstream g;
     g << "set terminal pngcairo size 1000,550 font 'Sans,11' noenhanced\nset output 'hold.png'\n"
@@ -450,7 +450,7 @@ nlohmann::json hold_outputs(const engine::SweepResults& r, const std::string& ou
          "'' skip 1 using ($1==2?$2+0.05:1/0):3:4:5 with yerrorlines lw 2 title 'current, D = 2', "
          "'' skip 1 using ($1==1?$2+0.1:1/0):6:7:8 with yerrorlines dt 2 title 'anchor, D = 1', "
          "'' skip 1 using ($1==2?$2+0.15:1/0):6:7:8 with yerrorlines dt 2 title 'anchor, D = 2'\n";
-    sim::run_gnuplot(out_dir, "hold.gp", g.str());
+    util::run_gnuplot(out_dir, "hold.gp", g.str());
   }
   j["files"] = {"hold.csv", "hold_runs.csv", "hold.png"};
   return j;

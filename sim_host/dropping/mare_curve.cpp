@@ -8,14 +8,14 @@
 #include <sstream>
 
 #include "experiments.hpp"
-#include "oneshot/sim/output_files.hpp"
-#include "oneshot/sim/parallel.hpp"
+#include "oneshot/util/output_files.hpp"
+#include "oneshot/util/parallel.hpp"
 #include "study_format.hpp"
 
 namespace oneshot::dropping {
 
 nlohmann::json run_mare_curve(const DroppingPlant& plant, const StudyOptions& opt, const LambdaCOptions& lc) {
-  sim::make_directory(opt.out_dir);
+  util::make_directory(opt.out_dir);
   const MareModel<kN, kP> m = plant.mare();
   const LambdaCBracket b = lambda_c_bisection(m, plant.lambda_sys, lc.bracket_width, lc.mare);
   if (!b.hi_converges) throw std::runtime_error("the MARE diverges at lambda = 1: no curve to draw");
@@ -36,7 +36,7 @@ nlohmann::json run_mare_curve(const DroppingPlant& plant, const StudyOptions& op
     Certificate c;
   };
   std::vector<Point> pts(lambdas.size());
-  sim::parallel_for(lambdas.size(), sim::worker_count(opt.threads), nullptr, [&](std::size_t i) {
+  util::parallel_for(lambdas.size(), util::worker_count(opt.threads), nullptr, [&](std::size_t i) {
     Matrix<double, kN, kN> p;
     pts[i].o = mare_fixed_point(m, lambdas[i], p, lc.mare);
     pts[i].k = pts[i].o.converged ? mare_gain(m, p) : Matrix<double, kN, kP>{} * std::numeric_limits<double>::quiet_NaN();
@@ -63,7 +63,7 @@ nlohmann::json run_mare_curve(const DroppingPlant& plant, const StudyOptions& op
                     {"certificate_reason", p.c.reason}});
   }
   const std::string dir = opt.out_dir;
-  sim::write_csv((std::filesystem::path(dir) / "mare_curve.csv").string(),
+  util::write_csv((std::filesystem::path(dir) / "mare_curve.csv").string(),
                  {"lambda", "converged", "trace_p", "iterations", "K1", "K2", "K3", "certified", "trace_times_distance"}, csv);
   if (opt.plots) {
     std::ostringstream g;
@@ -78,13 +78,13 @@ nlohmann::json run_mare_curve(const DroppingPlant& plant, const StudyOptions& op
          "plot 'mare_curve.csv' skip 1 using 1:3 with linespoints pt 7 ps 0.4 title 'MARE fixed point', "
          "'' skip 1 using 1:($8==1?$3:1/0) with points pt 6 ps 1.2 lc rgb 'dark-green' title 'LMI certificate holds'\n"
          "set title 'zoom [0.34, 0.42]'\nset xrange [0.34:0.42]\nreplot\nunset multiplot\n";
-    sim::run_gnuplot(dir, "mare_curve.gp", g.str());
+    util::run_gnuplot(dir, "mare_curve.gp", g.str());
     std::ostringstream k;
     k << "set terminal pngcairo size 900,500 font 'Sans,11' noenhanced\nset output 'mare_gain.png'\n"
          "set datafile separator ','\nset datafile missing 'nan'\nset grid\nset xlabel 'lambda'\nset ylabel 'Kbar'\n"
          "set title 'E3: Kbar(lambda) = M C^T (C M C^T + R)^-1 at the MARE fixed point'\nset xrange ["
       << b.hi << ":1]\nplot for [c=5:7] 'mare_curve.csv' skip 1 using 1:c with lines lw 2 title columnhead(c)\n";
-    sim::run_gnuplot(dir, "mare_gain.gp", k.str());
+    util::run_gnuplot(dir, "mare_gain.gp", k.str());
   }
   nlohmann::json j;
   j["experiment"] = "mare";

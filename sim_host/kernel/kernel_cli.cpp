@@ -10,7 +10,7 @@
 #include "oneshot/engine/cpu.hpp"
 #include "oneshot/engine/cpu_analysis.hpp"
 #include "oneshot/sim/cli_commands.hpp"
-#include "oneshot/sim/output_files.hpp"
+#include "oneshot/util/output_files.hpp"
 #include "kernel_gantt.hpp"
 
 namespace oneshot::sim {
@@ -80,7 +80,7 @@ nlohmann::json kernel_simulate(const TaskSet& set, double duration_s, std::uint6
     for (const CpuLogEntry& e : cpu.log()) {
       o << static_cast<double>(e.t_ns) * 1e-3 << "," << cpu.entity_name(e.entity) << "," << e.job << "," << to_string(e.kind) << "\n";
     }
-    write_text(out.log_path, o.str());
+    util::write_text(out.log_path, o.str());
     j["log"] = {{"file", out.log_path}, {"entries", cpu.log().size()}, {"dropped", cpu.log_dropped()}};
   }
   if (!out.out_dir.empty()) j["gantt"] = write_gantt(cpu, hyper, out.out_dir, out.plots);
@@ -99,7 +99,7 @@ void register_kernel_study(CLI::App& app) {
     const TaskSet set = load_task_set(c->tasks);
     const Analysis a = analyze(set);
     const nlohmann::json j = analysis_json(set, a);
-    if (!c->json.empty()) write_json(c->json, j);
+    if (!c->json.empty()) util::write_json(c->json, j);
     if (c->json != "-") {
       std::cout << (a.schedulable ? "schedulable" : "NOT schedulable: " + a.first_miss + " (" + a.reason + ")")
                 << ", U = " << a.utilization << "\n";
@@ -127,7 +127,7 @@ void register_kernel_study(CLI::App& app) {
     double wall = 0;
     const nlohmann::json j =
         kernel_simulate(set, c->duration_s, c->seed, KernelOutputs{c->out_dir, c->log_path, !c->no_plots}, &wall);
-    if (!c->json.empty()) write_json(c->json, j);
+    if (!c->json.empty()) util::write_json(c->json, j);
     if (c->json != "-") {
       for (const auto& t : j["tasks"]) {
         std::cout << "  " << t["name"].get<std::string>() << ": response " << t["response_min_us"] << " .. "

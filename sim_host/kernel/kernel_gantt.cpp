@@ -6,7 +6,7 @@
 #include <numeric>
 #include <sstream>
 
-#include "oneshot/sim/output_files.hpp"
+#include "oneshot/util/output_files.hpp"
 
 namespace oneshot::sim {
 
@@ -48,8 +48,8 @@ nlohmann::json write_gantt(const Cpu& cpu, engine::Duration span, const std::str
   }
   std::vector<std::vector<double>> rows;
   for (const Segment& s : segs) rows.push_back({static_cast<double>(s.row), s.from_ms, s.to_ms});
-  make_directory(dir);
-  write_csv(dir + "/gantt.csv", {"row", "start_ms", "end_ms"}, rows);
+  util::make_directory(dir);
+  util::write_csv(dir + "/gantt.csv", {"row", "start_ms", "end_ms"}, rows);
   nlohmann::json j = {{"span_us", static_cast<double>(span.count()) * 1e-3}, {"segments", segs.size()},
                       {"files", {"gantt.csv"}}};
   if (plots) {
@@ -57,11 +57,11 @@ nlohmann::json write_gantt(const Cpu& cpu, engine::Duration span, const std::str
     g << "set terminal pngcairo size 1200," << 160 + 40 * cpu.entities() << " font 'Sans,10' noenhanced\n"
       << "set output 'gantt.png'\nset datafile separator ','\nset xlabel 'time (ms)'\nset grid xtics\n"
       << "set yrange [-0.7:" << static_cast<double>(cpu.entities()) - 0.3 << "]\nset xrange [0:" << end_ms << "]\n"
-      << "set title " << gnuplot_quote("first hyperperiod (at most 1 s): " + std::to_string(span.count() / 1000) + " us") << "\nset ytics (";
-    for (std::size_t r = 0; r < cpu.entities(); ++r) g << (r ? ", " : "") << gnuplot_quote(cpu.entity_name(r)) << " " << r;
+      << "set title " << util::gnuplot_quote("first hyperperiod (at most 1 s): " + std::to_string(span.count() / 1000) + " us") << "\nset ytics (";
+    for (std::size_t r = 0; r < cpu.entities(); ++r) g << (r ? ", " : "") << util::gnuplot_quote(cpu.entity_name(r)) << " " << r;
     g << ")\nset style fill solid 0.8\nunset key\n"
       << "plot 'gantt.csv' skip 1 using (($2+$3)/2):1:(($3-$2)/2):(0.35):1 with boxxyerror lc variable\n";
-    run_gnuplot(dir, "gantt.gp", g.str());
+    util::run_gnuplot(dir, "gantt.gp", g.str());
     j["files"].push_back("gantt.png");
   }
   return j;

@@ -14,8 +14,8 @@
 #include "ncs_loop.hpp"
 #include "oneshot/engine/sweep.hpp"
 #include "oneshot/sim/cli_commands.hpp"
-#include "oneshot/sim/output_files.hpp"
-#include "oneshot/sim/statistics.hpp"
+#include "oneshot/util/output_files.hpp"
+#include "oneshot/util/statistics.hpp"
 
 namespace oneshot::ncs {
 namespace {
@@ -92,7 +92,7 @@ nlohmann::json fault_table(const Context& ctx, const FaultTableOptions& o) {
   j["first_seed"] = o.first_seed;
   std::vector<double> clean;
   for (std::size_t k = 0; k < o.seeds; ++k) clean.push_back(r.at(0, 0, k, 0));
-  const sim::Summary cs = sim::summarize(clean);
+  const util::Summary cs = util::summarize(clean);
   j["clean_cost"] = {{"mean", cs.mean}, {"ci95", cs.ci95}};
   std::ostringstream md;
   md << "Approach " << name(o.approach) << ", scenario " << o.scenario.name << " (" << describe(o.scenario) << "), "
@@ -115,7 +115,7 @@ nlohmann::json fault_table(const Context& ctx, const FaultTableOptions& o) {
         if (ratio.back() > 3) ++lost;
       }
     }
-    const sim::Summary rs = sim::summarize(ratio);
+    const util::Summary rs = util::summarize(ratio);
     nlohmann::json e = {{"name", cases[c].name}, {"node", cases[c].node}, {"spec", cases[c].spec},
                         {"non_finite_runs", non_finite}, {"injected_per_run", mean_of(a, 1)}};
     e["cost_ratio"] = nullptr;
@@ -172,7 +172,7 @@ nlohmann::json fault_table(const Context& ctx, const FaultTableOptions& o) {
   }
   j["markdown"] = md.str();
   if (!o.out_dir.empty()) {
-    sim::make_directory(o.out_dir);
+    util::make_directory(o.out_dir);
     std::ofstream((std::filesystem::path(o.out_dir) / "faults.md").string()) << md.str();
   }
   return j;
@@ -228,7 +228,7 @@ void add_ncs_faults_command(CLI::App* study) {
     const auto ctx = ncs::Context::load(*plant);
     const nlohmann::json j = ncs::fault_table(*ctx, *o);
     if (*json != "-") std::cout << j.at("markdown").get<std::string>() << "written to " << o->out_dir << "/faults.md\n";
-    if (!json->empty()) write_json(*json, j);
+    if (!json->empty()) util::write_json(*json, j);
   });
 }
 

@@ -19,10 +19,10 @@
 #include "ncs_live_nodes.hpp"
 #include "ncs_loop.hpp"
 #include "oneshot/engine/quantiles.hpp"
-#include "oneshot/host/child_process.hpp"
+#include "oneshot/util/child_process.hpp"
 #include "oneshot/posix/udp_network.hpp"
 #include "oneshot/sim/cli_commands.hpp"
-#include "oneshot/sim/output_files.hpp"
+#include "oneshot/util/output_files.hpp"
 
 namespace oneshot::ncs {
 
@@ -243,7 +243,7 @@ nlohmann::json run_live(const LiveOptions& o) {
   }
   (void)half_wave_periods(*ctx, o.scenario);
   engine::check_fault_targets(engine::parse_fault_spec(o.inject), link_names(o.approach), node_names());
-  sim::make_directory(o.out_dir);
+  util::make_directory(o.out_dir);
   for (const char* role : {"plant", "sensor", "controller", "actuator", "relay"}) {
     std::filesystem::remove(std::filesystem::path(o.out_dir) / (std::string(role) + ".csv"));
     std::filesystem::remove(std::filesystem::path(o.out_dir) / ("counters_" + std::string(role) + ".json"));
@@ -271,23 +271,23 @@ nlohmann::json run_live(const LiveOptions& o) {
   r.controller_port = posix::bound_port(controller.fd);
   r.actuator_port = posix::bound_port(actuator.fd);
   r.t0_ns = posix::monotonic_ns() + o.startup_ms * 1'000'000;
-  sim::write_json(o.out_dir + "/run.json", to_json(r));
+  util::write_json(o.out_dir + "/run.json", to_json(r));
   struct Role {
     const char* name;
     int net, io;
   };
   const Role roles[5] = {{"plant", plant.fd, -1}, {"relay", relay.fd, -1}, {"controller", controller.fd, -1},
                          {"sensor", sensor.fd, sensor_io.fd}, {"actuator", actuator.fd, actuator_io.fd}};
-  std::vector<std::unique_ptr<host::ChildProcess>> children;
+  std::vector<std::unique_ptr<util::ChildProcess>> children;
   for (const Role& role : roles) {
-    host::ProcessSpec spec;
+    util::ProcessSpec spec;
     spec.argv = {o.executable, "ncs", "node", "--role", role.name, "--run", o.out_dir, "--net-fd", "3"};
     spec.extra_fds.emplace_back(role.net, 3);
     if (role.io >= 0) {
       spec.argv.insert(spec.argv.end(), {"--io-fd", "4"});
       spec.extra_fds.emplace_back(role.io, 4);
     }
-    children.push_back(std::make_unique<host::ChildProcess>(spec));
+    children.push_back(std::make_unique<util::ChildProcess>(spec));
   }
   // Every process ends on its own shortly after the end. A process that fails stops the run
   // at once; one still running long after the end (10 s: slow sanitizer builds) is ended.
@@ -299,7 +299,7 @@ nlohmann::json run_live(const LiveOptions& o) {
       if (ended[i] || !children[i]->wait_for(20)) continue;
       ended[i] = true;
       --left;
-      const host::ExitStatus s = children[i]->wait();
+      const util::ExitStatus s = children[i]->wait();
       if (!s.success()) failures += std::string(" ") + roles[i].name + ": " + s.describe() + ";";
     }
     if (left > 0 && posix::monotonic_ns() > end_at + 10'000'000'000) {
@@ -310,7 +310,7 @@ nlohmann::json run_live(const LiveOptions& o) {
   for (auto& c : children) c->terminate(2000);  // no-op for the ended ones
   if (!failures.empty()) throw std::runtime_error("ncs live: a process failed:" + failures);
   nlohmann::json j = analyse_live(o.out_dir);
-  sim::write_json(o.out_dir + "/summary.json", j);
+  util::write_json(o.out_dir + "/summary.json", j);
   return j;
 }
 
@@ -397,7 +397,7 @@ void add_ncs_live_commands(CLI::App* study) {
       o->executable = self_executable();
       const nlohmann::json j = ncs::run_live(*o);
       if (*json != "-") print_summary(j);
-      if (!json->empty()) write_json(*json, j);
+      if (!json->empty()) util::write_json(*json, j);
     });
   }
   {
@@ -409,7 +409,7 @@ void add_ncs_live_commands(CLI::App* study) {
     cmd->callback([dir, json]() {
       const nlohmann::json j = ncs::analyse_live(*dir);
       if (*json != "-") print_summary(j);
-      if (!json->empty()) write_json(*json, j);
+      if (!json->empty()) util::write_json(*json, j);
     });
   }
   {

@@ -14,7 +14,7 @@
 #include "ncs_live.hpp"
 #include "oneshot/engine/sweep_registry.hpp"
 #include "oneshot/sim/cli_commands.hpp"
-#include "oneshot/sim/output_files.hpp"
+#include "oneshot/util/output_files.hpp"
 #include "oneshot/sim/study_report.hpp"
 
 namespace oneshot::sim {
@@ -38,7 +38,7 @@ void add_common(CLI::App* cmd, NcsCli& c, const std::string& default_out) {
 }
 
 void emit(const NcsCli& c, const nlohmann::json& j) {
-  if (!c.json.empty()) write_json(c.json, j);
+  if (!c.json.empty()) util::write_json(c.json, j);
   if (c.json != "-") std::cout << "ncs " << j.value("experiment", std::string("result")) << ": written to " << c.out << "\n";
 }
 
@@ -139,15 +139,15 @@ void register_ncs_study(CLI::App& app) {
       }
       t->first_seed = c->seed;
       const engine::Shard part = engine::parse_shard(*shard);
-      make_directory(c->out);
+      util::make_directory(c->out);
       const auto start = std::chrono::steady_clock::now();
       const engine::SweepResults r = ncs::table_sweep(*ctx, *t, part);
       const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-      write_json((std::filesystem::path(c->out) / "timing.json").string(), {{"experiment", "ncs table"}, {"wall_time_s", wall}});
+      util::write_json((std::filesystem::path(c->out) / "timing.json").string(), {{"experiment", "ncs table"}, {"wall_time_s", wall}});
       nlohmann::json j;
       if (!part.whole()) {
         j = engine::shard_to_json(r);
-        write_json((std::filesystem::path(c->out) / engine::shard_file_name("table", part)).string(), j);
+        util::write_json((std::filesystem::path(c->out) / engine::shard_file_name("table", part)).string(), j);
       } else {
         j = ncs::table_outputs(r, c->out, !c->no_plots);
         if (c->json != "-") std::cout << j.at("markdown").get<std::string>() << "order: " << j.at("order_text").get<std::string>() << "\n";
@@ -181,10 +181,10 @@ void register_ncs_study(CLI::App& app) {
       rc.rel_dir = ".";
       rc.seed = c->seed;
       rc.plots = !c->no_plots;
-      make_directory(rc.out_dir);
+      util::make_directory(rc.out_dir);
       const StudyReportResult r = report_section(rc);
       std::ofstream((std::filesystem::path(c->out) / "ncs.md").string()) << r.markdown;
-      write_json((std::filesystem::path(c->out) / "ncs.json").string(), r.json);
+      util::write_json((std::filesystem::path(c->out) / "ncs.json").string(), r.json);
       nlohmann::json j = r.json;
       j["experiment"] = "report";
       emit(*c, j);

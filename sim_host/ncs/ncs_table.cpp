@@ -13,7 +13,7 @@
 #include "ncs_experiments.hpp"
 #include "ncs_loop.hpp"
 #include "oneshot/engine/sweep_statistics.hpp"
-#include "oneshot/sim/output_files.hpp"
+#include "oneshot/util/output_files.hpp"
 
 namespace oneshot::ncs {
 namespace {
@@ -82,7 +82,7 @@ engine::SweepResults table_sweep(const Context& ctx, const TableOptions& opt, co
 }
 
 nlohmann::json table_outputs(const engine::SweepResults& results, const std::string& out_dir, bool plots) {
-  sim::make_directory(out_dir);
+  util::make_directory(out_dir);
   const engine::SweepSpec& spec = results.spec;
   const std::size_t na = spec.approaches.size();
   const std::size_t ns = spec.scenarios.size();

@@ -8,7 +8,7 @@
 
 #include "ncs_experiments.hpp"
 #include "ncs_loop.hpp"
-#include "oneshot/sim/output_files.hpp"
+#include "oneshot/util/output_files.hpp"
 
 namespace oneshot::ncs {
 namespace {
@@ -46,7 +46,7 @@ void write_x1(const std::string& path, const std::vector<const RunResult*>& runs
     row.push_back(runs[0]->setpoint[i].v[0]);
     rows.push_back(row);
   }
-  sim::write_csv(path, header, rows);
+  util::write_csv(path, header, rows);
 }
 
 std::string x1_plot(const std::string& png, const std::string& csv, const std::string& title,
@@ -67,7 +67,7 @@ std::string x1_plot(const std::string& png, const std::string& csv, const std::s
 nlohmann::json compare(const Context& ctx, const char* experiment, const char* scenario_name, const std::vector<Approach>& approaches,
                        bool noise_free, std::uint64_t seed, double duration_s, const std::string& out_dir, bool plots,
                        const std::string& title) {
-  sim::make_directory(out_dir);
+  util::make_directory(out_dir);
   const Scenario sc = pick(scenario_name, duration_s);
   RunOptions ro;
   ro.noise_free = noise_free;
@@ -88,7 +88,7 @@ nlohmann::json compare(const Context& ctx, const char* experiment, const char* s
   j["files"] = {csv};
   if (plots) {
     const std::string png = std::string(experiment) + ".png";
-    sim::run_gnuplot(out_dir, std::string(experiment) + ".gp", x1_plot(png, csv, title, names));
+    util::run_gnuplot(out_dir, std::string(experiment) + ".gp", x1_plot(png, csv, title, names));
     j["files"].push_back(png);
   }
   return j;
@@ -97,7 +97,7 @@ nlohmann::json compare(const Context& ctx, const char* experiment, const char* s
 }  // namespace
 
 nlohmann::json run_e1(const Context& ctx, std::uint64_t seed, double duration_s, const std::string& out_dir, bool plots) {
-  sim::make_directory(out_dir);
+  util::make_directory(out_dir);
   const Scenario sc = pick("a0.2-T4-d8-s16", duration_s);
   RunOptions ro;
   ro.trace_step_s = kTraceStep;
@@ -116,13 +116,13 @@ nlohmann::json run_e1(const Context& ctx, std::uint64_t seed, double duration_s,
     ++n_est;
     rows.push_back({e.t_s, e.v[0], e.v[1], x.v[0], x.v[1]});
   }
-  sim::write_csv(path_in(out_dir, "e1_estimates.csv"), {"t_s", "xhat1", "xhat2", "x1", "x2"}, rows);
+  util::write_csv(path_in(out_dir, "e1_estimates.csv"), {"t_s", "xhat1", "xhat2", "x1", "x2"}, rows);
   rows.clear();
   for (std::size_t i = 0; i < r.samples.size(); ++i) rows.push_back({r.samples[i].t_s, r.samples[i].v[0], r.samples[i].v[1]});
-  sim::write_csv(path_in(out_dir, "e1_samples.csv"), {"t_s", "y1", "y2"}, rows);
+  util::write_csv(path_in(out_dir, "e1_samples.csv"), {"t_s", "y1", "y2"}, rows);
   rows.clear();
   for (const Point& p : r.truth) rows.push_back({p.t_s, p.v[0], p.v[1]});
-  sim::write_csv(path_in(out_dir, "e1_truth.csv"), {"t_s", "x1", "x2"}, rows);
+  util::write_csv(path_in(out_dir, "e1_truth.csv"), {"t_s", "x1", "x2"}, rows);
   const double ns = static_cast<double>(r.samples.size());
   const double ne = static_cast<double>(n_est);
   nlohmann::json j = {{"experiment", "e1"},
@@ -146,7 +146,7 @@ nlohmann::json run_e1(const Context& ctx, std::uint64_t seed, double duration_s,
         << " at t_k'\n";
     }
     g << "unset multiplot\n";
-    sim::run_gnuplot(out_dir, "e1.gp", g.str());
+    util::run_gnuplot(out_dir, "e1.gp", g.str());
     j["files"].push_back("e1.png");
   }
   return j;

@@ -11,7 +11,7 @@
 #include "oneshot/engine/cpu.hpp"
 #include "oneshot/engine/cpu_analysis.hpp"
 #include "oneshot/engine/sweep_statistics.hpp"
-#include "oneshot/sim/output_files.hpp"
+#include "oneshot/util/output_files.hpp"
 
 namespace oneshot::sim {
 
@@ -181,7 +181,7 @@ nlohmann::json run_kernel_experiment(const SimContext& ctx, const CommonOptions&
                  {"context_switch_us", k.context_switch_us}, {"isr_instructions", k.isr_instructions},
                  {"duration_s", k.duration_s}, {"configurations", configs}, {"excluded", excluded},
                  {"number_format", to_string(opt.format)}, {"discretizer", to_string(opt.discretizer)}};
-  if (!sets.empty()) write_json(path_in(opt.out_dir, "kernel_tasks_example.json"), task_set_json(sets.back()));
+  if (!sets.empty()) util::write_json(path_in(opt.out_dir, "kernel_tasks_example.json"), task_set_json(sets.back()));
   std::vector<Approach> approaches;
   for (const std::string& l : spec.approaches) approaches.push_back(parse_approach(l));
   const engine::SweepResults r = engine::run_sweep(
@@ -199,7 +199,7 @@ nlohmann::json run_kernel_experiment(const SimContext& ctx, const CommonOptions&
       "kernel");
   if (!k.shard.whole()) {
     const nlohmann::json j = engine::shard_to_json(r);
-    write_json(path_in(opt.out_dir, engine::shard_file_name("kernel", k.shard)), j);
+    util::write_json(path_in(opt.out_dir, engine::shard_file_name("kernel", k.shard)), j);
     return j;
   }
   return kernel_outputs(r, opt.out_dir, opt.plots);
@@ -240,7 +240,7 @@ nlohmann::json kernel_outputs(const engine::SweepResults& r, const std::string& 
     e["cost_A_mean"] = sm.per_scenario[0][s].mean;
     e["cost_A_ci95"] = sm.per_scenario[0][s].ci95;
     for (std::size_t a = 1; a < na; ++a) {
-      const Summary& q = sm.per_scenario_ratio[a][s];
+      const util::Summary& q = sm.per_scenario_ratio[a][s];
       md << " " << fmt("%.4f ± %.4f", q.mean, q.ci95) << " |";
       row.push_back(q.mean);
       row.push_back(q.ci95);
@@ -298,13 +298,13 @@ nlohmann::json kernel_outputs(const engine::SweepResults& r, const std::string& 
     out << "\n";
   }
   j["markdown"] = out.str();
-  write_text(path_in(out_dir, "kernel.md"), out.str());
+  util::write_text(path_in(out_dir, "kernel.md"), out.str());
   std::vector<std::string> header = {"priority_index", "utilization"};
   for (std::size_t a = 1; a < na; ++a) {
     header.push_back("ratio_" + spec.approaches[a]);
     header.push_back("ci95_" + spec.approaches[a]);
   }
-  write_csv(path_in(out_dir, "kernel.csv"), header, rows);
+  util::write_csv(path_in(out_dir, "kernel.csv"), header, rows);
   j["files"] = {"kernel.md", "kernel.csv", "kernel_tasks_example.json"};
   if (plots && ns > 0) {
     std::ostringstream g;
@@ -312,15 +312,15 @@ nlohmann::json kernel_outputs(const engine::SweepResults& r, const std::string& 
       << "set datafile separator ','\nset grid\nset xlabel 'CPU utilization'\nset ylabel 'cost / cost of A'\n"
       << "set key top left\nset multiplot layout 1,3\n";
     for (std::size_t p = 0; p < 3; ++p) {
-      g << "set title " << gnuplot_quote(std::string("control task priority: ") + to_string(kPositions[p])) << "\nplot ";
+      g << "set title " << util::gnuplot_quote(std::string("control task priority: ") + to_string(kPositions[p])) << "\nplot ";
       for (std::size_t a = 1; a < na; ++a) {
         g << (a > 1 ? ", " : "") << "'kernel.csv' skip 1 using ($1==" << p << "?$2:1/0):" << 2 * a + 1 << ":" << 2 * a + 2
-          << " with yerrorlines title " << gnuplot_quote(spec.approaches[a] + "/A");
+          << " with yerrorlines title " << util::gnuplot_quote(spec.approaches[a] + "/A");
       }
       g << "\n";
     }
     g << "unset multiplot\n";
-    run_gnuplot(out_dir, "kernel.gp", g.str());
+    util::run_gnuplot(out_dir, "kernel.gp", g.str());
     j["files"].push_back("kernel.png");
   }
   return j;

@@ -9,7 +9,7 @@
 #include "kernel_experiment.hpp"
 #include "oneshot/engine/sweep_registry.hpp"
 #include "oneshot/sim/cli_commands.hpp"
-#include "oneshot/sim/output_files.hpp"
+#include "oneshot/util/output_files.hpp"
 #include "oneshot/sim/study_report.hpp"
 #include "table1.hpp"
 
@@ -59,7 +59,7 @@ void register_kernel_experiment(CLI::App& study) {
     const auto ctx = SimContext::load(c->plant);
     const nlohmann::json j = run_kernel_experiment(*ctx, c->common, c->k);
     if (c->json != "-" && j.contains("markdown")) std::cout << j["markdown"].get<std::string>();
-    if (!c->json.empty()) write_json(c->json, j);
+    if (!c->json.empty()) util::write_json(c->json, j);
   });
 }
 

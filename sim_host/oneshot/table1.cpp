@@ -11,7 +11,7 @@
 #include "oneshot/design/design_report.hpp"
 #include "oneshot/engine/random_stream.hpp"
 #include "oneshot/engine/sweep_statistics.hpp"
-#include "oneshot/sim/output_files.hpp"
+#include "oneshot/util/output_files.hpp"
 
 namespace oneshot::sim {
 namespace {
@@ -118,9 +118,9 @@ nlohmann::json table1_outputs(const engine::SweepResults& results, const std::st
         "|---|---|---|---|---|---|---|\n";
   std::vector<std::vector<double>> csv_rows;
   for (std::size_t a = 0; a < na; ++a) {
-    const Summary& c = sm.value[a];
-    const Summary& r = sm.ratio[a];
-    const Summary& w = sm.ratio_weighted[a];
+    const util::Summary& c = sm.value[a];
+    const util::Summary& r = sm.ratio[a];
+    const util::Summary& w = sm.ratio_weighted[a];
     const std::string& letter = spec.approaches[a];
     const char* description = info(parse_approach(letter)).description;
     j["approaches"][letter] = {{"description", description},
@@ -187,7 +187,7 @@ nlohmann::json table1_outputs(const engine::SweepResults& results, const std::st
     out << "Table I: mean cost over " << ns << " scenarios, " << seeds << " seeds each ("
         << cfg.at("number_format").get<std::string>() << ", " << cfg.at("discretizer").get<std::string>() << ")\n\n"
         << md.str() << "\nPer scenario (mean over seeds):\n\n" << per.str();
-    write_text(path_in(out_dir, "table1.md"), out.str());  // atomic and checked; creates the folder
+    util::write_text(path_in(out_dir, "table1.md"), out.str());  // atomic and checked; creates the folder
   }
   std::vector<std::vector<double>> raw;
   for (std::size_t a = 0; a < na; ++a)
@@ -195,11 +195,11 @@ nlohmann::json table1_outputs(const engine::SweepResults& results, const std::st
       for (std::size_t k = 0; k < seeds; ++k)
         raw.push_back({static_cast<double>(a), static_cast<double>(s), static_cast<double>(spec.first_seed + k),
                        results.at(a, s, k, cost)});
-  write_csv(path_in(out_dir, "table1_runs.csv"), {"approach_index", "scenario_index", "seed", "cost"}, raw);
-  write_csv(path_in(out_dir, "table1.csv"), {"approach_index", "cost_mean", "cost_ci95", "ratio_mean", "ratio_ci95"}, csv_rows);
+  util::write_csv(path_in(out_dir, "table1_runs.csv"), {"approach_index", "scenario_index", "seed", "cost"}, raw);
+  util::write_csv(path_in(out_dir, "table1.csv"), {"approach_index", "cost_mean", "cost_ci95", "ratio_mean", "ratio_ci95"}, csv_rows);
   if (plots) {
     std::ostringstream xtics;
-    for (std::size_t a = 0; a < na; ++a) xtics << (a == 0 ? "" : ", ") << gnuplot_quote(spec.approaches[a]) << " " << a;
+    for (std::size_t a = 0; a < na; ++a) xtics << (a == 0 ? "" : ", ") << util::gnuplot_quote(spec.approaches[a]) << " " << a;
     std::ostringstream g;
     g << "set terminal pngcairo size 1100,700 font 'Sans,11' noenhanced\n"
       << "set output 'table1.png'\nset datafile separator ','\nset grid ytics\nset style fill solid 0.6\n"
@@ -207,7 +207,7 @@ nlohmann::json table1_outputs(const engine::SweepResults& results, const std::st
       << "set title 'Table I: mean control cost over " << ns << " scenarios x " << seeds << " seeds (95 % CI)'\n"
       << "set ylabel 'cost J'\nset key off\n"
       << "plot 'table1.csv' using 1:2 skip 1 with boxes lc rgb '#4c72b0', '' using 1:2:3 skip 1 with yerrorbars pt 0 lw 2 lc rgb 'black'\n";
-    run_gnuplot(out_dir, "table1.gp", g.str());
+    util::run_gnuplot(out_dir, "table1.gp", g.str());
   }
   j["files"] = {"table1.md", "table1.csv", "table1_runs.csv", "table1.png"};
   return j;
@@ -223,7 +223,7 @@ nlohmann::json run_table1(const SimContext& ctx, const CommonOptions& opt, const
   const engine::SweepResults r = table1_sweep(ctx, opt, scenarios, seeds, shard, wall_time_s);
   if (!shard.whole()) {
     const nlohmann::json j = engine::shard_to_json(r);
-    write_json(path_in(opt.out_dir, engine::shard_file_name("table1", shard)), j);
+    util::write_json(path_in(opt.out_dir, engine::shard_file_name("table1", shard)), j);
     return j;
   }
   return table1_outputs(r, opt.out_dir, opt.plots);

@@ -11,7 +11,7 @@
 #include <stdexcept>
 
 #include "oneshot/app/petc_pil.hpp"
-#include "oneshot/host/file_io.hpp"
+#include "oneshot/util/file_io.hpp"
 #include "oneshot/sim/pil_link.hpp"
 
 namespace oneshot::sim::petc {
@@ -298,7 +298,7 @@ nlohmann::json run_exectime(const PetcSetup& setup, const ExectimeOptions& opt) 
   j["stack_peak_bytes"] = link.stack_peak_bytes();
   const std::string stack_file = link.image() + ".stack.txt";
   if (std::filesystem::is_regular_file(stack_file)) {
-    std::istringstream in(host::read_text_file(stack_file, "stack bound", 4096));
+    std::istringstream in(util::read_text_file(stack_file, "stack bound", 4096));
     std::size_t bound = 0;
     if (in >> bound) {
       j["stack_bound_bytes"] = bound;

@@ -8,7 +8,7 @@
 #include <stdexcept>
 
 #include "oneshot/engine/sweep_statistics.hpp"
-#include "oneshot/sim/output_files.hpp"
+#include "oneshot/util/output_files.hpp"
 #include "oneshot/sim/sweep_faults.hpp"
 
 namespace oneshot::sim::petc {
@@ -19,7 +19,7 @@ const char* kPng = "set terminal pngcairo size 1100,700 font 'Sans,11' noenhance
 
 std::string join(const std::string& dir, const std::string& name) { return dir + "/" + name; }
 
-nlohmann::json mean_ci(const Summary& s) { return {{"mean", s.mean}, {"ci95", s.ci95}}; }
+nlohmann::json mean_ci(const util::Summary& s) { return {{"mean", s.mean}, {"ci95", s.ci95}}; }
 
 std::string fmt(double x, int digits = 4) {
   char buf[64];
@@ -77,7 +77,7 @@ nlohmann::json run_table(const PetcSetup& setup, const SweepOptions& opt) {
                       {"delta_c", c.delta_c}, {"noise", c.noise}};
   spec.config["cases"] = labels;
   sim::add_fault_metrics(spec, opt.faults, "tracking error sqrt(sum_k (r - y_k)^2)");
-  make_directory(opt.out_dir);
+  util::make_directory(opt.out_dir);
   const engine::SweepResults r = finish(
       spec, opt,
       [&](std::size_t a, std::size_t, std::uint64_t seed) {
@@ -93,14 +93,14 @@ nlohmann::json run_table(const PetcSetup& setup, const SweepOptions& opt) {
       "petc table");
   if (!opt.shard.whole()) {
     const nlohmann::json j = engine::shard_to_json(r);
-    write_json(join(opt.out_dir, engine::shard_file_name("table", opt.shard)), j);
+    util::write_json(join(opt.out_dir, engine::shard_file_name("table", opt.shard)), j);
     return j;
   }
   return table_outputs(r, opt.out_dir, opt.plots);
 }
 
 nlohmann::json table_outputs(const engine::SweepResults& r, const std::string& out_dir, bool /*plots*/) {
-  make_directory(out_dir);
+  util::make_directory(out_dir);
   const engine::SweepSpec& spec = r.spec;
   std::vector<engine::SweepSummary> sums;
   for (std::size_t m = 0; m < spec.metrics.size(); ++m) sums.push_back(engine::summarize_metric(r, m, 0));
@@ -130,7 +130,7 @@ nlohmann::json table_outputs(const engine::SweepResults& r, const std::string& o
     j["inject"] = spec.config.at("inject");
     j["markdown_faults"] = sim::fault_markdown(r);
   }
-  write_json(join(out_dir, "table.json"), j);
+  util::write_json(join(out_dir, "table.json"), j);
   return j;
 }
 
@@ -183,20 +183,20 @@ nlohmann::json run_gpi(const PetcSetup& setup, const SweepOptions& opt, std::siz
   spec.metrics = metric_names();
   spec.config = setup_config(setup);
   spec.config["grid"] = points;
-  make_directory(opt.out_dir);
+  util::make_directory(opt.out_dir);
   const engine::SweepResults r = finish(
       spec, opt, [&](std::size_t a, std::size_t, std::uint64_t seed) { return run_case(setup, cases[a], seed); },
       "petc gpi");
   if (!opt.shard.whole()) {
     const nlohmann::json j = engine::shard_to_json(r);
-    write_json(join(opt.out_dir, engine::shard_file_name("gpi", opt.shard)), j);
+    util::write_json(join(opt.out_dir, engine::shard_file_name("gpi", opt.shard)), j);
     return j;
   }
   return gpi_outputs(r, opt.out_dir, opt.plots);
 }
 
 nlohmann::json gpi_outputs(const engine::SweepResults& r, const std::string& out_dir, bool plots) {
-  make_directory(out_dir);
+  util::make_directory(out_dir);
   const engine::SweepSpec& spec = r.spec;
   const nlohmann::json& grid = spec.config.at("grid");
   const std::size_t na = spec.approaches.size();
@@ -228,12 +228,12 @@ nlohmann::json gpi_outputs(const engine::SweepResults& r, const std::string& out
     rows.push_back({s, c, gpi.value[a].mean, gpi.value[a].ci95, uc.value[a].mean, ua.value[a].mean, ne.value[a].mean,
                     front[a] ? 1.0 : 0.0});
   }
-  write_csv(join(out_dir, "gpi.csv"), {"sigma_s", "sigma_c", "gpi", "gpi_ci95", "u_c", "u_a", "n_e", "pareto"}, rows);
+  util::write_csv(join(out_dir, "gpi.csv"), {"sigma_s", "sigma_c", "gpi", "gpi_ci95", "u_c", "u_a", "n_e", "pareto"}, rows);
   write_runs_csv(r, join(out_dir, "gpi_runs.csv"));
   nlohmann::json j = {{"study", "petc"}, {"experiment", "gpi"}, {"seeds", spec.seeds}, {"weights", {0.45, 0.45, 0.1}},
                       {"setting", "case 4 (noise, known-model disturbance); delta = sigma on both links"},
                       {"points", pts}, {"best", pts.at(best)}};
-  write_json(join(out_dir, "gpi.json"), j);
+  util::write_json(join(out_dir, "gpi.json"), j);
   if (plots) {
     std::ostringstream g;
     g << kPng << "set output 'gpi.png'\nset multiplot layout 1,2\n"
@@ -243,14 +243,14 @@ nlohmann::json gpi_outputs(const engine::SweepResults& r, const std::string& out
       << "set title 'Pareto front: traffic vs N_E'\nset xlabel 'U_c + U_a'\nset ylabel 'N_E'\nset logscale y\n"
       << "plot 'gpi.csv' every ::1 using ($5+$6):7 with points pt 7 title 'grid', "
       << "'gpi.csv' every ::1 using ($8 > 0 ? $5+$6 : 1/0):7 with points pt 6 ps 2 title 'Pareto'\nunset multiplot\n";
-    run_gnuplot(out_dir, "gpi.gp", g.str());
+    util::run_gnuplot(out_dir, "gpi.gp", g.str());
     j["plots"] = {"gpi.png"};
   }
   return j;
 }
 
 nlohmann::json run_traces(const PetcSetup& setup, std::uint64_t seed, const std::string& out_dir, bool plots) {
-  make_directory(out_dir);
+  util::make_directory(out_dir);
   nlohmann::json j = nlohmann::json::object();
   const std::vector<CaseSpec> cases = default_cases();
   for (std::size_t ci : {std::size_t{3}, std::size_t{4}, std::size_t{5}, std::size_t{6}}) {
@@ -267,7 +267,7 @@ nlohmann::json run_traces(const PetcSetup& setup, std::uint64_t seed, const std:
       rows.push_back({static_cast<double>(k), t.y_true[k], t.u[k], t.d[k], t.d_hat[k],
                       static_cast<double>(t.sensor_sent[k]), static_cast<double>(t.actuator_sent[k]), n});
     }
-    write_csv(join(out_dir, "trace_case" + tag + ".csv"), {"k", "y", "u", "d", "d_hat", "sensor_sent", "actuator_sent", "N"},
+    util::write_csv(join(out_dir, "trace_case" + tag + ".csv"), {"k", "y", "u", "d", "d_hat", "sensor_sent", "actuator_sent", "N"},
               rows);
     j[c.name] = {{"seed", seed}, {"N_E", v[3]}, {"d_error_rms", v[17]}, {"d_rms", v[18]}, {"N_max", v[12]}};
     if (plots) {
@@ -278,7 +278,7 @@ nlohmann::json run_traces(const PetcSetup& setup, std::uint64_t seed, const std:
         << "lines title 'd_hat'\nset title 'multiplicity N at each arrival'\n"
         << "plot 'trace_case" << tag << ".csv' every ::1 using 1:($6 > 0 ? $8 : 1/0) with impulses title 'N'\n"
         << "unset multiplot\n";
-      run_gnuplot(out_dir, "trace_case" + tag + ".gp", g.str());
+      util::run_gnuplot(out_dir, "trace_case" + tag + ".gp", g.str());
     }
   }
   return j;

@@ -8,7 +8,7 @@
 #include "oneshot/engine/frame_faults.hpp"
 #include "oneshot/engine/sweep_registry.hpp"
 #include "oneshot/sim/cli_commands.hpp"
-#include "oneshot/sim/output_files.hpp"
+#include "oneshot/util/output_files.hpp"
 #include "oneshot/sim/pil_link.hpp"
 #include "oneshot/sim/study_report.hpp"
 #include "petc_exectime.hpp"
@@ -59,7 +59,7 @@ void add_sweep_options(CLI::App* cmd, Cli& c) {
 }
 
 void emit(const Cli& c, const nlohmann::json& j) {
-  if (!c.json.empty()) write_json(c.json, j);
+  if (!c.json.empty()) util::write_json(c.json, j);
 }
 
 std::string design_text(const nlohmann::json& d) {

@@ -9,8 +9,8 @@
 
 #include "oneshot/engine/sweep.hpp"
 #include "oneshot/node/send_cause.hpp"
-#include "oneshot/sim/output_files.hpp"
-#include "oneshot/sim/statistics.hpp"
+#include "oneshot/util/output_files.hpp"
+#include "oneshot/util/statistics.hpp"
 #include "sod_experiments.hpp"
 
 namespace oneshot::sod {
@@ -24,7 +24,7 @@ std::string g4(double v) {
   std::snprintf(b, sizeof b, "%g", v);
   return b;
 }
-nlohmann::json ci(const sim::Summary& s) { return {{"mean", s.mean}, {"ci95", s.ci95}}; }
+nlohmann::json ci(const util::Summary& s) { return {{"mean", s.mean}, {"ci95", s.ci95}}; }
 
 }  // namespace
 
@@ -67,7 +67,7 @@ nlohmann::json run_curve(const SodModel& model, const StudyOptions& opt, const s
   auto stat = [&](const engine::SweepResults& r, std::size_t a, std::size_t s, std::size_t m) {
     std::vector<double> v;
     for (std::size_t k = 0; k < seeds; ++k) v.push_back(r.at(a, s, k, m));
-    return sim::summarize(v);
+    return util::summarize(v);
   };
   std::vector<std::vector<std::uint32_t>> every(na, std::vector<std::uint32_t>(ns));
   for (std::size_t a = 0; a < na; ++a)
@@ -98,7 +98,7 @@ nlohmann::json run_curve(const SodModel& model, const StudyOptions& opt, const s
       for (const engine::SweepResults* r : {&r1, &r2}) {
         nlohmann::json part;
         for (std::size_t m = 0; m < 4; ++m) {
-          const sim::Summary x = stat(*r, a, s, m);
+          const util::Summary x = stat(*r, a, s, m);
           part[spec.metrics[m]] = ci(x);
           line.push_back(x.mean);
           line.push_back(x.ci95);
@@ -108,14 +108,14 @@ nlohmann::json run_curve(const SodModel& model, const StudyOptions& opt, const s
       for (std::size_t m = 0; m < 2; ++m) {  // paired: event − periodic at the same seed
         std::vector<double> d;
         for (std::size_t k = 0; k < seeds; ++k) d.push_back(r1.at(a, s, k, m) - r2.at(a, s, k, m));
-        row["paired_event_minus_periodic"][spec.metrics[m]] = ci(sim::summarize(d));
+        row["paired_event_minus_periodic"][spec.metrics[m]] = ci(util::summarize(d));
       }
       j["rows"].push_back(row);
       csv.push_back(line);
     }
   }
-  sim::make_directory(opt.out_dir);
-  sim::write_csv(path_in(opt.out_dir, "curve.csv"),
+  util::make_directory(opt.out_dir);
+  util::write_csv(path_in(opt.out_dir, "curve.csv"),
                  {"loss", "delta_t_s", "periodic_every", "ev_e1", "ev_e1_ci", "ev_e2", "ev_e2_ci", "ev_packets",
                   "ev_packets_ci", "ev_nees", "ev_nees_ci", "pe_e1", "pe_e1_ci", "pe_e2", "pe_e2_ci", "pe_packets",
                   "pe_packets_ci", "pe_nees", "pe_nees_ci"},
@@ -136,7 +136,7 @@ nlohmann::json run_curve(const SodModel& model, const StudyOptions& opt, const s
           << "'' using ($1 == " << losses[s] << " && $2 < 0 ? $8 : 1/0):" << ec << " skip 1 with points pt 7 ps 1.5 title 'plain SOD'\n";
       }
     g << "unset multiplot\n";
-    sim::run_gnuplot(opt.out_dir, "curve.gp", g.str());
+    util::run_gnuplot(opt.out_dir, "curve.gp", g.str());
     j["files"].push_back("curve.png");
   }
   return j;
@@ -197,15 +197,15 @@ nlohmann::json run_traces(const SodModel& model, const StudyOptions& opt, double
       for (std::size_t i = 0; i < kNodes; ++i) {
         std::vector<double> x;
         for (std::size_t k = 0; k < opt.seeds; ++k) x.push_back(r.at(a, 0, k, i * bins + b));
-        const sim::Summary sm = sim::summarize(x);
+        const util::Summary sm = util::summarize(x);
         line.push_back(sm.mean);
         line.push_back(sm.ci95);
       }
     rows.push_back(line);
   }
-  sim::make_directory(opt.out_dir);
-  sim::write_csv(path_in(opt.out_dir, "e4_error.csv"),
-                 {"t_s", "sod_e1", "sod_e1_ci", "sod_e2", "sod_e2_ci", "msod_e1", "msod_e1_ci", "msod_e2", "msod_e2_ci"}, rows, sim::NonFinite::kMissing);
+  util::make_directory(opt.out_dir);
+  util::write_csv(path_in(opt.out_dir, "e4_error.csv"),
+                 {"t_s", "sod_e1", "sod_e1_ci", "sod_e2", "sod_e2_ci", "msod_e1", "msod_e1_ci", "msod_e2", "msod_e2_ci"}, rows, util::NonFinite::kMissing);
   // One run (the first seed): y1, x1, both estimates, the instants of (2b) sends and of losses.
   RunTrace ta, tc;
   simulate_run(model, config(0), opt.seed, &ta);
@@ -220,7 +220,7 @@ nlohmann::json run_traces(const SodModel& model, const StudyOptions& opt, double
                    sent && tc.arrived[0][k] == 0 ? tc.y[0][k] : kNaN});
   }
   // Send and loss markers are NaN where nothing happened (gnuplot draws no point there).
-  sim::write_csv(path_in(opt.out_dir, "e4_run.csv"), {"t_s", "x1", "y1", "xhat1_sod", "xhat1_msod", "time_send_y1", "lost_y1"}, run, sim::NonFinite::kMissing);
+  util::write_csv(path_in(opt.out_dir, "e4_run.csv"), {"t_s", "x1", "y1", "xhat1_sod", "xhat1_msod", "time_send_y1", "lost_y1"}, run, util::NonFinite::kMissing);
   nlohmann::json j = {{"experiment", "E4"}, {"loss", loss}, {"seeds", opt.seeds}, {"first_seed", opt.seed},
                       {"n_t", {config(1).n_t[0], config(1).n_t[1]}}, {"bin_s", static_cast<double>(per_bin) * T},
                       {"time_rule_sends_node1_first_seed", time_sends}, {"files", {"e4_error.csv", "e4_run.csv"}}};
@@ -245,7 +245,7 @@ nlohmann::json run_traces(const SodModel& model, const StudyOptions& opt, double
        << "plot 'e4_run.csv' using 1:3 skip 1 with lines lc rgb '#999999' title 'y1', '' using 1:5 skip 1 with lines lw 2 title 'x1 estimate (c)', "
        << "'' using 1:6 skip 1 with points pt 7 ps 0.8 title '(2b) send', '' using 1:7 skip 1 with points pt 2 ps 1.2 title 'lost'\n"
        << "unset multiplot\n";
-    sim::run_gnuplot(opt.out_dir, "e4_traces.gp", gp.str());
+    util::run_gnuplot(opt.out_dir, "e4_traces.gp", gp.str());
     j["files"].push_back("e4_traces.png");
   }
   return j;

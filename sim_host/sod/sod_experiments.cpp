@@ -11,8 +11,8 @@
 #include <sstream>
 #include <stdexcept>
 
-#include "oneshot/sim/output_files.hpp"
-#include "oneshot/sim/statistics.hpp"
+#include "oneshot/util/output_files.hpp"
+#include "oneshot/util/statistics.hpp"
 #include "sod_experiments.hpp"
 
 namespace oneshot::sod {
@@ -23,7 +23,7 @@ void emit_json(const nlohmann::json& j, const std::string& path) {
     std::cout << j.dump(2) << "\n";
     return;
   }
-  sim::write_json(path, j);
+  util::write_json(path, j);
 }
 
 namespace {
@@ -64,10 +64,10 @@ MeanGap measure_mean_gap(const SodModel& model, const StudyOptions& opt, double 
       gap.push_back(r.at(0, 0, k, i));
       sends.push_back(r.at(0, 0, k, 2 + i));
     }
-    const sim::Summary s = sim::summarize(gap);
+    const util::Summary s = util::summarize(gap);
     g.mean_s[i] = s.mean;
     g.ci95_s[i] = s.ci95;
-    g.sends[i] = sim::summarize(sends).mean;
+    g.sends[i] = util::summarize(sends).mean;
   }
   return g;
 }
@@ -161,11 +161,11 @@ nlohmann::json run_grid(const SodModel& model, const StudyOptions& opt, const st
   }
   // Grouped by loss rate, so that gnuplot draws one connected line per ξ.
   std::stable_sort(rows.begin(), rows.end(), [](const std::vector<double>& a, const std::vector<double>& b) { return a[1] < b[1]; });
-  sim::make_directory(opt.out_dir);
+  util::make_directory(opt.out_dir);
   const std::string csv = (std::filesystem::path(opt.out_dir) / "e2_delta_t.csv").string();
   // An unbounded δt* (brief §5: the constraint never binds) is written as gnuplot's missing value.
-  sim::write_csv(csv, {"delta_y", "loss", "delta_t1_s", "delta_t2_s", "mean_gap1_s", "mean_gap2_s"}, rows,
-                 sim::NonFinite::kMissing);
+  util::write_csv(csv, {"delta_y", "loss", "delta_t1_s", "delta_t2_s", "mean_gap1_s", "mean_gap2_s"}, rows,
+                 util::NonFinite::kMissing);
   j["files"] = {"e2_delta_t.csv"};
   if (opt.plots) {
     std::ostringstream g;
@@ -181,7 +181,7 @@ nlohmann::json run_grid(const SodModel& model, const StudyOptions& opt, const st
       g << "\n";
     }
     g << "unset multiplot\n";
-    sim::run_gnuplot(opt.out_dir, "e2_delta_t.gp", g.str());
+    util::run_gnuplot(opt.out_dir, "e2_delta_t.gp", g.str());
     j["files"].push_back("e2_delta_t.png");
   }
   return j;

@@ -8,7 +8,7 @@
 
 #include "oneshot/engine/sweep_registry.hpp"
 #include "oneshot/sim/cli_commands.hpp"
-#include "oneshot/sim/output_files.hpp"
+#include "oneshot/util/output_files.hpp"
 #include "oneshot/sim/study_report.hpp"
 #include "sod_experiments.hpp"
 #include "sod_report.hpp"
@@ -135,7 +135,7 @@ void register_sod_study(CLI::App& app) {
     cmd->add_option("--json", c->json, "write the section's JSON to PATH ('-' for standard output)");
     cmd->add_flag("--no-plots", c->no_plots, "CSV files only (no gnuplot)");
     cmd->callback([c] {
-      make_directory(c->opt.out_dir);
+      util::make_directory(c->opt.out_dir);
       StudyReportContext ctx;
       ctx.out_dir = c->opt.out_dir;
       ctx.rel_dir = ".";

@@ -10,8 +10,8 @@
 
 #include "oneshot/engine/random_stream.hpp"
 #include "oneshot/engine/sweep_statistics.hpp"
-#include "oneshot/sim/output_files.hpp"
-#include "oneshot/sim/statistics.hpp"
+#include "oneshot/util/output_files.hpp"
+#include "oneshot/util/statistics.hpp"
 #include "sod_experiments.hpp"
 
 namespace oneshot::sod {
@@ -43,7 +43,7 @@ std::string f4(double v) {
   std::snprintf(b, sizeof b, "%.4g", v);
   return b;
 }
-nlohmann::json ci(const sim::Summary& s) { return {{"mean", s.mean}, {"ci95", s.ci95}}; }
+nlohmann::json ci(const util::Summary& s) { return {{"mean", s.mean}, {"ci95", s.ci95}}; }
 
 }  // namespace
 
@@ -107,16 +107,16 @@ nlohmann::json run_table(const SodModel& model, const StudyOptions& opt) {
         return v;
       }, "sod table");
   if (!opt.shard.whole()) {
-    sim::make_directory(opt.out_dir);
+    util::make_directory(opt.out_dir);
     const nlohmann::json j = engine::shard_to_json(r);
-    sim::write_json(path_in(opt.out_dir, engine::shard_file_name("table", opt.shard)), j);
+    util::write_json(path_in(opt.out_dir, engine::shard_file_name("table", opt.shard)), j);
     return j;
   }
   return table_outputs(r, opt.out_dir, opt.plots);
 }
 
 nlohmann::json table_outputs(const engine::SweepResults& results, const std::string& out_dir, bool plots) {
-  sim::make_directory(out_dir);
+  util::make_directory(out_dir);
   const engine::SweepSpec& spec = results.spec;
   const std::size_t na = spec.approaches.size(), ns = spec.scenarios.size(), seeds = spec.seeds;
   auto series = [&](std::size_t a, std::size_t s, const std::string& m) {
@@ -125,7 +125,7 @@ nlohmann::json table_outputs(const engine::SweepResults& results, const std::str
     for (std::size_t k = 0; k < seeds; ++k) v.push_back(results.at(a, s, k, mi));
     return v;
   };
-  auto stat = [&](std::size_t a, std::size_t s, const std::string& m) { return sim::summarize(series(a, s, m)); };
+  auto stat = [&](std::size_t a, std::size_t s, const std::string& m) { return util::summarize(series(a, s, m)); };
   nlohmann::json j = {{"experiment", "E3 table"}, {"config", spec.config}, {"seeds", seeds}, {"first_seed", spec.first_seed}};
   if (spec.config.contains("inject")) j["inject"] = spec.config.at("inject");
   std::ostringstream md;
@@ -175,7 +175,7 @@ nlohmann::json table_outputs(const engine::SweepResults& results, const std::str
         const auto x = series(p[0], s, m), y = series(p[1], s, m);
         std::vector<double> d(x.size());
         for (std::size_t k = 0; k < x.size(); ++k) d[k] = x[k] - y[k];
-        const sim::Summary sd = sim::summarize(d);
+        const util::Summary sd = util::summarize(d);
         e[m] = ci(sd);
         pd << " | " << f4(sd.mean) << " ± " << f4(sd.ci95);
       }
@@ -196,7 +196,7 @@ nlohmann::json table_outputs(const engine::SweepResults& results, const std::str
     std::ofstream out(path_in(out_dir, "table.md"));
     out << "E3 table: " << seeds << " seeds per cell\n\n" << md.str() << "\nPaired differences:\n\n" << pd.str();
   }
-  sim::write_csv(path_in(out_dir, "table.csv"),
+  util::write_csv(path_in(out_dir, "table.csv"),
                  {"configuration_index", "loss", "e1", "e1_ci95", "e2", "e2_ci95", "nees", "nees_ci95", "packets"}, csv);
   engine::write_runs_csv(results, path_in(out_dir, "table_runs.csv"));
   j["files"] = {"table.md", "table.csv", "table_runs.csv"};
@@ -213,7 +213,7 @@ nlohmann::json table_outputs(const engine::SweepResults& results, const std::str
       g << "\n";
     }
     g << "unset multiplot\n";
-    sim::run_gnuplot(out_dir, "table.gp", g.str());
+    util::run_gnuplot(out_dir, "table.gp", g.str());
     j["files"].push_back("table.png");
   }
   return j;

@@ -7,7 +7,7 @@
 #include "oneshot/design/design_report.hpp"
 #include "oneshot/design/plant_description.hpp"
 #include "oneshot/sim/cli_commands.hpp"
-#include "oneshot/sim/output_files.hpp"
+#include "oneshot/util/output_files.hpp"
 
 namespace oneshot::sim {
 
@@ -26,11 +26,11 @@ void register_design_command(CLI::App& app) {
     const design::DesignResult result = design::synthesize(plant);
     const nlohmann::json j = design::design_json(plant, result);
     if (opt->json == "-") {
-      write_json("-", j);
+      util::write_json("-", j);
       return;
     }
     design::print_design(std::cout, plant, result);
-    if (!opt->json.empty()) write_json(opt->json, j);
+    if (!opt->json.empty()) util::write_json(opt->json, j);
   });
 }
 

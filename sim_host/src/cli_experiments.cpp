@@ -14,8 +14,8 @@
 
 #include "oneshot/sim/cli_commands.hpp"
 #include "oneshot/sim/experiments.hpp"
-#include "oneshot/sim/output_files.hpp"
-#include "oneshot/sim/parallel.hpp"
+#include "oneshot/util/output_files.hpp"
+#include "oneshot/util/parallel.hpp"
 #include "oneshot/sim/pil_link.hpp"
 
 namespace oneshot::sim {
@@ -119,7 +119,7 @@ void add_common(CLI::App* cmd, CliCommon& c, const std::string& default_out) {
 }
 
 void emit(const CliCommon& c, const nlohmann::json& j) {
-  if (!c.json.empty()) write_json(c.json, j);
+  if (!c.json.empty()) util::write_json(c.json, j);
   if (c.json != "-") {
     std::cout << j.value("experiment", std::string("result")) << ": written to " << c.opt.out_dir << "\n";
   }
@@ -127,8 +127,8 @@ void emit(const CliCommon& c, const nlohmann::json& j) {
 
 /// Wall time and threads of a sweep, kept out of the deterministic results: OUT/timing.json.
 void write_timing(const CommonOptions& o, const std::string& experiment, double wall_time_s) {
-  write_json((std::filesystem::path(o.out_dir) / "timing.json").string(),
-             {{"experiment", experiment}, {"wall_time_s", wall_time_s}, {"threads", worker_count(o.threads)}});
+  util::write_json((std::filesystem::path(o.out_dir) / "timing.json").string(),
+             {{"experiment", experiment}, {"wall_time_s", wall_time_s}, {"threads", util::worker_count(o.threads)}});
 }
 
 std::vector<Scenario> scenarios_from(const std::string& path) { return path.empty() ? default_scenarios() : load_scenarios(path); }
@@ -201,7 +201,7 @@ void register_experiment_commands(CLI::App& app) {
       write_timing(o, "table1", wall);
       if (c->json != "-") {
         if (part.whole()) std::cout << j["markdown"].get<std::string>();
-        std::cout << "wall time " << wall << " s on " << worker_count(o.threads) << " threads\n";
+        std::cout << "wall time " << wall << " s on " << util::worker_count(o.threads) << " threads\n";
       }
       emit(*c, j);
     });
@@ -255,9 +255,9 @@ void register_experiment_commands(CLI::App& app) {
         Scenario sc = find_scenario(default_scenarios(), *scenario);
         sc.duration_s = *duration;
         j = run_pil_compare(*ctx, o, p, sc, parse_approach(*approach));
-        if (c->json != "-") write_json("-", j);
+        if (c->json != "-") util::write_json("-", j);
       }
-      if (!c->json.empty()) write_json(c->json, j);
+      if (!c->json.empty()) util::write_json(c->json, j);
     });
   }
   {
@@ -297,7 +297,7 @@ void register_experiment_commands(CLI::App& app) {
                       v["stack_peak_bytes"].get<int>());
         }
       }
-      if (!c->json.empty()) write_json(c->json, j);
+      if (!c->json.empty()) util::write_json(c->json, j);
     });
   }
   {
@@ -368,8 +368,8 @@ void register_experiment_commands(CLI::App& app) {
     cmd->callback([c, seconds]() {
       const auto ctx = SimContext::load(c->plant);
       const nlohmann::json j = run_benchmark(*ctx, c->resolve(), *seconds);
-      if (c->json != "-") write_json("-", j);
-      if (!c->json.empty()) write_json(c->json, j);
+      if (c->json != "-") util::write_json("-", j);
+      if (!c->json.empty()) util::write_json(c->json, j);
     });
   }
   {
@@ -402,7 +402,7 @@ void register_experiment_commands(CLI::App& app) {
       r.firmware_dir = *fw_dir;
       r.mcu = !*no_mcu;
       const nlohmann::json all = run_report(*ctx, o, r);
-      if (!c->json.empty()) write_json(c->json, all);
+      if (!c->json.empty()) util::write_json(c->json, all);
       std::cout << "report: " << (std::filesystem::path(o.out_dir) / "report.md").string() << "\n";
     });
   }

@@ -6,10 +6,10 @@
 
 #include "oneshot/engine/sweep.hpp"
 #include "oneshot/engine/sweep_registry.hpp"
-#include "oneshot/host/file_io.hpp"
-#include "oneshot/host/strict_json.hpp"
+#include "oneshot/util/file_io.hpp"
+#include "oneshot/util/strict_json.hpp"
 #include "oneshot/sim/cli_commands.hpp"
-#include "oneshot/sim/output_files.hpp"
+#include "oneshot/util/output_files.hpp"
 
 namespace oneshot::sim {
 namespace {
@@ -21,10 +21,10 @@ engine::SweepResults read_shard(const std::string& path) {
   nlohmann::json j;
   try {
     // Bounded read (a directory, device or oversized file is named as such); duplicate keys refused.
-    j = host::parse_json_strict(host::read_text_file(path, "shard file", kMaxShardBytes));
-  } catch (const host::FileError& e) {
+    j = util::parse_json_strict(util::read_text_file(path, "shard file", kMaxShardBytes));
+  } catch (const util::FileError& e) {
     throw std::invalid_argument(e.what());
-  } catch (const host::JsonError& e) {
+  } catch (const util::JsonError& e) {
     throw std::invalid_argument(path + ": " + e.what());
   }
   try {
@@ -56,7 +56,7 @@ void register_merge_command(CLI::App& app) {
     const engine::SweepResults all = engine::merge_shards(shards);
     const auto& summarize = engine::find_summarizer(all.spec.study, all.spec.experiment);
     const nlohmann::json j = summarize(all, o->out, !o->no_plots);
-    if (!o->json.empty()) write_json(o->json, j);
+    if (!o->json.empty()) util::write_json(o->json, j);
     if (o->json != "-") {
       std::cout << all.spec.study << " " << all.spec.experiment << ": " << shards.size() << " shards, "
                 << all.spec.runs() << " runs merged, written to " << o->out << "\n";

@@ -16,12 +16,12 @@
 #include <sstream>
 
 #include "oneshot/sim/engine_benchmark.hpp"
-#include "oneshot/host/child_process.hpp"
-#include "oneshot/host/file_io.hpp"
-#include "oneshot/sim/output_files.hpp"
-#include "oneshot/sim/parallel.hpp"
-#include "oneshot/sim/progress_bar.hpp"
-#include "oneshot/sim/statistics.hpp"
+#include "oneshot/util/child_process.hpp"
+#include "oneshot/util/file_io.hpp"
+#include "oneshot/util/output_files.hpp"
+#include "oneshot/util/parallel.hpp"
+#include "oneshot/util/progress_bar.hpp"
+#include "oneshot/util/statistics.hpp"
 
 /// The function callgrind counts (see run_exectime): one replay of the recorded jobs.
 extern "C" __attribute__((noinline)) void oneshot_exectime_replay(const std::function<void()>* replay) {
@@ -93,7 +93,7 @@ nlohmann::json run_noise_experiment(const SimContext& ctx, const CommonOptions& 
   for (std::size_t i = 0; i < n; ++i) header.push_back(state_label(ctx, i) + "_estimate");
   for (std::size_t i = 0; i < n; ++i) header.push_back(state_label(ctx, i) + "_true");
   header.push_back("setpoint_volts");
-  write_csv(path_in(opt, "noise_jobs.csv"), header, rows);
+  util::write_csv(path_in(opt, "noise_jobs.csv"), header, rows);
   std::vector<std::vector<double>> trace;
   for (const TracePoint& p : r.trace) {
     std::vector<double> row = {p.t_s};
@@ -104,7 +104,7 @@ nlohmann::json run_noise_experiment(const SimContext& ctx, const CommonOptions& 
   std::vector<std::string> theader = {"t_s"};
   for (std::size_t i = 0; i < n; ++i) theader.push_back(state_label(ctx, i));
   theader.push_back("setpoint_volts");
-  write_csv(path_in(opt, "noise_trace.csv"), theader, trace);
+  util::write_csv(path_in(opt, "noise_trace.csv"), theader, trace);
 
   const double rms_meas = std::sqrt(se_meas / static_cast<double>(r.job_records.size()));
   const double rms_est = std::sqrt(se_est / static_cast<double>(r.job_records.size()));
@@ -112,18 +112,18 @@ nlohmann::json run_noise_experiment(const SimContext& ctx, const CommonOptions& 
     std::ostringstream g;
     g << png_terminal() << "set output 'noise.png'\nset datafile separator ','\nset key outside right top\n"
       << "set multiplot layout " << std::min<std::size_t>(n, 2) << ",1 title 'Noise removal: one-shot controller with half Kalman filter (jitter 0-20 ms)'\n"
-      << "set grid\nset ylabel " << gnuplot_quote(state_label(ctx, 0) + " (V)") << "\n"
+      << "set grid\nset ylabel " << util::gnuplot_quote(state_label(ctx, 0) + " (V)") << "\n"
       << "plot 'noise_jobs.csv' using 1:2 skip 1 with points pt 7 ps 0.5 lc rgb '#999999' title 'measured (ADC)', "
       << "'noise_trace.csv' using 1:" << n + 2 << " skip 1 with lines dt 2 lw 1.5 lc rgb 'black' title 'set-point', "
       << "'noise_trace.csv' using 1:2 skip 1 with lines lw 2 lc rgb '#1f77b4' title 'true', "
       << "'noise_jobs.csv' using 3:4 skip 1 with steps lw 2 lc rgb '#d62728' title 'estimate'\n";
     if (n >= 2) {
-      g << "set xlabel 'time (s)'\nset ylabel " << gnuplot_quote(state_label(ctx, 1) + " (V)") << "\n"
+      g << "set xlabel 'time (s)'\nset ylabel " << util::gnuplot_quote(state_label(ctx, 1) + " (V)") << "\n"
         << "plot 'noise_trace.csv' using 1:3 skip 1 with lines lw 2 lc rgb '#1f77b4' title 'true', "
         << "'noise_jobs.csv' using 3:5 skip 1 with steps lw 2 lc rgb '#d62728' title 'estimate'\n";
     }
     g << "unset multiplot\n";
-    run_gnuplot(opt.out_dir, "noise.gp", g.str());
+    util::run_gnuplot(opt.out_dir, "noise.gp", g.str());
   }
   nlohmann::json j = common_json(ctx, opt);
   j["experiment"] = "noise";
@@ -141,7 +141,7 @@ nlohmann::json run_jitter_experiment(const SimContext& ctx, const CommonOptions&
   const Scenario sc = uniform_scenario("jitter-demo", jitter_us, 0.2, 1.0, duration_s);
   const std::array<Approach, 4> approaches = {Approach::kA, Approach::kB, Approach::kD, Approach::kE};
   std::vector<RunResult> results(approaches.size());
-  parallel_for(approaches.size(), worker_count(opt.threads), nullptr, [&](std::size_t i) {
+  util::parallel_for(approaches.size(), util::worker_count(opt.threads), nullptr, [&](std::size_t i) {
     RunOptions ro = run_options(opt, approaches[i]);
     ro.trace_step_us = 1000;
     results[i] = simulate(ctx, sc, opt.seed, ro);
@@ -153,18 +153,18 @@ nlohmann::json run_jitter_experiment(const SimContext& ctx, const CommonOptions&
     rows.push_back(row);
   }
   const std::string v = state_label(ctx, 0);
-  write_csv(path_in(opt, "jitter.csv"), {"t_s", "setpoint_volts", v + "_A", v + "_B", v + "_D", v + "_E"}, rows);
+  util::write_csv(path_in(opt, "jitter.csv"), {"t_s", "setpoint_volts", v + "_A", v + "_B", v + "_D", v + "_E"}, rows);
   if (opt.plots) {
     std::ostringstream g;
     g << png_terminal() << "set output 'jitter.png'\nset datafile separator ','\nset key top left box opaque\nset grid\n"
       << "set title 'Response under jitter (release 0-" << jitter_us / 1000.0 << " ms): one-shot + half Kalman vs standard controllers'\n"
-      << "set xlabel 'time (s)'\nset ylabel " << gnuplot_quote(v + " (V)") << "\n"
+      << "set xlabel 'time (s)'\nset ylabel " << util::gnuplot_quote(v + " (V)") << "\n"
       << "plot 'jitter.csv' using 1:2 skip 1 with lines dt 2 lw 1.5 lc rgb 'black' title 'set-point', "
       << "'' using 1:3 skip 1 with lines lw 3 lc rgb '#bbbbbb' title 'A: standard + Kalman, no jitter', "
       << "'' using 1:4 skip 1 with lines lw 1.5 lc rgb '#d62728' title 'B: one-shot + half Kalman', "
       << "'' using 1:5 skip 1 with lines lw 1.5 lc rgb '#1f77b4' title 'D: standard + Kalman', "
       << "'' using 1:6 skip 1 with lines lw 1.5 lc rgb '#2ca02c' title 'E: standard, no Kalman'\n";
-    run_gnuplot(opt.out_dir, "jitter.gp", g.str());
+    util::run_gnuplot(opt.out_dir, "jitter.gp", g.str());
   }
   nlohmann::json j = common_json(ctx, opt);
   j["experiment"] = "jitter";
@@ -205,7 +205,7 @@ nlohmann::json run_gain_experiment(const SimContext& ctx, const CommonOptions& o
     }
     spread[i] = hi - lo;
   }
-  write_csv(path_in(opt, "gain.csv"), {"job", "t_half_s", "K1_half", "t_complete_s", "K1_complete", "t_standard_s", "K1_standard"},
+  util::write_csv(path_in(opt, "gain.csv"), {"job", "t_half_s", "K1_half", "t_complete_s", "K1_complete", "t_standard_s", "K1_standard"},
             rows);
   if (opt.plots) {
     std::ostringstream g;
@@ -215,7 +215,7 @@ nlohmann::json run_gain_experiment(const SimContext& ctx, const CommonOptions& o
       << "plot 'gain.csv' using 2:3 skip 1 with linespoints pt 7 ps 0.6 lw 1.5 lc rgb '#d62728' title 'half Kalman (one-shot, jitter)', "
       << "'' using 4:5 skip 1 with linespoints pt 6 ps 0.9 lw 1 dt 2 lc rgb '#9467bd' title 'complete Kalman (one-shot, jitter)', "
       << "'' using 6:7 skip 1 with linespoints pt 5 ps 0.5 lw 1.5 lc rgb '#1f77b4' title 'standard controller + Kalman, no jitter'\n";
-    run_gnuplot(opt.out_dir, "gain.gp", g.str());
+    util::run_gnuplot(opt.out_dir, "gain.gp", g.str());
   }
   nlohmann::json j = common_json(ctx, opt);
   j["experiment"] = "gain";
@@ -270,16 +270,16 @@ double callgrind_instructions(const std::string& self, const CommonOptions& opt,
 #if defined(__SANITIZE_ADDRESS__)
   return -1;  // valgrind cannot run an AddressSanitizer binary
 #endif
-  if (host::find_program("valgrind").empty()) return -1;
-  make_directory(opt.out_dir);
+  if (util::find_program("valgrind").empty()) return -1;
+  util::make_directory(opt.out_dir);
   const std::string out_file = path_in(opt, "callgrind." + variant + ".out");
-  host::ProcessSpec spec;
+  util::ProcessSpec spec;
   spec.argv = {"valgrind", "--tool=callgrind", "--collect-atstart=no", "--toggle-collect=oneshot_exectime_replay",
                "--callgrind-out-file=" + valgrind_literal(out_file), self, "exectime-probe", "--variant", variant};
   spec.argv.insert(spec.argv.end(), extra_args.begin(), extra_args.end());
-  const host::CapturedRun run = host::run_captured(spec);
+  const util::CapturedRun run = util::run_captured(spec);
   if (!run.status.success()) throw std::runtime_error("callgrind run failed (" + run.status.describe() + "):\n" + run.output);
-  const std::string text = host::read_text_file(out_file, "callgrind output", std::size_t{256} << 20);
+  const std::string text = util::read_text_file(out_file, "callgrind output", std::size_t{256} << 20);
   std::istringstream in(text);
   std::string line;
   double total = -1;
@@ -364,7 +364,7 @@ nlohmann::json run_exectime(const SimContext& ctx, const CommonOptions& opt, con
     rows.push_back({static_cast<double>(rows.size()), p["host_us_per_4s"].get<double>(), ins(p),
                     q["host_us_per_4s"].get<double>(), ins(q)});
   }
-  write_csv(path_in(opt, "exectime.csv"),
+  util::write_csv(path_in(opt, "exectime.csv"),
             {"variant_index", std::string("us_per_4s_") + primary_name, std::string("instructions_per_job_") + primary_name,
              std::string("us_per_4s_") + other_name, std::string("instructions_per_job_") + other_name},
             rows);
@@ -383,7 +383,7 @@ nlohmann::json run_exectime(const SimContext& ctx, const CommonOptions& opt, con
       << "plot 'exectime.csv' using ($1-0.18):3 skip 1 with boxes lc rgb '#4c72b0' title '" << primary_name << " Q', "
       << "'' using ($1+0.18):5 skip 1 with boxes lc rgb '#dd8452' title '" << other_name << " Q'\n"
       << "unset multiplot\n";
-    run_gnuplot(opt.out_dir, "exectime.gp", g.str());
+    util::run_gnuplot(opt.out_dir, "exectime.gp", g.str());
   }
   j["files"] = {"exectime.csv", "exectime.png"};
   return j;
@@ -410,7 +410,7 @@ nlohmann::json run_single(const SimContext& ctx, const CommonOptions& opt, const
   for (std::size_t i = 0; i < n; ++i) header.push_back(state_label(ctx, i) + "_true_at_sample");
   for (std::size_t i = 0; i < n; ++i) header.push_back(state_label(ctx, i) + "_estimate");
   header.insert(header.end(), {"K1", "setpoint_volts", "u_volts"});
-  write_csv(path_in(opt, "run_jobs.csv"), header, rows);
+  util::write_csv(path_in(opt, "run_jobs.csv"), header, rows);
   if (trace_step_us > 0) {
     std::vector<std::vector<double>> trace;
     for (const TracePoint& p : r.trace) {
@@ -423,19 +423,19 @@ nlohmann::json run_single(const SimContext& ctx, const CommonOptions& opt, const
     std::vector<std::string> th = {"t_s"};
     for (std::size_t i = 0; i < n; ++i) th.push_back(state_label(ctx, i));
     th.insert(th.end(), {"setpoint_volts", "u_volts"});
-    write_csv(path_in(opt, "run_trace.csv"), th, trace);
+    util::write_csv(path_in(opt, "run_trace.csv"), th, trace);
     if (opt.plots) {
       std::ostringstream g;
       g << png_terminal() << "set output 'run.png'\nset datafile separator ','\nset key outside right top\nset grid\n"
         << "set multiplot layout 2,1 title "
-        << gnuplot_quote("Run: approach " + std::string(1, info(approach).letter) + " (" + info(approach).description +
+        << util::gnuplot_quote("Run: approach " + std::string(1, info(approach).letter) + " (" + info(approach).description +
                          "), scenario " + scenario.name + ", seed " + std::to_string(opt.seed))
-        << "\nset ylabel " << gnuplot_quote(state_label(ctx, 0) + " (V)") << "\nplot 'run_trace.csv' using 1:" << n + 2
+        << "\nset ylabel " << util::gnuplot_quote(state_label(ctx, 0) + " (V)") << "\nplot 'run_trace.csv' using 1:" << n + 2
         << " skip 1 with lines dt 2 lc rgb 'black' title 'set-point', '' using 1:2 skip 1 with lines lw 2 lc rgb '#1f77b4' title 'true', "
         << "'run_jobs.csv' using 2:" << 5 + n << " skip 1 with steps lc rgb '#d62728' title 'estimate'\n"
         << "set xlabel 'time (s)'\nset ylabel 'u (V)'\nplot 'run_trace.csv' using 1:" << n + 3
         << " skip 1 with steps lw 1.5 lc rgb '#2ca02c' title 'commanded input'\nunset multiplot\n";
-      run_gnuplot(opt.out_dir, "run.gp", g.str());
+      util::run_gnuplot(opt.out_dir, "run.gp", g.str());
     }
   }
   nlohmann::json j = common_json(ctx, opt);

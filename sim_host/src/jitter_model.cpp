@@ -7,7 +7,7 @@
 #include <filesystem>
 #include <sstream>
 
-#include "oneshot/host/file_io.hpp"
+#include "oneshot/util/file_io.hpp"
 
 namespace oneshot::sim {
 
@@ -163,8 +163,8 @@ std::vector<JobTiming> parse_jitter_trace(const std::string& text, const std::st
 std::vector<JobTiming> load_jitter_trace(const std::string& path) {
   std::string text;
   try {
-    text = host::read_text_file(path, "jitter trace");
-  } catch (const host::FileError& e) {
+    text = util::read_text_file(path, "jitter trace");
+  } catch (const util::FileError& e) {
     throw ScenarioError(e.what());
   }
   return parse_jitter_trace(text, path);

@@ -6,13 +6,13 @@
 #include <iostream>
 #include <string>
 
-#include "oneshot/host/termination_cleanup.hpp"
+#include "oneshot/util/termination_cleanup.hpp"
 #include "oneshot/sim/cli_commands.hpp"
 
 int main(int argc, char** argv) {
   // Interrupted runs end their child processes and remove temporary files; a child that
   // died must give an error on write, not kill us with SIGPIPE.
-  oneshot::host::install_termination_handlers();
+  oneshot::util::install_termination_handlers();
   std::signal(SIGPIPE, SIG_IGN);
   CLI::App app{"oneshot-sim: discrete-event simulator of control loops on small MCUs and over networks.\n"
                "Studies: oneshot-sim <study> <experiment> (oneshot-sim <study> --help); the one-shot study's\n"

@@ -9,18 +9,18 @@
 #include <random>
 #include <sstream>
 
-#include "oneshot/host/file_io.hpp"
+#include "oneshot/util/file_io.hpp"
 #include "oneshot/sim/c_job_host.hpp"
 #include "oneshot/sim/experiments.hpp"
-#include "oneshot/sim/output_files.hpp"
+#include "oneshot/util/output_files.hpp"
 #include "oneshot/sim/pil_link.hpp"
-#include "oneshot/sim/progress_bar.hpp"
-#include "oneshot/sim/statistics.hpp"
+#include "oneshot/util/progress_bar.hpp"
+#include "oneshot/util/statistics.hpp"
 
 namespace oneshot::sim {
 
 std::pair<std::size_t, std::size_t> image_memory(const std::string& path) {
-  const std::string d = host::read_text_file(path, "firmware image", kMaxImageBytes);
+  const std::string d = util::read_text_file(path, "firmware image", kMaxImageBytes);
   const auto u16 = [&](std::size_t o) {
     return static_cast<std::uint32_t>(static_cast<unsigned char>(d.at(o)) | static_cast<unsigned char>(d.at(o + 1)) << 8);
   };
@@ -135,7 +135,7 @@ nlohmann::json c_job_only_image(const PilOptions& base, const std::string& varia
   nlohmann::json j{{"image", image}, {"flash_bytes", flash}, {"ram_static_bytes", ram}};
   std::string stack_text;  // the build's stack bound, when it computed one
   if (std::filesystem::is_regular_file(image + ".stack.txt"))
-    stack_text = host::read_text_file(image + ".stack.txt", "stack bound", 4096);
+    stack_text = util::read_text_file(image + ".stack.txt", "stack bound", 4096);
   std::istringstream stack(stack_text);
   std::size_t bound = 0;
   if (stack >> bound) {
@@ -186,7 +186,7 @@ nlohmann::json soft_float_calls(const PilOptions& image, std::uint32_t approach,
     }
   }
   const fs::path file = dir / (fs::path(elf).stem().string() + ".profile");
-  std::istringstream in(fs::exists(file) ? host::read_text_file(file.string(), "instruction profile", kMaxImageBytes) : "");
+  std::istringstream in(fs::exists(file) ? util::read_text_file(file.string(), "instruction profile", kMaxImageBytes) : "");
   fs::remove_all(dir);
   std::map<std::string, double> per_routine;
   double total = 0;
@@ -252,7 +252,7 @@ nlohmann::json run_pil_table1(const SimContext& ctx, const CommonOptions& opt, c
   std::size_t identical = 0;
   const auto t0 = std::chrono::steady_clock::now();
   {
-    ProgressBar bar("pil table1", scenarios.size() * seeds * na);
+    util::ProgressBar bar("pil table1", scenarios.size() * seeds * na);
     for (std::size_t s = 0; s < scenarios.size(); ++s)
       for (std::size_t k = 0; k < seeds; ++k)
         for (std::size_t a = 0; a < na; ++a) {
@@ -280,13 +280,13 @@ nlohmann::json run_pil_table1(const SimContext& ctx, const CommonOptions& opt, c
   j["bit_identical_jobs"] = identical;
   j["resends"] = link.resends();
   j["wall_time_s"] = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  const Summary a_host = summarize(per_seed_host[0]);
-  const Summary a_mcu = summarize(per_seed_mcu[0]);
+  const util::Summary a_host = util::summarize(per_seed_host[0]);
+  const util::Summary a_mcu = util::summarize(per_seed_mcu[0]);
   std::ostringstream md;
   md << "| approach | host mean cost | 95 % CI | MCU mean cost | 95 % CI | MCU ratio to A |\n|---|---|---|---|---|---|\n";
   for (std::size_t a = 0; a < na; ++a) {
-    const Summary h = summarize(per_seed_host[a]);
-    const Summary m = summarize(per_seed_mcu[a]);
+    const util::Summary h = util::summarize(per_seed_host[a]);
+    const util::Summary m = util::summarize(per_seed_mcu[a]);
     const std::string letter(1, info(kAllApproaches[a]).letter);
     j["approaches"][letter] = {{"host_cost_mean", h.mean}, {"host_cost_ci95", h.ci95}, {"cost_mean", m.mean},
                                {"cost_ci95", m.ci95}, {"ratio_to_A", m.mean / a_mcu.mean},
@@ -384,7 +384,7 @@ nlohmann::json run_exectime_target(const SimContext& ctx, const CommonOptions& o
       for (std::size_t v = 0; v < approaches.size(); ++v) {
         std::vector<double> per_job;
         for (std::size_t k = 0; k < jobs.size(); ++k) per_job.push_back(static_cast<double>(counts[1 + v * jobs.size() + k] - overhead));
-        const Summary s = summarize(per_job);
+        const util::Summary s = util::summarize(per_job);
         double total = 0;
         for (double x : per_job) total += x;
         const bool is_q15 = approaches[v] == kCJobQ15Approach;

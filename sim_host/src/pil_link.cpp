@@ -12,8 +12,8 @@
 #include <sys/mman.h>
 #include <unistd.h>
 
-#include "oneshot/host/child_process.hpp"
-#include "oneshot/host/file_io.hpp"
+#include "oneshot/util/child_process.hpp"
+#include "oneshot/util/file_io.hpp"
 
 namespace oneshot::sim {
 
@@ -30,8 +30,8 @@ std::string firmware_image_path(const PilOptions& o) {
 std::uint32_t elf_symbol_address(const std::string& path, const std::string& name) {
   std::string data;
   try {
-    data = host::read_text_file(path, "firmware image", kMaxImageBytes);
-  } catch (const host::FileError& e) {
+    data = util::read_text_file(path, "firmware image", kMaxImageBytes);
+  } catch (const util::FileError& e) {
     throw PilError(e.what());
   }
   const auto u16 = [&](std::size_t off) {
@@ -102,7 +102,7 @@ PilLink::PilLink(const PilOptions& options) : options_(options), image_(firmware
     throw PilError(image_ + ": firmware image not found (build the host project with arm-none-eabi-gcc installed)");
   }
   const std::string machine = options.target == "cortex-m4f" ? "mps2-an386" : "microbit";
-  host::ProcessSpec spec;
+  util::ProcessSpec spec;
   spec.argv = {"qemu-system-arm", "-M",      machine, "-kernel", image_, "-display", "none",
                "-serial",         "stdio",  "-monitor", "none", "-icount", "shift=0,sleep=off"};
   stderr_fd_ = memory_file("qemu-stderr");
@@ -137,8 +137,8 @@ PilLink::PilLink(const PilOptions& options) : options_(options), image_(firmware
   to_qemu_ = in_pipe[1];
   from_qemu_ = out_pipe[0];
   try {
-    qemu_ = std::make_unique<host::ChildProcess>(spec);
-  } catch (const host::ProcessError& e) {
+    qemu_ = std::make_unique<util::ChildProcess>(spec);
+  } catch (const util::ProcessError& e) {
     ::close(in_pipe[0]);
     ::close(out_pipe[1]);
     throw PilError(std::string("cannot start QEMU (apt-get install qemu-system-arm): ") + e.what());

@@ -8,11 +8,11 @@
 #include <iostream>
 #include <sstream>
 
-#include "oneshot/host/file_io.hpp"
+#include "oneshot/util/file_io.hpp"
 #include "oneshot/sim/experiments.hpp"
 #include "oneshot/sim/study_report.hpp"
-#include "oneshot/sim/output_files.hpp"
-#include "oneshot/sim/parallel.hpp"
+#include "oneshot/util/output_files.hpp"
+#include "oneshot/util/parallel.hpp"
 #include "oneshot/sim/pil_link.hpp"
 
 namespace oneshot::sim {
@@ -65,8 +65,8 @@ nlohmann::json table_section(const SimContext& ctx, std::ostringstream& md) {
   std::string text;
   if (ctx.generated()) {
     try {
-      text = host::read_text_file(ONESHOT_LUT_REPORT_PATH, "table report");
-    } catch (const host::FileError&) {
+      text = util::read_text_file(ONESHOT_LUT_REPORT_PATH, "table report");
+    } catch (const util::FileError&) {
       text.clear();  // a build without the generated table: reported below
     }
   }
@@ -110,7 +110,7 @@ nlohmann::json mcu_section(const SimContext& ctx, const CommonOptions& o, const 
       oe.noise = NoiseModel::kConstant;
       j["exectime"][target] = run_exectime_target(ctx, oe, p);
       // The measured counts as a file of their own: `oneshot kernel` (and its report section) reads them.
-      write_json((std::filesystem::path(o.out_dir) / (std::string("exectime-") + target + ".json")).string(),
+      util::write_json((std::filesystem::path(o.out_dir) / (std::string("exectime-") + target + ".json")).string(),
                  j["exectime"][target]);
     }
     md << "Instructions per control job (QEMU TCG plugin, exact), over the " << j["exectime"]["cortex-m0"]["jobs_per_4s"]
@@ -235,7 +235,7 @@ nlohmann::json run_report(const SimContext& ctx, const CommonOptions& o, const R
      << ", complete " << gain["K1_spread_second_half"]["complete"].get<double>() << ", standard "
      << gain["K1_spread_second_half"]["standard"].get<double>() << ".\n\n"
      << "## 4. Table I\n\n" << table1["seeds"].get<std::size_t>() << " seeds x " << table1["scenarios"].get<std::size_t>()
-     << " scenarios, " << table1_wall_s << " s wall on " << worker_count(o.threads)
+     << " scenarios, " << table1_wall_s << " s wall on " << util::worker_count(o.threads)
      << " threads.\n\n" << table1["markdown"].get<std::string>() << "\n![table1](table1.png)\n\nPer scenario:\n\n"
      << table1["markdown_per_scenario"].get<std::string>() << "\n";
   std::cerr << "report: number formats\n";
@@ -271,7 +271,7 @@ nlohmann::json run_report(const SimContext& ctx, const CommonOptions& o, const R
     sc.threads = o.threads;
     sc.seed = o.seed;
     sc.plots = o.plots;
-    make_directory(sc.out_dir);
+    util::make_directory(sc.out_dir);
     StudyReportResult res = section.run(sc);
     md << res.markdown << "\n";
     studies[section.study] = std::move(res.json);
@@ -283,8 +283,8 @@ nlohmann::json run_report(const SimContext& ctx, const CommonOptions& o, const R
   if (!lut.is_null()) all["table"] = lut;  // sections that did not run are left out, not null
   if (!mcu.is_null()) all["mcu"] = mcu;
   all["wall_time_s"] = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  write_json((std::filesystem::path(o.out_dir) / "report.json").string(), all);
-  write_text((std::filesystem::path(o.out_dir) / "report.md").string(), md.str());
+  util::write_json((std::filesystem::path(o.out_dir) / "report.json").string(), all);
+  util::write_text((std::filesystem::path(o.out_dir) / "report.md").string(), md.str());
   return all;
 }
 

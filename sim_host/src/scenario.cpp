@@ -8,8 +8,8 @@
 #include <map>
 #include <sstream>
 
-#include "oneshot/host/file_io.hpp"
-#include "oneshot/host/strict_json.hpp"
+#include "oneshot/util/file_io.hpp"
+#include "oneshot/util/strict_json.hpp"
 
 namespace oneshot::sim {
 namespace {
@@ -73,8 +73,8 @@ std::vector<Scenario> parse_scenarios(const std::string& text, const std::string
                                       const TraceLoader& load_trace) {
   nlohmann::json root;
   try {
-    root = host::parse_json_strict(text);
-  } catch (const host::JsonError& e) {
+    root = util::parse_json_strict(text);
+  } catch (const util::JsonError& e) {
     throw ScenarioError(source + ": " + e.what());
   }
   try {
@@ -134,8 +134,8 @@ std::vector<Scenario> parse_scenarios(const std::string& text, const std::string
 std::vector<Scenario> load_scenarios(const std::string& path) {
   std::string text;
   try {
-    text = host::read_text_file(path, "scenario file");
-  } catch (const host::FileError& e) {
+    text = util::read_text_file(path, "scenario file");
+  } catch (const util::FileError& e) {
     throw ScenarioError(e.what());
   }
   return parse_scenarios(text, path, std::filesystem::path(path).parent_path().string());

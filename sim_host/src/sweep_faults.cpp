@@ -6,7 +6,7 @@
 #include <cstdio>
 #include <sstream>
 
-#include "oneshot/sim/statistics.hpp"
+#include "oneshot/util/statistics.hpp"
 
 namespace oneshot::sim {
 
@@ -39,7 +39,7 @@ nlohmann::json fault_row(const engine::SweepResults& r, std::size_t a, std::size
       const double x = r.at(a, s, k, m);
       if (std::isfinite(x)) v.push_back(x);
     }
-    const Summary sm = summarize(v);
+    const util::Summary sm = util::summarize(v);
     const auto finite_or_null = [](double x) { return std::isfinite(x) ? nlohmann::json(x) : nlohmann::json(nullptr); };
     row[name] = {{"mean", finite_or_null(sm.mean)}, {"ci95", finite_or_null(sm.ci95)}, {"n", v.size()}};
   }

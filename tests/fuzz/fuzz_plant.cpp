@@ -19,7 +19,7 @@
 #include "oneshot/design/controller_synthesis.hpp"
 #include "oneshot/design/design_report.hpp"
 #include "oneshot/design/plant_description.hpp"
-#include "oneshot/host/strict_json.hpp"
+#include "oneshot/util/strict_json.hpp"
 
 namespace {
 
@@ -62,7 +62,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   } catch (const d::DesignError&) {
     return 0;
   }
-  const std::string bad = oneshot::host::first_non_finite(d::design_json(plant, design));
+  const std::string bad = oneshot::util::first_non_finite(d::design_json(plant, design));
   require(bad.empty(), "accepted plant, design JSON field '" + bad + "' is NaN, infinite or null");
   const Eigen::MatrixXd phi = eigen_of(design.phi_h);
   const Eigen::MatrixXd k = eigen_of(design.kalman_gain);

@@ -10,7 +10,7 @@
 #include <sstream>
 #include <unistd.h>
 
-#include "oneshot/host/child_process.hpp"
+#include "oneshot/util/child_process.hpp"
 #include "support/run_command.hpp"
 #include "support/temp_files.hpp"
 #include "support/test_plants.hpp"
@@ -33,7 +33,7 @@ std::string scenario_named(const std::string& file, const std::string& name) {
 }
 
 TEST(CliHardening, AScenarioNameIsDataInTheGnuplotScript) {
-  if (host::find_program("gnuplot").empty()) GTEST_SKIP() << "gnuplot not installed";
+  if (util::find_program("gnuplot").empty()) GTEST_SKIP() << "gnuplot not installed";
   const std::string dir = fresh_dir("gp_name");
   // gnuplot's command-running function, spelt in two pieces (tests/no_shell.cmake).
   const std::string run = std::string("sys") + "tem";
@@ -49,7 +49,7 @@ TEST(CliHardening, AScenarioNameIsDataInTheGnuplotScript) {
 }
 
 TEST(CliHardening, AnOutputFolderWithAnApostropheOrShellSyntaxPlots) {
-  if (host::find_program("gnuplot").empty()) GTEST_SKIP() << "gnuplot not installed";
+  if (util::find_program("gnuplot").empty()) GTEST_SKIP() << "gnuplot not installed";
   const std::string base = fresh_dir("gp_folder");
   const std::string out = base + "/it's $(touch " + base + "/pwned) 'x'; touch " + base + "/pwned2";
   const auto r = run_command({sim(), "noise", "--duration", "0.5", "--out", out});
@@ -63,7 +63,7 @@ TEST(CliHardening, AnOutputFolderIsNotACommandForValgrind) {
 #if defined(__SANITIZE_ADDRESS__)
   GTEST_SKIP() << "valgrind cannot run an AddressSanitizer build of oneshot-sim";
 #endif
-  if (host::find_program("valgrind").empty()) GTEST_SKIP() << "valgrind not installed";
+  if (util::find_program("valgrind").empty()) GTEST_SKIP() << "valgrind not installed";
   const std::string base = fresh_dir("vg_folder");
   const std::string out = base + "/a'; touch " + base + "/pwned; echo '%p";
   const auto r = run_command({sim(), "exectime", "--no-plots", "--json", "-", "--out", out});

@@ -11,7 +11,7 @@
 #include <limits>
 #include <unistd.h>
 
-#include "oneshot/sim/output_files.hpp"
+#include "oneshot/util/output_files.hpp"
 #include "oneshot/sim/scenario.hpp"
 #include "support/run_command.hpp"
 
@@ -98,30 +98,30 @@ TEST(OutputFiles, NonFiniteNumbersAreRefusedNotWrittenAsNullOrNan) {
   const fs::path dir = fs::temp_directory_path() / ("oneshot_out_nan_" + std::to_string(::getpid()));
   fs::remove_all(dir);
   const nlohmann::json j = {{"cost", {{"total", std::numeric_limits<double>::infinity()}}}};
-  const std::string m = error_of([&] { write_json((dir / "r.json").string(), j); });
+  const std::string m = error_of([&] { util::write_json((dir / "r.json").string(), j); });
   EXPECT_NE(m.find("field 'cost.total' is not a finite number"), std::string::npos) << m;
-  const std::string c = error_of([&] { write_csv((dir / "r.csv").string(), {"t", "x"}, {{0, 1}, {1, std::nan("")}}); });
+  const std::string c = error_of([&] { util::write_csv((dir / "r.csv").string(), {"t", "x"}, {{0, 1}, {1, std::nan("")}}); });
   EXPECT_NE(c.find("row 2, column 'x' is not a finite number"), std::string::npos) << c;
   EXPECT_FALSE(fs::exists(dir));  // nothing written, not even the folder
   // A divergence a study reports as its finding: written as gnuplot's missing value, on request only.
-  write_csv((dir / "d.csv").string(), {"t", "x"}, {{0, 1}, {1, std::numeric_limits<double>::infinity()}},
-            NonFinite::kMissing);
+  util::write_csv((dir / "d.csv").string(), {"t", "x"}, {{0, 1}, {1, std::numeric_limits<double>::infinity()}},
+            util::NonFinite::kMissing);
   std::ifstream in(dir / "d.csv");
   std::stringstream text;
   text << in.rdbuf();
   EXPECT_EQ(text.str(), "t,x\n0,1\n1,nan\n");
   // An explicit null (an unbounded delta_t) is a result, written as such.
-  EXPECT_NO_THROW(write_json((dir / "n.json").string(), nlohmann::json{{"delta_t_s", nullptr}}));
+  EXPECT_NO_THROW(util::write_json((dir / "n.json").string(), nlohmann::json{{"delta_t_s", nullptr}}));
   fs::remove_all(dir);
 }
 
 TEST(OutputFiles, GnuplotLabelsAreQuotedAsData) {
-  EXPECT_EQ(gnuplot_quote("plain"), "'plain'");
+  EXPECT_EQ(util::gnuplot_quote("plain"), "'plain'");
   // gnuplot's command-running function, spelt in two pieces: the project's sources must not
   // contain the word followed by '(' (see tests/no_shell.cmake).
   const std::string run = std::string("sys") + "tem";
-  EXPECT_EQ(gnuplot_quote("a' . " + run + "('id') . 'b"), "'a'' . " + run + "(''id'') . ''b'");
-  EXPECT_EQ(gnuplot_quote("line\nbreak\r`cmd`"), "'line break `cmd`'");  // backquotes are inert in '…'
+  EXPECT_EQ(util::gnuplot_quote("a' . " + run + "('id') . 'b"), "'a'' . " + run + "(''id'') . ''b'");
+  EXPECT_EQ(util::gnuplot_quote("line\nbreak\r`cmd`"), "'line break `cmd`'");  // backquotes are inert in '…'
 }
 
 }  // namespace

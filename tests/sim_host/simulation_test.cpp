@@ -6,7 +6,7 @@
 
 #include "oneshot/sim/scenario.hpp"
 #include "oneshot/sim/simulation.hpp"
-#include "oneshot/sim/statistics.hpp"
+#include "oneshot/util/statistics.hpp"
 #include "support/run_command.hpp"
 
 namespace oneshot::sim {
@@ -268,11 +268,11 @@ TEST(Scenario, TraceJitterIsReadAndChecked) {
 }
 
 TEST(Statistics, StudentIntervalsMatchTables) {
-  EXPECT_NEAR(student_t975(1), 12.7062, 1e-4);
-  EXPECT_NEAR(student_t975(19), 2.0930, 1e-4);
-  EXPECT_NEAR(student_t975(60), 2.0003, 2e-4);
-  EXPECT_NEAR(student_t975(120), 1.9799, 2e-4);
-  const Summary s = summarize({1, 2, 3, 4});
+  EXPECT_NEAR(util::student_t975(1), 12.7062, 1e-4);
+  EXPECT_NEAR(util::student_t975(19), 2.0930, 1e-4);
+  EXPECT_NEAR(util::student_t975(60), 2.0003, 2e-4);
+  EXPECT_NEAR(util::student_t975(120), 1.9799, 2e-4);
+  const util::Summary s = util::summarize({1, 2, 3, 4});
   EXPECT_DOUBLE_EQ(s.mean, 2.5);
   EXPECT_NEAR(s.ci95, 3.1824 * std::sqrt(5.0 / 3.0) / 2, 1e-4);
 }

@@ -9,7 +9,7 @@
 #include <sstream>
 
 #include "oneshot/engine/json_fields.hpp"
-#include "oneshot/host/file_io.hpp"
+#include "oneshot/util/file_io.hpp"
 
 namespace oneshot::engine::cpu {
 
@@ -29,8 +29,8 @@ std::string at(const std::string& where, const char* key) { return where.empty()
 std::vector<Duration> read_exec_trace(const std::string& path, const std::string& field) {
   std::string text;
   try {
-    text = host::read_text_file(path, "execution-time trace");
-  } catch (const host::FileError& e) {
+    text = util::read_text_file(path, "execution-time trace");
+  } catch (const util::FileError& e) {
     fail(field, e.what());
   }
   std::istringstream in(text);
@@ -67,8 +67,8 @@ std::vector<Duration> read_exec_trace(const std::string& path, const std::string
 void read_exectime_file(ExecModel& m, const std::string& path, const std::string& variant, const std::string& field) {
   std::string text;
   try {
-    text = host::read_text_file(path, "exectime file");
-  } catch (const host::FileError& e) {
+    text = util::read_text_file(path, "exectime file");
+  } catch (const util::FileError& e) {
     fail(field + ".exectime_file", e.what());
   }
   const nlohmann::json j = parse_json_strict(text, path);
@@ -313,8 +313,8 @@ TaskSet parse_task_set(const std::string& text, const std::string& source, const
 TaskSet load_task_set(const std::string& path) {
   std::string text;
   try {
-    text = host::read_text_file(path, "task file");
-  } catch (const host::FileError& e) {
+    text = util::read_text_file(path, "task file");
+  } catch (const util::FileError& e) {
     throw InputError(e.what());
   }
   return parse_task_set(text, path, std::filesystem::path(path).parent_path().string());

@@ -7,7 +7,7 @@
 #include <sstream>
 
 #include "oneshot/engine/json_fields.hpp"
-#include "oneshot/host/file_io.hpp"
+#include "oneshot/util/file_io.hpp"
 
 namespace oneshot::engine {
 namespace {
@@ -157,8 +157,8 @@ DelayModel parse_delay_model(const nlohmann::json& j, const std::string& field, 
     }
     std::string text;
     try {
-      text = host::read_text_file(d.trace_path, "delay trace", std::size_t{1} << 28);  // bounded: 256 MiB
-    } catch (const host::FileError& e) {
+      text = util::read_text_file(d.trace_path, "delay trace", std::size_t{1} << 28);  // bounded: 256 MiB
+    } catch (const util::FileError& e) {
       throw InputError("field '" + field + ".file': " + e.what());
     }
     d.trace = parse_delay_trace(text, d.trace_path);

@@ -8,7 +8,7 @@
 #include <sstream>
 
 #include "oneshot/dimension_limits.hpp"
-#include "oneshot/host/file_io.hpp"
+#include "oneshot/util/file_io.hpp"
 #include "study_parse_detail.hpp"
 
 namespace oneshot::engine {
@@ -308,8 +308,8 @@ StudyFile load_study(const std::string& path, const StudySchema* schema) {
   if (!std::filesystem::is_regular_file(path, ec)) throw InputError(path + ": not a readable regular file");
   std::string text;
   try {
-    text = host::read_text_file(path, "study file", std::size_t{1} << 26);  // bounded: 64 MiB
-  } catch (const host::FileError& e) {
+    text = util::read_text_file(path, "study file", std::size_t{1} << 26);  // bounded: 64 MiB
+  } catch (const util::FileError& e) {
     throw InputError(e.what());
   }
   return parse_study(text, path, schema, std::filesystem::path(path).parent_path().string());

@@ -6,8 +6,8 @@
 #include <limits>
 #include <stdexcept>
 
-#include "oneshot/sim/parallel.hpp"
-#include "oneshot/sim/progress_bar.hpp"
+#include "oneshot/util/parallel.hpp"
+#include "oneshot/util/progress_bar.hpp"
 
 namespace oneshot::engine {
 namespace {
@@ -117,8 +117,8 @@ SweepResults run_sweep(const SweepSpec& spec, const Shard& shard, unsigned threa
   for (std::size_t i = 0; i < spec.runs(); ++i)
     if (shard.owns(i)) mine.push_back(i);
   const std::size_t per_a = spec.scenarios.size() * spec.seeds;
-  sim::ProgressBar bar(label, mine.size());
-  sim::parallel_for(mine.size(), sim::worker_count(threads), &bar, [&](std::size_t i) {
+  util::ProgressBar bar(label, mine.size());
+  util::parallel_for(mine.size(), util::worker_count(threads), &bar, [&](std::size_t i) {
     const std::size_t idx = mine[i];
     const std::size_t a = idx / per_a;
     const std::size_t s = (idx % per_a) / spec.seeds;

@@ -7,7 +7,7 @@
 #include <sstream>
 #include <stdexcept>
 
-#include "oneshot/sim/output_files.hpp"
+#include "oneshot/util/output_files.hpp"
 
 namespace oneshot::engine {
 namespace {
@@ -31,18 +31,18 @@ SweepSummary summarize_metric(const SweepResults& r, std::size_t metric, std::si
       for (std::size_t s = 0; s < ns; ++s) out.per_seed[a][k] += r.at(a, s, k, metric) / static_cast<double>(ns);
   for (std::size_t s = 0; s < ns; ++s)
     for (std::size_t k = 0; k < nk; ++k) out.reference_has_zero = out.reference_has_zero || r.at(reference, s, k, metric) == 0;
-  const double ref_mean = sim::summarize(out.per_seed[reference]).mean;
+  const double ref_mean = util::summarize(out.per_seed[reference]).mean;
   for (std::size_t a = 0; a < na; ++a) {
-    out.value.push_back(sim::summarize(out.per_seed[a]));
+    out.value.push_back(util::summarize(out.per_seed[a]));
     out.ratio_of_means.push_back(out.value[a].mean / ref_mean);
     std::vector<double> ratios(nk);
     for (std::size_t k = 0; k < nk; ++k) ratios[k] = out.per_seed[a][k] / out.per_seed[reference][k];
-    out.ratio.push_back(sim::summarize(ratios));
+    out.ratio.push_back(util::summarize(ratios));
     std::vector<double> weighted(nk, 0);
     for (std::size_t k = 0; k < nk; ++k)
       for (std::size_t s = 0; s < ns; ++s)
         weighted[k] += r.at(a, s, k, metric) / r.at(reference, s, k, metric) / static_cast<double>(ns);
-    out.ratio_weighted.push_back(sim::summarize(weighted));
+    out.ratio_weighted.push_back(util::summarize(weighted));
     std::vector<Summary> per;
     std::vector<Summary> per_ratio;
     for (std::size_t s = 0; s < ns; ++s) {
@@ -52,8 +52,8 @@ SweepSummary summarize_metric(const SweepResults& r, std::size_t metric, std::si
         v[k] = r.at(a, s, k, metric);
         q[k] = v[k] / r.at(reference, s, k, metric);
       }
-      per.push_back(sim::summarize(v));
-      per_ratio.push_back(sim::summarize(q));
+      per.push_back(util::summarize(v));
+      per_ratio.push_back(util::summarize(q));
     }
     out.per_scenario.push_back(per);
     out.per_scenario_ratio.push_back(per_ratio);
@@ -62,7 +62,7 @@ SweepSummary summarize_metric(const SweepResults& r, std::size_t metric, std::si
     for (std::size_t b = a + 1; b < na; ++b) {
       std::vector<double> d(nk);
       for (std::size_t k = 0; k < nk; ++k) d[k] = out.per_seed[a][k] - out.per_seed[b][k];
-      out.paired.push_back({a, b, sim::summarize(d)});
+      out.paired.push_back({a, b, util::summarize(d)});
     }
   return out;
 }
@@ -101,7 +101,7 @@ nlohmann::json summary_json(const SweepResults& r, const SweepSummary& sm) {
   return j;
 }
 
-void write_runs_csv(const SweepResults& r, const std::string& path, sim::NonFinite non_finite) {
+void write_runs_csv(const SweepResults& r, const std::string& path, util::NonFinite non_finite) {
   std::vector<std::string> header = {"approach_index", "scenario_index", "seed"};
   header.insert(header.end(), r.spec.metrics.begin(), r.spec.metrics.end());
   std::vector<std::vector<double>> rows;
@@ -113,7 +113,7 @@ void write_runs_csv(const SweepResults& r, const std::string& path, sim::NonFini
         for (std::size_t m = 0; m < r.spec.metrics.size(); ++m) row.push_back(r.at(a, s, k, m));
         rows.push_back(row);
       }
-  sim::write_csv(path, header, rows, non_finite);
+  util::write_csv(path, header, rows, non_finite);
 }
 
 void write_summary_files(const SweepResults& r, const SweepSummary& sm, const std::string& dir, const std::string& prefix,
@@ -124,24 +124,24 @@ void write_summary_files(const SweepResults& r, const SweepSummary& sm, const st
   for (std::size_t a = 0; a < r.spec.approaches.size(); ++a) {
     rows.push_back({static_cast<double>(a), sm.value[a].mean, sm.value[a].ci95, sm.ratio[a].mean, sm.ratio[a].ci95});
   }
-  sim::write_csv(in(prefix + "_summary.csv"), {"approach_index", "mean", "ci95", "ratio_mean", "ratio_ci95"}, rows);
+  util::write_csv(in(prefix + "_summary.csv"), {"approach_index", "mean", "ci95", "ratio_mean", "ratio_ci95"}, rows);
   if (!plots) return;
   // Names may come from a study or shard file: every label reaches gnuplot as a quoted
-  // string constant (sim::gnuplot_quote), never as script text.
+  // string constant (util::gnuplot_quote), never as script text.
   std::ostringstream tics;
   for (std::size_t a = 0; a < r.spec.approaches.size(); ++a) {
-    tics << (a ? ", " : "") << sim::gnuplot_quote(r.spec.approaches[a]) << " " << a;
+    tics << (a ? ", " : "") << util::gnuplot_quote(r.spec.approaches[a]) << " " << a;
   }
   std::ostringstream g;
-  g << "set terminal pngcairo size 1100,700 font 'Sans,11' noenhanced\nset output " << sim::gnuplot_quote(prefix + ".png") << "\n"
+  g << "set terminal pngcairo size 1100,700 font 'Sans,11' noenhanced\nset output " << util::gnuplot_quote(prefix + ".png") << "\n"
     << "set datafile separator ','\nset grid ytics\nset style fill solid 0.6\nset boxwidth 0.6\nset key off\n"
     << "set xtics (" << tics.str() << ")\nset xrange [-0.6:" << static_cast<double>(r.spec.approaches.size()) - 0.4 << "]\nset yrange [0:*]\n"
     << "set ylabel "
-    << sim::gnuplot_quote(r.spec.metrics[sm.metric] + " (mean over scenarios, 95 % CI over " + std::to_string(r.spec.seeds) +
+    << util::gnuplot_quote(r.spec.metrics[sm.metric] + " (mean over scenarios, 95 % CI over " + std::to_string(r.spec.seeds) +
                           " seeds)")
-    << "\nplot " << sim::gnuplot_quote(prefix + "_summary.csv") << " using 1:2 skip 1 with boxes lc rgb '#4c72b0', '' using 1:2:3 skip 1 with "
+    << "\nplot " << util::gnuplot_quote(prefix + "_summary.csv") << " using 1:2 skip 1 with boxes lc rgb '#4c72b0', '' using 1:2:3 skip 1 with "
     << "yerrorbars pt 0 lw 2 lc rgb 'black'\n";
-  sim::run_gnuplot(dir, prefix + ".gp", g.str());
+  util::run_gnuplot(dir, prefix + ".gp", g.str());
 }
 
 }  // namespace oneshot::engine

@@ -11,7 +11,7 @@
 #include <sstream>
 
 #include "oneshot/engine/random_stream.hpp"
-#include "oneshot/host/child_process.hpp"
+#include "oneshot/util/child_process.hpp"
 #include "oneshot/engine/sweep.hpp"
 #include "oneshot/engine/sweep_statistics.hpp"
 
@@ -124,7 +124,7 @@ TEST(SweepStatistics, SummaryFilesHoldTheRunsAndTheIntervals) {
 }
 
 TEST(SweepStatistics, NamesReachGnuplotAsQuotedStringsNotCommands) {
-  if (host::find_program("gnuplot").empty()) GTEST_SKIP() << "gnuplot not installed";
+  if (util::find_program("gnuplot").empty()) GTEST_SKIP() << "gnuplot not installed";
   // Names come from study and shard files. gnuplot's command-running function is spelt in
   // two pieces (tests/no_shell.cmake); gnuplot runs in `dir`, so ../pwnedN would land in root.
   const std::string run = std::string("sys") + "tem";

@@ -12,9 +12,9 @@
 
 #include "oneshot/app/pil_protocol.hpp"
 
-namespace oneshot::host {
+namespace oneshot::util {
 class ChildProcess;
-}  // namespace oneshot::host
+}  // namespace oneshot::util
 
 namespace oneshot::sim {
 
@@ -102,7 +102,7 @@ class PilLink {
 
   PilOptions options_;
   std::string image_;
-  std::unique_ptr<host::ChildProcess> qemu_;  // own process group, ended with us
+  std::unique_ptr<util::ChildProcess> qemu_;  // own process group, ended with us
   int stderr_fd_ = -1;   // QEMU's standard error: an in-memory file (no temporary folder)
   int counts_fd_ = -1;   // the plugin's instruction counts: an in-memory file
   int to_qemu_ = -1;

@@ -13,7 +13,7 @@
 #include <limits>
 #include <vector>
 
-#include "oneshot/sim/statistics.hpp"
+#include "oneshot/util/statistics.hpp"
 
 namespace oneshot::engine {
 
@@ -32,7 +32,7 @@ struct TailSummary {
   double median = std::numeric_limits<double>::quiet_NaN();       ///< 50 % quantile.
   double p10 = std::numeric_limits<double>::quiet_NaN();          ///< 10 % quantile.
   double p90 = std::numeric_limits<double>::quiet_NaN();          ///< 90 % quantile.
-  sim::Summary mean;         ///< Mean, sd, 95 % interval (Student t) of the finite values.
+  util::Summary mean;         ///< Mean, sd, 95 % interval (Student t) of the finite values.
   std::size_t nan_count = 0; ///< Values left out (NaN).
 };
 
@@ -46,7 +46,7 @@ inline TailSummary tail_summary(std::vector<double> values) {
   t.median = sorted_quantile(values, 0.5);
   t.p10 = sorted_quantile(values, 0.1);
   t.p90 = sorted_quantile(values, 0.9);
-  t.mean = sim::summarize(values);
+  t.mean = util::summarize(values);
   return t;
 }
 

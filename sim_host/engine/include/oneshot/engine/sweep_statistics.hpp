@@ -19,12 +19,12 @@
 #include <vector>
 
 #include "oneshot/engine/sweep.hpp"
-#include "oneshot/sim/output_files.hpp"
-#include "oneshot/sim/statistics.hpp"
+#include "oneshot/util/output_files.hpp"
+#include "oneshot/util/statistics.hpp"
 
 namespace oneshot::engine {
 
-using sim::Summary;
+using util::Summary;
 
 /// Summary of one metric of a complete sweep.
 struct SweepSummary {
@@ -60,7 +60,7 @@ nlohmann::json summary_json(const SweepResults& results, const SweepSummary& sum
 /// Writes the raw runs as CSV: approach_index, scenario_index, seed, one column per metric;
 /// a NaN or infinite value is refused unless `non_finite` is kMissing (a divergence the study reports).
 void write_runs_csv(const SweepResults& results, const std::string& path,
-                    sim::NonFinite non_finite = sim::NonFinite::kRefuse);
+                    util::NonFinite non_finite = util::NonFinite::kRefuse);
 
 /// Writes DIR/PREFIX_runs.csv (raw runs), DIR/PREFIX_summary.csv (approach_index, mean,
 /// ci95, ratio_mean, ratio_ci95 of the summarized metric) and, with `plots`, DIR/PREFIX.png

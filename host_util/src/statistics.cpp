@@ -1,10 +1,10 @@
 /// @file statistics.cpp
 /// @brief Confidence intervals.
-#include "oneshot/sim/statistics.hpp"
+#include "oneshot/util/statistics.hpp"
 
 #include <cmath>
 
-namespace oneshot::sim {
+namespace oneshot::util {
 
 double student_t975(std::size_t dof) {
   static const double kTable[] = {0,      12.7062, 4.3027, 3.1824, 2.7764, 2.5706, 2.4469, 2.3646, 2.3060, 2.2622,
@@ -36,4 +36,4 @@ Summary summarize(const std::vector<double>& samples) {
   return s;
 }
 
-}  // namespace oneshot::sim
+}  // namespace oneshot::util

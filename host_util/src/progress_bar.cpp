@@ -1,11 +1,11 @@
 /// @file progress_bar.cpp
 /// @brief Progress bar.
-#include "oneshot/sim/progress_bar.hpp"
+#include "oneshot/util/progress_bar.hpp"
 
 #include <cstdio>
 #include <unistd.h>
 
-namespace oneshot::sim {
+namespace oneshot::util {
 
 ProgressBar::ProgressBar(std::string label, std::size_t total)
     : label_(std::move(label)), total_(total), enabled_(::isatty(STDERR_FILENO) != 0),
@@ -42,4 +42,4 @@ void ProgressBar::draw(std::size_t done) {
   std::fflush(stderr);
 }
 
-}  // namespace oneshot::sim
+}  // namespace oneshot::util

@@ -1,7 +1,7 @@
 /// @file output_files.hpp
 /// @brief CSV, JSON and text files of the experiments, and plots drawn by gnuplot.
 ///
-/// Every file is written atomically (oneshot/host/file_io.hpp) and every write is checked;
+/// Every file is written atomically (oneshot/util/file_io.hpp) and every write is checked;
 /// a number that is not finite is refused with the field named instead of being written as
 /// `nan` or `null`. Folders are created when the first file goes into them, so a run
 /// refused before it starts leaves nothing behind.
@@ -11,7 +11,7 @@
 #include <string>
 #include <vector>
 
-namespace oneshot::sim {
+namespace oneshot::util {
 
 /// What write_csv does with a NaN or infinite value.
 enum class NonFinite {
@@ -45,4 +45,4 @@ std::string gnuplot_quote(const std::string& label);
 /// message on failure, or when gnuplot is not installed (apt-get install gnuplot-nox).
 void run_gnuplot(const std::string& dir, const std::string& script_name, const std::string& script);
 
-}  // namespace oneshot::sim
+}  // namespace oneshot::util

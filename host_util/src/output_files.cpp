@@ -1,6 +1,6 @@
 /// @file output_files.cpp
 /// @brief Output files and plots.
-#include "oneshot/sim/output_files.hpp"
+#include "oneshot/util/output_files.hpp"
 
 #include <cmath>
 #include <cstdio>
@@ -8,11 +8,11 @@
 #include <iostream>
 #include <stdexcept>
 
-#include "oneshot/host/child_process.hpp"
-#include "oneshot/host/file_io.hpp"
-#include "oneshot/host/strict_json.hpp"
+#include "oneshot/util/child_process.hpp"
+#include "oneshot/util/file_io.hpp"
+#include "oneshot/util/strict_json.hpp"
 
-namespace oneshot::sim {
+namespace oneshot::util {
 
 void write_csv(const std::string& path, const std::vector<std::string>& header,
                const std::vector<std::vector<double>>& rows, NonFinite non_finite) {
@@ -43,8 +43,8 @@ void write_csv(const std::string& path, const std::vector<std::string>& header,
 void write_json(const std::string& path, const nlohmann::json& j) {
   std::string text;
   try {
-    text = host::dump_finite(j) + "\n";
-  } catch (const host::JsonError& e) {
+    text = util::dump_finite(j) + "\n";
+  } catch (const util::JsonError& e) {
     throw std::runtime_error((path == "-" ? std::string("JSON result") : path) + ": " + e.what());
   }
   if (path == "-") {
@@ -55,9 +55,9 @@ void write_json(const std::string& path, const nlohmann::json& j) {
   write_text(path, text);
 }
 
-void write_text(const std::string& path, const std::string& text) { host::write_file_atomic(path, text); }
+void write_text(const std::string& path, const std::string& text) { util::write_file_atomic(path, text); }
 
-void make_directory(const std::string& dir) { host::create_directories(dir); }
+void make_directory(const std::string& dir) { util::create_directories(dir); }
 
 std::string gnuplot_quote(const std::string& label) {
   std::string q = "'";
@@ -76,13 +76,13 @@ std::string gnuplot_quote(const std::string& label) {
 
 void run_gnuplot(const std::string& dir, const std::string& script_name, const std::string& script) {
   write_text((std::filesystem::path(dir) / script_name).string(), script);
-  host::ProcessSpec spec;
+  util::ProcessSpec spec;
   spec.argv = {"gnuplot", script_name};
   spec.working_dir = dir;
-  host::CapturedRun r;
+  util::CapturedRun r;
   try {
-    r = host::run_captured(spec);
-  } catch (const host::ProcessError& e) {
+    r = util::run_captured(spec);
+  } catch (const util::ProcessError& e) {
     throw std::runtime_error(std::string("cannot run gnuplot (apt-get install gnuplot-nox), or use --no-plots: ") +
                              e.what());
   }
@@ -92,4 +92,4 @@ void run_gnuplot(const std::string& dir, const std::string& script_name, const s
   }
 }
 
-}  // namespace oneshot::sim
+}  // namespace oneshot::util

@@ -10,7 +10,7 @@
 #include <stdexcept>
 #include <string>
 
-namespace oneshot::host {
+namespace oneshot::util {
 
 /// Invalid or ambiguous JSON; what() says where (a key path such as scenarios[1].name).
 class JsonError : public std::runtime_error {
@@ -34,4 +34,4 @@ std::string first_non_finite_number(const nlohmann::json& j);
 /// (an unbounded δt, a divergent MARE) is written as null, next to the reason the study gives.
 std::string dump_finite(const nlohmann::json& j, int indent = 2);
 
-}  // namespace oneshot::host
+}  // namespace oneshot::util

@@ -1,6 +1,6 @@
 /// @file file_io.cpp
 /// @brief Bounded reads and atomic writes (see file_io.hpp).
-#include "oneshot/host/file_io.hpp"
+#include "oneshot/util/file_io.hpp"
 
 #include <cerrno>
 #include <cstdio>
@@ -11,9 +11,9 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
-#include "oneshot/host/termination_cleanup.hpp"
+#include "oneshot/util/termination_cleanup.hpp"
 
-namespace oneshot::host {
+namespace oneshot::util {
 namespace {
 
 namespace fs = std::filesystem;
@@ -128,4 +128,4 @@ void write_file_atomic(const std::string& path, const std::string& bytes) {
   if (d.fd >= 0) ::fsync(d.fd);
 }
 
-}  // namespace oneshot::host
+}  // namespace oneshot::util

@@ -1,6 +1,6 @@
 /// @file child_process.cpp
 /// @brief fork + execve with an argument vector (see child_process.hpp).
-#include "oneshot/host/child_process.hpp"
+#include "oneshot/util/child_process.hpp"
 
 #include <algorithm>
 #include <array>
@@ -16,11 +16,11 @@
 #include <thread>
 #include <unistd.h>
 
-#include "oneshot/host/termination_cleanup.hpp"
+#include "oneshot/util/termination_cleanup.hpp"
 
 extern char** environ;
 
-namespace oneshot::host {
+namespace oneshot::util {
 namespace {
 
 /// What the child reports through the error pipe when it cannot exec.
@@ -233,4 +233,4 @@ CapturedRun run_captured(ProcessSpec spec, std::size_t max_output) {
   return r;
 }
 
-}  // namespace oneshot::host
+}  // namespace oneshot::util

@@ -12,7 +12,7 @@
 #include <stdexcept>
 #include <string>
 
-namespace oneshot::host {
+namespace oneshot::util {
 
 /// A file could not be read or written; what() names the path and the reason.
 class FileError : public std::runtime_error {
@@ -38,4 +38,4 @@ void write_file_atomic(const std::string& path, const std::string& bytes);
 /// Creates `dir` and its parents (FileError naming it when impossible or not a folder).
 void create_directories(const std::string& dir);
 
-}  // namespace oneshot::host
+}  // namespace oneshot::util

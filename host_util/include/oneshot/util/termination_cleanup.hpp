@@ -10,7 +10,7 @@
 
 #include <string>
 
-namespace oneshot::host {
+namespace oneshot::util {
 
 /// Installs the handlers (once; a signal the caller ignores stays ignored).
 void install_termination_handlers();
@@ -39,4 +39,4 @@ class TempFileGuard {
   bool committed_ = false;
 };
 
-}  // namespace oneshot::host
+}  // namespace oneshot::util

@@ -10,9 +10,9 @@
 #include <thread>
 #include <vector>
 
-#include "oneshot/sim/progress_bar.hpp"
+#include "oneshot/util/progress_bar.hpp"
 
-namespace oneshot::sim {
+namespace oneshot::util {
 
 /// Number of worker threads to use (`requested`, or every core when 0).
 inline unsigned worker_count(unsigned requested) {
@@ -50,4 +50,4 @@ void parallel_for(std::size_t n, unsigned threads, ProgressBar* progress, F&& f)
   if (error) std::rethrow_exception(error);
 }
 
-}  // namespace oneshot::sim
+}  // namespace oneshot::util

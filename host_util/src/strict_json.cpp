@@ -1,12 +1,12 @@
 /// @file strict_json.cpp
 /// @brief Duplicate-key detection and finite-number checks (see strict_json.hpp).
-#include "oneshot/host/strict_json.hpp"
+#include "oneshot/util/strict_json.hpp"
 
 #include <cmath>
 #include <set>
 #include <vector>
 
-namespace oneshot::host {
+namespace oneshot::util {
 namespace {
 
 using json = nlohmann::json;
@@ -122,4 +122,4 @@ std::string dump_finite(const json& j, int indent) {
   return j.dump(indent);
 }
 
-}  // namespace oneshot::host
+}  // namespace oneshot::util

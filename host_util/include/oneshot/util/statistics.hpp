@@ -5,7 +5,7 @@
 #include <cstddef>
 #include <vector>
 
-namespace oneshot::sim {
+namespace oneshot::util {
 
 /// Mean and the half-width of its 95 % confidence interval.
 struct Summary {
@@ -21,4 +21,4 @@ double student_t975(std::size_t dof);
 /// Summary of `samples`.
 Summary summarize(const std::vector<double>& samples);
 
-}  // namespace oneshot::sim
+}  // namespace oneshot::util

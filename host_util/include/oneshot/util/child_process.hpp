@@ -16,7 +16,7 @@
 #include <utility>
 #include <vector>
 
-namespace oneshot::host {
+namespace oneshot::util {
 
 /// A program could not be started (not installed, not executable, bad folder).
 class ProcessError : public std::runtime_error {
@@ -85,4 +85,4 @@ CapturedRun run_captured(ProcessSpec spec, std::size_t max_output = std::size_t{
 /// Full path of `program` on PATH, or empty when it is not there.
 std::string find_program(const std::string& program);
 
-}  // namespace oneshot::host
+}  // namespace oneshot::util

@@ -1,4 +1,4 @@
-/// @file host_io_test.cpp
+/// @file host_util_test.cpp
 /// @brief Host services: bounded reads, atomic writes, strict JSON, children without a shell.
 #include <gtest/gtest.h>
 
@@ -10,9 +10,9 @@
 #include <sys/resource.h>
 #include <unistd.h>
 
-#include "oneshot/host/child_process.hpp"
-#include "oneshot/host/file_io.hpp"
-#include "oneshot/host/strict_json.hpp"
+#include "oneshot/util/child_process.hpp"
+#include "oneshot/util/file_io.hpp"
+#include "oneshot/util/strict_json.hpp"
 #include "support/temp_files.hpp"
 
 namespace oneshot::host {
@@ -21,7 +21,7 @@ namespace {
 namespace fs = std::filesystem;
 
 /// A fresh empty folder `name` (any characters) for one test.
-std::string fresh_dir(const std::string& name) { return test::made_dir("oneshot_host_io", name); }
+std::string fresh_dir(const std::string& name) { return test::made_dir("oneshot_host_util", name); }
 
 std::string message_of(const std::function<void()>& f) {
   try {

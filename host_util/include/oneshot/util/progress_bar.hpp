@@ -9,7 +9,7 @@
 #include <mutex>
 #include <string>
 
-namespace oneshot::sim {
+namespace oneshot::util {
 
 /// Thread-safe progress bar.
 class ProgressBar {
@@ -34,4 +34,4 @@ class ProgressBar {
   std::mutex mutex_;
 };
 
-}  // namespace oneshot::sim
+}  // namespace oneshot::util

@@ -1,6 +1,6 @@
 /// @file termination_cleanup.cpp
 /// @brief Signal handlers ending child groups and removing temporary files.
-#include "oneshot/host/termination_cleanup.hpp"
+#include "oneshot/util/termination_cleanup.hpp"
 
 #include <array>
 #include <atomic>
@@ -10,7 +10,7 @@
 #include <mutex>
 #include <unistd.h>
 
-namespace oneshot::host {
+namespace oneshot::util {
 namespace {
 
 constexpr std::size_t kSlots = 64;
@@ -92,4 +92,4 @@ TempFileGuard::~TempFileGuard() {
   if (slot_ >= 0) g_temp[static_cast<std::size_t>(slot_)].state.store(kFree, std::memory_order_release);
 }
 
-}  // namespace oneshot::host
+}  // namespace oneshot::util
