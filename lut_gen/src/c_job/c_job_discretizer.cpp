@@ -382,14 +382,7 @@ void VariantEmitter::emit_discretize(CodeWriter& w) {
   w.line(triple_type() + " full;");
   w.open("if (tau_us < 0) {").line("tau_us = 0;").line("status = ONESHOT_JOB_STATUS_CLAMPED;").close();
   w.open("if (tau_us <= " + range + ") {").line(fn("in_range") + "(tau_us, d" + sat_arg() + ");").line("return status;").close();
-  w.line("repeats = " + divide_by_constant("tau_us", static_cast<std::uint32_t>(t.range_us), max_arg, divisions_) + ";");
-  w.line("remainder = tau_us - repeats * " + range + ";");
-  w.line("status = ONESHOT_JOB_STATUS_EXTENDED;");
-  w.open("if (repeats > 4 || (repeats == 4 && remainder > 0)) {")
-      .line("repeats = 4;")
-      .line("remainder = 0;")
-      .line("status = ONESHOT_JOB_STATUS_CLAMPED;")
-      .close();
+  emit_range_split(w, "", static_cast<std::uint32_t>(t.range_us), max_arg, divisions_);
   w.line(fn("in_range") + "(" + range + ", &full" + sat_arg() + ");");
   w.open("if (remainder > 0) {").line(fn("in_range") + "(remainder, d" + sat_arg() + ");");
   w.middle("} else {").line("*d = full;").close();

@@ -124,14 +124,7 @@ void VariantEmitter::emit_q15_advance(CodeWriter& w) {
   w.line("int32_t index;");
   w.open("if (tau_us < 0) {").line("tau_us = 0;").line("status = ONESHOT_JOB_STATUS_CLAMPED;").close();
   w.open("if (tau_us > " + range + ") {");
-  w.line("int32_t repeats = " + divide_by_constant("tau_us", static_cast<std::uint32_t>(t.range_us), max_arg, divisions_) + ";");
-  w.line("int32_t remainder = tau_us - repeats * " + range + ";");
-  w.line("status = ONESHOT_JOB_STATUS_EXTENDED;");
-  w.open("if (repeats > 4 || (repeats == 4 && remainder > 0)) {")
-      .line("repeats = 4;")
-      .line("remainder = 0;")
-      .line("status = ONESHOT_JOB_STATUS_CLAMPED;")
-      .close();
+  emit_range_split(w, "int32_t ", static_cast<std::uint32_t>(t.range_us), max_arg, divisions_);
   w.line(fn("interval") + "((uint8_t)" + std::to_string(last) + "u, " + r0 + "&d, sat);  /* the whole range */");
   w.open("for (; repeats > 0; --repeats) {").line(fn("predict") + "(s, &d, sat);").close();
   w.line("tau_us = remainder;");

@@ -57,6 +57,19 @@ std::string string_literal(const std::string& s) {
   return out;
 }
 
+void emit_range_split(CodeWriter& w, const std::string& decl, std::uint32_t range_us, std::uint32_t max_tau_us,
+                      int& divisions) {
+  const std::string range = int_literal(range_us, 32);
+  w.line(decl + "repeats = " + divide_by_constant("tau_us", range_us, max_tau_us, divisions) + ";");
+  w.line(decl + "remainder = tau_us - repeats * " + range + ";");
+  w.line("status = ONESHOT_JOB_STATUS_EXTENDED;");
+  w.open("if (repeats > 4 || (repeats == 4 && remainder > 0)) {")
+      .line("repeats = 4;")
+      .line("remainder = 0;")
+      .line("status = ONESHOT_JOB_STATUS_CLAMPED;")
+      .close();
+}
+
 std::string divide_by_constant(const std::string& x, std::uint32_t d, std::uint32_t max_x, int& divisions) {
   if (d == 0) throw std::logic_error("divide_by_constant: division by zero");
   // Strip the power of two: floor(floor(x / 2^k) / d') = floor(x / d).

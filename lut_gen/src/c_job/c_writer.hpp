@@ -64,4 +64,11 @@ std::string string_literal(const std::string& s);
 /// 32-bit reciprocal is exact on that domain.
 std::string divide_by_constant(const std::string& x, std::uint32_t d, std::uint32_t max_x, int& divisions);
 
+/// Emits the split of tau_us (> range_us) into whole ranges and a remainder, both discretizers'
+/// OutOfRange::kExtend rule: repeats = floor(tau_us / range), remainder = tau_us − repeats·range,
+/// status EXTENDED; more than 4 ranges clamp to exactly 4 (status CLAMPED). `decl` prefixes the
+/// two assignments ("int32_t " to declare them there, "" when they are declared already).
+void emit_range_split(CodeWriter& w, const std::string& decl, std::uint32_t range_us, std::uint32_t max_tau_us,
+                      int& divisions);
+
 }  // namespace oneshot::design::cjob
