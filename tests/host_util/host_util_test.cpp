@@ -15,7 +15,7 @@
 #include "oneshot/util/strict_json.hpp"
 #include "support/temp_files.hpp"
 
-namespace oneshot::host {
+namespace oneshot::util {
 namespace {
 
 namespace fs = std::filesystem;
@@ -182,4 +182,4 @@ TEST(ChildProcess, WaitForIsBounded) {
 }
 
 }  // namespace
-}  // namespace oneshot::host
+}  // namespace oneshot::util
