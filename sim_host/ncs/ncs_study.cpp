@@ -121,6 +121,9 @@ void register_ncs_study(CLI::App& app) {
     add_common(cmd, *c, "out/ncs");
     cmd->add_option("--seeds", t->seeds, "seeds per scenario")->check(CLI::Range(2, 100000))->capture_default_str();
     cmd->add_flag("--noise-free", t->noise_free, "no process or measurement noise (delays stay): A must equal I");
+    cmd->add_flag("--analytic", t->analytic,
+                  "also the exact expected cost over the noise for each run's timing (analytic_mean, analytic_ci95, "
+                  "variance_reduction; refused approaches named with the reason)");
     cmd->add_option("--duration", t->duration_s, "seconds per run")->check(CLI::Range(0.1, 3600.0))->capture_default_str();
     cmd->add_option("--scenarios", *scenario_file, "scenario file (default: the ten of the brief, sim_host/ncs/scenarios.json)")
         ->check(CLI::ExistingFile);
