@@ -121,7 +121,9 @@ std::unique_ptr<AnalyticTracker> make_tracker(const Context& ctx, const Scenario
 }
 
 void refuse_nonlinear_runs(RunResult& r) {
-  if (!r.analytic_refusal.empty()) return;
+  // These causes come first: they explain the tracker's own refusals (a clamped command
+  // takes the mean off the simulated trajectory), unless the approach is not supported at all.
+  if (r.analytic_refusal == kUnsupportedKalman || r.analytic_refusal == kFaults) return;
   if (r.saturated > 0) r.analytic_refusal = kClamp;
   else if (r.late > 0) r.analytic_refusal = kLate;
   else if (r.faults > 0) r.analytic_refusal = kInexact;

@@ -1,0 +1,139 @@
+/// @file ncs_analytic_test.cpp
+/// @brief Study ncs, analytic mode (issue 23): noise-free the expected cost is the simulated
+///        cost on every supported approach; with noise the analytic mean lies in the Monte
+///        Carlo interval of the same loop; unsupported approaches and non-linear runs are
+///        refused with the reason; the table's analytic keys.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <vector>
+
+#include "ncs_analytic.hpp"
+#include "ncs_experiments.hpp"
+#include "ncs_loop.hpp"
+#include "oneshot/sim/statistics.hpp"
+
+namespace oneshot::ncs {
+namespace {
+
+const Context& context() {
+  static const auto ctx = Context::load("");
+  return *ctx;
+}
+
+Scenario scenario(double amplitude, double d_ms, double s, double duration) {
+  Scenario sc;
+  sc.name = "test";
+  sc.amplitude_volts = amplitude;
+  sc.period_s = 1;
+  sc.max_delay_ms = d_ms;
+  sc.noise_scale = s;
+  sc.duration_s = duration;
+  return sc;
+}
+
+constexpr Approach kSupported[] = {Approach::kI,   Approach::kS,   Approach::kA,    Approach::kAK,
+                                   Approach::kAKx, Approach::kAKl, Approach::kSPlus};
+
+TEST(NcsAnalytic, NoiseFreeEqualsTheSimulatedCostOnEverySupportedApproach) {
+  RunOptions nf;
+  nf.noise_free = true;
+  nf.analytic = true;
+  double worst = 0;
+  double worst_mismatch = 0;
+  for (const Approach a : kSupported)
+    for (std::uint64_t seed = 1; seed <= 2; ++seed) {
+      const RunResult r = run(context(), a, scenario(0.5, 14, 1, 3), seed, nf);
+      ASSERT_EQ(r.analytic_refusal, "") << name(a);
+      EXPECT_EQ(r.analytic.covariance, 0) << name(a);
+      EXPECT_EQ(r.analytic.noise_path, 0) << name(a);
+      worst = std::fmax(worst, std::fabs(r.analytic.total() / r.cost - 1));
+      worst_mismatch = std::fmax(worst_mismatch, r.analytic_mismatch);
+      // With noise the mean part is still the noise-free cost the run simulated.
+      RunOptions an;
+      an.analytic = true;
+      const RunResult n = run(context(), a, scenario(0.5, 14, 4, 3), seed, an);
+      ASSERT_EQ(n.analytic_refusal, "") << name(a);
+      worst = std::fmax(worst, std::fabs(n.analytic.mean / n.cost - 1));
+      if (a != Approach::kI) {
+        EXPECT_GT(n.analytic.covariance + n.analytic.noise_path, 0) << name(a);
+      }
+    }
+  std::printf("noise-free analytic vs simulated: worst relative %.3g, worst mean mismatch %.3g\n", worst, worst_mismatch);
+  EXPECT_LT(worst, 1e-13);  // brief: 1e-9
+  EXPECT_LT(worst_mismatch, 1e-13);
+}
+
+TEST(NcsAnalytic, WithNoiseTheAnalyticMeanIsInsideTheMonteCarloInterval) {
+  const Scenario sc = scenario(0.2, 8, 16, 2);  // noise-dominated
+  RunOptions mc;
+  RunOptions an;
+  an.analytic = true;
+  for (const Approach a : {Approach::kS, Approach::kA, Approach::kAK, Approach::kAKl, Approach::kSPlus}) {
+    std::vector<double> cost;
+    std::vector<double> analytic;
+    std::vector<double> diff;
+    for (std::uint64_t seed = 1; seed <= 100; ++seed) {
+      cost.push_back(run(context(), a, sc, seed, mc).cost);
+      const RunResult r = run(context(), a, sc, seed, an);
+      ASSERT_EQ(r.analytic_refusal, "") << name(a);
+      analytic.push_back(r.analytic.total());
+      diff.push_back(cost.back() - analytic.back());
+    }
+    const sim::Summary c = sim::summarize(cost);
+    const sim::Summary e = sim::summarize(analytic);
+    const sim::Summary d = sim::summarize(diff);
+    std::printf("%s: MC %.6f ± %.6f, analytic %.6f ± %.6f, paired MC − analytic %.6f ± %.6f\n", name(a), c.mean, c.ci95,
+                e.mean, e.ci95, d.mean, d.ci95);
+    EXPECT_LT(std::fabs(e.mean - c.mean), c.ci95) << name(a);
+    EXPECT_LT(std::fabs(d.mean), d.ci95) << name(a);
+    EXPECT_LT(e.ci95, c.ci95) << name(a);  // the noise no longer adds to the interval
+  }
+}
+
+TEST(NcsAnalytic, UnsupportedApproachesAndNonLinearRunsAreRefusedWithTheReason) {
+  RunOptions an;
+  an.analytic = true;
+  for (const Approach a : {Approach::kSK, Approach::kIK}) {
+    const RunResult r = run(context(), a, scenario(0.5, 8, 1, 1), 1, an);
+    EXPECT_EQ(r.analytic_refusal, analytic_unsupported_reason(a)) << name(a);
+    EXPECT_NE(r.analytic_refusal, "");
+  }
+  // A 4 V step drives the command into the ±1.65 V clamp: no longer affine.
+  const RunResult big = run(context(), Approach::kAK, scenario(4, 8, 1, 2), 1, an);
+  EXPECT_GT(big.saturated, 0U);
+  EXPECT_EQ(big.analytic_refusal, "the noise-free trajectory reaches the actuator's clamp");
+  // Chains longer than h: late commands.
+  const RunResult late = run(context(), Approach::kA, scenario(0.5, 40, 1, 2), 1, an);
+  EXPECT_GT(late.late, 0U);
+  EXPECT_NE(late.analytic_refusal, "");
+  RunOptions faulty = an;
+  faulty.faults = engine::parse_fault_spec("dup:link=sc,rate=0.5");
+  EXPECT_NE(run(context(), Approach::kA, scenario(0.5, 8, 1, 1), 1, faulty).analytic_refusal, "");
+  EXPECT_EQ(analytic_refusal_code(""), 0);
+  EXPECT_STREQ(analytic_refusal_text(analytic_refusal_code(big.analytic_refusal)), big.analytic_refusal.c_str());
+}
+
+TEST(NcsAnalytic, TableReportsTheAnalyticKeys) {
+  TableOptions t;
+  t.seeds = 3;
+  t.threads = 1;
+  t.analytic = true;
+  t.approaches = {Approach::kI, Approach::kA, Approach::kAK, Approach::kSK};
+  t.scenarios = {scenario(0.5, 8, 4, 2)};
+  const nlohmann::json j = table_outputs(table_sweep(context(), t, engine::Shard{}), testing::TempDir() + "ncs_analytic",
+                                         false);
+  for (const char* a : {"A", "AK"}) {
+    const auto& e = j.at("approaches").at(a);
+    EXPECT_GT(e.at("analytic_mean").get<double>(), 0) << a;
+    EXPECT_GT(e.at("analytic_ci95").get<double>(), 0) << a;
+    EXPECT_GT(e.at("variance_reduction").get<double>(), 1) << a;
+    EXPECT_TRUE(e.contains("cost_mean") && e.contains("cost_ci95"));
+  }
+  EXPECT_EQ(j.at("approaches").at("SK").at("analytic_refused").get<std::string>(), analytic_unsupported_reason(Approach::kSK));
+  EXPECT_GT(j.at("variance_reduction").get<double>(), 1);
+}
+
+}  // namespace
+}  // namespace oneshot::ncs
