@@ -9,9 +9,6 @@ namespace oneshot::ncs {
 
 namespace {
 
-constexpr const char* kUnsupportedKalman =
-    "the core StandardKalman cannot be probed: its x̂ can only be set through reset(), which re-arms its "
-    "first-sample flag (no prediction at the next update), so a copy does not reproduce the node's map";
 constexpr const char* kClamp = "the noise-free trajectory reaches the actuator's clamp";
 constexpr const char* kLate = "a command was late (held)";
 constexpr const char* kInexact = "an estimator run was not exact";
@@ -21,14 +18,9 @@ constexpr const char* kTwoSamples = "two samples in flight before a computation"
 constexpr const char* kNoSample = "a computation without a new sample";
 constexpr const char* kTwice = "a command applied twice";
 /// Every reason, by code (1 …).
-constexpr const char* kReasons[] = {kUnsupportedKalman, kClamp, kLate, kInexact, kFaults,
-                                    kMismatch,          kTwoSamples, kNoSample, kTwice};
+constexpr const char* kReasons[] = {kClamp, kLate, kInexact, kFaults, kMismatch, kTwoSamples, kNoSample, kTwice};
 
 }  // namespace
-
-const char* analytic_unsupported_reason(Approach a) {
-  return a == Approach::kSK || a == Approach::kIK ? kUnsupportedKalman : "";
-}
 
 int analytic_refusal_code(const std::string& reason) {
   if (reason.empty()) return 0;
@@ -111,11 +103,11 @@ std::unique_ptr<AnalyticTracker> make_tracker(const Context& ctx, const Scenario
   const bool noisy = !opt.noise_free && a != Approach::kI;
   const auto pc = plant_config(ctx, sc, noisy);
   const engine::JumpLinearPlant<kN, kM> jp{pc.a, pc.b, noisy ? pc.qc : Matrix<double, kN, kN>{}, pc.q1c, pc.q2c};
-  // The memory starts as the nodes' objects do: x̂ = x0 (synchronized estimators), S+'s u_{k−1} = 0.
-  const Vector<double, kN> mem0 = actuation_synchronized(a) ? x0 : Vector<double, kN>{};
+  // The memory starts as the nodes' objects do: x̂ = x0 (estimators), S+'s u_{k−1} = 0.
+  const bool filter = actuation_synchronized(a) || a == Approach::kSK || a == Approach::kIK;
+  const Vector<double, kN> mem0 = filter ? x0 : Vector<double, kN>{};
   auto t = std::make_unique<AnalyticTracker>(jp, pc.c, noisy ? d.r : Matrix<double, kP, kP>{}, d.l, x0, mem0);
   t->set_reference(x0, u_ref0);
-  if (*analytic_unsupported_reason(a) != 0) t->refuse(analytic_unsupported_reason(a));
   if (!opt.faults.empty()) t->refuse(kFaults);
   return t;
 }
@@ -123,7 +115,7 @@ std::unique_ptr<AnalyticTracker> make_tracker(const Context& ctx, const Scenario
 void refuse_nonlinear_runs(RunResult& r) {
   // These causes come first: they explain the tracker's own refusals (a clamped command
   // takes the mean off the simulated trajectory), unless the approach is not supported at all.
-  if (r.analytic_refusal == kUnsupportedKalman || r.analytic_refusal == kFaults) return;
+  if (r.analytic_refusal == kFaults) return;
   if (r.saturated > 0) r.analytic_refusal = kClamp;
   else if (r.late > 0) r.analytic_refusal = kLate;
   else if (r.faults > 0) r.analytic_refusal = kInexact;

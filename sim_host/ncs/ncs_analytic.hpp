@@ -13,9 +13,9 @@
 ///  - an apply:   u ← command, echo ← u (the value the next request carries).
 /// Every mean is checked against the value the simulated nodes produced (y, x̂, u): the largest
 /// difference is reported and a run whose difference passes 1e-9 of the signal is refused.
-/// Refused too: the loops whose map cannot be probed (SK, IK: the core StandardKalman has no
-/// way to set x̂ on a copy without re-arming its first-sample flag), runs with a clamped,
-/// late or filled command, two samples in flight, or injected faults.
+/// Every approach of the study is linear given the timing; a run is refused (with the reason)
+/// when a command was clamped, late or filled, an estimator run inexact, two samples in flight,
+/// or faults injected.
 #pragma once
 
 #include <cmath>
@@ -35,6 +35,7 @@
 #include "oneshot/node/message.hpp"
 #include "oneshot/node/sampling_sync_laws.hpp"
 #include "oneshot/node/sync_estimators.hpp"
+#include "oneshot/standard_kalman.hpp"
 
 namespace oneshot::ncs {
 
@@ -42,8 +43,6 @@ inline constexpr std::size_t kZ = 10;  ///< Size of the closed-loop state z.
 /// Offsets in z: plant state, held input, sample in flight, controller memory, command, echo.
 enum ZIndex : std::size_t { kZx = 0, kZu = 2, kZy = 3, kZmem = 5, kZcmd = 8, kZecho = 9 };
 
-/// Why an approach has no analytic cost ("" when it has one).
-const char* analytic_unsupported_reason(Approach a);
 /// The code of a refusal reason (0: none; the table stores it per run).
 int analytic_refusal_code(const std::string& reason);
 /// The reason of a refusal code.
@@ -65,15 +64,50 @@ void set_estimate(node::HalfKalmanEstimator<F, S, D>& e, const Vector<double, kN
 template <typename F, typename S, typename D>
 void set_estimate(node::SampledStatePredictor<F, S, D>&, const Vector<double, kN>&, const Vector<double, kM>&) {}
 
-/// A law copy's memory set to `m` (S+: u_{k−1}; static feedback: none).
+/// x̂ of a StandardKalman copy set to `x`, P and the first-sample flag kept: through the
+/// filter's protected core, on a probe derived from it and sliced back.
+template <typename F, typename S>
+void set_filter_estimate(StandardKalman<F, S>& f, const Vector<double, kN>& x) {
+  struct Probe : StandardKalman<F, S> {
+    explicit Probe(const StandardKalman<F, S>& b) : StandardKalman<F, S>(b) {}
+    void set(const Vector<double, kN>& v) { this->core_.reset(v, this->core_.covariance()); }
+  };
+  Probe p(f);
+  p.set(x);
+  f = p;
+}
+
+/// A law's memory in z: S+ [u_{k−1}; 0; 0], static feedback none, the periodic Kalman law
+/// [x̂ (2); the input it predicts with]. get_memory reads it, set_memory sets it on a copy.
+template <typename R>
+Vector<double, 3> get_memory(node::DelayCompensatedLaw<double, kN, kM, R>& law) { return Vector<double, 3>({law.u_prev[0], 0, 0}); }
+/// S+: u_{k−1}.
 template <typename R>
 void set_memory(node::DelayCompensatedLaw<double, kN, kM, R>& law, const Vector<double, 3>& m) { law.u_prev[0] = m[0]; }
 /// Static feedback has no memory.
 template <typename R>
+Vector<double, 3> get_memory(node::StateFeedbackLaw<double, kN, kM, R>&) { return Vector<double, 3>{}; }
+/// Static feedback has no memory.
+template <typename R>
 void set_memory(node::StateFeedbackLaw<double, kN, kM, R>&, const Vector<double, 3>&) {}
-/// The periodic Kalman law's x̂ cannot be set on a copy (analytic_unsupported_reason): its runs are refused.
+/// The periodic Kalman law: x̂ and its applied input.
 template <typename F, typename S, typename R>
-void set_memory(node::PeriodicKalmanLaw<F, S, R>&, const Vector<double, 3>&) {}
+Vector<double, 3> get_memory(node::PeriodicKalmanLaw<F, S, R>& law, const Vector<double, kM>& u) {
+  const auto& x = law.filter().prediction();
+  return Vector<double, 3>({x[0], x[1], u[0]});
+}
+/// The periodic Kalman law: x̂ and its applied input.
+template <typename F, typename S, typename R>
+void set_memory(node::PeriodicKalmanLaw<F, S, R>& law, const Vector<double, 3>& m) {
+  set_filter_estimate(law.filter(), Vector<double, kN>({m[0], m[1]}));
+  law.filter().set_applied_input(Vector<double, kM>({m[2]}));
+}
+/// The memory after a computation that sent u (the laws without a filter ignore u).
+template <typename Law>
+Vector<double, 3> memory_after(Law& law, const Vector<double, kM>&) { return get_memory(law); }
+/// The periodic Kalman law: x̂ and u.
+template <typename F, typename S, typename R>
+Vector<double, 3> memory_after(node::PeriodicKalmanLaw<F, S, R>& law, const Vector<double, kM>& u) { return get_memory(law, u); }
 
 /// Mean and covariance of z through one run's events, and the expected cost.
 class AnalyticTracker {
@@ -133,20 +167,21 @@ class AnalyticTracker {
   template <typename Law>
   void compute_law(const Law& before, node::SequenceNumber seq) {
     if (!take_sample()) return;
-    const std::size_t idx[3] = {kZy, kZy + 1, kZmem};
-    const auto eval = [&](const Vector<double, 3>& w) {
+    const std::size_t idx[5] = {kZy, kZy + 1, kZmem, kZmem + 1, kZmem + 2};
+    const auto eval = [&](const Vector<double, 5>& w) {
       Law law = before;
-      set_memory(law, Vector<double, 3>({w[2], 0, 0}));
+      set_memory(law, Vector<double, 3>({w[2], w[3], w[4]}));
       node::Message<node::VectorPayload<double, kN>> m{};
       m.seq = seq;
       m.payload.value = Vector<double, kN>({w[0], w[1]});
       Vector<double, kM> u{};
       (void)law.compute(m, true, McuInstant{}, u);
-      return Vector<double, 2>({u[0], u[0]});  // the command and the memory (u_{k−1} ← u)
+      const Vector<double, 3> mem = memory_after(law, u);
+      return Vector<double, 4>({u[0], mem[0], mem[1], mem[2]});  // the command and the memory after
     };
     Map e = Map::identity();
     Z g{};
-    probe<3, 2>(eval, idx, {kZcmd, kZmem}, 1e-4, e, g);
+    probe<5, 4>(eval, idx, {kZcmd, kZmem, kZmem + 1, kZmem + 2}, 1e-4, e, g);
     jl_.jump(e, g);
     cmd_fresh_ = true;
   }
@@ -210,7 +245,7 @@ class AnalyticTracker {
 
 /// The tracker of a run of `a` on `sc` (noise of the approach unless `opt.noise_free`; I has
 /// none), started at x0 with x̂ = x0 and the set-point (x0, u_ref0); refused from the start
-/// when the approach is unsupported or faults are injected.
+/// when faults are injected.
 std::unique_ptr<AnalyticTracker> make_tracker(const Context& ctx, const Scenario& sc, Approach a, const Design& d,
                                               const RunOptions& opt, const Vector<double, kN>& x0,
                                               const Vector<double, kM>& u_ref0);

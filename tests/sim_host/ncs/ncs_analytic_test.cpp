@@ -1,8 +1,8 @@
 /// @file ncs_analytic_test.cpp
 /// @brief Study ncs, analytic mode (issue 23): noise-free the expected cost is the simulated
-///        cost on every supported approach; with noise the analytic mean lies in the Monte
-///        Carlo interval of the same loop; unsupported approaches and non-linear runs are
-///        refused with the reason; the table's analytic keys.
+///        cost on every approach; with noise the analytic mean lies in the Monte
+///        Carlo interval of the same loop; runs that leave the linear regime are refused
+///        with the reason; the table's analytic keys.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -33,16 +33,14 @@ Scenario scenario(double amplitude, double d_ms, double s, double duration) {
   return sc;
 }
 
-constexpr Approach kSupported[] = {Approach::kI,   Approach::kS,   Approach::kA,    Approach::kAK,
-                                   Approach::kAKx, Approach::kAKl, Approach::kSPlus};
 
-TEST(NcsAnalytic, NoiseFreeEqualsTheSimulatedCostOnEverySupportedApproach) {
+TEST(NcsAnalytic, NoiseFreeEqualsTheSimulatedCostOnEveryApproach) {
   RunOptions nf;
   nf.noise_free = true;
   nf.analytic = true;
   double worst = 0;
   double worst_mismatch = 0;
-  for (const Approach a : kSupported)
+  for (const Approach a : kAllApproaches)
     for (std::uint64_t seed = 1; seed <= 2; ++seed) {
       const RunResult r = run(context(), a, scenario(0.5, 14, 1, 3), seed, nf);
       ASSERT_EQ(r.analytic_refusal, "") << name(a);
@@ -70,7 +68,8 @@ TEST(NcsAnalytic, WithNoiseTheAnalyticMeanIsInsideTheMonteCarloInterval) {
   RunOptions mc;
   RunOptions an;
   an.analytic = true;
-  for (const Approach a : {Approach::kS, Approach::kA, Approach::kAK, Approach::kAKl, Approach::kSPlus}) {
+  for (const Approach a : {Approach::kS, Approach::kA, Approach::kAK, Approach::kAKl, Approach::kSK, Approach::kSPlus,
+                           Approach::kIK}) {
     std::vector<double> cost;
     std::vector<double> analytic;
     std::vector<double> diff;
@@ -92,14 +91,9 @@ TEST(NcsAnalytic, WithNoiseTheAnalyticMeanIsInsideTheMonteCarloInterval) {
   }
 }
 
-TEST(NcsAnalytic, UnsupportedApproachesAndNonLinearRunsAreRefusedWithTheReason) {
+TEST(NcsAnalytic, NonLinearRunsAreRefusedWithTheReason) {
   RunOptions an;
   an.analytic = true;
-  for (const Approach a : {Approach::kSK, Approach::kIK}) {
-    const RunResult r = run(context(), a, scenario(0.5, 8, 1, 1), 1, an);
-    EXPECT_EQ(r.analytic_refusal, analytic_unsupported_reason(a)) << name(a);
-    EXPECT_NE(r.analytic_refusal, "");
-  }
   // A 4 V step drives the command into the ±1.65 V clamp: no longer affine.
   const RunResult big = run(context(), Approach::kAK, scenario(4, 8, 1, 2), 1, an);
   EXPECT_GT(big.saturated, 0U);
@@ -124,15 +118,17 @@ TEST(NcsAnalytic, TableReportsTheAnalyticKeys) {
   t.scenarios = {scenario(0.5, 8, 4, 2)};
   const nlohmann::json j = table_outputs(table_sweep(context(), t, engine::Shard{}), testing::TempDir() + "ncs_analytic",
                                          false);
-  for (const char* a : {"A", "AK"}) {
+  for (const char* a : {"A", "AK", "SK"}) {
     const auto& e = j.at("approaches").at(a);
     EXPECT_GT(e.at("analytic_mean").get<double>(), 0) << a;
     EXPECT_GT(e.at("analytic_ci95").get<double>(), 0) << a;
-    EXPECT_GT(e.at("variance_reduction").get<double>(), 1) << a;
-    EXPECT_TRUE(e.contains("cost_mean") && e.contains("cost_ci95"));
+    EXPECT_GT(e.at("variance_reduction").get<double>(), 0) << a;
+    EXPECT_TRUE(e.contains("cost_mean") && e.contains("cost_ci95") && e.contains("mc_minus_analytic_ci95"));
   }
-  EXPECT_EQ(j.at("approaches").at("SK").at("analytic_refused").get<std::string>(), analytic_unsupported_reason(Approach::kSK));
-  EXPECT_GT(j.at("variance_reduction").get<double>(), 1);
+  // The filters' cost hardly depends on the delays: the noise was nearly all of the interval.
+  EXPECT_GT(j.at("approaches").at("AK").at("variance_reduction").get<double>(), 100);
+  // SK's cost varies with the delays it does not model: the table's figure (the smallest) is its.
+  EXPECT_EQ(j.at("variance_reduction").get<double>(), j.at("approaches").at("SK").at("variance_reduction").get<double>());
 }
 
 }  // namespace
