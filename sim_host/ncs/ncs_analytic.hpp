@@ -47,9 +47,13 @@ enum ZIndex : std::size_t { kZx = 0, kZu = 2, kZy = 3, kZmem = 5, kZcmd = 8, kZe
 int analytic_refusal_code(const std::string& reason);
 /// The reason of a refusal code.
 const char* analytic_refusal_text(int code);
+/// `ncs analytic-benchmark`: ns per flow and per jump of the engine's propagation on z, and
+/// the wall time of an analytic AK run beside the noise-free run (a benchmark, not a test).
+nlohmann::json analytic_benchmark(const Context& ctx, std::uint64_t seed);
 /// `ncs table --analytic`: per approach analytic_mean, analytic_ci95 (over the timing
 /// draws), the analytic ratio to I, the paired MC − analytic, variance_reduction (or
-/// analytic_refused with the reason), the table's variance_reduction (the smallest), and a
+/// analytic_refused with the reason), the table's variance_reduction (the smallest; and the
+/// median, variance_reduction_median), and a
 /// markdown table appended to `md`; `mc` is the summary of the Monte Carlo cost.
 void analytic_outputs(const engine::SweepResults& results, const engine::SweepSummary& mc, nlohmann::json& j,
                       std::ostringstream& md);

@@ -9,6 +9,7 @@
 #include <memory>
 #include <sstream>
 
+#include "ncs_analytic.hpp"
 #include "ncs_experiments.hpp"
 #include "ncs_faults.hpp"
 #include "ncs_live.hpp"
@@ -192,6 +193,14 @@ void register_ncs_study(CLI::App& app) {
       j["experiment"] = "report";
       emit(*c, j);
     });
+  }
+  {
+    auto c = std::make_shared<NcsCli>();
+    CLI::App* cmd = study->add_subcommand("analytic-benchmark",
+                                          "Cost of `table --analytic`: covariance propagation per event, analytic run "
+                                          "against the noise-free run (benchmark, not a test)");
+    add_common(cmd, *c, "out/ncs-analytic-benchmark");
+    cmd->callback([c]() { emit(*c, ncs::analytic_benchmark(*ncs::Context::load(c->plant), c->seed)); });
   }
   add_ncs_live_commands(study);
   add_ncs_faults_command(study);
