@@ -53,7 +53,8 @@ nlohmann::json analytic_benchmark(const Context& ctx, std::uint64_t seed);
 /// `ncs table --analytic`: per approach analytic_mean, analytic_ci95 (over the timing
 /// draws), the analytic ratio to I, the paired MC − analytic, variance_reduction (or
 /// analytic_refused with the reason), the table's variance_reduction (the smallest; and the
-/// median, variance_reduction_median), and a
+/// median, variance_reduction_median), analytic_paired_differences (per seed, as
+/// paired_differences), and a
 /// markdown table appended to `md`; `mc` is the summary of the Monte Carlo cost.
 void analytic_outputs(const engine::SweepResults& results, const engine::SweepSummary& mc, nlohmann::json& j,
                       std::ostringstream& md);

@@ -77,6 +77,10 @@ void analytic_outputs(const engine::SweepResults& results, const engine::SweepSu
                   std::isfinite(vr) ? std::to_string(vr).c_str() : "∞ (no timing spread)");
     md << line;
   }
+  for (const auto& p : an.paired) {
+    j["analytic_paired_differences"][spec.approaches[p.a] + "-" + spec.approaches[p.b]] = {{"mean", p.diff.mean},
+                                                                                          {"ci95", p.diff.ci95}};
+  }
   // The table's figure: the smallest reduction over the approaches with a spread (and their median).
   if (std::isfinite(table_vr)) {
     j["variance_reduction"] = table_vr;
