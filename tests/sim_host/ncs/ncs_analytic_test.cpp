@@ -12,26 +12,11 @@
 #include "ncs_analytic.hpp"
 #include "ncs_experiments.hpp"
 #include "ncs_loop.hpp"
+#include "ncs_test_support.hpp"
 #include "oneshot/sim/statistics.hpp"
 
 namespace oneshot::ncs {
 namespace {
-
-const Context& context() {
-  static const auto ctx = Context::load("");
-  return *ctx;
-}
-
-Scenario scenario(double amplitude, double d_ms, double s, double duration) {
-  Scenario sc;
-  sc.name = "test";
-  sc.amplitude_volts = amplitude;
-  sc.period_s = 1;
-  sc.max_delay_ms = d_ms;
-  sc.noise_scale = s;
-  sc.duration_s = duration;
-  return sc;
-}
 
 
 TEST(NcsAnalytic, NoiseFreeEqualsTheSimulatedCostOnEveryApproach) {
@@ -42,7 +27,7 @@ TEST(NcsAnalytic, NoiseFreeEqualsTheSimulatedCostOnEveryApproach) {
   double worst_mismatch = 0;
   for (const Approach a : kAllApproaches)
     for (std::uint64_t seed = 1; seed <= 2; ++seed) {
-      const RunResult r = run(context(), a, scenario(0.5, 14, 1, 3), seed, nf);
+      const RunResult r = run(context(), a, short_scenario(0.5, 14, 1, 3), seed, nf);
       ASSERT_EQ(r.analytic_refusal, "") << name(a);
       EXPECT_EQ(r.analytic.covariance, 0) << name(a);
       EXPECT_EQ(r.analytic.noise_path, 0) << name(a);
@@ -51,7 +36,7 @@ TEST(NcsAnalytic, NoiseFreeEqualsTheSimulatedCostOnEveryApproach) {
       // With noise the mean part is still the noise-free cost the run simulated.
       RunOptions an;
       an.analytic = true;
-      const RunResult n = run(context(), a, scenario(0.5, 14, 4, 3), seed, an);
+      const RunResult n = run(context(), a, short_scenario(0.5, 14, 4, 3), seed, an);
       ASSERT_EQ(n.analytic_refusal, "") << name(a);
       worst = std::fmax(worst, std::fabs(n.analytic.mean / n.cost - 1));
       if (a != Approach::kI) {
@@ -64,7 +49,7 @@ TEST(NcsAnalytic, NoiseFreeEqualsTheSimulatedCostOnEveryApproach) {
 }
 
 TEST(NcsAnalytic, WithNoiseTheAnalyticMeanIsInsideTheMonteCarloInterval) {
-  const Scenario sc = scenario(0.2, 8, 16, 2);  // noise-dominated
+  const Scenario sc = short_scenario(0.2, 8, 16, 2);  // noise-dominated
   RunOptions mc;
   RunOptions an;
   an.analytic = true;
@@ -95,16 +80,16 @@ TEST(NcsAnalytic, NonLinearRunsAreRefusedWithTheReason) {
   RunOptions an;
   an.analytic = true;
   // A 4 V step drives the command into the ±1.65 V clamp: no longer affine.
-  const RunResult big = run(context(), Approach::kAK, scenario(4, 8, 1, 2), 1, an);
+  const RunResult big = run(context(), Approach::kAK, short_scenario(4, 8, 1, 2), 1, an);
   EXPECT_GT(big.saturated, 0U);
   EXPECT_EQ(big.analytic_refusal, "the noise-free trajectory reaches the actuator's clamp");
   // Chains longer than h: late commands.
-  const RunResult late = run(context(), Approach::kA, scenario(0.5, 40, 1, 2), 1, an);
+  const RunResult late = run(context(), Approach::kA, short_scenario(0.5, 40, 1, 2), 1, an);
   EXPECT_GT(late.late, 0U);
   EXPECT_NE(late.analytic_refusal, "");
   RunOptions faulty = an;
   faulty.faults = engine::parse_fault_spec("dup:link=sc,rate=0.5");
-  EXPECT_NE(run(context(), Approach::kA, scenario(0.5, 8, 1, 1), 1, faulty).analytic_refusal, "");
+  EXPECT_NE(run(context(), Approach::kA, short_scenario(0.5, 8, 1, 1), 1, faulty).analytic_refusal, "");
   EXPECT_EQ(analytic_refusal_code(""), 0);
   EXPECT_STREQ(analytic_refusal_text(analytic_refusal_code(big.analytic_refusal)), big.analytic_refusal.c_str());
 }
@@ -115,7 +100,7 @@ TEST(NcsAnalytic, TableReportsTheAnalyticKeys) {
   t.threads = 1;
   t.analytic = true;
   t.approaches = {Approach::kI, Approach::kA, Approach::kAK, Approach::kSK};
-  t.scenarios = {scenario(0.5, 8, 4, 2)};
+  t.scenarios = {short_scenario(0.5, 8, 4, 2)};
   const nlohmann::json j = table_outputs(table_sweep(context(), t, engine::Shard{}), testing::TempDir() + "ncs_analytic",
                                          false);
   for (const char* a : {"A", "AK", "SK"}) {

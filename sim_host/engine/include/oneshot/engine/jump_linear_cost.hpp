@@ -20,7 +20,6 @@
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
-#include <unordered_map>
 
 #include "oneshot/engine/exact_segment.hpp"
 #include "oneshot/engine/process_noise.hpp"
@@ -117,10 +116,10 @@ class JumpLinearCost {
     for (std::size_t i = 0; i < K; ++i)
       for (std::size_t j = 0; j < N; ++j) s_(i, j) = cols(i, j);
     if (noisy_) {
-      const Entry& en = entry(delta);
+      const Matrix<double, N, N>& qd = noise_.interval_covariance(delta);
       for (std::size_t i = 0; i < N; ++i)
-        for (std::size_t j = 0; j < N; ++j) s_(i, j) += en.qd(i, j);
-      cost_.noise_path += en.cost;
+        for (std::size_t j = 0; j < N; ++j) s_(i, j) += qd(i, j);
+      cost_.noise_path += noise_.interval_cost(delta);
     }
     mirror_upper(s_);
   }
@@ -144,20 +143,6 @@ class JumpLinearCost {
   const ExpectedCost& cost() const { return cost_; }  ///< Expected cost so far.
 
  private:
-  struct Entry {
-    Matrix<double, N, N> qd;
-    double cost = 0;
-  };
-  const Entry& entry(Duration delta) {
-    const auto it = cache_.find(delta.count());
-    if (it != cache_.end()) return it->second;
-    if (cache_.size() > 8192) cache_.clear();
-    Entry en;
-    en.qd = noise_.covariance(delta);
-    en.cost = noise_.expected_cost(delta);
-    return cache_.emplace(delta.count(), en).first->second;
-  }
-
   JumpLinearPlant<N, M> plant_;
   ProcessNoise<N> noise_;
   ExactSegmentCache<N, M> segments_;
@@ -167,7 +152,6 @@ class JumpLinearCost {
   Vector<double, N> x_ref_{};
   Vector<double, M> u_ref_{};
   ExpectedCost cost_{};
-  std::unordered_map<std::int64_t, Entry> cache_;
 };
 
 }  // namespace oneshot::engine
