@@ -285,5 +285,36 @@ TEST(JumpLinearCost, WithNoiseInsideTheMonteCarloInterval) {
   EXPECT_GT(jl.cost().covariance + jl.cost().noise_path, 0.2 * jl.cost().total());  // noise matters here
 }
 
+TEST(JumpLinearCost, EventCostIsTheQuadraticMeanPlusTheTrace) {
+  // z = m + chol·n: E[(z − c)ᵀ W (z − c)] by its definition over a Monte Carlo of 20000 draws.
+  Jlc jl(engine_plant(designed(), true));
+  Jlc::Z m({1, -0.5, 0.2, 0.3, 0});
+  Jlc::Cov l;  // lower factor
+  RandomStream rng(3, "factor");
+  for (std::size_t i = 0; i < kK; ++i)
+    for (std::size_t j = 0; j <= i; ++j) l(i, j) = rng.uniform(-0.5, 0.5) + (i == j ? 1 : 0);
+  jl.reset(m, l * l.transposed());
+  Jlc::Map w;
+  for (std::size_t i = 0; i < kK; ++i) w(i, i) = 1 + static_cast<double>(i);
+  w(0, 1) = w(1, 0) = 0.3;
+  Jlc::Z c({0.5, 0, 0, 0, 1});
+  jl.add_event_cost(w, c);
+  double sum = 0;
+  double sum2 = 0;
+  const int n = 20000;
+  RandomStream draws(4, "draws");
+  for (int k = 0; k < n; ++k) {
+    Jlc::Z v;
+    for (std::size_t i = 0; i < kK; ++i) v[i] = draws.normal();
+    const double q = quadratic_form(w, Jlc::Z(m + l * v - c));
+    sum += q;
+    sum2 += q * q;
+  }
+  const double mean = sum / n;
+  const double half = 1.96 * std::sqrt((sum2 - n * mean * mean) / (n - 1) / n);
+  EXPECT_LT(std::fabs(jl.cost().total() - mean), half) << jl.cost().total() << " vs " << mean << " ± " << half;
+  EXPECT_NEAR(jl.cost().mean, quadratic_form(w, Jlc::Z(m - c)), 1e-15);
+}
+
 }  // namespace
 }  // namespace oneshot::engine

@@ -14,7 +14,8 @@
 /// (G from exact_segment.hpp, the last term from process_noise.hpp; all cached per Δ).
 /// At an event the study supplies the affine map z⁺ = E z + F v + g, v ~ N(0, R) drawn
 /// there (measurement noise):  m⁺ = E m + g,  Σ⁺ = E Σ Eᵀ + F R Fᵀ.
-/// The engine knows no study: the event maps come from the caller.
+/// A discrete cost at an event, E[(z − c)ᵀW(z − c)] = (m − c)ᵀW(m − c) + tr(WΣ), is
+/// add_event_cost(). The engine knows no study: the event maps come from the caller.
 #pragma once
 
 #include <cmath>
@@ -136,6 +137,18 @@ class JumpLinearCost {
     m_ = e * m_ + g;
     s_ = e * s_ * e.transposed();
     mirror_upper(s_);
+  }
+
+  /// A discrete cost term at an event (a discrete plant's per-step cost, a penalty per
+  /// message): E[(z − c)ᵀ W (z − c)] = (m − c)ᵀ W (m − c) + tr(W Σ), added to the mean and
+  /// covariance parts.
+  void add_event_cost(const Map& w, const Z& c) {
+    const Z d = m_ - c;
+    double tr = 0;
+    for (std::size_t i = 0; i < K; ++i)
+      for (std::size_t j = 0; j < K; ++j) tr += w(i, j) * s_(j, i);
+    cost_.mean += quadratic_form(w, d);
+    cost_.covariance += tr;
   }
 
   const Z& mean() const { return m_; }              ///< m = E z now.
