@@ -39,6 +39,9 @@ struct RunOptions {
   /// Also the exact expected cost over the noise for this run's timing (ncs_analytic.hpp);
   /// the simulation itself then runs noise-free (same delays and τ_c: streams per source).
   bool analytic = false;
+  /// ≠ 0: the process and measurement noise drawn from this seed, the timing still from the
+  /// run's (a Monte Carlo over the noise alone for one timing draw).
+  std::uint64_t noise_seed = 0;
 };
 
 /// One row of a recorded sample or estimate.

@@ -76,6 +76,28 @@ TEST(NcsAnalytic, WithNoiseTheAnalyticMeanIsInsideTheMonteCarloInterval) {
   }
 }
 
+/// One timing draw, the noise alone drawn again and again: the sharpest check of the
+/// covariance maps (half Kalman, StandardKalman probe, S+'s memory, the filterless predictor).
+TEST(NcsAnalytic, OneTimingDrawAgainstAMonteCarloOverTheNoiseAlone) {
+  const Scenario sc = short_scenario(0.2, 8, 16, 2);
+  RunOptions an;
+  an.analytic = true;
+  for (const Approach a : {Approach::kA, Approach::kAK, Approach::kSK, Approach::kSPlus}) {
+    const RunResult r = run(context(), a, sc, 7, an);
+    ASSERT_EQ(r.analytic_refusal, "") << name(a);
+    std::vector<double> cost;
+    RunOptions mc;
+    for (std::uint64_t n = 1; n <= 1000; ++n) {
+      mc.noise_seed = 1000 + n;
+      cost.push_back(run(context(), a, sc, 7, mc).cost);
+    }
+    const sim::Summary c = sim::summarize(cost);
+    std::printf("%s, timing seed 7: MC over the noise %.6f ± %.6f (%.2f %%), analytic %.6f\n", name(a), c.mean, c.ci95,
+                100 * c.ci95 / c.mean, r.analytic.total());
+    EXPECT_LT(std::fabs(r.analytic.total() - c.mean), c.ci95) << name(a);
+  }
+}
+
 TEST(NcsAnalytic, NonLinearRunsAreRefusedWithTheReason) {
   RunOptions an;
   an.analytic = true;
