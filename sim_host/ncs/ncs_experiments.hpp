@@ -26,6 +26,7 @@ struct TableOptions {
   std::vector<Scenario> scenarios;  ///< Scenarios (empty: the ten defaults, with duration_s).
   double duration_s = 20;          ///< Run length per default scenario.
   engine::FaultSpec faults;        ///< Faults injected in every run (empty: clean).
+  bool analytic = false;           ///< Also E[J] over the noise per run's timing (ncs_analytic.hpp).
 };
 
 /// Runs the table's sweep (or one shard of it).

@@ -8,6 +8,7 @@
 #include <optional>
 #include <stdexcept>
 
+#include "ncs_analytic.hpp"
 #include "ncs_counters.hpp"
 #include "oneshot/engine/continuous_plant.hpp"
 #include "oneshot/engine/kernel.hpp"
@@ -53,9 +54,10 @@ class Harness {
         design_(ctx.controller_design(sc.noise_scale)),
         disc_(ctx.discretizer_model(sc.noise_scale)),
         kernel_(seed),
-        plant_(plant_config(ctx, sc, noisy(a, opt)), kernel_.stream("process")),
+        plant_(plant_config(ctx, sc, noisy(a, opt)),
+               engine::RandomStream(opt.noise_seed != 0 ? opt.noise_seed : seed, "process")),
         net_(kernel_),
-        measurement_(kernel_.stream("measurement")),
+        measurement_(opt.noise_seed != 0 ? opt.noise_seed : seed, "measurement"),
         compute_(kernel_.stream("compute")),
         ref_(reference(ctx, sc)),
         noisy_(noisy(a, opt)),
@@ -74,21 +76,30 @@ class Harness {
     const Vector<double, kN> x0 = ref_.state(0);
     plant_.set_state(x0);
     plant_.set_reference(x0, ref_.input(0));
+    if (opt.analytic) an_ = make_tracker(ctx, sc, a, design_, opt, x0, ref_.input(0));
     if (opt.trace_step_s > 0) plant_.record_trace(engine::from_seconds(opt.trace_step_s, "trace step"), kernel_.stream("trace"));
     // Set-point switches on the kh grid (before anything else at that instant but the plant).
     const HandlerId sw = kernel_.add_handler("setpoint", [this](std::uint64_t k) {
-      plant_.advance_to(kernel_.now());
-      plant_.set_reference(ref_.state(static_cast<node::SequenceNumber>(k)), ref_.input(static_cast<node::SequenceNumber>(k)));
+      advance();
+      const auto kk = static_cast<node::SequenceNumber>(k);
+      plant_.set_reference(ref_.state(kk), ref_.input(kk));
+      if (an_) an_->set_reference(ref_.state(kk), ref_.input(kk));
     });
     const std::uint64_t half = half_wave_periods(ctx, sc);
     for (std::uint64_t k = half; SimTime{h_ * static_cast<std::int64_t>(k)} < end_; k += half) {
       kernel_.schedule(SimTime{h_ * static_cast<std::int64_t>(k)}, EventClass::kEnvironment, sw, k);
     }
-    const HandlerId end = kernel_.add_handler("end", [this](std::uint64_t) { plant_.advance_to(kernel_.now()); });
+    const HandlerId end = kernel_.add_handler("end", [this](std::uint64_t) { advance(); });
     kernel_.schedule(end_, EventClass::kEnd, end);
   }
 
-  static bool noisy(Approach a, const RunOptions& opt) { return !opt.noise_free && a != Approach::kI; }
+  static bool noisy(Approach a, const RunOptions& opt) { return !opt.noise_free && !opt.analytic && a != Approach::kI; }
+
+  /// The plant (and the analytic tracker) at now.
+  void advance() {
+    plant_.advance_to(kernel_.now());
+    if (an_) an_->flow_to(kernel_.now());
+  }
 
   engine::LinkConfig leg(const char* name) const { return ncs::leg(ctx_, sc_, approach_, name); }
 
@@ -100,7 +111,7 @@ class Harness {
 
   /// The plant at now and a sample y = C x + v.
   OutputVec sample() {
-    plant_.advance_to(kernel_.now());
+    advance();
     OutputVec y = plant_.output();
     if (noisy_) {
       const double n0 = measurement_.normal();
@@ -112,12 +123,14 @@ class Harness {
     const OutputVec clean = plant_.output();
     result_.samples.push_back(Point{t, {y[0], y[1]}});
     result_.sample_truth.push_back(Point{t, {clean[0], clean[1]}});
+    if (an_) an_->sample(kernel_.now(), y);
     return y;
   }
 
   void apply(const InputVec& u) {
-    plant_.advance_to(kernel_.now());
+    advance();
     plant_.set_input(u);
+    if (an_) an_->apply(u);
     ++result_.commands;
   }
 
@@ -133,6 +146,7 @@ class Harness {
     kernel_.run_until(end_);
     result_.injected = net_.fault_counters();
     result_.cost = plant_.cost().total();
+    if (an_) an_->report(result_);
     for (const auto& s : plant_.trace()) {
       const double t = engine::to_seconds(s.t);
       result_.truth.push_back(Point{t, {s.x[0], s.x[1]}});
@@ -159,6 +173,7 @@ class Harness {
   InputVec u_min_;
   InputVec u_max_;
   RunResult result_;
+  std::unique_ptr<AnalyticTracker> an_;
 };
 
 /// The actuation-synchronized loop with estimator `est` (brief §1).
@@ -200,8 +215,14 @@ RunResult run_synchronized(Harness& hs, Estimator est, std::int32_t late_us) {
     net.run_node(kSensor, [&]() { sensor->on_sample(net.node_clock(kSensor), y); });
   });
   const HandlerId compute_h = k.add_handler("compute", [&](std::uint64_t) {
+    const Estimator before = ctrl->estimator();
+    const std::uint32_t runs = ctrl->statistics().computations;
     net.run_node(kController, [&]() { ctrl->on_receive(net.node_clock(kController)); });
     hs.estimate(ctrl->last_k(), ctrl->estimator().estimate());
+    if (hs.an_ && ctrl->statistics().computations != runs) {
+      hs.an_->compute_sync(before, ctrl->estimator(), hs.ctx_.period_us(), hs.ref_.state(ctrl->last_k()),
+                           hs.ref_.input(ctrl->last_k()), ctrl->last_command());
+    }
   });
   net.add_node(kSensor, "sensor", Duration{0}, [&]() {
     const McuInstant now = net.node_clock(kSensor);
@@ -288,8 +309,11 @@ RunResult run_sampling(Harness& hs, Law law, Saturated saturated) {
   bool sensor_restarted = false;
   engine::Network& net = hs.net_;
   engine::Kernel& k = hs.kernel_;
+  std::uint32_t samples = 0;  // the sequence number of the next sample (no restart in analytic runs)
   const HandlerId compute_h = k.add_handler("compute", [&](std::uint64_t) {
+    const Law before = ctrl->law();
     net.run_node(kController, [&]() { ctrl->on_receive(net.node_clock(kController)); });
+    if (hs.an_) hs.an_->compute_law(before, samples - 1);
   });
   net.add_node(kSensor, "sensor", Duration{0}, nullptr);
   net.add_node(kController, "controller", Duration{0},
@@ -324,6 +348,7 @@ RunResult run_sampling(Harness& hs, Law law, Saturated saturated) {
       sensor_n0 = n;
     }
     const OutputVec y = hs.sample();
+    ++samples;
     const auto seq = static_cast<node::SequenceNumber>(n - sensor_n0);
     net.run_node(kSensor, [&]() { sensor->on_sample(seq, net.node_clock(kSensor), y); });
     const SimTime t_next = k.now() + hs.h_;
@@ -414,6 +439,12 @@ std::vector<std::string> link_names(Approach a) {
 std::vector<std::string> node_names() { return {"sensor", "controller", "actuator"}; }
 
 RunResult run(const Context& ctx, Approach a, const Scenario& sc, std::uint64_t seed, const RunOptions& options) {
+  RunResult r = run_approach(ctx, a, sc, seed, options);
+  if (options.analytic) refuse_nonlinear_runs(r);
+  return r;
+}
+
+RunResult run_approach(const Context& ctx, Approach a, const Scenario& sc, std::uint64_t seed, const RunOptions& options) {
   Harness hs(ctx, a, sc, seed, options);
   const Vector<double, kN> x0 = hs.ref_.state(0);
   using HalfEst = node::HalfKalmanEstimator<Fmt, Structure, Disc>;

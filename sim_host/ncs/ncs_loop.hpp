@@ -23,6 +23,7 @@
 
 #include "ncs_model.hpp"
 #include "oneshot/engine/continuous_plant.hpp"
+#include "oneshot/engine/jump_linear_cost.hpp"
 #include "oneshot/engine/fault_spec.hpp"
 #include "oneshot/engine/frame_faults.hpp"
 #include "oneshot/engine/link.hpp"
@@ -35,6 +36,12 @@ struct RunOptions {
   bool noise_free = false;  ///< No process or measurement noise (delays stay).
   double trace_step_s = 0;  ///< > 0: record the true state every step (bridged, never changes the run).
   engine::FaultSpec faults;  ///< Faults injected (empty: a clean run, bit-identical to none).
+  /// Also the exact expected cost over the noise for this run's timing (ncs_analytic.hpp);
+  /// the simulation itself then runs noise-free (same delays and τ_c: streams per source).
+  bool analytic = false;
+  /// ≠ 0: the process and measurement noise drawn from this seed, the timing still from the
+  /// run's (a Monte Carlo over the noise alone for one timing draw).
+  std::uint64_t noise_seed = 0;
 };
 
 /// One row of a recorded sample or estimate.
@@ -51,6 +58,9 @@ struct RunResult {
   std::uint32_t faults = 0;    ///< Estimator runs whose status was not exact.
   std::uint32_t commands = 0;  ///< Commands applied.
   engine::FaultCounters injected;  ///< Faults injected.
+  engine::ExpectedCost analytic;   ///< Analytic runs: E[J] over the noise, split by origin.
+  std::string analytic_refusal;    ///< Analytic runs: why the expected cost is not valid ("" when it is).
+  double analytic_mismatch = 0;    ///< Analytic runs: largest |mean − simulated| (relative to max(1, |value|)).
   std::vector<double> counters;    ///< Node counters (ncs_counters.hpp, order of counter_names()).
   std::vector<Point> truth;      ///< True state every trace step (x1, x2).
   std::vector<Point> samples;    ///< Samples y at their instants.
@@ -78,7 +88,11 @@ std::vector<std::string> link_names(Approach a);
 /// The restartable nodes: "sensor", "controller", "actuator".
 std::vector<std::string> node_names();
 
-/// Runs approach `a` on `scenario` with `seed`.
+/// Runs approach `a` on `scenario` with `seed` (with RunOptions::analytic, refused by
+/// refuse_nonlinear_runs() when a command was clamped, late or an estimator run inexact).
 RunResult run(const Context& ctx, Approach a, const Scenario& scenario, std::uint64_t seed, const RunOptions& options);
+
+/// The run without the analytic post-checks.
+RunResult run_approach(const Context& ctx, Approach a, const Scenario& scenario, std::uint64_t seed, const RunOptions& options);
 
 }  // namespace oneshot::ncs

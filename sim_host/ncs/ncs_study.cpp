@@ -9,6 +9,7 @@
 #include <memory>
 #include <sstream>
 
+#include "ncs_analytic.hpp"
 #include "ncs_experiments.hpp"
 #include "ncs_faults.hpp"
 #include "ncs_live.hpp"
@@ -121,6 +122,9 @@ void register_ncs_study(CLI::App& app) {
     add_common(cmd, *c, "out/ncs");
     cmd->add_option("--seeds", t->seeds, "seeds per scenario")->check(CLI::Range(2, 100000))->capture_default_str();
     cmd->add_flag("--noise-free", t->noise_free, "no process or measurement noise (delays stay): A must equal I");
+    cmd->add_flag("--analytic", t->analytic,
+                  "also the exact expected cost over the noise for each run's timing (analytic_mean, analytic_ci95, "
+                  "variance_reduction; refused approaches named with the reason)");
     cmd->add_option("--duration", t->duration_s, "seconds per run")->check(CLI::Range(0.1, 3600.0))->capture_default_str();
     cmd->add_option("--scenarios", *scenario_file, "scenario file (default: the ten of the brief, sim_host/ncs/scenarios.json)")
         ->check(CLI::ExistingFile);
@@ -189,6 +193,14 @@ void register_ncs_study(CLI::App& app) {
       j["experiment"] = "report";
       emit(*c, j);
     });
+  }
+  {
+    auto c = std::make_shared<NcsCli>();
+    CLI::App* cmd = study->add_subcommand("analytic-benchmark",
+                                          "Cost of `table --analytic`: covariance propagation per event, analytic run "
+                                          "against the noise-free run (benchmark, not a test)");
+    add_common(cmd, *c, "out/ncs-analytic-benchmark");
+    cmd->callback([c]() { emit(*c, ncs::analytic_benchmark(*ncs::Context::load(c->plant), c->seed)); });
   }
   add_ncs_live_commands(study);
   add_ncs_faults_command(study);

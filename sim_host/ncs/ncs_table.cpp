@@ -10,6 +10,7 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "ncs_analytic.hpp"
 #include "ncs_experiments.hpp"
 #include "ncs_loop.hpp"
 #include "oneshot/engine/sweep_statistics.hpp"
@@ -67,16 +68,29 @@ engine::SweepResults table_sweep(const Context& ctx, const TableOptions& opt, co
     engine::check_fault_targets(opt.faults, {"as", "sc", "ca"}, node_names());
     spec.config["inject"] = opt.faults.text;
   }
+  if (opt.analytic) {  // only then: the table's spec stays as it was without
+    spec.config["analytic"] = true;
+    spec.metrics.insert(spec.metrics.end(), {"analytic", "analytic_refused", "analytic_mismatch"});
+  }
   const std::vector<Approach> approaches = opt.approaches;
   RunOptions ro;
   ro.noise_free = opt.noise_free;
   ro.faults = opt.faults;
+  RunOptions ra = ro;
+  ra.analytic = true;
+  const bool analytic = opt.analytic;
   return engine::run_sweep(
       spec, shard, opt.threads,
       [&](std::size_t a, std::size_t s, std::uint64_t seed) {
         const RunResult r = run(ctx, approaches[a], scenarios[s], seed, ro);
-        return std::vector<double>{r.cost, static_cast<double>(r.late), static_cast<double>(r.saturated),
-                                   static_cast<double>(r.faults)};
+        std::vector<double> v{r.cost, static_cast<double>(r.late), static_cast<double>(r.saturated),
+                              static_cast<double>(r.faults)};
+        if (analytic) {
+          const RunResult x = run(ctx, approaches[a], scenarios[s], seed, ra);
+          const int code = analytic_refusal_code(x.analytic_refusal);
+          v.insert(v.end(), {code == 0 ? x.analytic.total() : 0.0, static_cast<double>(code), x.analytic_mismatch});
+        }
+        return v;
       },
       opt.noise_free ? "ncs table (noise-free)" : "ncs table");
 }
@@ -207,6 +221,7 @@ nlohmann::json table_outputs(const engine::SweepResults& results, const std::str
     }
     j["S_ratio_increases_with_delay"] = increasing;
   }
+  if (spec.config.contains("analytic")) analytic_outputs(results, sm, j, md);
   j["markdown"] = md.str();
   j["markdown_per_scenario"] = per.str();
   {

@@ -9,25 +9,10 @@
 #include "ncs_experiments.hpp"
 #include "ncs_loop.hpp"
 #include "ncs_model.hpp"
+#include "ncs_test_support.hpp"
 
 namespace oneshot::ncs {
 namespace {
-
-const Context& context() {
-  static const auto ctx = Context::load("");
-  return *ctx;
-}
-
-Scenario short_scenario(double amplitude, double d_ms, double s = 1, double duration = 3) {
-  Scenario sc;
-  sc.name = "test";
-  sc.amplitude_volts = amplitude;
-  sc.period_s = 1;
-  sc.max_delay_ms = d_ms;
-  sc.noise_scale = s;
-  sc.duration_s = duration;
-  return sc;
-}
 
 /// Noise-free: A predicts the sampled state exactly to t_k, so it is I for any delays that
 /// fit in h; S pays for its delay, more as d grows.

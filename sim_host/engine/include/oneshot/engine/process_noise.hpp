@@ -116,6 +116,8 @@ class ProcessNoise {
 
   /// The expected noise cost of an interval of length Δ (cached).
   double interval_cost(Duration delta) { return entry(delta).cost; }
+  /// Q_d(Δ) (cached with the cost).
+  const Matrix<double, N, N>& interval_covariance(Duration delta) { return entry(delta).qd; }
 
   /// n(a) given n(Δ) = `end` for a path started at 0 (0 < a ≤ Δ), from `rng`.
   Vector<double, N> bridge(Duration a, Duration delta, const Vector<double, N>& end, RandomStream& rng) const {
@@ -133,6 +135,7 @@ class ProcessNoise {
  private:
   static constexpr std::size_t kTerms = 40;
   struct Entry {
+    Matrix<double, N, N> qd;
     Matrix<double, N, N> chol;
     double cost = 0;
   };
@@ -141,7 +144,8 @@ class ProcessNoise {
     if (it != cache_.end()) return it->second;
     if (cache_.size() > 4096) cache_.clear();
     Entry e;
-    e.chol = psd_cholesky(covariance(delta));
+    e.qd = covariance(delta);
+    e.chol = psd_cholesky(e.qd);
     e.cost = expected_cost(delta);
     return cache_.emplace(delta.count(), e).first->second;
   }

@@ -1,0 +1,320 @@
+/// @file jump_linear_cost_test.cpp
+/// @brief JumpLinearCost against three oracles: the closed-form stationary LQG cost rate
+///        (Riccati solutions, Eigen), a direct noise-free simulation (Eigen exponentials and
+///        quadrature), and a Monte Carlo of the same loop on the engine's ContinuousPlant.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <vector>
+
+#include "oneshot/engine/continuous_plant.hpp"
+#include "oneshot/engine/jump_linear_cost.hpp"
+#include "oneshot/engine/random_stream.hpp"
+#include "support/eigen_reference.hpp"
+
+namespace oneshot::engine {
+namespace {
+
+using test::MatX;
+using test::VecX;
+constexpr std::size_t kN = 2;
+constexpr std::size_t kM = 1;
+constexpr std::size_t kK = 5;  // z = [x (2); u (1); x̂⁻ (2)]
+using Jlc = JumpLinearCost<kN, kM, kK>;
+
+/// Lightly damped oscillator, position measured; cost Q1c = I, Q2c = 0.1.
+struct Loop {
+  MatX a = (MatX(2, 2) << 0, 1, -4, -0.4).finished();
+  MatX b = (MatX(2, 1) << 0, 1).finished();
+  MatX c = (MatX(1, 2) << 1, 0).finished();
+  MatX qc = (MatX(2, 2) << 0.01, 0, 0, 0.04).finished();
+  MatX q1c = MatX::Identity(2, 2);
+  double q2c = 0.1;
+  double r = 0.02;  // measurement variance
+  double h = 0.1;
+  MatX phi, gamma, qd, l, k, s, pf;
+  MatX gc;  // sampled cost weight of [x; u] over h
+};
+
+/// ∫₀^t [Φ(s) Γ(s)]ᵀ Q1c [Φ(s) Γ(s)] ds + blkdiag(0, Q2c t) by composite Gauss–Legendre.
+MatX sampled_cost(const Loop& p, double t) {
+  static const double x[5] = {-0.9061798459386640, -0.5384693101056831, 0.0, 0.5384693101056831, 0.9061798459386640};
+  static const double w[5] = {0.2369268850561891, 0.4786286704993665, 0.5688888888888889, 0.4786286704993665,
+                              0.2369268850561891};
+  MatX g = MatX::Zero(3, 3);
+  const int panels = 40;
+  const double hp = t / panels;
+  for (int q = 0; q < panels; ++q)
+    for (int i = 0; i < 5; ++i) {
+      const double sv = hp * (q + 0.5 + 0.5 * x[i]);
+      const test::Triple tr = test::reference_triple(p.a, p.b, p.qc, sv);
+      MatX m(2, 3);
+      m << tr.phi, tr.gamma;
+      g += 0.5 * hp * w[i] * m.transpose() * p.q1c * m;
+    }
+  g(2, 2) += p.q2c * t;
+  return g;
+}
+
+/// ∫₀^t tr(Q1c Q_d(s)) ds by composite Gauss–Legendre (Q_d by Eigen's Van Loan).
+double noise_path(const Loop& p, double t) {
+  static const double x[5] = {-0.9061798459386640, -0.5384693101056831, 0.0, 0.5384693101056831, 0.9061798459386640};
+  static const double w[5] = {0.2369268850561891, 0.4786286704993665, 0.5688888888888889, 0.4786286704993665,
+                              0.2369268850561891};
+  double sum = 0;
+  const int panels = 40;
+  const double hp = t / panels;
+  for (int q = 0; q < panels; ++q)
+    for (int i = 0; i < 5; ++i) {
+      const double sv = hp * (q + 0.5 + 0.5 * x[i]);
+      sum += 0.5 * hp * w[i] * (p.q1c * test::reference_triple(p.a, p.b, p.qc, sv).qd).trace();
+    }
+  return sum;
+}
+
+/// LQ gain of the sampled cost (DARE with cross term) and the stationary Kalman gain, by iteration.
+Loop designed() {
+  Loop p;
+  const test::Triple tr = test::reference_triple(p.a, p.b, p.qc, p.h);
+  p.phi = tr.phi;
+  p.gamma = tr.gamma;
+  p.qd = tr.qd;
+  p.gc = sampled_cost(p, p.h);
+  const MatX q1 = p.gc.topLeftCorner(2, 2);
+  const MatX q12 = p.gc.topRightCorner(2, 1);
+  const MatX q2 = p.gc.bottomRightCorner(1, 1);
+  MatX s = q1;
+  for (int i = 0; i < 20000; ++i) {
+    const MatX w = q2 + p.gamma.transpose() * s * p.gamma;
+    const MatX l = w.inverse() * (p.gamma.transpose() * s * p.phi + q12.transpose());
+    const MatX next = q1 + p.phi.transpose() * s * p.phi - (p.phi.transpose() * s * p.gamma + q12) * l;
+    const double change = (next - s).cwiseAbs().maxCoeff();
+    s = 0.5 * (next + next.transpose());
+    if (change < 1e-15 * s.cwiseAbs().maxCoeff()) break;
+  }
+  p.s = s;
+  p.l = (q2 + p.gamma.transpose() * s * p.gamma).inverse() * (p.gamma.transpose() * s * p.phi + q12.transpose());
+  MatX pm = p.qd;
+  for (int i = 0; i < 20000; ++i) {
+    const double inn = (p.c * pm * p.c.transpose())(0, 0) + p.r;
+    const MatX f = pm - pm * p.c.transpose() * p.c * pm / inn;
+    const MatX next = p.phi * f * p.phi.transpose() + p.qd;
+    const double change = (next - pm).cwiseAbs().maxCoeff();
+    pm = 0.5 * (next + next.transpose());
+    if (change < 1e-17) break;
+  }
+  const double inn = (p.c * pm * p.c.transpose())(0, 0) + p.r;
+  p.k = pm * p.c.transpose() / inn;
+  p.pf = pm - pm * p.c.transpose() * p.c * pm / inn;
+  return p;
+}
+
+/// The event at a sampling instant: y = C x + v, x̂ = x̂⁻ + K (y − C x̂⁻), u = u_ref − L (x̂ − x_ref),
+/// x̂⁻ ← Φ(h) x̂ + Γ(h) u, as z⁺ = E z + F v + g.
+struct EventMap {
+  Jlc::Map e = Jlc::Map::identity();
+  Matrix<double, kK, 1> f;
+  Jlc::Z g;
+};
+EventMap event_map(const Loop& p, double x_ref, double u_ref) {
+  const MatX ikc = MatX::Identity(2, 2) - p.k * p.c;
+  const MatX kc = p.k * p.c;
+  const MatX acl = p.phi - p.gamma * p.l;
+  const double gu = u_ref + (p.l * VecX((VecX(2) << x_ref, 0).finished()))(0);
+  EventMap m;
+  for (std::size_t j = 0; j < 5; ++j) m.e(2, j) = 0;
+  for (int j = 0; j < 2; ++j) {
+    m.e(2, static_cast<std::size_t>(j)) = -(p.l * kc)(0, j);
+    m.e(2, 3 + static_cast<std::size_t>(j)) = -(p.l * ikc)(0, j);
+  }
+  for (int i = 0; i < 2; ++i) {
+    const auto zi = 3 + static_cast<std::size_t>(i);
+    for (std::size_t j = 0; j < 5; ++j) m.e(zi, j) = 0;
+    for (int j = 0; j < 2; ++j) {
+      m.e(zi, static_cast<std::size_t>(j)) = (acl * kc)(i, j);
+      m.e(zi, 3 + static_cast<std::size_t>(j)) = (acl * ikc)(i, j);
+    }
+    m.f(zi, 0) = (acl * p.k)(i, 0);
+    m.g[zi] = p.gamma(i, 0) * gu;
+  }
+  m.f(2, 0) = -(p.l * p.k)(0, 0);
+  m.g[2] = gu;
+  return m;
+}
+
+JumpLinearPlant<kN, kM> engine_plant(const Loop& p, bool noisy) {
+  JumpLinearPlant<kN, kM> e;
+  for (std::size_t i = 0; i < 2; ++i) {
+    for (std::size_t j = 0; j < 2; ++j) {
+      const auto ii = static_cast<Eigen::Index>(i);
+      const auto jj = static_cast<Eigen::Index>(j);
+      e.a(i, j) = p.a(ii, jj);
+      e.qc(i, j) = noisy ? p.qc(ii, jj) : 0;
+      e.q1c(i, j) = p.q1c(ii, jj);
+    }
+    e.b(i, 0) = p.b(static_cast<Eigen::Index>(i), 0);
+  }
+  e.q2c(0, 0) = p.q2c;
+  return e;
+}
+
+TEST(JumpLinearCost, PeriodicLqgEqualsTheClosedFormStationaryCostRate) {
+  const Loop p = designed();
+  Jlc jl(engine_plant(p, true));
+  const EventMap m = event_map(p, 0, 0);
+  Matrix<double, 1, 1> r;
+  r(0, 0) = p.r;
+  const Duration h = from_us(100000);
+  const auto periods = [&](int n) {
+    for (int i = 0; i < n; ++i) {
+      jl.jump(m.e, m.f, m.g, r);
+      jl.flow(h);
+    }
+  };
+  periods(3000);
+  const double before = jl.cost().total();
+  periods(200);
+  const double rate = (jl.cost().total() - before) / (200 * p.h);
+  // Completion of squares: h·J = tr(S Q_d) + tr(P_f Lᵀ (Q2 + ΓᵀSΓ) L) + ∫₀^h tr(Q1c Q_d(s)) ds.
+  const MatX w = p.gc.bottomRightCorner(1, 1) + p.gamma.transpose() * p.s * p.gamma;
+  const double closed = ((p.s * p.qd).trace() + (p.pf * p.l.transpose() * w * p.l).trace() + noise_path(p, p.h)) / p.h;
+  std::printf("LQG rate %.15g closed %.15g rel %.3g\n", rate, closed, rate / closed - 1);
+  EXPECT_NEAR(rate / closed - 1, 0, 1e-9) << rate << " vs " << closed;
+  EXPECT_NEAR(jl.cost().mean, 0, 1e-300);  // starts at rest on the reference
+}
+
+/// Irregular intervals around h (whole µs), the same for the analytic run and its oracles.
+std::vector<std::int64_t> jittered_intervals_us(int n) {
+  RandomStream rng(7, "intervals");
+  std::vector<std::int64_t> d;
+  for (int i = 0; i < n; ++i) d.push_back(80000 + 10000 * rng.uniform_int(0, 4));
+  return d;
+}
+
+TEST(JumpLinearCost, NoiseFreeEqualsADirectSimulation) {
+  const Loop p = designed();
+  Jlc jl(engine_plant(p, false));
+  Jlc::Z m0{};
+  m0[0] = 1.0;
+  m0[3] = 0.8;
+  jl.reset(m0, Jlc::Cov{});
+  const std::vector<std::int64_t> d = jittered_intervals_us(300);
+  // Direct: x(t) by Eigen's exponential, ∫ by quadrature of the same (sampled_cost over each Δ).
+  VecX x = (VecX(2) << 1.0, 0).finished();
+  VecX xh = (VecX(2) << 0.8, 0).finished();
+  double u = 0;
+  double j_direct = 0;
+  for (std::size_t i = 0; i < d.size(); ++i) {
+    const double x_ref = i >= 150 ? 0.5 : 0.0;  // a set-point step halfway
+    const double u_ref = 4 * x_ref;
+    const VecX xr = (VecX(2) << x_ref, 0).finished();
+    jl.set_reference(Vector<double, 2>({x_ref, 0}), Vector<double, 1>({u_ref}));
+    const EventMap m = event_map(p, x_ref, u_ref);
+    jl.jump(m.e, m.g);
+    const VecX xf = xh + p.k * (p.c * x - p.c * xh);
+    u = u_ref - (p.l * (xf - xr))(0);
+    xh = p.phi * xf + p.gamma * u;
+    const double t = static_cast<double>(d[i]) * 1e-6;
+    jl.flow(from_us(d[i]));
+    VecX q(3);
+    q << x - xr, u - u_ref;
+    j_direct += q.dot(sampled_cost(p, t) * q);
+    const test::Triple tr = test::reference_triple(p.a, p.b, p.qc, t);
+    x = xr + tr.phi * (x - xr) + tr.gamma * (u - u_ref);
+  }
+  std::printf("noise-free rel %.3g x %.3g\n", jl.cost().total() / j_direct - 1, jl.mean()[0] - x(0));
+  EXPECT_NEAR(jl.cost().total() / j_direct - 1, 0, 1e-12);
+  EXPECT_NEAR(jl.mean()[0], x(0), 1e-12);
+  EXPECT_NEAR(jl.mean()[4], xh(1), 1e-12);
+  EXPECT_EQ(jl.cost().covariance, 0);
+  EXPECT_EQ(jl.cost().noise_path, 0);
+}
+
+TEST(JumpLinearCost, WithNoiseInsideTheMonteCarloInterval) {
+  const Loop p = designed();
+  Jlc jl(engine_plant(p, true));
+  Jlc::Z m0{};
+  m0[0] = 0.5;
+  jl.reset(m0, Jlc::Cov{});
+  const std::vector<std::int64_t> d = jittered_intervals_us(40);
+  const EventMap m = event_map(p, 0, 0);
+  Matrix<double, 1, 1> r;
+  r(0, 0) = p.r;
+  for (const std::int64_t di : d) {
+    jl.jump(m.e, m.f, m.g, r);
+    jl.flow(from_us(di));
+  }
+  // Monte Carlo of the same loop: the engine's plant (exact process-noise draws) and drawn v.
+  ContinuousPlantConfig<2, 1, 1, 1> cfg;
+  const JumpLinearPlant<2, 1> ep = engine_plant(p, true);
+  cfg.a = ep.a;
+  cfg.b = ep.b;
+  cfg.qc = ep.qc;
+  cfg.q1c = ep.q1c;
+  cfg.q2c = ep.q2c;
+  cfg.c(0, 0) = 1;
+  const int runs = 1500;
+  double sum = 0;
+  double sum2 = 0;
+  RandomStream meas(11, "measurement");
+  for (int run = 0; run < runs; ++run) {
+    ContinuousPlant<2, 1, 1, 1> plant(cfg, RandomStream(static_cast<std::uint64_t>(run), "process"));
+    plant.set_state(Vector<double, 2>({0.5, 0}));
+    VecX xh = VecX::Zero(2);
+    SimTime t{0};
+    for (const std::int64_t di : d) {
+      plant.advance_to(t);
+      const double y = plant.output()[0] + std::sqrt(p.r) * meas.normal();
+      const VecX xf = xh + p.k * (y - (p.c * xh)(0));
+      const double u = -(p.l * xf)(0);
+      xh = p.phi * xf + p.gamma * u;
+      plant.set_input(Vector<double, 1>({u}));
+      t += from_us(di);
+    }
+    plant.advance_to(t);
+    const double j = plant.cost().total();
+    sum += j;
+    sum2 += j * j;
+  }
+  const double mean = sum / runs;
+  const double sd = std::sqrt((sum2 - runs * mean * mean) / (runs - 1));
+  const double half = 1.96 * sd / std::sqrt(static_cast<double>(runs));
+  std::printf("mc %.6g analytic %.6g half %.3g\n", mean, jl.cost().total(), half);
+  EXPECT_LT(std::fabs(jl.cost().total() - mean), half) << jl.cost().total() << " vs " << mean << " ± " << half;
+  EXPECT_GT(jl.cost().covariance + jl.cost().noise_path, 0.2 * jl.cost().total());  // noise matters here
+}
+
+TEST(JumpLinearCost, EventCostIsTheQuadraticMeanPlusTheTrace) {
+  // z = m + chol·n: E[(z − c)ᵀ W (z − c)] by its definition over a Monte Carlo of 20000 draws.
+  Jlc jl(engine_plant(designed(), true));
+  Jlc::Z m({1, -0.5, 0.2, 0.3, 0});
+  Jlc::Cov l;  // lower factor
+  RandomStream rng(3, "factor");
+  for (std::size_t i = 0; i < kK; ++i)
+    for (std::size_t j = 0; j <= i; ++j) l(i, j) = rng.uniform(-0.5, 0.5) + (i == j ? 1 : 0);
+  jl.reset(m, l * l.transposed());
+  Jlc::Map w;
+  for (std::size_t i = 0; i < kK; ++i) w(i, i) = 1 + static_cast<double>(i);
+  w(0, 1) = w(1, 0) = 0.3;
+  Jlc::Z c({0.5, 0, 0, 0, 1});
+  jl.add_event_cost(w, c);
+  double sum = 0;
+  double sum2 = 0;
+  const int n = 20000;
+  RandomStream draws(4, "draws");
+  for (int k = 0; k < n; ++k) {
+    Jlc::Z v;
+    for (std::size_t i = 0; i < kK; ++i) v[i] = draws.normal();
+    const double q = quadratic_form(w, Jlc::Z(m + l * v - c));
+    sum += q;
+    sum2 += q * q;
+  }
+  const double mean = sum / n;
+  const double half = 1.96 * std::sqrt((sum2 - n * mean * mean) / (n - 1) / n);
+  EXPECT_LT(std::fabs(jl.cost().total() - mean), half) << jl.cost().total() << " vs " << mean << " ± " << half;
+  EXPECT_NEAR(jl.cost().mean, quadratic_form(w, Jlc::Z(m - c)), 1e-15);
+}
+
+}  // namespace
+}  // namespace oneshot::engine
