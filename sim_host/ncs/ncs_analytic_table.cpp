@@ -9,7 +9,7 @@
 #include <vector>
 
 #include "ncs_analytic.hpp"
-#include "oneshot/sim/statistics.hpp"
+#include "oneshot/util/statistics.hpp"
 
 namespace oneshot::ncs {
 
@@ -51,7 +51,7 @@ void analytic_outputs(const engine::SweepResults& results, const engine::SweepSu
     }
     std::vector<double> diff;
     for (std::size_t k = 0; k < spec.seeds; ++k) diff.push_back(mc.per_seed[a][k] - an.per_seed[a][k]);
-    const sim::Summary d = sim::summarize(diff);
+    const util::Summary d = util::summarize(diff);
     const double ci_an = an.value[a].ci95;
     // An interval at the rounding level of the mean: the timing does not move the expected
     // cost (I, IK: no delays; AKl: τ = D fixed), no Monte Carlo width can be compared.

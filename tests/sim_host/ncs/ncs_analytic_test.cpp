@@ -13,7 +13,7 @@
 #include "ncs_experiments.hpp"
 #include "ncs_loop.hpp"
 #include "ncs_test_support.hpp"
-#include "oneshot/sim/statistics.hpp"
+#include "oneshot/util/statistics.hpp"
 
 namespace oneshot::ncs {
 namespace {
@@ -65,9 +65,9 @@ TEST(NcsAnalytic, WithNoiseTheAnalyticMeanIsInsideTheMonteCarloInterval) {
       analytic.push_back(r.analytic.total());
       diff.push_back(cost.back() - analytic.back());
     }
-    const sim::Summary c = sim::summarize(cost);
-    const sim::Summary e = sim::summarize(analytic);
-    const sim::Summary d = sim::summarize(diff);
+    const util::Summary c = util::summarize(cost);
+    const util::Summary e = util::summarize(analytic);
+    const util::Summary d = util::summarize(diff);
     std::printf("%s: MC %.6f ± %.6f, analytic %.6f ± %.6f, paired MC − analytic %.6f ± %.6f\n", name(a), c.mean, c.ci95,
                 e.mean, e.ci95, d.mean, d.ci95);
     EXPECT_LT(std::fabs(e.mean - c.mean), c.ci95) << name(a);
@@ -91,7 +91,7 @@ TEST(NcsAnalytic, OneTimingDrawAgainstAMonteCarloOverTheNoiseAlone) {
       mc.noise_seed = 1000 + n;
       cost.push_back(run(context(), a, sc, 7, mc).cost);
     }
-    const sim::Summary c = sim::summarize(cost);
+    const util::Summary c = util::summarize(cost);
     std::printf("%s, timing seed 7: MC over the noise %.6f ± %.6f (%.2f %%), analytic %.6f\n", name(a), c.mean, c.ci95,
                 100 * c.ci95 / c.mean, r.analytic.total());
     EXPECT_LT(std::fabs(r.analytic.total() - c.mean), c.ci95) << name(a);
