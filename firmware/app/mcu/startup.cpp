@@ -6,6 +6,8 @@
 #include <cstddef>
 #include <cstdint>
 
+#include "oneshot/mcu/soc.hpp"  // the interrupt numbers of this image's SoC
+
 extern "C" {
 extern std::uint32_t __data_load;
 extern std::uint32_t __data_start;
@@ -112,9 +114,11 @@ void* __dso_handle = nullptr;
 namespace {
 
 using Vector = void (*)();
-constexpr std::size_t kIrqCount = ONESHOT_MCU_IRQ_COUNT;
-constexpr std::size_t kActuationIrq = ONESHOT_MCU_ACTUATION_IRQ;
-constexpr std::size_t kUartIrq = ONESHOT_MCU_UART_IRQ;
+namespace soc = oneshot::mcu::soc;
+constexpr std::size_t kIrqCount = soc::kIrqCount;
+constexpr std::size_t kActuationIrq = soc::ActuationTimer::kIrq;
+constexpr std::size_t kUartIrq = soc::Uart::kIrq;
+static_assert(kActuationIrq < kIrqCount && kUartIrq < kIrqCount && soc::IdleWakeup::kIrq < kIrqCount);
 
 /// Initial stack pointer, then exceptions 1–15 and the SoC interrupts.
 struct VectorTable {
@@ -129,9 +133,7 @@ constexpr VectorTable make_vectors() {
   t.handlers[2] = oneshot_fault_handler;                       // 3: hard fault
   t.handlers[15 + kActuationIrq] = oneshot_actuation_timer_handler;  // 16 + irq
   t.handlers[15 + kUartIrq] = oneshot_uart_rx_handler;
-#if defined(ONESHOT_MCU_IDLE_IRQ)
-  t.handlers[15 + ONESHOT_MCU_IDLE_IRQ] = oneshot_idle_wakeup_handler;
-#endif
+  if (soc::IdleWakeup::kHasIrq) t.handlers[15 + soc::IdleWakeup::kIrq] = oneshot_idle_wakeup_handler;
   return t;
 }
 
