@@ -64,6 +64,20 @@ std::uint32_t oneshot_stack_peak_bytes() {
 /// Unexpected interrupts and faults.
 void default_handler() { oneshot_fault_handler(); }
 
+/// The vectors an image may leave out (weak: the image's definition wins). The PIL images
+/// define them all (pil_link.cpp and their main); the job-only images and the probes have
+/// no link, so there an interrupt does nothing and a fault stops the core.
+__attribute__((weak)) void oneshot_actuation_timer_handler() {}
+/// See oneshot_actuation_timer_handler().
+__attribute__((weak)) void oneshot_uart_rx_handler() {}
+/// See oneshot_actuation_timer_handler().
+__attribute__((weak)) void oneshot_idle_wakeup_handler() {}
+/// See oneshot_actuation_timer_handler().
+[[noreturn]] __attribute__((weak)) void oneshot_fault_handler() {
+  for (;;) {
+  }
+}
+
 /// Freestanding C library pieces the compiler may emit calls to.
 void* memcpy(void* d, const void* s, std::size_t n) {
   auto* dp = static_cast<unsigned char*>(d);
