@@ -133,6 +133,8 @@ constexpr std::size_t kIrqCount = soc::kIrqCount;
 constexpr std::size_t kActuationIrq = soc::ActuationTimer::kIrq;
 constexpr std::size_t kUartIrq = soc::Uart::kIrq;
 static_assert(kActuationIrq < kIrqCount && kUartIrq < kIrqCount && soc::IdleWakeup::kIrq < kIrqCount);
+constexpr bool kIdleIrqFree = soc::IdleWakeup::kIrq != kActuationIrq && soc::IdleWakeup::kIrq != kUartIrq;
+static_assert(kActuationIrq != kUartIrq && (!soc::IdleWakeup::kHasIrq || kIdleIrqFree), "one vector per interrupt line");
 
 /// Initial stack pointer, then exceptions 1–15 and the SoC interrupts.
 struct VectorTable {
