@@ -1,5 +1,7 @@
 # Cross build of the firmware images (included when CMAKE_CROSSCOMPILING, see toolchain/).
-# Images: oneshot-<target>-<float|fixed>-<table|generic>.elf, each with every approach.
+# Every image goes through oneshot_firmware_image() below: the PIL images
+# oneshot-<target>-<float|fixed>-<table|nearest|generic>.elf, the C-job-only images, the petc
+# image (Cortex-M4F) and the probes that are not part of ALL (heap, size, -Og).
 if(NOT ONESHOT_FIRMWARE_TARGET)
   message(FATAL_ERROR "use a toolchain file from toolchain/ (it sets ONESHOT_FIRMWARE_TARGET)")
 endif()
@@ -30,17 +32,13 @@ include(${PROJECT_SOURCE_DIR}/cmake/oneshot_generated_tables.cmake)
 oneshot_generated_tables(LUT_GEN ${lut_gen_exe} TOOL_DEPENDS ${lut_gen_dep} GENERATED_DIR ${generated_dir}
                          REPORT ${CMAKE_BINARY_DIR}/lut_report.json)
 
+# The SoC of each target: its define selects hal/mcu/include/oneshot/mcu/soc.hpp's drivers,
+# which hold every interrupt number and board constant; the linker script holds its memory map.
 if(ONESHOT_FIRMWARE_TARGET STREQUAL "cortex-m0")
   set(soc_define ONESHOT_MCU_NRF51)
-  set(irq_count 32)
-  set(uart_irq 2)
-  set(extra_defines)
   set(linker_script ${PROJECT_SOURCE_DIR}/firmware/app/mcu/nrf51_microbit.ld)
 elseif(ONESHOT_FIRMWARE_TARGET STREQUAL "cortex-m4f")
   set(soc_define ONESHOT_MCU_MPS2)
-  set(irq_count 48)
-  set(uart_irq 0)
-  set(extra_defines ONESHOT_MCU_IDLE_IRQ=9)
   set(linker_script ${PROJECT_SOURCE_DIR}/firmware/app/mcu/mps2_an386.ld)
 else()
   message(FATAL_ERROR "unknown firmware target ${ONESHOT_FIRMWARE_TARGET}")
@@ -63,121 +61,104 @@ set_source_files_properties(${c_job_source} PROPERTIES GENERATED TRUE)
 if(ONESHOT_WERROR)
   list(APPEND fw_common_options -Werror)
 endif()
+# startup.cpp implements memcpy/memset: keep the compiler from turning their loops into calls to themselves.
+set_source_files_properties(firmware/app/mcu/startup.cpp PROPERTIES COMPILE_OPTIONS "-fno-builtin;-fno-tree-loop-distribute-patterns")
 
-function(oneshot_firmware_link target)
-  target_link_options(${target} PRIVATE -nostdlib -T ${linker_script} -L ${PROJECT_SOURCE_DIR}/firmware/app/mcu
-                      -Wl,--gc-sections -Wl,-Map=$<TARGET_FILE:${target}>.map)
-  target_link_libraries(${target} PRIVATE gcc)
+# oneshot_firmware_image(<image> SOURCES <src>... [C_JOB] [PIL] [EXCLUDE_FROM_ALL] [STACK_BOUND]
+#                        [INCLUDES <dir>...] [DEFINES <def>...] [OPTIONS <opt>...])
+# One firmware image <image>.elf for ONESHOT_FIRMWARE_TARGET: SOURCES with startup.cpp, the
+# SoC's define and linker script, the firmware flags (OPTIONS replaces them), -nostdlib (libgcc
+# only, so any heap use fails the link), its size printed after the link. C_JOB adds the
+# generated tables and C99 job; PIL the PIL link (pil_link.cpp: the runtime's vectors and
+# assert handler); STACK_BOUND writes <image>.elf.stack.txt, the sum of every frame in the
+# image (-fstack-usage; no recursion, so no call chain can need more).
+function(oneshot_firmware_image image)
+  cmake_parse_arguments(PARSE_ARGV 1 arg "C_JOB;PIL;EXCLUDE_FROM_ALL;STACK_BOUND" "" "SOURCES;INCLUDES;DEFINES;OPTIONS")
+  set(sources ${arg_SOURCES} firmware/app/mcu/startup.cpp)
+  set(includes firmware/core/include hal/mcu/include ${arg_INCLUDES})
+  if(arg_PIL)
+    list(APPEND sources firmware/app/mcu/pil_link.cpp)
+    list(APPEND includes firmware/app/include hal/include)
+  endif()
+  if(arg_C_JOB)
+    list(APPEND sources ${c_job_source})
+    list(APPEND includes ${generated_dir} ${generated_dir}/oneshot_c)
+  endif()
+  set(exclude)
+  if(arg_EXCLUDE_FROM_ALL)
+    set(exclude EXCLUDE_FROM_ALL)
+  endif()
+  add_executable(${image} ${exclude} ${sources})
+  set_target_properties(${image} PROPERTIES SUFFIX ".elf" C_STANDARD 99 C_STANDARD_REQUIRED ON C_EXTENSIONS OFF)
+  if(arg_C_JOB)
+    add_dependencies(${image} oneshot_generated)
+  endif()
+  target_include_directories(${image} PRIVATE ${includes})
+  if(DEFINED arg_OPTIONS)
+    target_compile_options(${image} PRIVATE ${arg_OPTIONS})
+  else()
+    target_compile_options(${image} PRIVATE ${fw_common_options})
+  endif()
+  target_compile_definitions(${image} PRIVATE ${soc_define} ${arg_DEFINES})
+  target_link_options(${image} PRIVATE -nostdlib -T ${linker_script} -L ${PROJECT_SOURCE_DIR}/firmware/app/mcu
+                      -Wl,--gc-sections -Wl,-Map=$<TARGET_FILE:${image}>.map)
+  target_link_libraries(${image} PRIVATE gcc)
+  set(post COMMAND arm-none-eabi-size $<TARGET_FILE:${image}>)
+  if(arg_STACK_BOUND)
+    list(APPEND post COMMAND ${CMAKE_COMMAND} -DDIR=${CMAKE_CURRENT_BINARY_DIR}/CMakeFiles/${image}.dir
+                     -DOUT=$<TARGET_FILE:${image}>.stack.txt -P ${PROJECT_SOURCE_DIR}/cmake/oneshot_stack_bound.cmake)
+  endif()
+  add_custom_command(TARGET ${image} POST_BUILD ${post} COMMENT "size of ${image}")
 endfunction()
 
+# The PIL images, oneshot-<target>-<float|fixed>-<table|nearest|generic>.elf, each with every
+# approach (firmware/app/mcu/main.cpp).
 foreach(format float fixed)
   foreach(disc table nearest generic)
-    set(image oneshot-${ONESHOT_FIRMWARE_TARGET}-${format}-${disc})
-    add_executable(${image} firmware/app/mcu/main.cpp firmware/app/mcu/startup.cpp ${c_job_source})
-    set_target_properties(${image} PROPERTIES C_STANDARD 99 C_STANDARD_REQUIRED ON C_EXTENSIONS OFF)
-    # startup.cpp implements memcpy/memset: keep the compiler from turning their loops into calls to themselves.
-    set_source_files_properties(firmware/app/mcu/startup.cpp PROPERTIES COMPILE_OPTIONS "-fno-builtin;-fno-tree-loop-distribute-patterns")
-    set_target_properties(${image} PROPERTIES SUFFIX ".elf")
-    add_dependencies(${image} oneshot_generated)
-    target_include_directories(${image} PRIVATE
-      firmware/core/include firmware/app/include hal/include hal/mcu/include ${generated_dir} ${generated_dir}/oneshot_c)
-    target_compile_options(${image} PRIVATE ${fw_common_options})
-    target_compile_definitions(${image} PRIVATE ${soc_define}
-      ONESHOT_MCU_IRQ_COUNT=${irq_count} ONESHOT_MCU_ACTUATION_IRQ=8 ONESHOT_MCU_UART_IRQ=${uart_irq} ${extra_defines}
-      ONESHOT_FW_FIXED=$<STREQUAL:${format},fixed>
-      ONESHOT_FW_DISC=$<IF:$<STREQUAL:${disc},generic>,1,$<IF:$<STREQUAL:${disc},nearest>,2,0>>)
-    oneshot_firmware_link(${image})
-    add_custom_command(TARGET ${image} POST_BUILD
-      COMMAND arm-none-eabi-size $<TARGET_FILE:${image}>
-      COMMENT "size of ${image}")
+    oneshot_firmware_image(oneshot-${ONESHOT_FIRMWARE_TARGET}-${format}-${disc} C_JOB PIL
+      SOURCES firmware/app/mcu/main.cpp
+      DEFINES ONESHOT_FW_FIXED=$<STREQUAL:${format},fixed>
+              ONESHOT_FW_DISC=$<IF:$<STREQUAL:${disc},generic>,1,$<IF:$<STREQUAL:${disc},nearest>,2,0>>)
   endforeach()
 endforeach()
 
-# Job-only images of the generated C job (no PIL link), one per variant, for flash and RAM:
-# oneshot-<target>-cjob-<variant>.elf; <image>.stack.txt bounds the stack by the sum of every
-# frame in the image (-fstack-usage; no recursion, so no call chain can need more).
-foreach(variant fixed_table fixed_nearest float_table float_nearest q15_table q15_nearest)
-  set(image oneshot-${ONESHOT_FIRMWARE_TARGET}-cjob-${variant})
-  add_executable(${image} firmware/app/mcu/c_job_only.cpp firmware/app/mcu/startup.cpp ${c_job_source})
-  set_target_properties(${image} PROPERTIES SUFFIX ".elf" C_STANDARD 99 C_STANDARD_REQUIRED ON C_EXTENSIONS OFF)
-  add_dependencies(${image} oneshot_generated)
-  target_include_directories(${image} PRIVATE firmware/core/include ${generated_dir}/oneshot_c)
-  target_compile_options(${image} PRIVATE ${fw_common_options})
+# Job-only images of the generated C job (no PIL link), one per variant, for flash, RAM and
+# stack bound: oneshot-<target>-cjob-<variant>.elf.
+set(c_job_variants fixed_table fixed_nearest float_table float_nearest q15_table q15_nearest)
+foreach(variant ${c_job_variants})
   string(TOUPPER ${variant} variant_upper)
-  set(others fixed_table fixed_nearest float_table float_nearest q15_table q15_nearest)
+  set(others ${c_job_variants})
   list(REMOVE_ITEM others ${variant})
   list(TRANSFORM others TOUPPER)
   list(TRANSFORM others PREPEND ONESHOT_JOB_WITHOUT_)
-  target_compile_definitions(${image} PRIVATE ${soc_define} ONESHOT_MCU_IRQ_COUNT=${irq_count}
-    ONESHOT_MCU_ACTUATION_IRQ=8 ONESHOT_MCU_UART_IRQ=${uart_irq} ${extra_defines}
-    ONESHOT_CJOB_VARIANT=${variant} ONESHOT_CJOB_HAS=ONESHOT_JOB_HAS_${variant_upper} ${others})
-  oneshot_firmware_link(${image})
-  add_custom_command(TARGET ${image} POST_BUILD
-    COMMAND arm-none-eabi-size $<TARGET_FILE:${image}>
-    COMMAND ${CMAKE_COMMAND} -DDIR=${CMAKE_CURRENT_BINARY_DIR}/CMakeFiles/${image}.dir
-            -DOUT=$<TARGET_FILE:${image}>.stack.txt -P ${PROJECT_SOURCE_DIR}/cmake/oneshot_stack_bound.cmake
-    COMMENT "size and stack bound of ${image}")
+  oneshot_firmware_image(oneshot-${ONESHOT_FIRMWARE_TARGET}-cjob-${variant} C_JOB STACK_BOUND
+    SOURCES firmware/app/mcu/c_job_only.cpp
+    DEFINES ONESHOT_CJOB_VARIANT=${variant} ONESHOT_CJOB_HAS=ONESHOT_JOB_HAS_${variant_upper} ${others})
 endforeach()
 
 # A heap use must fail the link: this probe allocates and is never part of ALL.
-add_executable(oneshot-heap-probe-${ONESHOT_FIRMWARE_TARGET} EXCLUDE_FROM_ALL
-  firmware/app/mcu/heap_probe.cpp firmware/app/mcu/startup.cpp)
-target_compile_options(oneshot-heap-probe-${ONESHOT_FIRMWARE_TARGET} PRIVATE -ffreestanding -fno-exceptions -fno-rtti)
-target_compile_definitions(oneshot-heap-probe-${ONESHOT_FIRMWARE_TARGET} PRIVATE
-  ONESHOT_MCU_IRQ_COUNT=${irq_count} ONESHOT_MCU_ACTUATION_IRQ=8 ONESHOT_MCU_UART_IRQ=${uart_irq})
-oneshot_firmware_link(oneshot-heap-probe-${ONESHOT_FIRMWARE_TARGET})
+oneshot_firmware_image(oneshot-heap-probe-${ONESHOT_FIRMWARE_TARGET} EXCLUDE_FROM_ALL
+  SOURCES firmware/app/mcu/heap_probe.cpp OPTIONS -ffreestanding -fno-exceptions -fno-rtti)
 
 # Size probes: one control job (half Kalman, generic float discretizer) for a synthetic dense
-# n-state plant, n = ONESHOT_PROBE_N; not part of ALL. <image>.stack.txt bounds its stack.
+# n-state plant, n = ONESHOT_PROBE_N; not part of ALL.
 foreach(probe_n RANGE 2 16)
-  set(image oneshot-${ONESHOT_FIRMWARE_TARGET}-size-probe-n${probe_n})
-  add_executable(${image} EXCLUDE_FROM_ALL firmware/app/mcu/size_probe.cpp firmware/app/mcu/startup.cpp)
-  set_target_properties(${image} PROPERTIES SUFFIX ".elf")
-  target_include_directories(${image} PRIVATE firmware/core/include)
-  target_compile_options(${image} PRIVATE ${fw_common_options})
-  target_compile_definitions(${image} PRIVATE ${soc_define} ONESHOT_MCU_IRQ_COUNT=${irq_count}
-    ONESHOT_MCU_ACTUATION_IRQ=8 ONESHOT_MCU_UART_IRQ=${uart_irq} ${extra_defines} ONESHOT_PROBE_N=${probe_n})
-  oneshot_firmware_link(${image})
-  add_custom_command(TARGET ${image} POST_BUILD
-    COMMAND arm-none-eabi-size $<TARGET_FILE:${image}>
-    COMMAND ${CMAKE_COMMAND} -DDIR=${CMAKE_CURRENT_BINARY_DIR}/CMakeFiles/${image}.dir
-            -DOUT=$<TARGET_FILE:${image}>.stack.txt -P ${PROJECT_SOURCE_DIR}/cmake/oneshot_stack_bound.cmake
-    COMMENT "size and stack bound of ${image}")
+  oneshot_firmware_image(oneshot-${ONESHOT_FIRMWARE_TARGET}-size-probe-n${probe_n} EXCLUDE_FROM_ALL STACK_BOUND
+    SOURCES firmware/app/mcu/size_probe.cpp DEFINES ONESHOT_PROBE_N=${probe_n})
 endforeach()
 
 # The fixed-point job must link no soft-float routine at any optimisation level (its
 # constants are integer-exact): the fixed table image built at -Og, never part of ALL; a
 # test builds it and checks its symbols (tests/pil/og_no_floating_point.cmake).
-set(og_probe oneshot-og-probe-${ONESHOT_FIRMWARE_TARGET})
-add_executable(${og_probe} EXCLUDE_FROM_ALL firmware/app/mcu/main.cpp firmware/app/mcu/startup.cpp ${c_job_source})
-set_target_properties(${og_probe} PROPERTIES SUFFIX ".elf" C_STANDARD 99 C_STANDARD_REQUIRED ON C_EXTENSIONS OFF)
-add_dependencies(${og_probe} oneshot_generated)
-target_include_directories(${og_probe} PRIVATE
-  firmware/core/include firmware/app/include hal/include hal/mcu/include ${generated_dir} ${generated_dir}/oneshot_c)
 set(og_options ${fw_common_options})
 list(REMOVE_ITEM og_options ${ONESHOT_FIRMWARE_OPT} -Werror)
-target_compile_options(${og_probe} PRIVATE ${og_options} -Og)
-target_compile_definitions(${og_probe} PRIVATE ${soc_define}
-  ONESHOT_MCU_IRQ_COUNT=${irq_count} ONESHOT_MCU_ACTUATION_IRQ=8 ONESHOT_MCU_UART_IRQ=${uart_irq} ${extra_defines}
-  ONESHOT_FW_FIXED=1 ONESHOT_FW_DISC=0)
-oneshot_firmware_link(${og_probe})
+oneshot_firmware_image(oneshot-og-probe-${ONESHOT_FIRMWARE_TARGET} EXCLUDE_FROM_ALL C_JOB PIL
+  SOURCES firmware/app/mcu/main.cpp OPTIONS ${og_options} -Og DEFINES ONESHOT_FW_FIXED=1 ONESHOT_FW_DISC=0)
 
 # The petc image (Cortex-M4F only: the node with H = 200 needs ~49 KB of RAM, the nRF51 has 16 KB):
 # the PETC controller node behind the PIL link, one NUMRE arrival per request between the
-# instruction-count markers (firmware/app/mcu/petc_main.cpp); <image>.stack.txt as above.
+# instruction-count markers (firmware/app/mcu/petc_main.cpp).
 if(ONESHOT_FIRMWARE_TARGET STREQUAL "cortex-m4f")
-  set(image oneshot-${ONESHOT_FIRMWARE_TARGET}-petc)
-  add_executable(${image} firmware/app/mcu/petc_main.cpp firmware/app/mcu/startup.cpp)
-  set_target_properties(${image} PROPERTIES SUFFIX ".elf")
-  target_include_directories(${image} PRIVATE
-    firmware/core/include firmware/app/include firmware/node/include hal/include hal/mcu/include)
-  target_compile_options(${image} PRIVATE ${fw_common_options})
-  target_compile_definitions(${image} PRIVATE ${soc_define}
-    ONESHOT_MCU_IRQ_COUNT=${irq_count} ONESHOT_MCU_ACTUATION_IRQ=8 ONESHOT_MCU_UART_IRQ=${uart_irq} ${extra_defines})
-  oneshot_firmware_link(${image})
-  add_custom_command(TARGET ${image} POST_BUILD
-    COMMAND arm-none-eabi-size $<TARGET_FILE:${image}>
-    COMMAND ${CMAKE_COMMAND} -DDIR=${CMAKE_CURRENT_BINARY_DIR}/CMakeFiles/${image}.dir
-            -DOUT=$<TARGET_FILE:${image}>.stack.txt -P ${PROJECT_SOURCE_DIR}/cmake/oneshot_stack_bound.cmake
-    COMMENT "size and stack bound of ${image}")
+  oneshot_firmware_image(oneshot-${ONESHOT_FIRMWARE_TARGET}-petc PIL STACK_BOUND
+    SOURCES firmware/app/mcu/petc_main.cpp INCLUDES firmware/node/include)
 endif()

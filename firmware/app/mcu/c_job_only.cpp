@@ -22,13 +22,10 @@ volatile bool g_run;
 volatile std::uint16_t g_pwm_register;  // stands for PDC1
 }  // namespace
 
+/// The actuation interrupt: the prepared code goes out (the other vectors: startup.cpp's).
 extern "C" void oneshot_actuation_timer_handler() { g_pwm_register = g_prepared; }
-extern "C" void oneshot_uart_rx_handler() {}
+/// Stands for the sampling instant's interrupt.
 extern "C" void oneshot_idle_wakeup_handler() { g_run = true; }
-extern "C" [[noreturn]] void oneshot_fault_handler() {
-  for (;;) {
-  }
-}
 
 int main() {
   ONESHOT_CJOB(init)(&g_job, static_cast<std::uint16_t>(ONESHOT_JOB_PWM_STEPS / 2));
@@ -40,12 +37,5 @@ int main() {
   }
 }
 #else
-extern "C" void oneshot_actuation_timer_handler() {}
-extern "C" void oneshot_uart_rx_handler() {}
-extern "C" void oneshot_idle_wakeup_handler() {}
-extern "C" [[noreturn]] void oneshot_fault_handler() {
-  for (;;) {
-  }
-}
 int main() {}  // this plant has no such variant
 #endif

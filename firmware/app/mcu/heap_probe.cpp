@@ -6,14 +6,6 @@
 
 extern "C" void* malloc(unsigned int size);
 
-extern "C" void oneshot_actuation_timer_handler() {}
-extern "C" void oneshot_uart_rx_handler() {}
-extern "C" void oneshot_idle_wakeup_handler() {}
-extern "C" [[noreturn]] void oneshot_fault_handler() {
-  for (;;) {
-  }
-}
-
 /// Where the allocations escape to (so the compiler cannot elide them).
 std::uint32_t* volatile g_escape = nullptr;
 

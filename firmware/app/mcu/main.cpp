@@ -11,7 +11,6 @@
 #include "oneshot/app/control_task.hpp"
 #include "oneshot/app/pil_protocol.hpp"
 #include "oneshot/app/wait_until_set.hpp"
-#include "oneshot/assert_handler.hpp"
 #include "oneshot/complete_kalman.hpp"
 #include "oneshot/controller.hpp"
 #include "oneshot/deadbeat_observer.hpp"
@@ -20,33 +19,15 @@
 #include "oneshot/generic_discretizer.hpp"
 #include "oneshot/half_kalman.hpp"
 #include "oneshot/mcu/pil_board.hpp"
-#include "oneshot/mcu/rx_ring.hpp"
 #include "oneshot/standard_kalman.hpp"
 #include "oneshot/table_discretizer.hpp"
 #include "oneshot_job.h"  // the generated C99 job (lut_gen --c-job-dir), approaches 5 and 6
 #include "c_job_loop.hpp"
-
-#if defined(ONESHOT_MCU_NRF51)
-#include "oneshot/mcu/nrf51.hpp"
-namespace soc = oneshot::mcu::nrf51;
-#elif defined(ONESHOT_MCU_MPS2)
-#include "oneshot/mcu/mps2_an386.hpp"
-namespace soc = oneshot::mcu::mps2;
-#else
-#error "define ONESHOT_MCU_NRF51 or ONESHOT_MCU_MPS2"
-#endif
+#include "pil_link.hpp"
 
 namespace oneshot::mcu {
 PilRegisters g_pil;
 }  // namespace oneshot::mcu
-
-/// Instruction-count markers: the QEMU plugin counts from the first instruction of
-/// begin to the first of end.
-extern "C" __attribute__((noinline, used)) void oneshot_job_begin() { __asm__ volatile("" ::: "memory"); }
-/// See oneshot_job_begin().
-extern "C" __attribute__((noinline, used)) void oneshot_job_end() { __asm__ volatile("" ::: "memory"); }
-/// Deepest stack use since reset, bytes (startup.cpp paints the free stack).
-extern "C" std::uint32_t oneshot_stack_peak_bytes();
 
 namespace {
 
@@ -55,6 +36,8 @@ namespace pil = app::pil;
 using app::TaskModel;
 using mcu::PilBoard;
 using mcu::g_pil;
+using mcu::PilLink;
+namespace soc = mcu::soc;
 
 #if ONESHOT_FW_FIXED
 #if !ONESHOT_GENERATED_FIXED_POINT
@@ -94,12 +77,6 @@ using Disc = TableDiscretizer<Fmt, Structure, Storage>;
 const Disc g_disc(K::kTable);
 #endif
 constexpr std::uint8_t kDiscId = ONESHOT_FW_DISC;
-
-#if defined(ONESHOT_MCU_NRF51)
-constexpr std::uint8_t kTargetId = 0;  // cortex-m0
-#else
-constexpr std::uint8_t kTargetId = 1;  // cortex-m4f
-#endif
 
 /// Raw 32-bit image of a scalar: IEEE bits, or the sign-extended fixed mantissa.
 template <typename T>
@@ -206,31 +183,9 @@ struct JobOutcome {
 /// generated C99 job (B's job, table images only); 6: its q15 twin (fixed table images).
 std::uint8_t g_approach = 1;
 volatile bool g_tick_done = false;
-mcu::RxRing g_rx;
 
-/// The core's interrupt mask and sleep, for app::wait_until_set.
-struct Cpu {
-  static void interrupts_off() { mcu::interrupts_off(); }
-  static void interrupts_on() { mcu::interrupts_on(); }
-  static void wait_for_interrupt() { mcu::wait_for_interrupt(); }
-};
-
-/// Next received byte; sleeps until the receive interrupt when there is none.
-std::uint8_t next_byte() {
-  for (;;) {
-    std::uint8_t b = 0;
-    mcu::interrupts_off();
-    if (g_rx.pop(b)) {
-      soc::IdleWakeup::disarm();
-      mcu::interrupts_on();
-      return b;
-    }
-    soc::IdleWakeup::arm();
-    mcu::wait_for_interrupt();  // a pending interrupt ends it even with PRIMASK set
-    soc::Uart::drain([](std::uint8_t c) { g_rx.push(c); });  // whatever woke us
-    mcu::interrupts_on();
-  }
-}
+/// This image as its kHello reply states it.
+constexpr pil::ImageInfo kImage{soc::kPilTargetId, kFormatId, kDiscId, kN, kM, kP};
 
 template <typename F>
 decltype(auto) with_loop(F&& f) {
@@ -248,12 +203,6 @@ decltype(auto) with_loop(F&& f) {
   }
 }
 
-void send(const pil::Frame& f) {
-  std::uint8_t out[2 * (pil::kMaxPayload + 5) + 2];
-  const std::size_t n = pil::encode(f, out);
-  for (std::size_t i = 0; i < n; ++i) soc::Uart::put(out[i]);
-}
-
 void write_pwm(pil::Writer& w) {
   w.u(static_cast<std::uint32_t>(g_pil.writes), 1);
   for (std::size_t i = 0; i < g_pil.writes; ++i) {
@@ -262,44 +211,18 @@ void write_pwm(pil::Writer& w) {
   }
 }
 
-void hello(pil::Frame& r) {
-  r.type = static_cast<pil::Type>(static_cast<std::uint8_t>(pil::Type::kHello) | 0x80U);
-  pil::Writer w(r);
-  w.u(pil::kProtocolVersion, 1);
-  w.u(kTargetId, 1);
-  w.u(kFormatId, 1);
-  w.u(kDiscId, 1);
-  w.u(kN, 1);
-  w.u(kM, 1);
-  w.u(kP, 1);
-  w.u(oneshot_stack_peak_bytes(), 2);
-}
-
-/// Refuses a request whose payload does not decode (wrong length or value): a fault
-/// reply naming it, never a job run on zeros.
-void malformed(pil::Frame& r) {
-  r.type = pil::Type::kFault;
-  pil::Writer w(r);
-  w.u(pil::kFaultMalformedRequest, 4);
-}
-
 /// Waits for the actuation interrupt without sleeping through it: the flag is tested with
 /// interrupts masked, and WFI still wakes on the pending interrupt, which runs as soon as
 /// they are unmasked (a test then a WFI with interrupts on could miss the wake-up).
 void wait_for_tick() {
-  app::wait_until_set<Cpu>(g_tick_done);
+  app::wait_until_set<mcu::Cpu>(g_tick_done);
 }
 
+/// This image's requests (PilRuntime answers kHello, kCalibrate and kEcho); `r` is begun.
 void handle(const pil::Frame& q, pil::Frame& r) {
-  r.seq = q.seq;
-  r.type = static_cast<pil::Type>(static_cast<std::uint8_t>(q.type) | 0x80U);
-  r.length = 0;
+  using pil::malformed;
   pil::Writer w(r);
   switch (q.type) {
-    case pil::Type::kHello:
-      if (q.length != 0) return malformed(r);
-      hello(r);
-      return;
     case pil::Type::kConfig: {
       pil::ConfigRequest<kM> c;
       if (!pil::decode(q, c)) return malformed(r);
@@ -357,31 +280,13 @@ void handle(const pil::Frame& q, pil::Frame& r) {
       write_pwm(w);
       return;
     }
-    case pil::Type::kCalibrate:
-      if (q.length != 0) return malformed(r);
-      oneshot_job_begin();
-      oneshot_job_end();
-      return;
-    case pil::Type::kEcho:
-      for (std::size_t i = 0; i < q.length; ++i) r.payload[i] = q.payload[i];
-      r.length = q.length;
-      return;
     default:
-      r.type = pil::Type::kFault;
-      w.u(pil::kFaultUnknownRequest, 4);
+      pil::write_fault(r, pil::kFaultUnknownRequest);
       return;
   }
 }
 
 }  // namespace
-
-/// The idle wake-up timer (see IdleWakeup).
-extern "C" void oneshot_idle_wakeup_handler() { soc::IdleWakeup::acknowledge(); }
-
-/// The UART receive interrupt.
-extern "C" void oneshot_uart_rx_handler() {
-  soc::Uart::drain([](std::uint8_t b) { g_rx.push(b); });
-}
 
 /// The actuation timer interrupt: the task's one-shot actuation.
 extern "C" void oneshot_actuation_timer_handler() {
@@ -390,52 +295,9 @@ extern "C" void oneshot_actuation_timer_handler() {
   g_tick_done = true;
 }
 
-/// Faults and failed invariants: report once over the link, then stop.
-extern "C" [[noreturn]] void oneshot_fault_handler() {
-  pil::Frame f;
-  f.type = pil::Type::kFault;
-  pil::Writer w(f);
-  w.u(pil::kFaultHard, 4);
-  send(f);
-  for (;;) {
-  }
-}
-
-namespace oneshot {
-[[noreturn]] void assert_failed(const char* file, int line, const char* /*expression*/) {
-  pil::Frame f;
-  f.type = pil::Type::kFault;
-  pil::Writer w(f);
-  w.u(static_cast<std::uint32_t>(line), 4);
-  for (std::size_t i = 0; file[i] != '\0' && f.length < pil::kMaxPayload; ++i) w.u(static_cast<std::uint8_t>(file[i]), 1);
-  send(f);
-  for (;;) {
-  }
-}
-}  // namespace oneshot
-
 int main() {
-  soc::Uart::init();
+  PilLink::init();
   soc::ActuationTimer::init();
-  soc::IdleWakeup::init();
   mcu::interrupts_on();
-  pil::Frame r;
-  hello(r);
-  send(r);
-  pil::Decoder decoder;
-  pil::Frame last_reply;
-  bool have_last = false;
-  for (;;) {
-    if (!decoder.feed(next_byte())) continue;
-    const pil::Frame& q = decoder.frame();
-    // A repeated sequence number is a retransmission: the reply was lost, not the job.
-    if (have_last && q.seq == last_reply.seq &&
-        static_cast<std::uint8_t>(last_reply.type) == (static_cast<std::uint8_t>(q.type) | 0x80U)) {
-      send(last_reply);
-      continue;
-    }
-    handle(q, last_reply);
-    have_last = true;
-    send(last_reply);
-  }
+  PilLink::serve(kImage, handle);
 }

@@ -38,13 +38,6 @@ const typename Disc::Model* volatile g_model = &kModel;
 
 }  // namespace
 
-extern "C" void oneshot_actuation_timer_handler() {}
-extern "C" void oneshot_uart_rx_handler() {}
-extern "C" void oneshot_idle_wakeup_handler() {}
-extern "C" [[noreturn]] void oneshot_fault_handler() {
-  for (;;) {
-  }
-}
 
 /// Inputs and outputs of the job loop (a debugger or a test harness would drive them).
 volatile std::int32_t g_tau_us = 7000;

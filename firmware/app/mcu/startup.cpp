@@ -6,6 +6,8 @@
 #include <cstddef>
 #include <cstdint>
 
+#include "oneshot/mcu/soc.hpp"  // the interrupt numbers of this image's SoC
+
 extern "C" {
 extern std::uint32_t __data_load;
 extern std::uint32_t __data_start;
@@ -62,6 +64,20 @@ std::uint32_t oneshot_stack_peak_bytes() {
 /// Unexpected interrupts and faults.
 void default_handler() { oneshot_fault_handler(); }
 
+/// The vectors an image may leave out (weak: the image's definition wins). The PIL images
+/// define them all (pil_link.cpp and their main); the job-only images and the probes have
+/// no link, so there an interrupt does nothing and a fault stops the core.
+__attribute__((weak)) void oneshot_actuation_timer_handler() {}
+/// See oneshot_actuation_timer_handler().
+__attribute__((weak)) void oneshot_uart_rx_handler() {}
+/// See oneshot_actuation_timer_handler().
+__attribute__((weak)) void oneshot_idle_wakeup_handler() {}
+/// See oneshot_actuation_timer_handler().
+[[noreturn]] __attribute__((weak)) void oneshot_fault_handler() {
+  for (;;) {
+  }
+}
+
 /// Freestanding C library pieces the compiler may emit calls to.
 void* memcpy(void* d, const void* s, std::size_t n) {
   auto* dp = static_cast<unsigned char*>(d);
@@ -112,9 +128,13 @@ void* __dso_handle = nullptr;
 namespace {
 
 using Vector = void (*)();
-constexpr std::size_t kIrqCount = ONESHOT_MCU_IRQ_COUNT;
-constexpr std::size_t kActuationIrq = ONESHOT_MCU_ACTUATION_IRQ;
-constexpr std::size_t kUartIrq = ONESHOT_MCU_UART_IRQ;
+namespace soc = oneshot::mcu::soc;
+constexpr std::size_t kIrqCount = soc::kIrqCount;
+constexpr std::size_t kActuationIrq = soc::ActuationTimer::kIrq;
+constexpr std::size_t kUartIrq = soc::Uart::kIrq;
+static_assert(kActuationIrq < kIrqCount && kUartIrq < kIrqCount && soc::IdleWakeup::kIrq < kIrqCount);
+constexpr bool kIdleIrqFree = soc::IdleWakeup::kIrq != kActuationIrq && soc::IdleWakeup::kIrq != kUartIrq;
+static_assert(kActuationIrq != kUartIrq && (!soc::IdleWakeup::kHasIrq || kIdleIrqFree), "one vector per interrupt line");
 
 /// Initial stack pointer, then exceptions 1–15 and the SoC interrupts.
 struct VectorTable {
@@ -129,9 +149,7 @@ constexpr VectorTable make_vectors() {
   t.handlers[2] = oneshot_fault_handler;                       // 3: hard fault
   t.handlers[15 + kActuationIrq] = oneshot_actuation_timer_handler;  // 16 + irq
   t.handlers[15 + kUartIrq] = oneshot_uart_rx_handler;
-#if defined(ONESHOT_MCU_IDLE_IRQ)
-  t.handlers[15 + ONESHOT_MCU_IDLE_IRQ] = oneshot_idle_wakeup_handler;
-#endif
+  if (soc::IdleWakeup::kHasIrq) t.handlers[15 + soc::IdleWakeup::kIrq] = oneshot_idle_wakeup_handler;
   return t;
 }
 

@@ -26,4 +26,15 @@ inline void wait_for_interrupt() { __asm__ volatile("wfi" ::: "memory"); }
 /// Compiler barrier.
 inline void barrier() { __asm__ volatile("" ::: "memory"); }
 
+/// The core's interrupt mask and sleep as one type, for the templates that take them
+/// (app::wait_until_set, app::pil::PilRuntime).
+struct Cpu {
+  /// See mcu::interrupts_off().
+  static void interrupts_off() { mcu::interrupts_off(); }
+  /// See mcu::interrupts_on().
+  static void interrupts_on() { mcu::interrupts_on(); }
+  /// See mcu::wait_for_interrupt().
+  static void wait_for_interrupt() { mcu::wait_for_interrupt(); }
+};
+
 }  // namespace oneshot::mcu

@@ -4,11 +4,17 @@
 /// Registers from the Cortex-M System Design Kit TRM (ARM DDI0479): APB UART, APB timer.
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
 
 #include "oneshot/mcu/mmio.hpp"
 
 namespace oneshot::mcu::mps2 {
+
+/// Interrupt lines of the AN386 (the vector table has 16 + kIrqCount entries).
+inline constexpr std::size_t kIrqCount = 48;
+/// The target's number in the PIL kHello reply.
+inline constexpr std::uint8_t kPilTargetId = 1;  // cortex-m4f
 
 /// CMSDK APB UART0 at 0x40004000 (receive IRQ 0): polled transmit, interrupt-driven receive.
 struct Uart {
@@ -85,6 +91,7 @@ struct ActuationTimer : CmsdkTimer<0x40000000U, 8> {
 /// with the CPU halted the rest of a frame would wait for an unrelated event; a pending
 /// timer gives the main loop its next iteration. Stopped before any job runs.
 struct IdleWakeup : CmsdkTimer<0x40001000U, 9> {
+  static constexpr bool kHasIrq = true;  ///< Its vector is oneshot_idle_wakeup_handler.
   /// Starts a 1 ms (25 000-cycle) one-shot.
   static void arm() { start(25000U); }
   /// Stops it.

@@ -4,11 +4,17 @@
 /// Registers from the nRF51 Series Reference Manual (UART chapter 29, TIMER chapter 18).
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
 
 #include "oneshot/mcu/mmio.hpp"
 
 namespace oneshot::mcu::nrf51 {
+
+/// Interrupt lines of the nRF51 (the vector table has 16 + kIrqCount entries).
+inline constexpr std::size_t kIrqCount = 32;
+/// The target's number in the PIL kHello reply.
+inline constexpr std::uint8_t kPilTargetId = 0;  // cortex-m0
 
 /// UART0 at 0x40002000 (IRQ 2): polled transmit, interrupt-driven receive.
 struct Uart {
@@ -91,7 +97,8 @@ struct ActuationTimer {
 
 /// The nRF51 UART model wakes QEMU on every byte read: nothing to do while idle.
 struct IdleWakeup {
-  static constexpr unsigned kIrq = 0;  ///< Unused.
+  static constexpr bool kHasIrq = false;  ///< No interrupt line, no vector.
+  static constexpr unsigned kIrq = 0;     ///< Unused.
   static void init() {}
   static void arm() {}
   static void disarm() {}
