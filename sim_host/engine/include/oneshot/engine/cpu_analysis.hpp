@@ -26,8 +26,14 @@
 /// up to the synchronous busy period L = Σ ⌈(L + J)/T⌉ C',
 ///     Σ_i max(0, ⌊(t + J_i − D_i)/T_i⌋ + 1) C'_i + Σ_{ISR} ⌈(t + J_k)/T_k⌉ C_k
 ///       + max_{D_j > t} NP_j ≤ t,                   C'_i = C_i + 2 cs
-/// and the WCRT bound under EDF is the deadline (a response-time analysis for EDF is not
-/// done: `wcrt_method` says so). Implicit deadlines without jitter, blocking or ISRs:
+/// EDF response time (Spuri 1996, with release jitter): the analysed job of i arrives at
+/// x − J_i (released at x), every other task released at 0 after its largest jitter; only
+/// jobs with absolute deadline ≤ d = x − J_i + D_i compete; B = max_{j≠i} NP_j:
+///     L    = B + Σ_{all} ⌈(L + J)/T⌉ C'                       (longest busy period)
+///     w(x) = B + (1 + ⌊x/T_i⌋) C'_i + Σ_{j≠i} min(⌈(w + J_j)/T_j⌉, (1 + ⌊(d + J_j − D_j)/T_j⌋)⁺) C'_j
+///            + Σ_{ISR} ⌈(w + J_k)/T_k⌉ C_k,                C'_i = C_i + cs, C'_j = C_j + 2 cs
+///     R_i  = max_x w(x) − x + J_i,  x ∈ [0, L) ∩ ({k T_i} ∪ {k T_j + D_j − J_j − D_i + J_i})
+/// BCRT: ISRs only (as non-preemptive). Implicit deadlines without jitter, blocking or ISRs:
 /// schedulable iff U ≤ 1 (Liu & Layland 1973). Jitter bounds: sampling at the job's start
 /// lies in [cs, WCRT − C^b_i] after the arrival; actuation at its end in [BCRT, WCRT].
 /// A busy period longer than 10^4 of the largest period (at most 2^50 ns), or holding more than
