@@ -2,6 +2,7 @@
 /// @brief The CPU model: arrivals, releases, dispatching, preemption, completion, overruns.
 #include "oneshot/engine/cpu.hpp"
 
+#include <algorithm>
 #include <stdexcept>
 
 namespace oneshot::engine::cpu {
@@ -95,6 +96,8 @@ void Cpu::arrive(std::size_t e) {
   j.arrival = now;
   j.exec = s.exec.draw(en.exec_rng, index);
   j.remaining = j.exec;
+  j.sample_off = s.sample_at.offset(j.exec);
+  j.act_off = s.actuate_at.offset(j.exec);
   j.ready = now;
   if (s.release_jitter.count() > 0) j.ready = now + from_us(en.jitter_rng.uniform_int(0, s.release_jitter.count() / 1000));
   en.pending.push_back(j);
@@ -130,6 +133,15 @@ void Cpu::account() {
   const Duration d = kernel_.now() - run_since_;
   j.remaining -= d;
   j.done += d;
+  // The segment runs the rest of the dispatch's context switch, then own work: a point at own
+  // offset m with own_before < m ≤ own_after is reached at work_from + (m − own_before).
+  const Duration over = std::min(d, j.cs_left);
+  j.cs_left -= over;
+  const Duration own_before = j.own;
+  j.own += d - over;
+  const SimTime work_from = run_since_ + over;
+  if (j.sample.count() < 0 && j.sample_off > own_before && j.sample_off <= j.own) j.sample = work_from + (j.sample_off - own_before);
+  if (j.actuate.count() < 0 && j.act_off > own_before && j.act_off <= j.own) j.actuate = work_from + (j.act_off - own_before);
   stats_[running_].busy += d;
   run_since_ = kernel_.now();
 }
@@ -150,9 +162,16 @@ void Cpu::finish_job(std::size_t e, bool aborted) {
     ++st.finished;
     st.response_sum_s += to_seconds(response);
     if (response > en.spec->deadline) ++st.deadline_misses;
+    const Duration ls = j.sample - j.arrival, la = j.actuate - j.arrival, io = j.actuate - j.sample;
+    if (st.finished == 1 || ls < st.sample_min) st.sample_min = ls;
+    if (st.finished == 1 || la < st.actuate_min) st.actuate_min = la;
+    if (st.finished == 1 || io < st.io_min) st.io_min = io;
+    st.sample_max = std::max(st.sample_max, ls);
+    st.actuate_max = std::max(st.actuate_max, la);
+    st.io_max = std::max(st.io_max, io);
     record(e, j.index, CpuEventKind::kFinish);
   }
-  if (on_job_) on_job_(CpuJob{e, j.index, j.arrival, j.ready, j.start, kernel_.now(), j.exec, aborted});
+  if (on_job_) on_job_(CpuJob{e, j.index, j.arrival, j.ready, j.start, kernel_.now(), j.exec, aborted, j.sample, j.actuate});
 }
 
 void Cpu::complete(std::uint64_t generation) {
@@ -237,9 +256,12 @@ void Cpu::dispatch() {
     last_task_ = chosen;
     last_task_job_ = j.index;
   }
+  j.cs_left += cs;  // a switch cut short by an ISR is finished after it
   if (!j.started) {
     j.started = true;
     j.start = now + cs;
+    if (j.sample_off.count() == 0) j.sample = j.start;
+    if (j.act_off.count() == 0) j.actuate = j.start;
     CpuTaskStats& st = stats_[chosen];
     const Duration latency = j.start - j.arrival;
     if (st.started == 0 || latency < st.start_min) st.start_min = latency;

@@ -64,10 +64,22 @@ Load load_of(const TaskSpec& t, I extra) {
   return Load{t.exec.wcet.count() + extra, t.exec.bcet.count(), t.period.count(), t.release_jitter.count(), !t.sporadic};
 }
 
+/// Latency bounds of a point at own offset m(e) (cpu_job_point.hpp): it is reached after the
+/// first switch and m(C^b) of own work, and at least C^b − m(C^b) of own work before the end:
+///     [cs + m(C^b), WCRT − (C^b − m(C^b))]   (the end: [BCRT, WCRT]; the start: [cs, WCRT − C^b])
+/// input-output latency: [min_e (m_a(e) − m_s(e)), max actuation − min sample latency].
 void finish_bound(TaskBound& b, const TaskSpec& t, I cs) {
   b.schedulable = b.bounded && b.wcrt <= t.deadline;
-  b.sampling_latency_min = Duration{cs};
-  b.sampling_latency_max = b.bounded ? b.wcrt - t.exec.bcet : Duration{0};
+  const Duration bc = t.exec.bcet;
+  auto lo = [&](const JobPoint& p) { return p.kind == JobPoint::Kind::kEnd ? b.bcrt : Duration{cs} + p.offset(bc); };
+  auto hi = [&](const JobPoint& p) { return b.bounded ? b.wcrt - (bc - p.offset(bc)) : Duration{0}; };
+  b.sampling_latency_min = lo(t.sample_at);
+  b.sampling_latency_max = hi(t.sample_at);
+  b.actuation_latency_min = lo(t.actuate_at);
+  b.actuation_latency_max = hi(t.actuate_at);
+  const bool floors = t.sample_at.kind == JobPoint::Kind::kFraction || t.actuate_at.kind == JobPoint::Kind::kFraction;
+  b.io_latency_min = std::max(Duration{0}, min_work_between(t.sample_at, t.actuate_at, bc, t.exec.wcet) - Duration{floors ? 2 : 0});
+  b.io_latency_max = b.bounded ? b.actuation_latency_max - b.sampling_latency_min : Duration{0};
 }
 
 /// ISRs: preemptive fixed priority among themselves, no context switch, no blocking.
@@ -371,7 +383,19 @@ nlohmann::json analysis_json(const TaskSet& set, const Analysis& a) {
                         {"sampling_latency_max_us", b.bounded ? nlohmann::json(us(b.sampling_latency_max)) : nlohmann::json(nullptr)},
                         {"sampling_jitter_bound_us",
                          b.bounded ? nlohmann::json(us(b.sampling_latency_max - b.sampling_latency_min)) : nlohmann::json(nullptr)},
-                        {"actuation_jitter_bound_us", b.bounded ? nlohmann::json(us(b.wcrt - b.bcrt)) : nlohmann::json(nullptr)}};
+                        {"jitter_bound_us", b.bounded ? nlohmann::json(us(b.wcrt - b.bcrt)) : nlohmann::json(nullptr)},
+                        {"actuation_latency_min_us", us(b.actuation_latency_min)},
+                        {"actuation_latency_max_us", b.bounded ? nlohmann::json(us(b.actuation_latency_max)) : nlohmann::json(nullptr)},
+                        {"actuation_jitter_bound_us",
+                         b.bounded ? nlohmann::json(us(b.actuation_latency_max - b.actuation_latency_min)) : nlohmann::json(nullptr)},
+                        {"io_latency_min_us", us(b.io_latency_min)},
+                        {"io_latency_max_us", b.bounded ? nlohmann::json(us(b.io_latency_max)) : nlohmann::json(nullptr)},
+                        {"io_jitter_bound_us",
+                         b.bounded ? nlohmann::json(us(b.io_latency_max - b.io_latency_min)) : nlohmann::json(nullptr)}};
+    if (!b.isr) {
+      j["sample_at"] = job_point_json(t.sample_at);
+      j["actuate_at"] = job_point_json(t.actuate_at);
+    }
     return j;
   };
   nlohmann::json j = {{"schedulable", a.schedulable},

@@ -3,6 +3,9 @@
 ///        the jobs of a task set (cpu_task_set.hpp), with ISRs, context switches and
 ///        overrun policies; every scheduling event logged (compact) and counted.
 ///
+/// Sample and actuation: the instants at which a job's own work (switches excluded) reaches
+/// its task's sample_at / actuate_at offsets (cpu_job_point.hpp), found exactly when the run
+/// segment that crosses them is accounted (no extra event); an offset 0 is the job's start.
 /// Events: arrivals and completions in class kCompute; the dispatcher in class kBus, after
 /// every other event of the instant, so simultaneous releases are arbitrated together (no
 /// spurious preemption at an instant where several jobs arrive). The running job's
@@ -53,6 +56,8 @@ struct CpuJob {
   SimTime finish{0};           ///< Completion (or abort).
   Duration exec{0};            ///< Own execution time drawn.
   bool aborted = false;        ///< Aborted at its deadline.
+  SimTime sample{-1};          ///< When its input was read (sample_at reached; −1: not reached).
+  SimTime actuate{-1};         ///< When its output was written (actuate_at reached; −1: not reached).
 };
 
 /// Counters and response-time extremes of one task or ISR.
@@ -71,6 +76,12 @@ struct CpuTaskStats {
   Duration start_min{0};           ///< Smallest start − arrival (sampling latency).
   Duration start_max{0};           ///< Largest.
   Duration busy{0};                ///< CPU time consumed (context switches included).
+  Duration sample_min{0};          ///< Smallest sample − arrival (sampling latency at sample_at).
+  Duration sample_max{0};          ///< Largest.
+  Duration actuate_min{0};         ///< Smallest actuation − arrival (at actuate_at).
+  Duration actuate_max{0};         ///< Largest.
+  Duration io_min{0};              ///< Smallest actuation − sample (input-output latency).
+  Duration io_max{0};              ///< Largest.
 };
 
 /// The CPU: attach to a kernel, start, run the kernel, read the statistics.
@@ -104,6 +115,10 @@ class Cpu {
     std::uint64_t index = 0;
     SimTime arrival{0}, ready{0}, start{0};
     Duration exec{0}, remaining{0}, done{0};
+    Duration sample_off{0}, act_off{0};  // own work before the sample / actuation point
+    Duration own{0};                     // own work done (done without context switches)
+    Duration cs_left{0};                 // context switch still to run in this dispatch
+    SimTime sample{-1}, actuate{-1};
     bool started = false;
   };
   struct Entity {
