@@ -28,7 +28,11 @@ const char* to_string(CpuEventKind k) {
 
 Cpu::Cpu(Kernel& kernel, TaskSet set) : kernel_(kernel), set_(std::move(set)) {
   if (set_.tasks.size() + set_.isrs.size() > 60000) throw std::invalid_argument("cpu: at most 60000 tasks and ISRs");
-  for (const TaskSpec& t : set_.tasks) specs_.push_back(&t);
+  for (std::size_t i = 0; i < set_.tasks.size(); ++i) {
+    const TaskSpec& t = set_.tasks[i];
+    check_point_order(t.sample_at, t.actuate_at, t.exec.bcet, t.exec.wcet, "tasks[" + std::to_string(i) + "].actuate_at");
+    specs_.push_back(&t);
+  }
   for (const TaskSpec& t : set_.isrs) specs_.push_back(&t);
   for (std::size_t e = 0; e < specs_.size(); ++e) {
     const std::string& n = specs_[e]->name;

@@ -87,7 +87,8 @@ struct CpuTaskStats {
 /// The CPU: attach to a kernel, start, run the kernel, read the statistics.
 class Cpu {
  public:
-  /// A CPU running `set` on `kernel` (registers its handlers; nothing scheduled yet).
+  /// A CPU running `set` on `kernel` (registers its handlers; nothing scheduled yet). A task
+  /// whose actuate_at may precede its sample_at is refused (InputError, cpu_job_point.hpp).
   Cpu(Kernel& kernel, TaskSet set);
   Cpu(const Cpu&) = delete;
   Cpu& operator=(const Cpu&) = delete;
