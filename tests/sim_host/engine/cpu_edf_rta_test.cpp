@@ -14,32 +14,23 @@
 
 #include "oneshot/engine/cpu.hpp"
 #include "oneshot/engine/cpu_analysis.hpp"
+#include "sim_host/engine/cpu_test_support.hpp"
 
 namespace {
 
 using namespace oneshot::engine;
 using namespace oneshot::engine::cpu;
 
-/// A periodic EDF task in whole µs, constant or uniform execution time.
+/// A periodic EDF task in whole µs with relative deadline `deadline_us`.
 TaskSpec edf_task(const std::string& name, std::int64_t period_us, std::int64_t wcet_us, std::int64_t bcet_us, std::int64_t deadline_us,
                   int prio) {
-  TaskSpec t;
-  t.name = name;
-  t.period = from_us(period_us);
+  TaskSpec t = test_support::task(name, period_us, wcet_us, bcet_us, prio);
   t.deadline = from_us(deadline_us);
-  t.priority = prio;
-  t.exec.wcet = from_us(wcet_us);
-  t.exec.bcet = from_us(bcet_us);
-  t.exec.kind = bcet_us == wcet_us ? ExecModel::Kind::kConstant : ExecModel::Kind::kUniform;
   return t;
 }
 
 std::vector<CpuTaskStats> run(const TaskSet& set, SimTime duration, std::uint64_t seed) {
-  Kernel k(seed);
-  Cpu cpu(k, set);
-  cpu.start(duration);
-  k.run_until(duration);
-  return cpu.stats();
+  return test_support::simulate(set, duration, seed);
 }
 
 /// Hand computation (Spuri's candidates, docs/kernel.md): A (C 2, T = D 5), B (C 4, T = D 7).

@@ -14,29 +14,17 @@
 #include "oneshot/engine/cpu.hpp"
 #include "oneshot/engine/cpu_analysis.hpp"
 #include "oneshot/engine/json_fields.hpp"
+#include "sim_host/engine/cpu_test_support.hpp"
 
 namespace {
 
 using namespace oneshot::engine;
 using namespace oneshot::engine::cpu;
 
-TaskSpec task(const std::string& name, std::int64_t period_us, std::int64_t wcet_us, std::int64_t bcet_us, int prio) {
-  TaskSpec t;
-  t.name = name;
-  t.period = t.deadline = from_us(period_us);
-  t.priority = prio;
-  t.exec.wcet = from_us(wcet_us);
-  t.exec.bcet = from_us(bcet_us);
-  t.exec.kind = bcet_us == wcet_us ? ExecModel::Kind::kConstant : ExecModel::Kind::kUniform;
-  return t;
-}
+using test_support::task;
 
 std::vector<CpuTaskStats> run(const TaskSet& set, SimTime duration, std::uint64_t seed) {
-  Kernel k(seed);
-  Cpu cpu(k, set);
-  cpu.start(duration);
-  k.run_until(duration);
-  return cpu.stats();
+  return test_support::simulate(set, duration, seed);
 }
 
 JobPoint fraction(double f) {

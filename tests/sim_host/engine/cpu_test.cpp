@@ -15,34 +15,15 @@
 #include "oneshot/engine/cpu.hpp"
 #include "oneshot/engine/cpu_analysis.hpp"
 #include "oneshot/engine/json_fields.hpp"
+#include "sim_host/engine/cpu_test_support.hpp"
 
 namespace {
 
 using namespace oneshot::engine;
 using namespace oneshot::engine::cpu;
 
-/// A periodic task in whole µs with constant or uniform execution time.
-TaskSpec task(const std::string& name, std::int64_t period_us, std::int64_t wcet_us, std::int64_t bcet_us, int prio) {
-  TaskSpec t;
-  t.name = name;
-  t.period = from_us(period_us);
-  t.deadline = t.period;
-  t.priority = prio;
-  t.exec.wcet = from_us(wcet_us);
-  t.exec.bcet = from_us(bcet_us);
-  t.exec.kind = bcet_us == wcet_us ? ExecModel::Kind::kConstant : ExecModel::Kind::kUniform;
-  return t;
-}
-
-/// Simulates `set` for `duration` (seed `seed`); per entity: stats of the jobs finished by
-/// then (a job finishing later could miss interference from arrivals after the end).
-std::vector<CpuTaskStats> simulate(const TaskSet& set, SimTime duration, std::uint64_t seed) {
-  Kernel k(seed);
-  Cpu cpu(k, set);
-  cpu.start(duration);
-  k.run_until(duration);
-  return cpu.stats();
-}
+using test_support::simulate;
+using test_support::task;
 
 /// Periods (µs) whose hyperperiods stay small (every lcm divides 1.2 s).
 const std::int64_t kPeriodsUs[] = {1000, 2000, 2500, 3000, 4000, 5000, 6000, 8000, 10000, 12000, 15000, 20000, 25000, 30000, 40000, 50000};
