@@ -22,6 +22,8 @@ const char* to_string(CpuEventKind k) {
     case CpuEventKind::kFinish: return "finish";
     case CpuEventKind::kSkip: return "skip";
     case CpuEventKind::kAbort: return "abort";
+    case CpuEventKind::kSample: return "sample";
+    case CpuEventKind::kActuate: return "actuate";
   }
   return "?";
 }
@@ -66,6 +68,15 @@ void Cpu::record(std::size_t e, std::uint64_t job, CpuEventKind k) {
     return;
   }
   log_.push_back(CpuLogEntry{kernel_.now().count(), static_cast<std::uint32_t>(job), static_cast<std::uint16_t>(e), k});
+}
+
+void Cpu::log_point(std::size_t e, std::uint64_t job, CpuEventKind k, SimTime at) {
+  if (!log_enabled_) return;
+  if (log_.size() >= log_limit_) {
+    ++log_dropped_;
+    return;
+  }
+  log_.push_back(CpuLogEntry{at.count(), static_cast<std::uint32_t>(job), static_cast<std::uint16_t>(e), k});
 }
 
 void Cpu::request_dispatch(SimTime at) {
@@ -144,8 +155,14 @@ void Cpu::account() {
   const Duration own_before = j.own;
   j.own += d - over;
   const SimTime work_from = run_since_ + over;
-  if (j.sample.count() < 0 && j.sample_off > own_before && j.sample_off <= j.own) j.sample = work_from + (j.sample_off - own_before);
-  if (j.actuate.count() < 0 && j.act_off > own_before && j.act_off <= j.own) j.actuate = work_from + (j.act_off - own_before);
+  if (j.sample.count() < 0 && j.sample_off > own_before && j.sample_off <= j.own) {
+    j.sample = work_from + (j.sample_off - own_before);
+    log_point(running_, j.index, CpuEventKind::kSample, j.sample);
+  }
+  if (j.actuate.count() < 0 && j.act_off > own_before && j.act_off <= j.own) {
+    j.actuate = work_from + (j.act_off - own_before);
+    log_point(running_, j.index, CpuEventKind::kActuate, j.actuate);
+  }
   stats_[running_].busy += d;
   run_since_ = kernel_.now();
 }
@@ -264,14 +281,20 @@ void Cpu::dispatch() {
   if (!j.started) {
     j.started = true;
     j.start = now + cs;
-    if (j.sample_off.count() == 0) j.sample = j.start;
-    if (j.act_off.count() == 0) j.actuate = j.start;
     CpuTaskStats& st = stats_[chosen];
     const Duration latency = j.start - j.arrival;
     if (st.started == 0 || latency < st.start_min) st.start_min = latency;
     if (latency > st.start_max) st.start_max = latency;
     ++st.started;
     record(chosen, j.index, CpuEventKind::kStart);
+    if (j.sample_off.count() == 0) {
+      j.sample = j.start;
+      log_point(chosen, j.index, CpuEventKind::kSample, j.sample);
+    }
+    if (j.act_off.count() == 0) {
+      j.actuate = j.start;
+      log_point(chosen, j.index, CpuEventKind::kActuate, j.actuate);
+    }
   } else {
     record(chosen, j.index, CpuEventKind::kResume);
   }

@@ -291,7 +291,8 @@ TEST(Cpu, OverrunPoliciesAreCounted) {
   }
 }
 
-/// The log holds every release, start, preemption, resume and finish, in time order.
+/// The log holds every release, start, sample, preemption, resume, actuation and finish, in time order
+/// (default points: the sample at the start, the actuation at the end).
 TEST(Cpu, LogRecordsPreemptionAndResume) {
   TaskSet s;
   s.tasks = {task("hi", 4, 1, 1, 1), task("lo", 8, 5, 5, 2)};
@@ -303,8 +304,8 @@ TEST(Cpu, LogRecordsPreemptionAndResume) {
   std::string seq;
   for (const CpuLogEntry& e : cpu.log()) seq += std::string(to_string(e.kind)) + ":" + cpu.entity_name(e.entity) + "@" + std::to_string(e.t_ns / 1000) + " ";
   EXPECT_EQ(seq,
-            "release:hi@0 release:lo@0 start:hi@0 finish:hi@1 start:lo@1 release:hi@4 preempt:lo@4 start:hi@4 "
-            "finish:hi@5 resume:lo@5 finish:lo@7 ");
+            "release:hi@0 release:lo@0 start:hi@0 sample:hi@0 actuate:hi@1 finish:hi@1 start:lo@1 sample:lo@1 release:hi@4 "
+            "preempt:lo@4 start:hi@4 sample:hi@4 actuate:hi@5 finish:hi@5 resume:lo@5 actuate:lo@7 finish:lo@7 ");
 }
 
 }  // namespace

@@ -36,9 +36,12 @@ enum class CpuEventKind : std::uint8_t {
   kFinish,    ///< A job completed.
   kSkip,      ///< A release skipped (overrun policy skip).
   kAbort,     ///< A job aborted at its deadline (overrun policy abort).
+  kSample,    ///< A job read its input (sample_at reached; logged when found, with its own instant).
+  kActuate,   ///< A job wrote its output (actuate_at reached; likewise).
 };
 
-/// One log entry (16 bytes).
+/// One log entry (16 bytes). Entries are in time order except kSample / kActuate, which are
+/// logged when the run segment crossing them ends (not counted as scheduling events).
 struct CpuLogEntry {
   std::int64_t t_ns = 0;       ///< When.
   std::uint32_t job = 0;       ///< Job index of the entity (wraps after 2^32).
@@ -140,6 +143,7 @@ class Cpu {
   void account();
   void finish_job(std::size_t e, bool aborted);
   void record(std::size_t e, std::uint64_t job, CpuEventKind k);
+  void log_point(std::size_t e, std::uint64_t job, CpuEventKind k, SimTime at);
   bool before(std::size_t a, std::size_t b) const;
   const Job* head_ready(std::size_t e) const;
 
