@@ -70,6 +70,20 @@ nlohmann::json kernel_simulate(const TaskSet& set, double duration_s, std::uint6
                         {"skipped", s.skipped},
                         {"aborted", s.aborted},
                         {"preemptions", s.preemptions}};
+    if (e < set.tasks.size()) {
+      // At the task's sample_at / actuate_at (defaults: the start, the end).
+      t["sample_at"] = job_point_json(set.tasks[e].sample_at);
+      t["actuate_at"] = job_point_json(set.tasks[e].actuate_at);
+      t["sampling_latency_min_us"] = us_of(s.sample_min);
+      t["sampling_latency_max_us"] = us_of(s.sample_max);
+      t["sampling_jitter_us"] = us_of(s.sample_max - s.sample_min);
+      t["actuation_latency_min_us"] = us_of(s.actuate_min);
+      t["actuation_latency_max_us"] = us_of(s.actuate_max);
+      t["actuation_jitter_us"] = us_of(s.actuate_max - s.actuate_min);
+      t["io_latency_min_us"] = us_of(s.io_min);
+      t["io_latency_max_us"] = us_of(s.io_max);
+      t["io_jitter_us"] = us_of(s.io_max - s.io_min);
+    }
     j[e < set.tasks.size() ? "tasks" : "isrs"].push_back(t);
   }
   j["measured_utilization"] = duration_s > 0 ? engine::to_seconds(busy) / duration_s : 0.0;
@@ -110,7 +124,13 @@ void register_kernel_study(CLI::App& app) {
         } else {
           std::cout << "unbounded";
         }
-        std::cout << ", BCRT " << us_of(b.bcrt) << " us" << (b.schedulable ? "" : "  MISSES") << "\n";
+        std::cout << ", BCRT " << us_of(b.bcrt) << " us";
+        if (b.bounded) {
+          std::cout << ", response jitter <= " << us_of(b.wcrt - b.bcrt) << " us, sampling jitter <= "
+                    << us_of(b.sampling_latency_max - b.sampling_latency_min) << " us, input-output latency "
+                    << us_of(b.io_latency_min) << " .. " << us_of(b.io_latency_max) << " us";
+        }
+        std::cout << (b.schedulable ? "" : "  MISSES") << "\n";
       }
     }
   });

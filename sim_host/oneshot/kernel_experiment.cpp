@@ -36,7 +36,7 @@ constexpr Other kOthers[] = {{"uart_rx", 2000, 0.05, 6000}, {"comm", 5000, 0.15,
 /// One configuration's control-job timings and what the schedule did to them.
 struct ControlTrace {
   std::vector<JobTiming> jobs;
-  double latency_max_ms = 0;   // sampling: start − k·h
+  double latency_max_ms = 0;   // sampling: sample − k·h
   double response_max_ms = 0;  // finish − k·h
 };
 
@@ -48,12 +48,13 @@ ControlTrace control_trace(const TaskSet& set, std::uint64_t seed, double durati
   ControlTrace t;
   cpu.on_job([&](const CpuJob& j) {
     if (j.entity != control) return;
-    const auto rel = static_cast<std::int32_t>(std::llround(static_cast<double>((j.start - j.arrival).count()) * 1e-3));
-    const auto ex = static_cast<std::int32_t>(std::llround(static_cast<double>((j.finish - j.start).count()) * 1e-3));
+    // The trace's release is the sampling latency, its execution the sample-to-actuation time.
+    const auto rel = static_cast<std::int32_t>(std::llround(static_cast<double>((j.sample - j.arrival).count()) * 1e-3));
+    const auto ex = static_cast<std::int32_t>(std::llround(static_cast<double>((j.actuate - j.sample).count()) * 1e-3));
     if (j.aborted || rel + ex >= h_us) throw std::logic_error("kernel: control job beyond its period (analysis said otherwise)");
     if (t.jobs.size() != j.index) throw std::logic_error("kernel: control jobs out of order");
     t.jobs.push_back(JobTiming{rel, ex});
-    t.latency_max_ms = std::max(t.latency_max_ms, engine::to_seconds(j.start - j.arrival) * 1e3);
+    t.latency_max_ms = std::max(t.latency_max_ms, engine::to_seconds(j.sample - j.arrival) * 1e3);
     t.response_max_ms = std::max(t.response_max_ms, engine::to_seconds(j.finish - j.arrival) * 1e3);
   });
   const engine::SimTime end = engine::from_seconds(duration_s + 2 * static_cast<double>(h_us) * 1e-6, "duration");
@@ -111,6 +112,8 @@ TaskSet kernel_task_set(const ExecModel& job, std::int64_t period_us, double uti
   c.name = "control";
   c.period = c.deadline = engine::from_us(period_us);
   c.exec = job;
+  c.sample_at = k.sample_at;
+  c.actuate_at = k.actuate_at;
   const double h = static_cast<double>(c.period.count());
   const double rest = utilization - static_cast<double>(job.wcet.count()) / h - static_cast<double>(isr.exec.wcet.count()) / h;
   if (rest <= 0) throw std::invalid_argument("kernel: utilization " + fmt("%g", utilization) + " below the control job's own");
@@ -143,6 +146,7 @@ nlohmann::json run_kernel_experiment(const SimContext& ctx, const CommonOptions&
   if (k.seeds < 2) throw std::invalid_argument("--seeds: at least 2 for confidence intervals");
   const std::int64_t h_us = ctx.plant().period_us;
   const ExecModel job = control_job_model(k);
+  check_point_order(k.sample_at, k.actuate_at, job.bcet, job.wcet, "--actuate-at");
   Scenario base = uniform_scenario("kernel", 0, 0.2, 1.0, k.duration_s);
   engine::SweepSpec spec;
   spec.study = "oneshot";
@@ -178,7 +182,8 @@ nlohmann::json run_kernel_experiment(const SimContext& ctx, const CommonOptions&
   spec.config = {{"plant", ctx.plant().name}, {"period_us", h_us}, {"clock_mips", k.clock_mips},
                  {"control_job", job.source}, {"control_bcet_us", static_cast<double>(job.bcet.count()) * 1e-3},
                  {"control_wcet_us", static_cast<double>(job.wcet.count()) * 1e-3},
-                 {"context_switch_us", k.context_switch_us}, {"isr_instructions", k.isr_instructions},
+                 {"context_switch_us", k.context_switch_us}, {"sample_at", job_point_json(k.sample_at)},
+                 {"actuate_at", job_point_json(k.actuate_at)}, {"isr_instructions", k.isr_instructions},
                  {"duration_s", k.duration_s}, {"configurations", configs}, {"excluded", excluded},
                  {"number_format", to_string(opt.format)}, {"discretizer", to_string(opt.discretizer)}};
   if (!sets.empty()) util::write_json(path_in(opt.out_dir, "kernel_tasks_example.json"), task_set_json(sets.back()));
@@ -286,7 +291,8 @@ nlohmann::json kernel_outputs(const engine::SweepResults& r, const std::string& 
   out << "Control job: " << cfg.at("control_job").get<std::string>() << " (" << fmt("%.1f", cfg.at("control_bcet_us").get<double>())
       << "-" << fmt("%.1f", cfg.at("control_wcet_us").get<double>()) << " us), h = " << cfg.at("period_us").get<double>() * 1e-3
       << " ms, context switch " << cfg.at("context_switch_us") << " us, timer ISR " << cfg.at("isr_instructions")
-      << " instructions; " << spec.seeds << " seeds x " << cfg.at("duration_s") << " s per cell; ratios paired per seed.\n\n"
+      << " instructions; samples at " << cfg.value("sample_at", nlohmann::json("start")).dump() << ", D and E actuate at "
+      << cfg.value("actuate_at", nlohmann::json("end")).dump() << "; " << spec.seeds << " seeds x " << cfg.at("duration_s") << " s per cell; ratios paired per seed.\n\n"
       << md.str() << "\nLargest utilization at which the approach's mean cost ratio stays within 1 % of A, and within "
                      "1 % of its own ratio with the least schedule jitter (control task highest, lowest U), at that grid "
                      "point and every lower one:\n\n| approach | control priority | within 1 % of A | within 1 % of own "

@@ -4,8 +4,9 @@
 ///        model, issue 22); the schedule produces the jitter of approaches A–E.
 ///
 /// Per configuration (CPU utilization U × the control task's priority) and seed, the CPU is
-/// simulated for the scenario's duration; the control job samples at its start (latency
-/// start − k·h) and the standard approaches actuate at its end (finish − start later),
+/// simulated for the scenario's duration; the control job samples at its sample point
+/// (`--sample-at`, default its start: latency sample − k·h) and the standard approaches
+/// actuate at its actuation point (`--actuate-at`, default its end: actuation − sample later),
 /// the one-shot approaches at the next period boundary through the timer ISR (the ISR is in
 /// the task set). Those per-job timings are the scenario's jitter trace; A runs without
 /// jitter (the reference). Every approach of a seed sees the same schedule.
@@ -35,6 +36,8 @@ struct KernelExperimentOptions {
   double duration_s = 20;              ///< Simulated time per run.
   std::size_t seeds = 20;              ///< Seeds (as Table I).
   engine::Shard shard;                 ///< Part of the sweep.
+  engine::cpu::JobPoint sample_at = engine::cpu::job_start();  ///< Control job: where it reads the input.
+  engine::cpu::JobPoint actuate_at = engine::cpu::job_end();   ///< Where it writes the output (standard approaches).
 };
 
 /// Where the control task sits among the other tasks.
@@ -44,7 +47,7 @@ enum class ControlPriority : std::uint8_t { kHighest, kRateMonotonic, kLowest };
 const char* to_string(ControlPriority p);
 
 /// The CPU of one configuration: the actuation-timer ISR, the control task "control" (period
-/// h, execution `job`), and six others scaled so that Σ C/T = `utilization` (rate-monotonic
+/// h, execution `job`, sample and actuation points from `k`), and six others scaled so that Σ C/T = `utilization` (rate-monotonic
 /// among themselves): uart_rx (sporadic 2–6 ms), comm 5 ms, loop_fast 7 ms, loop_mid 13 ms,
 /// logger 31 ms, diag 97 ms; their jobs uniform in [C/2, C].
 engine::cpu::TaskSet kernel_task_set(const engine::cpu::ExecModel& job, std::int64_t period_us, double utilization,

@@ -23,6 +23,8 @@ struct KernelCliOptions {
   std::string plant;
   std::string shard = "0/1";
   std::string json;
+  std::string sample_at = "start";
+  std::string actuate_at = "end";
   bool no_plots = false;
 };
 
@@ -52,9 +54,16 @@ void register_kernel_experiment(CLI::App& study) {
   cmd->add_option("--shard", c->shard, "run part i/N of the sweep (merge with `oneshot-sim merge`)");
   cmd->add_option("--out", c->common.out_dir, "output folder (default out/kernel)");
   cmd->add_option("--json", c->json, "write the summary as JSON to PATH ('-' for standard output)");
+  cmd->add_option("--sample-at", c->sample_at,
+                  "where the control job reads its input: start (default), end, a fraction of its execution (0.5), "
+                  "<n>us of its execution, or <n>instr at the CPU clock");
+  cmd->add_option("--actuate-at", c->actuate_at,
+                  "where the standard approaches write the output: end (default) or as --sample-at; not before it");
   cmd->add_flag("--no-plots", c->no_plots, "no PNG plots");
   cmd->callback([c] {
     c->common.plots = !c->no_plots;
+    c->k.sample_at = engine::cpu::parse_job_point_text(c->sample_at, "--sample-at", c->k.clock_mips);
+    c->k.actuate_at = engine::cpu::parse_job_point_text(c->actuate_at, "--actuate-at", c->k.clock_mips);
     c->k.shard = engine::parse_shard(c->shard);
     const auto ctx = SimContext::load(c->plant);
     const nlohmann::json j = run_kernel_experiment(*ctx, c->common, c->k);

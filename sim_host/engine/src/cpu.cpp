@@ -2,6 +2,7 @@
 /// @brief The CPU model: arrivals, releases, dispatching, preemption, completion, overruns.
 #include "oneshot/engine/cpu.hpp"
 
+#include <algorithm>
 #include <stdexcept>
 
 namespace oneshot::engine::cpu {
@@ -21,13 +22,19 @@ const char* to_string(CpuEventKind k) {
     case CpuEventKind::kFinish: return "finish";
     case CpuEventKind::kSkip: return "skip";
     case CpuEventKind::kAbort: return "abort";
+    case CpuEventKind::kSample: return "sample";
+    case CpuEventKind::kActuate: return "actuate";
   }
   return "?";
 }
 
 Cpu::Cpu(Kernel& kernel, TaskSet set) : kernel_(kernel), set_(std::move(set)) {
   if (set_.tasks.size() + set_.isrs.size() > 60000) throw std::invalid_argument("cpu: at most 60000 tasks and ISRs");
-  for (const TaskSpec& t : set_.tasks) specs_.push_back(&t);
+  for (std::size_t i = 0; i < set_.tasks.size(); ++i) {
+    const TaskSpec& t = set_.tasks[i];
+    check_point_order(t.sample_at, t.actuate_at, t.exec.bcet, t.exec.wcet, "tasks[" + std::to_string(i) + "].actuate_at");
+    specs_.push_back(&t);
+  }
   for (const TaskSpec& t : set_.isrs) specs_.push_back(&t);
   for (std::size_t e = 0; e < specs_.size(); ++e) {
     const std::string& n = specs_[e]->name;
@@ -63,6 +70,15 @@ void Cpu::record(std::size_t e, std::uint64_t job, CpuEventKind k) {
   log_.push_back(CpuLogEntry{kernel_.now().count(), static_cast<std::uint32_t>(job), static_cast<std::uint16_t>(e), k});
 }
 
+void Cpu::log_point(std::size_t e, std::uint64_t job, CpuEventKind k, SimTime at) {
+  if (!log_enabled_) return;
+  if (log_.size() >= log_limit_) {
+    ++log_dropped_;
+    return;
+  }
+  log_.push_back(CpuLogEntry{at.count(), static_cast<std::uint32_t>(job), static_cast<std::uint16_t>(e), k});
+}
+
 void Cpu::request_dispatch(SimTime at) {
   if (at == kernel_.now()) {
     if (dispatch_at_ == at) return;
@@ -95,6 +111,8 @@ void Cpu::arrive(std::size_t e) {
   j.arrival = now;
   j.exec = s.exec.draw(en.exec_rng, index);
   j.remaining = j.exec;
+  j.sample_off = s.sample_at.offset(j.exec);
+  j.act_off = s.actuate_at.offset(j.exec);
   j.ready = now;
   if (s.release_jitter.count() > 0) j.ready = now + from_us(en.jitter_rng.uniform_int(0, s.release_jitter.count() / 1000));
   en.pending.push_back(j);
@@ -130,6 +148,21 @@ void Cpu::account() {
   const Duration d = kernel_.now() - run_since_;
   j.remaining -= d;
   j.done += d;
+  // The segment runs the rest of the dispatch's context switch, then own work: a point at own
+  // offset m with own_before < m ≤ own_after is reached at work_from + (m − own_before).
+  const Duration over = std::min(d, j.cs_left);
+  j.cs_left -= over;
+  const Duration own_before = j.own;
+  j.own += d - over;
+  const SimTime work_from = run_since_ + over;
+  if (j.sample.count() < 0 && j.sample_off > own_before && j.sample_off <= j.own) {
+    j.sample = work_from + (j.sample_off - own_before);
+    log_point(running_, j.index, CpuEventKind::kSample, j.sample);
+  }
+  if (j.actuate.count() < 0 && j.act_off > own_before && j.act_off <= j.own) {
+    j.actuate = work_from + (j.act_off - own_before);
+    log_point(running_, j.index, CpuEventKind::kActuate, j.actuate);
+  }
   stats_[running_].busy += d;
   run_since_ = kernel_.now();
 }
@@ -150,9 +183,16 @@ void Cpu::finish_job(std::size_t e, bool aborted) {
     ++st.finished;
     st.response_sum_s += to_seconds(response);
     if (response > en.spec->deadline) ++st.deadline_misses;
+    const Duration ls = j.sample - j.arrival, la = j.actuate - j.arrival, io = j.actuate - j.sample;
+    if (st.finished == 1 || ls < st.sample_min) st.sample_min = ls;
+    if (st.finished == 1 || la < st.actuate_min) st.actuate_min = la;
+    if (st.finished == 1 || io < st.io_min) st.io_min = io;
+    st.sample_max = std::max(st.sample_max, ls);
+    st.actuate_max = std::max(st.actuate_max, la);
+    st.io_max = std::max(st.io_max, io);
     record(e, j.index, CpuEventKind::kFinish);
   }
-  if (on_job_) on_job_(CpuJob{e, j.index, j.arrival, j.ready, j.start, kernel_.now(), j.exec, aborted});
+  if (on_job_) on_job_(CpuJob{e, j.index, j.arrival, j.ready, j.start, kernel_.now(), j.exec, aborted, j.sample, j.actuate});
 }
 
 void Cpu::complete(std::uint64_t generation) {
@@ -237,6 +277,7 @@ void Cpu::dispatch() {
     last_task_ = chosen;
     last_task_job_ = j.index;
   }
+  j.cs_left += cs;  // a switch cut short by an ISR is finished after it
   if (!j.started) {
     j.started = true;
     j.start = now + cs;
@@ -246,6 +287,14 @@ void Cpu::dispatch() {
     if (latency > st.start_max) st.start_max = latency;
     ++st.started;
     record(chosen, j.index, CpuEventKind::kStart);
+    if (j.sample_off.count() == 0) {
+      j.sample = j.start;
+      log_point(chosen, j.index, CpuEventKind::kSample, j.sample);
+    }
+    if (j.act_off.count() == 0) {
+      j.actuate = j.start;
+      log_point(chosen, j.index, CpuEventKind::kActuate, j.actuate);
+    }
   } else {
     record(chosen, j.index, CpuEventKind::kResume);
   }

@@ -64,10 +64,22 @@ Load load_of(const TaskSpec& t, I extra) {
   return Load{t.exec.wcet.count() + extra, t.exec.bcet.count(), t.period.count(), t.release_jitter.count(), !t.sporadic};
 }
 
+/// Latency bounds of a point at own offset m(e) (cpu_job_point.hpp): it is reached after the
+/// first switch and m(C^b) of own work, and at least C^b − m(C^b) of own work before the end:
+///     [cs + m(C^b), WCRT − (C^b − m(C^b))]   (the end: [BCRT, WCRT]; the start: [cs, WCRT − C^b])
+/// input-output latency: [min_e (m_a(e) − m_s(e)), max actuation − min sample latency].
 void finish_bound(TaskBound& b, const TaskSpec& t, I cs) {
   b.schedulable = b.bounded && b.wcrt <= t.deadline;
-  b.sampling_latency_min = Duration{cs};
-  b.sampling_latency_max = b.bounded ? b.wcrt - t.exec.bcet : Duration{0};
+  const Duration bc = t.exec.bcet;
+  auto lo = [&](const JobPoint& p) { return p.kind == JobPoint::Kind::kEnd ? b.bcrt : Duration{cs} + p.offset(bc); };
+  auto hi = [&](const JobPoint& p) { return b.bounded ? b.wcrt - (bc - p.offset(bc)) : Duration{0}; };
+  b.sampling_latency_min = lo(t.sample_at);
+  b.sampling_latency_max = hi(t.sample_at);
+  b.actuation_latency_min = lo(t.actuate_at);
+  b.actuation_latency_max = hi(t.actuate_at);
+  const bool floors = t.sample_at.kind == JobPoint::Kind::kFraction || t.actuate_at.kind == JobPoint::Kind::kFraction;
+  b.io_latency_min = std::max(Duration{0}, min_work_between(t.sample_at, t.actuate_at, bc, t.exec.wcet) - Duration{floors ? 2 : 0});
+  b.io_latency_max = b.bounded ? b.actuation_latency_max - b.sampling_latency_min : Duration{0};
 }
 
 /// ISRs: preemptive fixed priority among themselves, no context switch, no blocking.
@@ -182,6 +194,70 @@ TaskBound fp_bound(const TaskSet& s, std::size_t i, I limit) {
   return b;
 }
 
+/// EDF worst-case response time of task i (Spuri 1996, release jitter; equations in
+/// cpu_analysis.hpp): the analysed job arrives at x − J_i (released at x) in a busy period
+/// where every other task is released at 0 after its largest jitter and then as fast as it
+/// may; only jobs with absolute deadline ≤ d = x − J_i + D_i compete. −1: unbounded.
+I edf_wcrt(const TaskSet& s, std::size_t i, I limit, TaskBound& b) {
+  const I cs = s.context_switch.count();
+  const TaskSpec& t = s.tasks[i];
+  const I ci = t.exec.wcet.count() + cs, ti = t.period.count(), ji = t.release_jitter.count(), di = t.deadline.count();
+  std::vector<Load> others, isr;
+  std::vector<I> dl;
+  I blocking = 0;
+  for (std::size_t o = 0; o < s.tasks.size(); ++o) {
+    if (o == i) continue;
+    others.push_back(load_of(s.tasks[o], 2 * cs));
+    dl.push_back(s.tasks[o].deadline.count());
+    blocking = std::max(blocking, s.tasks[o].nonpreemptive.count());  // safe: any other task's section
+  }
+  for (const TaskSpec& k : s.isrs) isr.push_back(load_of(k, 0));
+  b.blocking = Duration{blocking};
+  // L = B + Σ_{all} ⌈(L + J)/T⌉ C': the longest busy period (jitter-synchronous release).
+  std::vector<Load> all = others;
+  all.push_back(Load{ci, 0, ti, ji, true});
+  all.insert(all.end(), isr.begin(), isr.end());
+  I sum_c = blocking;
+  for (const Load& l : all) sum_c += l.c;
+  const I busy = fixed_point(blocking, sum_c, all, limit);
+  if (busy < 0) return -1;
+  // Candidates x ∈ [0, L): x = k T_i, and x = k T_j + D_j − J_j − D_i + J_i (where the count
+  // of j's jobs with deadline ≤ d steps); w(x) − x is largest at these left ends.
+  std::vector<I> xs;
+  for (I x = 0; x < busy; x += ti) xs.push_back(x);
+  for (std::size_t o = 0; o < others.size(); ++o) {
+    const I first = dl[o] - others[o].j - di + ji;
+    for (I k = first < 0 ? ceil_div(-first, others[o].t) : 0; first + k * others[o].t < busy; ++k) {
+      xs.push_back(first + k * others[o].t);
+      if (static_cast<I>(xs.size()) > kMaxJobs) return -1;
+    }
+  }
+  std::sort(xs.begin(), xs.end());
+  xs.erase(std::unique(xs.begin(), xs.end()), xs.end());
+  I worst = 0;
+  std::vector<I> cap(others.size());
+  for (const I x : xs) {
+    // w = B + (1 + ⌊x/T_i⌋) C'_i + Σ_j min(⌈(w + J_j)/T_j⌉, (1 + ⌊(d + J_j − D_j)/T_j⌋)⁺) C'_j
+    //       + Σ_ISR ⌈(w + J_k)/T_k⌉ C_k
+    const I d = x - ji + di;
+    for (std::size_t o = 0; o < others.size(); ++o) cap[o] = std::max<I>(0, 1 + floor_div(d + others[o].j - dl[o], others[o].t));
+    const I base = blocking + (1 + x / ti) * ci;
+    I w = base;
+    for (;;) {
+      I next = base;
+      for (std::size_t o = 0; o < others.size(); ++o) {
+        next += std::min(ceil_div(w + others[o].j, others[o].t), cap[o]) * others[o].c;
+      }
+      for (const Load& l : isr) next += ceil_div(w + l.j, l.t) * l.c;
+      if (next <= w) break;
+      w = next;
+    }
+    worst = std::max(worst, w - x + ji);
+  }
+  b.jobs_examined = xs.size();
+  return worst;
+}
+
 void edf_analysis(const TaskSet& s, Analysis& a, I limit) {
   const I cs = s.context_switch.count();
   std::vector<Load> all;
@@ -252,10 +328,10 @@ void edf_analysis(const TaskSet& s, Analysis& a, I limit) {
     const TaskSpec& t = s.tasks[i];
     TaskBound b;
     b.name = t.name;
-    b.wcrt_method = "EDF: deadline, by the processor-demand test";
-    b.schedulable = miss.empty();
-    b.bounded = b.schedulable;
-    b.wcrt = b.schedulable ? t.deadline : Duration{0};
+    b.wcrt_method = "EDF response-time analysis (Spuri 1996, release jitter, candidate arrival offsets)";
+    const I w = u > 1.0 + 1e-12 ? -1 : edf_wcrt(s, i, limit, b);
+    b.bounded = w >= 0;
+    b.wcrt = Duration{b.bounded ? w : 0};
     std::vector<Load> isr;
     for (const TaskSpec& k : s.isrs) isr.push_back(load_of(k, 0));
     b.bcrt = Duration{best_case(t.exec.bcet.count() + cs, b.bounded ? b.wcrt.count() : t.exec.bcet.count() + cs, isr)};
@@ -307,7 +383,19 @@ nlohmann::json analysis_json(const TaskSet& set, const Analysis& a) {
                         {"sampling_latency_max_us", b.bounded ? nlohmann::json(us(b.sampling_latency_max)) : nlohmann::json(nullptr)},
                         {"sampling_jitter_bound_us",
                          b.bounded ? nlohmann::json(us(b.sampling_latency_max - b.sampling_latency_min)) : nlohmann::json(nullptr)},
-                        {"actuation_jitter_bound_us", b.bounded ? nlohmann::json(us(b.wcrt - b.bcrt)) : nlohmann::json(nullptr)}};
+                        {"jitter_bound_us", b.bounded ? nlohmann::json(us(b.wcrt - b.bcrt)) : nlohmann::json(nullptr)},
+                        {"actuation_latency_min_us", us(b.actuation_latency_min)},
+                        {"actuation_latency_max_us", b.bounded ? nlohmann::json(us(b.actuation_latency_max)) : nlohmann::json(nullptr)},
+                        {"actuation_jitter_bound_us",
+                         b.bounded ? nlohmann::json(us(b.actuation_latency_max - b.actuation_latency_min)) : nlohmann::json(nullptr)},
+                        {"io_latency_min_us", us(b.io_latency_min)},
+                        {"io_latency_max_us", b.bounded ? nlohmann::json(us(b.io_latency_max)) : nlohmann::json(nullptr)},
+                        {"io_jitter_bound_us",
+                         b.bounded ? nlohmann::json(us(b.io_latency_max - b.io_latency_min)) : nlohmann::json(nullptr)}};
+    if (!b.isr) {
+      j["sample_at"] = job_point_json(t.sample_at);
+      j["actuate_at"] = job_point_json(t.actuate_at);
+    }
     return j;
   };
   nlohmann::json j = {{"schedulable", a.schedulable},

@@ -173,7 +173,7 @@ TaskSpec parse_task(const nlohmann::json& j, const std::string& f, bool isr, con
                         "priority", "jitter_us"});
   } else {
     require_keys(j, f, {"name", "kind", "period_us", "max_interarrival_us", "wcet_us", "bcet_us", "exec", "priority",
-                        "offset_us", "deadline_us", "jitter_us", "nonpreemptive_us", "overrun"});
+                        "offset_us", "deadline_us", "jitter_us", "nonpreemptive_us", "overrun", "sample_at", "actuate_at"});
   }
   TaskSpec t;
   t.name = string_of(j, f, "name");
@@ -204,6 +204,10 @@ TaskSpec parse_task(const nlohmann::json& j, const std::string& f, bool isr, con
     t.nonpreemptive = us(integer_in(j, f, "nonpreemptive_us", 0, kMaxUs, true, 0));
     if (t.nonpreemptive > t.exec.bcet) fail(at(f, "nonpreemptive_us"), "exceeds the best-case execution time");
     t.overrun = parse_overrun(string_of(j, f, "overrun", true, "continue"), at(f, "overrun"));
+    const double mips = t.exec.kind == ExecModel::Kind::kInstructions ? t.exec.clock_mips : 0.0;
+    if (j.contains("sample_at")) t.sample_at = parse_job_point(j["sample_at"], at(f, "sample_at"), mips);
+    if (j.contains("actuate_at")) t.actuate_at = parse_job_point(j["actuate_at"], at(f, "actuate_at"), mips);
+    check_point_order(t.sample_at, t.actuate_at, t.exec.bcet, t.exec.wcet, at(f, "actuate_at"));
   }
   return t;
 }
@@ -333,6 +337,8 @@ nlohmann::json task_set_json(const TaskSet& set) {
     if (!isr) {
       j["deadline_us"] = t.deadline.count() / 1000;
       j["overrun"] = to_string(t.overrun);
+      if (t.sample_at.kind != JobPoint::Kind::kStart) j["sample_at"] = job_point_json(t.sample_at);
+      if (t.actuate_at.kind != JobPoint::Kind::kEnd) j["actuate_at"] = job_point_json(t.actuate_at);
     }
     if (t.release_jitter.count() > 0) j["jitter_us"] = t.release_jitter.count() / 1000;
     if (t.nonpreemptive.count() > 0) j["nonpreemptive_us"] = t.nonpreemptive.count() / 1000;

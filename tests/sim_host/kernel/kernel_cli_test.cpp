@@ -113,6 +113,49 @@ TEST(KernelCli, AnalyzeAndSimulateKeys) {
   EXPECT_NE(test::read_file(dir + "/gantt.csv").find("row,start_ms,end_ms"), std::string::npos);
 }
 
+/// EDF: `analyze` gives Spuri's response times under the FP keys (wcrt_us, bcrt_us,
+/// jitter_bound_us): A (2, 5) and B (4, 7) have WCRT 4 and 6 (cpu_edf_rta_test.cpp by hand).
+/// `simulate` with the low task sampling at its end: its sampling jitter is the closed form's
+/// 4 µs (cpu_sampling_test.cpp), at its start 0.
+TEST(KernelCli, EdfResponseTimesAndSamplePoint) {
+  const std::string dir = test::made_dir("oneshot_kernel_cli", "edf");
+  std::ofstream(dir + "/edf.json") << R"({"scheduler": "edf", "tasks": [
+    {"name": "A", "period_us": 5, "wcet_us": 2, "priority": 2}, {"name": "B", "period_us": 7, "wcet_us": 4, "priority": 1}]})";
+  const auto a = test::run_command({sim(), "kernel", "analyze", "--tasks", dir + "/edf.json", "--json", dir + "/a.json"});
+  ASSERT_EQ(a.exit_code, 0) << a.output;
+  const nlohmann::json ja = nlohmann::json::parse(test::read_file(dir + "/a.json"));
+  EXPECT_EQ(ja.at("tasks").at(0).at("wcrt_us").get<double>(), 4.0);
+  EXPECT_EQ(ja.at("tasks").at(1).at("wcrt_us").get<double>(), 6.0);
+  EXPECT_EQ(ja.at("tasks").at(0).at("bcrt_us").get<double>(), 2.0);
+  EXPECT_EQ(ja.at("tasks").at(0).at("jitter_bound_us").get<double>(), 2.0);
+  for (const char* at : {"start", "end"}) {
+    std::ofstream(dir + "/fp.json") << R"({"scheduler": "fixed_priority", "tasks": [
+      {"name": "hi", "period_us": 5, "wcet_us": 2, "priority": 1},
+      {"name": "lo", "period_us": 10, "wcet_us": 4, "bcet_us": 2, "priority": 2, "sample_at": ")" << at << R"("}]})";
+    const auto s = test::run_command({sim(), "kernel", "simulate", "--tasks", dir + "/fp.json", "--duration", "0.02", "--json",
+                                      dir + "/s.json", "--out", dir, "--no-plots"});
+    ASSERT_EQ(s.exit_code, 0) << s.output;
+    const nlohmann::json js = nlohmann::json::parse(test::read_file(dir + "/s.json"));
+    EXPECT_EQ(js.at("tasks").at(1).at("sampling_jitter_us").get<double>(), std::string(at) == "end" ? 4.0 : 0.0) << at;
+  }
+}
+
+/// The experiment's sample point reaches the control task; a bad one exits naming the option.
+TEST(KernelExperiment, SamplePointOption) {
+  sim::KernelExperimentOptions k;
+  k.sample_at = parse_job_point_text("0.5", "--sample-at", k.clock_mips);
+  const TaskSet s = sim::kernel_task_set(sim::control_job_model(k), 50000, 0.5, sim::ControlPriority::kLowest, k);
+  EXPECT_EQ(s.tasks.front().sample_at.kind, JobPoint::Kind::kFraction);
+  EXPECT_EQ(s.tasks.front().actuate_at.kind, JobPoint::Kind::kEnd);
+  const auto r = test::run_command({sim(), "oneshot", "kernel", "--sample-at", "middle", "--seeds", "2", "--duration", "1"});
+  EXPECT_NE(r.exit_code, 0);
+  EXPECT_NE(r.output.find("--sample-at"), std::string::npos) << r.output;
+  const auto o = test::run_command({sim(), "oneshot", "kernel", "--sample-at", "end", "--actuate-at", "start", "--seeds", "2",
+                                    "--duration", "1"});
+  EXPECT_NE(o.exit_code, 0);
+  EXPECT_NE(o.output.find("--actuate-at"), std::string::npos) << o.output;
+}
+
 TEST(KernelExperiment, TaskSetHitsUtilizationAndPositions) {
   sim::KernelExperimentOptions k;
   const ExecModel job = sim::control_job_model(k);

@@ -3,6 +3,9 @@
 ///        the jobs of a task set (cpu_task_set.hpp), with ISRs, context switches and
 ///        overrun policies; every scheduling event logged (compact) and counted.
 ///
+/// Sample and actuation: the instants at which a job's own work (switches excluded) reaches
+/// its task's sample_at / actuate_at offsets (cpu_job_point.hpp), found exactly when the run
+/// segment that crosses them is accounted (no extra event); an offset 0 is the job's start.
 /// Events: arrivals and completions in class kCompute; the dispatcher in class kBus, after
 /// every other event of the instant, so simultaneous releases are arbitrated together (no
 /// spurious preemption at an instant where several jobs arrive). The running job's
@@ -33,9 +36,12 @@ enum class CpuEventKind : std::uint8_t {
   kFinish,    ///< A job completed.
   kSkip,      ///< A release skipped (overrun policy skip).
   kAbort,     ///< A job aborted at its deadline (overrun policy abort).
+  kSample,    ///< A job read its input (sample_at reached; logged when found, with its own instant).
+  kActuate,   ///< A job wrote its output (actuate_at reached; likewise).
 };
 
-/// One log entry (16 bytes).
+/// One log entry (16 bytes). Entries are in time order except kSample / kActuate, which are
+/// logged when the run segment crossing them ends (not counted as scheduling events).
 struct CpuLogEntry {
   std::int64_t t_ns = 0;       ///< When.
   std::uint32_t job = 0;       ///< Job index of the entity (wraps after 2^32).
@@ -53,6 +59,8 @@ struct CpuJob {
   SimTime finish{0};           ///< Completion (or abort).
   Duration exec{0};            ///< Own execution time drawn.
   bool aborted = false;        ///< Aborted at its deadline.
+  SimTime sample{-1};          ///< When its input was read (sample_at reached; −1: not reached).
+  SimTime actuate{-1};         ///< When its output was written (actuate_at reached; −1: not reached).
 };
 
 /// Counters and response-time extremes of one task or ISR.
@@ -71,12 +79,19 @@ struct CpuTaskStats {
   Duration start_min{0};           ///< Smallest start − arrival (sampling latency).
   Duration start_max{0};           ///< Largest.
   Duration busy{0};                ///< CPU time consumed (context switches included).
+  Duration sample_min{0};          ///< Smallest sample − arrival (sampling latency at sample_at).
+  Duration sample_max{0};          ///< Largest.
+  Duration actuate_min{0};         ///< Smallest actuation − arrival (at actuate_at).
+  Duration actuate_max{0};         ///< Largest.
+  Duration io_min{0};              ///< Smallest actuation − sample (input-output latency).
+  Duration io_max{0};              ///< Largest.
 };
 
 /// The CPU: attach to a kernel, start, run the kernel, read the statistics.
 class Cpu {
  public:
-  /// A CPU running `set` on `kernel` (registers its handlers; nothing scheduled yet).
+  /// A CPU running `set` on `kernel` (registers its handlers; nothing scheduled yet). A task
+  /// whose actuate_at may precede its sample_at is refused (InputError, cpu_job_point.hpp).
   Cpu(Kernel& kernel, TaskSet set);
   Cpu(const Cpu&) = delete;
   Cpu& operator=(const Cpu&) = delete;
@@ -104,6 +119,10 @@ class Cpu {
     std::uint64_t index = 0;
     SimTime arrival{0}, ready{0}, start{0};
     Duration exec{0}, remaining{0}, done{0};
+    Duration sample_off{0}, act_off{0};  // own work before the sample / actuation point
+    Duration own{0};                     // own work done (done without context switches)
+    Duration cs_left{0};                 // context switch still to run in this dispatch
+    SimTime sample{-1}, actuate{-1};
     bool started = false;
   };
   struct Entity {
@@ -124,6 +143,7 @@ class Cpu {
   void account();
   void finish_job(std::size_t e, bool aborted);
   void record(std::size_t e, std::uint64_t job, CpuEventKind k);
+  void log_point(std::size_t e, std::uint64_t job, CpuEventKind k, SimTime at);
   bool before(std::size_t a, std::size_t b) const;
   const Job* head_ready(std::size_t e) const;
 

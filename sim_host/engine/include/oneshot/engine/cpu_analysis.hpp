@@ -26,10 +26,17 @@
 /// up to the synchronous busy period L = Σ ⌈(L + J)/T⌉ C',
 ///     Σ_i max(0, ⌊(t + J_i − D_i)/T_i⌋ + 1) C'_i + Σ_{ISR} ⌈(t + J_k)/T_k⌉ C_k
 ///       + max_{D_j > t} NP_j ≤ t,                   C'_i = C_i + 2 cs
-/// and the WCRT bound under EDF is the deadline (a response-time analysis for EDF is not
-/// done: `wcrt_method` says so). Implicit deadlines without jitter, blocking or ISRs:
-/// schedulable iff U ≤ 1 (Liu & Layland 1973). Jitter bounds: sampling at the job's start
-/// lies in [cs, WCRT − C^b_i] after the arrival; actuation at its end in [BCRT, WCRT].
+/// EDF response time (Spuri 1996, with release jitter): the analysed job of i arrives at
+/// x − J_i (released at x), every other task released at 0 after its largest jitter; only
+/// jobs with absolute deadline ≤ d = x − J_i + D_i compete; B = max_{j≠i} NP_j:
+///     L    = B + Σ_{all} ⌈(L + J)/T⌉ C'                       (longest busy period)
+///     w(x) = B + (1 + ⌊x/T_i⌋) C'_i + Σ_{j≠i} min(⌈(w + J_j)/T_j⌉, (1 + ⌊(d + J_j − D_j)/T_j⌋)⁺) C'_j
+///            + Σ_{ISR} ⌈(w + J_k)/T_k⌉ C_k,                C'_i = C_i + cs, C'_j = C_j + 2 cs
+///     R_i  = max_x w(x) − x + J_i,  x ∈ [0, L) ∩ ({k T_i} ∪ {k T_j + D_j − J_j − D_i + J_i})
+/// BCRT: ISRs only (as non-preemptive). Implicit deadlines without jitter, blocking or ISRs:
+/// schedulable iff U ≤ 1 (Liu & Layland 1973). Jitter bounds: a point at own offset m(e)
+/// (sample_at, actuate_at; cpu_job_point.hpp) lies in [cs + m(C^b), WCRT − (C^b − m(C^b))]
+/// after the arrival (the start: [cs, WCRT − C^b_i]; the end: [BCRT, WCRT]).
 /// A busy period longer than 10^4 of the largest period (at most 2^50 ns), or holding more than
 /// 10^6 jobs of the task, is reported unbounded (the WCRT is null in the JSON).
 #pragma once
@@ -54,8 +61,12 @@ struct TaskBound {
   Duration bcrt{0};                  ///< Best-case response time.
   Duration blocking{0};              ///< B_i.
   std::size_t jobs_examined = 1;     ///< q values examined in the busy period.
-  Duration sampling_latency_min{0};  ///< Earliest start after the arrival (cs).
-  Duration sampling_latency_max{0};  ///< Latest start: WCRT − C^b.
+  Duration sampling_latency_min{0};  ///< Earliest sample after the arrival (start: cs).
+  Duration sampling_latency_max{0};  ///< Latest sample (start: WCRT − C^b).
+  Duration actuation_latency_min{0};  ///< Earliest actuation after the arrival (end: BCRT).
+  Duration actuation_latency_max{0};  ///< Latest actuation (end: WCRT).
+  Duration io_latency_min{0};        ///< Least actuation − sample (start/end: C^b).
+  Duration io_latency_max{0};        ///< Largest: actuation max − sampling min.
   std::string wcrt_method;           ///< Which analysis produced wcrt.
 };
 

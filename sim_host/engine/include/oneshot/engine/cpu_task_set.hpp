@@ -14,6 +14,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "oneshot/engine/cpu_job_point.hpp"
 #include "oneshot/engine/random_stream.hpp"
 #include "oneshot/engine/sim_time.hpp"
 
@@ -69,6 +70,8 @@ struct TaskSpec {
   int priority = 1;                ///< 1 = highest (ties: earlier in the file first).
   ExecModel exec;                  ///< Execution time.
   OverrunPolicy overrun = OverrunPolicy::kContinue;  ///< Late jobs.
+  JobPoint sample_at = job_start();  ///< Where the job reads its input (cpu_job_point.hpp).
+  JobPoint actuate_at = job_end();   ///< Where it writes its output (not before sample_at).
 };
 
 /// A CPU and what runs on it.
