@@ -96,7 +96,7 @@ endforeach()
 # Job-only images of the generated C job (no PIL link), one per variant, for flash and RAM:
 # oneshot-<target>-cjob-<variant>.elf; <image>.stack.txt bounds the stack by the sum of every
 # frame in the image (-fstack-usage; no recursion, so no call chain can need more).
-foreach(variant fixed_table fixed_nearest float_table float_nearest q15_table q15_nearest)
+foreach(variant fixed_table fixed_nearest float_table float_nearest q15_table q15_nearest float_poly)
   set(image oneshot-${ONESHOT_FIRMWARE_TARGET}-cjob-${variant})
   add_executable(${image} firmware/app/mcu/c_job_only.cpp firmware/app/mcu/startup.cpp ${c_job_source})
   set_target_properties(${image} PROPERTIES SUFFIX ".elf" C_STANDARD 99 C_STANDARD_REQUIRED ON C_EXTENSIONS OFF)
@@ -104,7 +104,7 @@ foreach(variant fixed_table fixed_nearest float_table float_nearest q15_table q1
   target_include_directories(${image} PRIVATE firmware/core/include ${generated_dir}/oneshot_c)
   target_compile_options(${image} PRIVATE ${fw_common_options})
   string(TOUPPER ${variant} variant_upper)
-  set(others fixed_table fixed_nearest float_table float_nearest q15_table q15_nearest)
+  set(others fixed_table fixed_nearest float_table float_nearest q15_table q15_nearest float_poly)
   list(REMOVE_ITEM others ${variant})
   list(TRANSFORM others TOUPPER)
   list(TRANSFORM others PREPEND ONESHOT_JOB_WITHOUT_)
