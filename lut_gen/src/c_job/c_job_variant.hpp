@@ -113,6 +113,7 @@ class VariantEmitter {
   void emit_q15_reciprocal(CodeWriter& w) const;
   // The float_poly variant's discretization (float_poly.cpp).
   void emit_float_poly(CodeWriter& w) const;
+  void emit_float_poly_law(CodeWriter& w) const;
   // Pieces of the filter and the control law (c_job_filter.cpp).
   void emit_predict(CodeWriter& w) const;
   void emit_reciprocal(CodeWriter& w) const;

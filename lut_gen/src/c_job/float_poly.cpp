@@ -239,4 +239,40 @@ void VariantEmitter::emit_float_poly(CodeWriter& w) const {
   w.close();
 }
 
+void VariantEmitter::emit_float_poly_law(CodeWriter& w) const {
+  // u_j = N_u r - L (x - N_x r) with r = y_off + s_y sp, then steps = (u_j - u_min) steps_per_volt,
+  // folded into one affine form of x and the set-point code: v = steps + 1/2
+  //   = sum_i a_i x_i + b sp + c,  a_i = -L_ji spv,  b = (N_u + L N_x) s_y spv,
+  //   c = ((N_u + L N_x) y_off - u_min) spv + 1/2,
+  // and code = round half up (steps) clamped = (v <= 0) ? 0 : (v >= N) ? N : trunc(v).
+  const std::int32_t steps = design_.actuator_steps;
+  const std::string n = int_literal(steps, 32);
+  for (std::size_t j = 0; j < m_; ++j) {
+    const double spv = design_.steps_per_volt[j];
+    if (!(spv > 0.0) || !std::isfinite(spv)) throw DesignError("C job float_poly: PWM steps per volt must be positive");
+    double gain_r = design_.nu(j, 0);
+    for (std::size_t i = 0; i < n_; ++i) gain_r += design_.l(j, i) * design_.nx(i, 0);
+    std::vector<Term> terms;
+    add_value(terms, false, ar().constant(Qty::kInput, (gain_r * design_.y_offset[0] - design_.u_min[j]) * spv + 0.5, "c"));
+    for (std::size_t i = 0; i < n_; ++i) {
+      const double a = -design_.l(j, i) * spv;
+      if (a != 0.0) add_term(terms, false, state(i), ar().constant(Qty::kFeedbackGain, a, "a"));
+    }
+    const double b = gain_r * design_.volts_per_code[0] * spv;
+    if (b != 0.0) add_term(terms, false, Val::code("setpoint_code"), ar().constant(Qty::kFeedbackGain, b, "b"));
+    const std::string v = "v" + std::to_string(j);
+    const std::string code = "code" + std::to_string(j);
+    w.line("/* v = (u - u_min) steps_per_volt + 1/2, the law and the set-point's conversion folded into");
+    w.line("   constants; code = clamp(trunc(v), 0, " + std::to_string(steps) + "): round half up. */");
+    ar().accumulate(w, "const float " + v, Qty::kInput, terms);
+    const float top = static_cast<float>(steps);
+    w.open("if (!os_f32_positive(" + v + ")) {  /* !(0 < v) */").line(code + " = 0;");
+    w.middle("} else if (!os_f32_below(" + v + ", " + u32_literal(float_bits(top)) + ", " + float_literal(top) + ")) {")
+        .line(code + " = " + n + ";");
+    w.middle("} else {").line(code + " = os_f32_trunc(" + v + ");  /* 0 < v < " + std::to_string(steps) + " */").close();
+    emit_code_value(w, "s->u[" + std::to_string(j) + "]", Qty::kInput, "PWM", design_.u_min[j], design_.volts_per_step[j],
+                    code);
+  }
+}
+
 }  // namespace oneshot::design::cjob
