@@ -74,6 +74,10 @@ PilOptions matching(const PilOptions& base, const CommonOptions& opt) {
     throw std::invalid_argument("the q15 C job runs in the fixed-point table images as approach 6: see `exectime "
                                 "--noise-model exact` (c99_half_*_q15)");
   }
+  if (opt.format == NumberFormat::kFloatPoly) {
+    throw std::invalid_argument("the float_poly C job runs in the float table images as approach 6: see `exectime "
+                                "--noise-model exact` (c99_half_table_float_poly)");
+  }
   PilOptions p = base;
   p.format = to_string(opt.format);
   p.discretizer = to_string(opt.discretizer);
