@@ -441,6 +441,7 @@ nlohmann::json run_exectime_target(const SimContext& ctx, const CommonOptions& o
           }
           // The C job always predicts with the exact Q_d(τ): compared with B only under that model.
           j["variants"][name]["noise_model"] = "exact";
+          j["variants"][name]["bit_identical_to"] = "the C++ job of this image (approach B), byte for byte";
           if (opt.noise == NoiseModel::kExact) {
             j["variants"][name]["bit_identical_to_cpp_jobs"] = c_job_identical;
           } else {

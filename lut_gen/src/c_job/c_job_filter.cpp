@@ -336,7 +336,7 @@ void VariantEmitter::emit_run(CodeWriter& w) {
     emit_float_poly_law(w);
     w.close();
     w.line("s->status = status;");
-    w.line(scalar ? "return (uint16_t)code0;" : "");
+    if (scalar) w.line("return (uint16_t)code0;");
     if (!scalar)
       for (std::size_t j = 0; j < m_; ++j) w.line("pwm_code[" + std::to_string(j) + "] = (uint16_t)code" + std::to_string(j) + ";");
     w.close();
