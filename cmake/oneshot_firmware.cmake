@@ -124,7 +124,7 @@ endforeach()
 
 # Job-only images of the generated C job (no PIL link), one per variant, for flash, RAM and
 # stack bound: oneshot-<target>-cjob-<variant>.elf.
-set(c_job_variants fixed_table fixed_nearest float_table float_nearest q15_table q15_nearest)
+set(c_job_variants fixed_table fixed_nearest float_table float_nearest q15_table q15_nearest float_poly)
 foreach(variant ${c_job_variants})
   string(TOUPPER ${variant} variant_upper)
   set(others ${c_job_variants})

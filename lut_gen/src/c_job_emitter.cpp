@@ -110,6 +110,9 @@ void header_prologue(CodeWriter& w, const PlantDescription& plant, const DesignR
   w.line(" *                  per-interval polynomials fitted within 1/4 LSB of each entry's format;");
   w.line(" *                  its own arithmetic (no C++ core twin): rounding half up, saturation flagged");
   w.line(" *   q15_nearest    the same, tau rounded to the grid");
+  w.line(" *   float_poly     IEEE single precision, Phi, Gamma, Q_d as one polynomial in tau per entry");
+  w.line(" *                  (fitted to the exact discretization, no table, no composition): its own");
+  w.line(" *                  arithmetic, not bit-identical to the C++ core (the generated C is its oracle)");
   w.line(" * The fixed variants use only integer arithmetic (no floating point, no division, no library");
   w.line(" * call) and are safe with a 16-bit int: every intermediate is an explicitly typed int32_t or");
   w.line(" * int64_t. They need an arithmetic right shift of negative values (GCC, Clang, XC16, IAR and");
@@ -206,17 +209,23 @@ CJobSources emit_c_job(const PlantDescription& plant, const DesignResult& design
   cjob::TableText nearest_text = float_text(table_float);
   for (float v : cjob::composed_float_grid(table_float)) nearest_text.grid_values.push_back(cjob::float_literal(v));
   specs.push_back({"float_nearest", false, &float_arith, nearest_text});
+  specs.push_back({"float_poly", true, &float_arith, float_text(table_float), true});
 
   CodeWriter h;
   CodeWriter variants_h;
   CodeWriter variants_c;
   std::string skipped;
+  std::string unfit;
   for (const cjob::VariantSpec& spec : specs) {
     if (!spec.exact_subgrid && plant.period_us % spec.table.granularity_us != 0) {
       skipped += " " + spec.name;
       continue;
     }
     cjob::VariantEmitter v(plant, design, patterns, spec);
+    if (!v.available()) {
+      unfit += " " + spec.name;
+      continue;
+    }
     v.header(variants_h);
     v.source(variants_c);
     out.variants.push_back(spec.name);
@@ -226,6 +235,10 @@ CJobSources emit_c_job(const PlantDescription& plant, const DesignResult& design
   header_prologue(h, plant, design);
   if (!skipped.empty()) {
     h.line("/* Not generated (the period is not a multiple of the table granularity):" + skipped + ". */");
+  }
+  if (!unfit.empty()) {
+    h.line("/* Not generated (an entry of Phi, Gamma, Q_d needs a polynomial of degree > 6 over the range):" +
+           unfit + ". */");
   }
   if (formats == nullptr) h.line("/* No fixed-point variants: the design step found no fixed-point formats for this plant. */");
   out.header = h.str() + variants_h.str() + "#ifdef __cplusplus\n}\n#endif\n\n#endif /* ONESHOT_JOB_H */\n";

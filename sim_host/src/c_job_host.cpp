@@ -2,6 +2,7 @@
 /// @brief The host-compiled q15 C job (see c_job_host.hpp).
 #include "oneshot/sim/c_job_host.hpp"
 
+#include <cstring>
 #include <stdexcept>
 
 #include "oneshot_job.h"
@@ -50,5 +51,40 @@ bool HostCJobQ15::available() { return false; }
 #endif
 
 HostCJobQ15::~HostCJobQ15() = default;
+
+#if defined(ONESHOT_JOB_HAS_FLOAT_POLY) && ONESHOT_JOB_INPUTS == 1
+struct HostCJobFloatPoly::State {
+  oneshot_job_float_poly_t s{};
+};
+
+HostCJobFloatPoly::HostCJobFloatPoly(std::uint16_t pwm0) : s_(std::make_unique<State>()) {
+  oneshot_job_float_poly_init(&s_->s, pwm0);
+}
+
+std::vector<std::int32_t> HostCJobFloatPoly::run(std::int32_t tau_us, std::uint16_t adc_code,
+                                                 std::uint16_t setpoint_code) {
+  oneshot_job_float_poly_run(&s_->s, tau_us, adc_code, setpoint_code);
+  const auto bits = [](float v) {
+    std::uint32_t u = 0;
+    std::memcpy(&u, &v, sizeof u);
+    return static_cast<std::int32_t>(u);
+  };
+  std::vector<std::int32_t> out{bits(s_->s.u[0])};
+  for (std::size_t i = 0; i < ONESHOT_JOB_STATES; ++i) out.push_back(bits(s_->s.x[i]));
+  out.push_back(bits(s_->s.k[0]));
+  return out;
+}
+
+bool HostCJobFloatPoly::available() { return true; }
+#else
+struct HostCJobFloatPoly::State {};
+HostCJobFloatPoly::HostCJobFloatPoly(std::uint16_t) {
+  throw std::invalid_argument("the generated C job has no float_poly variant");
+}
+std::vector<std::int32_t> HostCJobFloatPoly::run(std::int32_t, std::uint16_t, std::uint16_t) { return {}; }
+bool HostCJobFloatPoly::available() { return false; }
+#endif
+
+HostCJobFloatPoly::~HostCJobFloatPoly() = default;
 
 }  // namespace oneshot::sim

@@ -37,6 +37,7 @@ struct CliCommon {
     o.format = format == "double" ? NumberFormat::kDouble
                : format == "fixed" ? NumberFormat::kFixed
                : format == "q15"   ? NumberFormat::kQ15
+               : format == "float_poly" ? NumberFormat::kFloatPoly
                                    : NumberFormat::kFloat;
     o.discretizer = discretizer == "generic"   ? DiscretizerKind::kGeneric
                     : discretizer == "nearest" ? DiscretizerKind::kNearest
@@ -97,9 +98,10 @@ void add_common(CLI::App* cmd, CliCommon& c, const std::string& default_out) {
       ->check(unsigned_up_to(kMaxSeed, "written exactly as a JSON/CSV number"))
       ->capture_default_str();
   cmd->add_option("--number-format", c.format,
-                  "number format of the control job (q15: approach B as the generated 16-bit C99 job, the "
-                  "other approaches in double)")
-      ->check(CLI::IsMember({"float", "double", "fixed", "q15"}))
+                  "number format of the control job (q15: approach B as the generated 16-bit C99 job, "
+                  "float_poly: as the generated float job with Phi/Gamma/Q_d polynomial in tau; the other "
+                  "approaches in double)")
+      ->check(CLI::IsMember({"float", "double", "fixed", "q15", "float_poly"}))
       ->capture_default_str();
   cmd->add_option("--discretizer", c.discretizer,
                   "Phi/Gamma/Qd of the one-shot filters: table (exact between grid points), nearest (table at "

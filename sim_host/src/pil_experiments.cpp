@@ -74,6 +74,10 @@ PilOptions matching(const PilOptions& base, const CommonOptions& opt) {
     throw std::invalid_argument("the q15 C job runs in the fixed-point table images as approach 6: see `exectime "
                                 "--noise-model exact` (c99_half_*_q15)");
   }
+  if (opt.format == NumberFormat::kFloatPoly) {
+    throw std::invalid_argument("the float_poly C job runs in the float table images as approach 6: see `exectime "
+                                "--noise-model exact` (c99_half_table_float_poly)");
+  }
   PilOptions p = base;
   p.format = to_string(opt.format);
   p.discretizer = to_string(opt.discretizer);
@@ -338,7 +342,10 @@ nlohmann::json run_exectime_target(const SimContext& ctx, const CommonOptions& o
       // Fixed-point table images also carry the q15 C job (approach 6), whose oracle is the
       // same C compiled into this program.
       const bool q15 = c_job && std::string(format) == "fixed" && HostCJobQ15::available();
-      if (q15) approaches.push_back(kCJobQ15Approach);
+      // Float table images: approach 6 is float_poly, likewise its own oracle.
+      const bool poly = c_job && std::string(format) == "float" && std::string(disc) == "table" &&
+                        HostCJobFloatPoly::available();
+      if (q15 || poly) approaches.push_back(kCJobQ15Approach);
       std::vector<std::vector<std::uint8_t>> replies_b;
       std::size_t c_job_identical = 0;
       std::size_t q15_identical = 0;
@@ -351,7 +358,11 @@ nlohmann::json run_exectime_target(const SimContext& ctx, const CommonOptions& o
         cw.u(static_cast<std::uint32_t>(std::lround(-ctx.design().u_min[0] * ctx.design().steps_per_volt[0])), 2);
         link.request(app::pil::Type::kConfig, cfg);
         std::unique_ptr<HostCJobQ15> host_q15;
-        if (a == kCJobQ15Approach) {
+        std::unique_ptr<HostCJobFloatPoly> host_poly;
+        if (a == kCJobQ15Approach && poly) {
+          host_poly = std::make_unique<HostCJobFloatPoly>(
+              static_cast<std::uint16_t>(std::lround(-ctx.design().u_min[0] * ctx.design().steps_per_volt[0])));
+        } else if (a == kCJobQ15Approach) {
           host_q15 = std::make_unique<HostCJobQ15>(
               std::string(disc) == "nearest",
               static_cast<std::uint16_t>(std::lround(-ctx.design().u_min[0] * ctx.design().steps_per_volt[0])));
@@ -362,13 +373,14 @@ nlohmann::json run_exectime_target(const SimContext& ctx, const CommonOptions& o
           if (a == static_cast<std::uint32_t>(Approach::kB)) replies_b.push_back(bytes);
           // Same inputs, same job: status, τ, saturation, estimate, gain and applied input byte for byte.
           if (a == kCJobApproach && bytes == replies_b.at(static_cast<std::size_t>(&r - jobs.data()))) ++c_job_identical;
-          if (host_q15) {
+          if (host_q15 || host_poly) {
             // The MCU's τ (from its timer) and the same codes through the host-compiled C.
             app::pil::Reader head(reply);
             head.u(1);
             const std::int32_t tau = head.s(4);
-            const std::vector<std::int32_t> host = host_q15->run(tau, static_cast<std::uint16_t>(r.y_code),
-                                                                 static_cast<std::uint16_t>(r.setpoint_code));
+            const auto y = static_cast<std::uint16_t>(r.y_code);
+            const auto sp = static_cast<std::uint16_t>(r.setpoint_code);
+            const std::vector<std::int32_t> host = host_poly ? host_poly->run(tau, y, sp) : host_q15->run(tau, y, sp);
             if (host == reply_values(reply, ctx.plant().n())) ++q15_identical;
           }
         }
@@ -389,7 +401,7 @@ nlohmann::json run_exectime_target(const SimContext& ctx, const CommonOptions& o
         for (double x : per_job) total += x;
         const bool is_q15 = approaches[v] == kCJobQ15Approach;
         const std::string name = std::string(v == 0 ? "half" : v == 1 ? "complete" : "c99_half") + "_" + disc + "_" +
-                                 (is_q15 ? "q15" : format);
+                                 (is_q15 ? (poly ? "float_poly" : "q15") : format);
         j["variants"][name] = {{"instructions_per_job", s.mean},
                                {"instructions_per_job_min", *std::min_element(per_job.begin(), per_job.end())},
                                {"instructions_per_job_max", *std::max_element(per_job.begin(), per_job.end())},
@@ -398,7 +410,20 @@ nlohmann::json run_exectime_target(const SimContext& ctx, const CommonOptions& o
                                {"ram_bytes", ram},
                                {"stack_peak_bytes", stack},
                                {"image", link.image()}};
-        if (is_q15) {
+        if (is_q15 && poly) {
+          PilOptions img = base;
+          img.format = format;
+          img.discretizer = disc;
+          j["variants"][name]["noise_model"] = "exact";
+          j["variants"][name]["bit_identical_to_host_c_job"] = q15_identical;
+          j["variants"][name]["bit_identical_to"] = "the generated float_poly C itself (host gcc), not the C++ core";
+          j["variants"][name]["jobs"] = jobs.size();
+          j["variants"][name]["job_only_image"] = c_job_only_image(base, "float_poly");
+          j["variants"][name]["soft_float_calls"] = soft_float_calls(
+              img, kCJobQ15Approach, opt.noise == NoiseModel::kExact,
+              static_cast<std::uint16_t>(std::lround(-ctx.design().u_min[0] * ctx.design().steps_per_volt[0])), jobs);
+          j["variants"][name]["instructions_target"] = 6000;  // Cortex-M0
+        } else if (is_q15) {
           j["variants"][name]["noise_model"] = "exact";
           j["variants"][name]["bit_identical_to_host_c_job"] = q15_identical;
           j["variants"][name]["jobs"] = jobs.size();
@@ -416,6 +441,7 @@ nlohmann::json run_exectime_target(const SimContext& ctx, const CommonOptions& o
           }
           // The C job always predicts with the exact Q_d(τ): compared with B only under that model.
           j["variants"][name]["noise_model"] = "exact";
+          j["variants"][name]["bit_identical_to"] = "the C++ job of this image (approach B), byte for byte";
           if (opt.noise == NoiseModel::kExact) {
             j["variants"][name]["bit_identical_to_cpp_jobs"] = c_job_identical;
           } else {

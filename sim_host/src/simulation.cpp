@@ -38,6 +38,7 @@ const char* to_string(NumberFormat f) {
     case NumberFormat::kDouble: return "double";
     case NumberFormat::kFixed: return "fixed";
     case NumberFormat::kQ15: return "q15";
+    case NumberFormat::kFloatPoly: return "float_poly";
   }
   return "?";
 }
@@ -136,8 +137,9 @@ decltype(auto) with_estimator(const RunOptions& opt, const Design& design, const
 /// Dispatches on the context (generated header or run-time plant) and the number format.
 template <typename F>
 decltype(auto) with_controller_parts(const SimContext& ctx, const RunOptions& opt, F&& f) {
-  if (opt.format == NumberFormat::kQ15) {
-    throw std::invalid_argument("--number-format q15 is the generated C job: closed-loop runs only (not the C++ core)");
+  if (opt.format == NumberFormat::kQ15 || opt.format == NumberFormat::kFloatPoly) {
+    throw std::invalid_argument(std::string("--number-format ") + to_string(opt.format) +
+                                " is the generated C job: closed-loop runs only (not the C++ core)");
   }
   if (ctx.generated()) {
     if (opt.format == NumberFormat::kFloat) {
@@ -231,6 +233,41 @@ ONESHOT_SIM_Q15_TRAITS(Q15Nearest, oneshot_job_q15_nearest_, ONESHOT_JOB_Q15_NEA
 #define ONESHOT_SIM_HAS_Q15 1
 #endif
 
+#if defined(ONESHOT_JOB_HAS_FLOAT_POLY) && ONESHOT_JOB_INPUTS == 1
+/// The float_poly C job (IEEE single values: binary points 0).
+struct FloatPolyJob {
+  using State = oneshot_job_float_poly_t;
+  static constexpr bool kFixed = false;
+  static constexpr int kStateFrac = 0;
+  static constexpr int kGainFrac = 0;
+  static constexpr int kInputFrac = 0;
+  static void init(State* s, std::uint16_t code) { oneshot_job_float_poly_init(s, code); }
+  static std::uint16_t run(State* s, std::int32_t tau, std::uint16_t adc, std::uint16_t sp) {
+    return oneshot_job_float_poly_run(s, tau, adc, sp);
+  }
+};
+#define ONESHOT_SIM_HAS_FLOAT_POLY 1
+#endif
+
+/// simulate() of approach B as the generated float_poly C job (the code approach 6 of the float
+/// table images runs).
+RunResult simulate_float_poly(const SimContext& ctx, const Scenario& scenario, std::uint64_t seed, const RunOptions& opt) {
+  if (!ctx.generated()) {
+    throw std::invalid_argument("--number-format float_poly runs the generated C job of the compiled-in plant: run without --plant");
+  }
+  if (opt.noise != NoiseModel::kExact) throw std::invalid_argument("the float_poly C job predicts with the exact Q_d: --noise-model exact");
+  if (opt.discretizer != DiscretizerKind::kTable) throw std::invalid_argument("the float_poly C job is exact in tau: --discretizer table");
+#ifdef ONESHOT_SIM_HAS_FLOAT_POLY
+  using S = generated::PlantStructure;
+  CJobDriver<FloatPolyJob, S::kStates> d;
+  return run_board_loop<S::kStates, 1, 1, app::TaskModel::kOneShot>(ctx, scenario, seed, opt, d);
+#else
+  static_cast<void>(scenario);
+  static_cast<void>(seed);
+  throw std::invalid_argument("this plant's generated C job has no float_poly variant");
+#endif
+}
+
 /// simulate() of approach B as the generated q15 C job (the code the MCU images run).
 RunResult simulate_q15(const SimContext& ctx, const Scenario& scenario, std::uint64_t seed, const RunOptions& opt) {
   if (!ctx.generated()) {
@@ -264,9 +301,12 @@ RunResult simulate(const SimContext& ctx, const Scenario& scenario, std::uint64_
                                 " is unavailable for this plant: " + ctx.design().deadbeat_unavailable_reason);
   }
   if (options.pil != nullptr) return simulate_pil(ctx, scenario, seed, options);
-  if (options.format == NumberFormat::kQ15) {
-    // The q15 C job is B's job; the other approaches run as the double oracle beside it.
-    if (options.approach == Approach::kB) return simulate_q15(ctx, scenario, seed, options);
+  if (options.format == NumberFormat::kQ15 || options.format == NumberFormat::kFloatPoly) {
+    // The q15 / float_poly C job is B's job; the other approaches run as the double oracle beside it.
+    if (options.approach == Approach::kB) {
+      return options.format == NumberFormat::kQ15 ? simulate_q15(ctx, scenario, seed, options)
+                                                  : simulate_float_poly(ctx, scenario, seed, options);
+    }
     RunOptions d = options;
     d.format = NumberFormat::kDouble;
     return simulate(ctx, scenario, seed, d);

@@ -1,4 +1,4 @@
-/* The generated C job against the C++ core (the q15 variants: against the same C compiled into
+/* The generated C job against the C++ core (the q15 variants and float_poly: against the same C compiled into
  * the reference writer, with other flags), compiled by the host C compiler as strict C99
  * (-std=c99 -pedantic -Wall -Wextra -Wconversion -Werror): every job of the reference file
  * must give the same PWM code, status, saturation flag, estimate, gain and applied input,
@@ -70,6 +70,9 @@ DEFINE_CHECK(q15_table, FIX)
 #if defined(ONESHOT_JOB_HAS_Q15_NEAREST)
 DEFINE_CHECK(q15_nearest, FIX)
 #endif
+#if defined(ONESHOT_JOB_HAS_FLOAT_POLY)
+DEFINE_CHECK(float_poly, FLT)
+#endif
 
 int main(int argc, char **argv) {
   static ref_file_t ref;
@@ -105,6 +108,9 @@ int main(int argc, char **argv) {
 #endif
 #if defined(ONESHOT_JOB_HAS_Q15_NEAREST)
     if (strcmp(r->name, "q15_nearest") == 0) bad = check_q15_nearest(r, statuses, &saturated);
+#endif
+#if defined(ONESHOT_JOB_HAS_FLOAT_POLY)
+    if (strcmp(r->name, "float_poly") == 0) bad = check_float_poly(r, statuses, &saturated);
 #endif
     if (bad < 0) {
       fprintf(stderr, "variant %s: not in the generated job\n", r->name);

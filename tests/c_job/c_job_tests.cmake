@@ -1,6 +1,6 @@
 # The generated C99 job (lut_gen --c-job-dir) against the C++ core, bit for bit:
 #   CJob.Reference                 the C++ core writes long random job sequences (fixture); the
-#                                  q15 variants' sequences come from the generated C itself, and
+#                                  q15 variants' and float_poly's sequences come from the generated C itself, and
 #                                  must stay within stated tolerances of the double core
 #   CJob.HostGccBitIdentical       the job compiled by the host C compiler as strict C99
 #   CJob.DivisionFreeReciprocal    the reciprocal without division against the core's algorithm

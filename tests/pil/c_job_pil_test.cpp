@@ -2,7 +2,7 @@
 /// @brief The generated C99 job inside the firmware images (approach 5): on each MCU under
 ///        QEMU it gives the C++ half-Kalman job's replies byte for byte on the exectime jobs,
 ///        costs fewer instructions than it, and its job-only image fits 12 KB flash / 1 KB RAM;
-///        the q15 job (approach 6) equals the host-compiled C and meets issue 25's budgets.
+///        the q15 job and float_poly (approach 6) equal the host-compiled C and meet their budgets.
 #include <gtest/gtest.h>
 
 #include <string>
@@ -65,6 +65,24 @@ TEST(CJobOnMcu, SameRepliesAsTheCppJobAndFewerInstructions) {
       ASSERT_TRUE(image.contains("flash_bytes")) << c;
       EXPECT_LE(image["flash_bytes"].get<int>(), 6 * 1024) << c;
       EXPECT_LE(image["ram_total_bound_bytes"].get<int>(), 512) << c;
+    }
+    // float_poly (approach 6 of the float table image): the float job with Φ, Γ, Q_d as one
+    // polynomial in τ per entry — its own arithmetic, so its oracle is the same C compiled on the
+    // host; exact between grid points like float_table, within 6000 Cortex-M0 instructions.
+    {
+      const std::string c = "c99_half_table_float_poly";
+      ASSERT_TRUE(j["variants"].contains(c)) << c;
+      const auto& v = j["variants"][c];
+      EXPECT_GT(v["jobs"].get<int>(), 50) << c;
+      EXPECT_EQ(v["bit_identical_to_host_c_job"].get<int>(), v["jobs"].get<int>()) << c;
+      if (target == "cortex-m0") {
+        EXPECT_LE(v["instructions_per_job"].get<double>(), 6000.0) << c;
+        EXPECT_LT(v["soft_float_calls"]["per_job"].get<double>(), 80.0) << c;
+      }
+      const auto& image = v["job_only_image"];
+      ASSERT_TRUE(image.contains("flash_bytes")) << c;
+      EXPECT_LE(image["flash_bytes"].get<int>(), 6 * 1024) << c;
+      EXPECT_LE(image["ram_total_bound_bytes"].get<int>(), 1024) << c;
     }
   }
 }

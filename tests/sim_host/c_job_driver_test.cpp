@@ -1,7 +1,7 @@
 /// @file c_job_driver_test.cpp
 /// @brief --number-format q15: approach B as the generated q15 C job in the closed loop (the
 ///        same C the MCU images run): its cost against the double job on the Table I scenarios,
-///        and what it refuses.
+///        and what it refuses; likewise --number-format float_poly.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -78,6 +78,41 @@ TEST(Q15CJob, NeedsTheCompiledPlantExactNoiseAndTheTable) {
   o = options(Approach::kB, NumberFormat::kQ15);
   o.discretizer = DiscretizerKind::kNearest;
   EXPECT_GT(simulate(*ctx, s, 1, o).jobs, 10U);
+}
+
+TEST(FloatPolyCJob, TableICostMatchesDoubleInEveryScenario) {
+  // GIVEN the ten Table I scenarios, seeds 1-3, B in double and as the float_poly C job
+  const auto ctx = SimContext::reference();
+  double worst = 0;
+  for (const Scenario& s : default_scenarios()) {
+    double d = 0, f = 0;
+    for (std::uint64_t seed = 1; seed <= 3; ++seed) {
+      d += simulate(*ctx, s, seed, options(Approach::kB, NumberFormat::kDouble)).cost.total();
+      const RunResult r = simulate(*ctx, s, seed, options(Approach::kB, NumberFormat::kFloatPoly));
+      EXPECT_EQ(r.faults, 0U) << s.name;
+      EXPECT_GT(r.jobs, 10U) << s.name;
+      f += r.cost.total();
+    }
+    worst = std::max(worst, std::fabs(f / d - 1));
+    // THEN each scenario's cost is within 0.03 % of double (table1's 20 seeds: worst scenario
+    // +0.0005 %, worst single run +0.0094 %)
+    EXPECT_NEAR(f / d, 1.0, 3e-4) << s.name;
+  }
+  std::printf("float_poly / double cost, seeds 1-3: worst scenario %+.5f %%\n", 100 * worst);
+}
+
+TEST(FloatPolyCJob, NeedsExactNoiseAndTheTableDiscretizer) {
+  const auto ctx = SimContext::reference();
+  Scenario s = default_scenarios()[3];
+  s.duration_s = 1;
+  RunOptions o = options(Approach::kB, NumberFormat::kFloatPoly);
+  o.noise = NoiseModel::kConstant;
+  EXPECT_THROW(simulate(*ctx, s, 1, o), std::invalid_argument);
+  o = options(Approach::kB, NumberFormat::kFloatPoly);
+  o.discretizer = DiscretizerKind::kNearest;
+  EXPECT_THROW(simulate(*ctx, s, 1, o), std::invalid_argument);
+  const double d = simulate(*ctx, s, 2, options(Approach::kA, NumberFormat::kDouble)).cost.total();
+  EXPECT_EQ(simulate(*ctx, s, 2, options(Approach::kA, NumberFormat::kFloatPoly)).cost.total(), d);
 }
 
 }  // namespace

@@ -125,7 +125,7 @@ struct Loop {
 
 // The generated C99 jobs: approach 5 is the job of this image's format and sub-grid policy
 // (B's job behind the same task interface, for instruction counts and the comparison with the
-// C++ job on the MCU), approach 6 its 16-bit q15 twin (fixed-point table images).
+// C++ job on the MCU), approach 6 its own-arithmetic twin (q15 in fixed-point images, float_poly in float table images).
 #define ONESHOT_CJOB_TRAITS(Name, prefix, fixed)                                             \
   struct Name {                                                                              \
     using State = prefix##t;                                                                 \
@@ -154,6 +154,11 @@ ONESHOT_CJOB_TRAITS(CJobQ15, oneshot_job_q15_nearest_, true)
 #elif ONESHOT_FW_FIXED && ONESHOT_FW_DISC == 0 && defined(ONESHOT_JOB_HAS_Q15_TABLE)
 #define ONESHOT_CJOB_Q15 1
 ONESHOT_CJOB_TRAITS(CJobQ15, oneshot_job_q15_table_, true)
+#elif !ONESHOT_FW_FIXED && ONESHOT_FW_DISC == 0 && defined(ONESHOT_JOB_HAS_FLOAT_POLY)
+// Float table images: approach 6 is float_poly, the float job with its own arithmetic (Φ, Γ,
+// Q_d as one polynomial in τ per entry), whose oracle is the same C compiled on the host.
+#define ONESHOT_CJOB_Q15 1
+ONESHOT_CJOB_TRAITS(CJobQ15, oneshot_job_float_poly_, false)
 #endif
 static_assert(kM == 1 && kP == 1, "the C job adapter serves one input and one output");
 #ifdef ONESHOT_CJOB
@@ -180,7 +185,8 @@ struct JobOutcome {
 };
 
 /// Approach letters A–E as 0–4: A, D standard Kalman; B half; C complete; E deadbeat; 5: the
-/// generated C99 job (B's job, table images only); 6: its q15 twin (fixed table images).
+/// generated C99 job (B's job, table images only); 6: its own-arithmetic twin (q15 in fixed images,
+/// float_poly in float table images).
 std::uint8_t g_approach = 1;
 volatile bool g_tick_done = false;
 

@@ -21,8 +21,9 @@ void VariantEmitter::header(CodeWriter& w) const {
   std::string states;
   for (std::size_t i = 0; i < n_; ++i) states += (i ? ", " : "") + comment_text(plant_.states[i]);
   w.line("/* ---- " + spec_.name + ": " + (ar().q15() ? "16-bit Q formats, 32-bit accumulators" : fixed() ? "fixed point" : "IEEE single precision") + ", " +
-         (spec_.exact_subgrid ? "exact between grid points (table + residual polynomial)"
-                              : "tau rounded to the nearest grid point") +
+         (spec_.polynomial      ? "Phi, Gamma, Q_d as one polynomial in tau per entry (own arithmetic)"
+          : spec_.exact_subgrid ? "exact between grid points (table + residual polynomial)"
+                                : "tau rounded to the nearest grid point") +
          " ---- */");
   w.line("#ifndef ONESHOT_JOB_WITHOUT_" + upper(spec_.name));
   w.line("");
@@ -78,7 +79,11 @@ void VariantEmitter::source(CodeWriter& w) {
   w.line("/* ======== " + spec_.name + " ======== */");
   w.line("#ifndef ONESHOT_JOB_WITHOUT_" + upper(spec_.name));
   w.line("");
-  if (ar().q15()) {
+  if (spec_.polynomial) {
+    emit_triple(w);
+    emit_float_poly(w);
+    emit_predict(w);
+  } else if (ar().q15()) {
     emit_triple(w);
     emit_q15_table(w);
     emit_q15_interval(w);

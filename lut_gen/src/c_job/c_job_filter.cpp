@@ -3,19 +3,10 @@
 ///        control_law(), quantize_input() and the converters, unrolled over the structure.
 #include <cmath>
 #include <cstdint>
-#include <cstring>
 
 #include "c_job/c_job_variant.hpp"
 
 namespace oneshot::design::cjob {
-namespace {
-/// The IEEE single bits of v.
-std::uint32_t float_bits(float v) {
-  std::uint32_t b = 0;
-  std::memcpy(&b, &v, sizeof b);
-  return b;
-}
-}  // namespace
 
 Val VariantEmitter::cov(std::size_t i, std::size_t j) const {
   return ar().val(Qty::kCovariance, "s->p[" + std::to_string(upper_index(n_, i, j)) + "]");
@@ -143,9 +134,28 @@ void VariantEmitter::emit_correct(CodeWriter& w) const {
     add_term(terms, false, ar().val(Qty::kKalmanGain, "k" + std::to_string(i)), ar().val(Qty::kState, "innovation"));
     ar().accumulate(w, "const " + st_t + " x" + std::to_string(i), Qty::kState, terms);
   }
+  // float_poly, C a unit row e_c: P+_cj = P_cj - (P_cc/S) P_cj = P_cj R/S = K_j R (one product).
+  std::size_t unit = n_;
+  if (spec_.polynomial) {
+    std::size_t ones = 0, zeros = 0;
+    for (std::size_t k = 0; k < n_; ++k) {
+      if (cp.is_one(0, k)) {
+        unit = k;
+        ++ones;
+      } else if (cp.is_zero(0, k)) {
+        ++zeros;
+      }
+    }
+    if (ones != 1 || zeros + 1 != n_) unit = n_;
+  }
   for (std::size_t i = 0; i < n_; ++i)
     for (std::size_t j = i; j < n_; ++j) {
       std::vector<Term> terms;
+      if (i == unit || j == unit) {
+        ar().mul(w, "const " + cov_t + " p" + std::to_string(i) + std::to_string(j), Qty::kCovariance,
+                 ar().val(Qty::kKalmanGain, "k" + std::to_string(i == unit ? j : i)), r);
+        continue;
+      }
       add_value(terms, false, cov(i, j));
       add_term(terms, true, ar().val(Qty::kKalmanGain, "k" + std::to_string(i)),
                ar().val(Qty::kCovariance, "pc" + std::to_string(j)));
@@ -280,8 +290,9 @@ void VariantEmitter::emit_run(CodeWriter& w) {
   w.line("/* The ADC and set-point codes in volts (output_of_code). */");
   emit_code_value(w, "const " + st_t + " y", Qty::kState, "ADC", design_.y_offset[0], design_.volts_per_code[0],
                   "adc_code");
-  emit_code_value(w, "const " + st_t + " r", Qty::kState, "ADC", design_.y_offset[0], design_.volts_per_code[0],
-                  "setpoint_code");
+  if (!spec_.polynomial)
+    emit_code_value(w, "const " + st_t + " r", Qty::kState, "ADC", design_.y_offset[0], design_.volts_per_code[0],
+                    "setpoint_code");
   w.line("/* Beyond +-" + std::to_string(bound) + " us every discretization below clamps exactly as at the bound,");
   w.line("   so bounding tau changes no result and keeps every integer in range. */");
   w.open("if (tau_us > " + int_literal(bound, 32) + ") {").line("tau_us = " + int_literal(bound, 32) + ";");
@@ -321,6 +332,16 @@ void VariantEmitter::emit_run(CodeWriter& w) {
   }
   w.line("/* Control law u = N_u r - L (x - N_x r), actuator codes, and the input they realise. */");
   w.open("{");
+  if (spec_.polynomial) {
+    emit_float_poly_law(w);
+    w.close();
+    w.line("s->status = status;");
+    if (scalar) w.line("return (uint16_t)code0;");
+    if (!scalar)
+      for (std::size_t j = 0; j < m_; ++j) w.line("pwm_code[" + std::to_string(j) + "] = (uint16_t)code" + std::to_string(j) + ";");
+    w.close();
+    return;
+  }
   const auto& pat = pat_;
   for (std::size_t i = 0; i < n_; ++i) {
     std::vector<Term> terms;

@@ -20,6 +20,7 @@
 namespace oneshot::design::cjob {
 
 struct Q15PolyTable;  // q15_poly_table.hpp
+struct FloatPoly;     // float_poly.hpp
 
 /// A table as the generated code stores it: layout, and the values as C literals.
 struct TableText {
@@ -48,6 +49,8 @@ struct VariantSpec {
   bool exact_subgrid = true; ///< SubGrid::kExact (else kNearest).
   const Arith* arith = nullptr;  ///< Number format.
   TableText table;           ///< Its table.
+  /// Float only: Φ, Γ, Q_d as one polynomial in τ per entry (float_poly.hpp) instead of the table.
+  bool polynomial = false;
 };
 
 /// Writes one variant: public declarations to `header`, definitions to `source`.
@@ -60,6 +63,8 @@ class VariantEmitter {
   void header(CodeWriter& w) const;
   /// Definitions for oneshot_job.c.
   void source(CodeWriter& w);
+  /// False when the variant cannot be generated for this plant (float_poly: no polynomial fits).
+  bool available();
   /// Divisions the integer code could not replace by an exact reciprocal multiplication.
   int divisions() const { return divisions_; }
   /// Largest |τ| the job distinguishes (beyond it, the result equals that of ±this bound).
@@ -106,6 +111,9 @@ class VariantEmitter {
   void emit_q15_interval(CodeWriter& w) const;
   void emit_q15_advance(CodeWriter& w);
   void emit_q15_reciprocal(CodeWriter& w) const;
+  // The float_poly variant's discretization (float_poly.cpp).
+  void emit_float_poly(CodeWriter& w) const;
+  void emit_float_poly_law(CodeWriter& w) const;
   // Pieces of the filter and the control law (c_job_filter.cpp).
   void emit_predict(CodeWriter& w) const;
   void emit_reciprocal(CodeWriter& w) const;
@@ -124,6 +132,7 @@ class VariantEmitter {
   std::vector<std::pair<std::size_t, std::size_t>> phi_free_, gamma_free_, qd_free_;  // qd: upper only
   int divisions_ = 0;
   std::shared_ptr<const Q15PolyTable> q15_table_;  // q15 variants: built by emit_q15_table
+  std::shared_ptr<const FloatPoly> float_poly_;    // float_poly: built by available()
 };
 
 }  // namespace oneshot::design::cjob

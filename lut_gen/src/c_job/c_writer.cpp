@@ -3,6 +3,7 @@
 #include "c_job/c_writer.hpp"
 
 #include <cstdio>
+#include <cstring>
 #include <stdexcept>
 
 namespace oneshot::design::cjob {
@@ -91,6 +92,12 @@ std::string divide_by_constant(const std::string& x, std::uint32_t d, std::uint3
   }
   ++divisions;
   return "(int32_t)((uint32_t)(" + x + ") / " + u32_literal(d) + ")";
+}
+
+std::uint32_t float_bits(float v) {
+  std::uint32_t b = 0;
+  std::memcpy(&b, &v, sizeof b);
+  return b;
 }
 
 }  // namespace oneshot::design::cjob

@@ -51,6 +51,8 @@ class CodeWriter {
 std::string int_literal(long long v, int bits);
 /// An unsigned 32-bit literal.
 std::string u32_literal(unsigned long long v);
+/// The IEEE single bits of v.
+std::uint32_t float_bits(float v);
 /// A float literal in hexadecimal (exact), e.g. 0x1.8p+1f.
 std::string float_literal(float v);
 /// Text safe inside a // comment (control characters replaced).

@@ -17,16 +17,15 @@ constexpr int kMaxDegree = 6;
 constexpr int kFitPoints = 33;    // least-squares samples per interval
 constexpr int kCheckPoints = 97;  // error check per interval
 
-/// Exact values of every member at each time (µs), in double.
 template <std::size_t N, std::size_t M>
-std::vector<std::vector<double>> exact(const PlantDescription& plant, const DesignResult& d,
-                                       const std::vector<Q15Member>& members, const std::vector<double>& t_us) {
+std::vector<std::vector<double>> exact_of(const PlantDescription& plant, const DesignResult& d,
+                                          const std::vector<Q15Member>& members, const std::vector<double>& t_us) {
   const GenericDiscretizer<UniformFormat<double>, N, M> gen(continuous_model_per_us<double, N, M>(plant, d));
   std::vector<std::vector<double>> out;
   for (double t : t_us) {
     Discretization<UniformFormat<double>, N, M> dd;
     if (gen.discretize(static_cast<std::int32_t>(t), dd, WithQd::kYes) != Status::kOk) {
-      throw DesignError("C job q15: the exponential of A·t fails at t = " + std::to_string(t) + " us");
+      throw DesignError("C job: the exponential of A·t fails at t = " + std::to_string(t) + " us");
     }
     std::vector<double> row;
     for (const Q15Member& m : members)
@@ -73,6 +72,14 @@ double horner(const std::vector<double>& c, double r) {
 
 }  // namespace
 
+std::vector<std::vector<double>> exact_member_values(const PlantDescription& plant, const DesignResult& design,
+                                                     const std::vector<Q15Member>& members,
+                                                     const std::vector<double>& t_us) {
+  return with_dimensions(plant.n(), plant.m(), 1, [&](auto n, auto m, auto) {
+    return exact_of<decltype(n)::value, decltype(m)::value>(plant, design, members, t_us);
+  });
+}
+
 Q15PolyTable design_q15_poly_table(const PlantDescription& plant, const DesignResult& design, const Arith& ar,
                                    std::int32_t g_us, std::int32_t range_us, std::vector<Q15Member> members,
                                    bool nearest) {
@@ -90,9 +97,7 @@ Q15PolyTable design_q15_poly_table(const PlantDescription& plant, const DesignRe
   }
   // Time in µs must be an integer for the discretizer: round the sample points, keep their r.
   for (double& x : times) x = std::round(x);
-  const auto values = with_dimensions(plant.n(), plant.m(), 1, [&](auto n, auto m, auto) {
-    return exact<decltype(n)::value, decltype(m)::value>(plant, design, t.members, times);
-  });
+  const auto values = exact_member_values(plant, design, t.members, times);
   const std::size_t per = static_cast<std::size_t>(kFitPoints + kCheckPoints);
   const auto r_of = [&](std::size_t k, std::size_t s) { return (times[k * per + s] - static_cast<double>(k) * g_us) / g_us; };
   // Slots: members with the same values (at every sample) and format share one polynomial.

@@ -46,6 +46,12 @@ struct Q15PolyTable {
   std::size_t width = 0;                       ///< Coefficients per row.
 };
 
+/// Exact values (double, the generic discretizer's matrix exponential) of every member at each
+/// time t_us (integers), one row per time.
+std::vector<std::vector<double>> exact_member_values(const PlantDescription& plant, const DesignResult& design,
+                                                     const std::vector<Q15Member>& members,
+                                                     const std::vector<double>& t_us);
+
 /// Designs the table for intervals k = 0 … range/g (the last one is used at r = 0 only).
 Q15PolyTable design_q15_poly_table(const PlantDescription& plant, const DesignResult& design, const Arith& ar,
                                    std::int32_t g_us, std::int32_t range_us, std::vector<Q15Member> members,

@@ -20,7 +20,7 @@ enum { kStop = 0, kInit = 1, kRun = 2 };
 /* Shared with the harness: AVR structs have no padding; the offsets are checked below. */
 struct mailbox_t {
   uint8_t command;      /* kStop, kInit, kRun */
-  uint8_t variant;      /* 0 fixed_table, 1 fixed_nearest, 2 float_table, 3 float_nearest, 4 q15_table, 5 q15_nearest */
+  uint8_t variant;      /* 0 fixed_table, 1 fixed_nearest, 2 float_table, 3 float_nearest, 4 q15_table, 5 q15_nearest, 6 float_poly */
   int32_t tau_us;       /* run: inputs */
   uint16_t adc;
   uint16_t setpoint;
@@ -113,6 +113,9 @@ int main(void) {
 #endif
 #if defined(ONESHOT_JOB_HAS_Q15_NEAREST)
       case 5: SERVE(q15_nearest, FIX); break;
+#endif
+#if defined(ONESHOT_JOB_HAS_FLOAT_POLY)
+      case 6: SERVE(float_poly, FLT); break;
 #endif
       default: break;
     }

@@ -40,6 +40,7 @@ enum class NumberFormat : std::uint8_t {
   kDouble,  ///< IEEE double (the oracle).
   kFixed,   ///< The design step's Q formats (built-in plant, or one compiled in with ONESHOT_PLANT).
   kQ15,     ///< Approach B as the generated q15 C99 job (oneshot_job.c); the other approaches in double.
+  kFloatPoly,  ///< Approach B as the generated float_poly C99 job (oneshot_job.c); the others in double.
 };
 
 /// Name of a number format ("float", "double", "fixed", "q15").

@@ -202,7 +202,8 @@ inline constexpr std::uint32_t kFaultMalformedRequest = 0xFFFFFFFDU;  ///< Wrong
 
 /// Approach id of the generated C99 job of the image's format (B's job; an image without one refuses it).
 inline constexpr std::uint8_t kCJobApproach = 5;
-/// Approach id of the generated q15 C99 job (fixed-point table images; others refuse it).
+/// Approach id of the generated C99 job's own-arithmetic twin: q15 in fixed-point images,
+/// float_poly in float table images (others refuse it).
 inline constexpr std::uint8_t kCJobQ15Approach = 6;
 /// Largest approach id of kConfig: 0–4 are A–E, 5 and 6 the generated C99 jobs.
 inline constexpr std::uint8_t kMaxApproach = kCJobQ15Approach;
