@@ -72,6 +72,8 @@ class JumpLinearCost {
     m_ = m;
     s_ = s;
   }
+  /// Starts the cost from zero again (the state and the caches stay): one period's cost at a time.
+  void clear_cost() { cost_ = {}; }
   /// The reference (x_ref, u_ref) of the cost from now on (must be an equilibrium of the plant).
   void set_reference(const Vector<double, N>& x_ref, const Vector<double, M>& u_ref) {
     x_ref_ = x_ref;
