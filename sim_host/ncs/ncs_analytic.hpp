@@ -191,6 +191,19 @@ class AnalyticTracker {
     cmd_fresh_ = true;
   }
 
+  /// Starts again at `t` from mean `m` and covariance `s`, the cost at zero, nothing in flight
+  /// (the stationary analysis runs one period at a time: ncs_stationary.hpp).
+  void restart(engine::SimTime t, const Z& m, const Jlc::Cov& s) {
+    jl_.reset(m, s);
+    jl_.clear_cost();
+    now_ = t;
+    last_sample_us_ = t.count() / 1000;
+    y_fresh_ = false;
+    cmd_fresh_ = false;
+    computed_ = false;
+  }
+  const Jlc::Cov& covariance() const { return jl_.covariance(); }  ///< Σ = Cov z now.
+
   /// Refuses the run with `reason` (the first reason is kept).
   void refuse(const std::string& reason) {
     if (refusal_.empty()) refusal_ = reason;

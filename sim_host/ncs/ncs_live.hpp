@@ -121,4 +121,6 @@ namespace oneshot::sim {
 void add_ncs_live_commands(CLI::App* study);
 /// Registers `ncs faults` (ncs_faults.hpp) under the study command.
 void add_ncs_faults_command(CLI::App* study);
+/// Adds `oneshot-sim ncs stationary` (ncs_stationary.hpp) under the study command.
+void add_ncs_stationary_command(CLI::App* study);
 }  // namespace oneshot::sim

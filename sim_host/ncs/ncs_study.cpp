@@ -204,6 +204,7 @@ void register_ncs_study(CLI::App& app) {
   }
   add_ncs_live_commands(study);
   add_ncs_faults_command(study);
+  add_ncs_stationary_command(study);
   engine::register_summarizer("ncs", "table", [](const engine::SweepResults& r, const std::string& out, bool plots) {
     return ncs::table_outputs(r, out, plots);
   });

@@ -60,6 +60,30 @@ TEST(StationaryCost, UnstableMixtureIsRefusedNamingTheSpectralRadius) {
   EXPECT_THROW((void)stationary_cost<1>({0.5, 0.4}, {1, 1}, run), std::invalid_argument);  // Σp ≠ 1
 }
 
+/// z = [x; spare]: x⁺ = 0.5 x + w, the spare slot never written (kept as it is).
+TEST(StationaryCost, DeadRegisterIsLeftOutOnlyWhenItMovesNothing) {
+  const auto run = [](std::size_t, const Matrix<double, 2, 2>& s) {
+    PeriodOutcome<2> o;
+    o.sigma(0, 0) = 0.25 * s(0, 0) + 1;
+    o.sigma(1, 1) = s(1, 1);  // spare: identity, eigenvalue 1
+    o.cost = s(0, 0);
+    return o;
+  };
+  EXPECT_THROW((void)stationary_cost<2>({1.0}, {1.0}, run), std::domain_error);
+  const StationaryCost r = stationary_cost<2>({1.0}, {1.0}, run, {true, false});
+  EXPECT_NEAR(r.sigma(0, 0), 1 / 0.75, 1e-15);
+  EXPECT_EQ(r.sigma(1, 1), 0);
+  // Declared dead but read by x: refused.
+  const auto coupled = [](std::size_t, const Matrix<double, 2, 2>& s) {
+    PeriodOutcome<2> o;
+    o.sigma(0, 0) = 0.25 * s(0, 0) + 0.1 * s(1, 1) + 1;
+    o.sigma(1, 1) = s(1, 1);
+    o.cost = s(0, 0);
+    return o;
+  };
+  EXPECT_THROW((void)stationary_cost<2>({1.0}, {1.0}, coupled, {true, false}), std::logic_error);
+}
+
 /// One period of the LQG loop: the sampling event, then a flow of `len`.
 PeriodOutcome<kK> lqg_period(Jlc& jl, const EventMap& m, const Matrix<double, 1, 1>& r, Duration len,
                              const Matrix<double, kK, kK>& s) {

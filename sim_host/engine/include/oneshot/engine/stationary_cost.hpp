@@ -16,6 +16,10 @@
 /// the symmetric basis (e_a e_bᵀ + e_b e_aᵀ), assembles 𝒜 = Σ p_i 𝓔_i, and solves
 /// (I − 𝒜) vech Σ = Σ p_i vech W_i by LAPACK. The loop is mean-square stable iff the spectral
 /// radius of 𝒜 is below 1; otherwise the cost is infinite and the call throws, naming it.
+/// A register of z that a loop never writes nor reads (a spare slot of a shared layout) keeps
+/// its covariance for ever (an eigenvalue 1 of 𝒜 that does not move the cost): the caller names
+/// the live entries, the others are held at zero, and each dead entry is probed once to check
+/// that it indeed moves neither a live entry nor the cost (std::logic_error otherwise).
 #pragma once
 
 #include <cstddef>
@@ -43,27 +47,41 @@ struct StationaryCost {
   double mean_period_s = 0;      ///< E[T_i] (s).
   double spectral_radius = 0;    ///< ρ(𝒜): below 1 (mean-square stable) or the call throws.
   double residual = 0;           ///< max |Σ − Σ_i p_i (𝓔_i(Σ) + W_i)| / max |Σ| at the solution.
-  design::DenseMatrix sigma;     ///< Stationary Σ at a period start (K×K).
+  design::DenseMatrix sigma;     ///< Stationary Σ at a period start (K×K, zero on dead entries).
 };
 
-/// The linear algebra of stationary_cost(): `ops` (n×n, n = K(K+1)/2) is 𝒜 in vech coordinates,
+/// The linear algebra of stationary_cost() on k live entries: `ops` (n×n, n = k(k+1)/2) is 𝒜 in vech coordinates,
 /// `w` (n) Σ p_i vech W_i, `q` (n) the cost functional on the basis and `c` Σ p_i c_i; std::domain_error
 /// when ρ(𝒜) ≥ 1 or the system is singular.
 StationaryCost solve_stationary(std::size_t k, const design::DenseMatrix& ops, const std::vector<double>& w,
                                 const std::vector<double>& q, double c, double mean_period_s);
 
 /// The stationary cost of the cases with probabilities `p` (summing to 1 within 1e-9) and
-/// lengths `period_s`; `run(i, Σ)` returns the PeriodOutcome of case i from Σ (mean zero).
+/// lengths `period_s`; `run(i, Σ)` returns the PeriodOutcome of case i from Σ (mean zero);
+/// `live` (empty: all) marks the entries of z the loop uses.
 template <std::size_t K, typename Run>
-StationaryCost stationary_cost(const std::vector<double>& p, const std::vector<double>& period_s, Run&& run) {
+StationaryCost stationary_cost(const std::vector<double>& p, const std::vector<double>& period_s, Run&& run,
+                               std::vector<bool> live = {}) {
   if (p.empty() || p.size() != period_s.size()) throw std::invalid_argument("stationary_cost: one probability and one length per case");
-  constexpr std::size_t n = K * (K + 1) / 2;
+  if (live.empty()) live.assign(K, true);
+  if (live.size() != K) throw std::invalid_argument("stationary_cost: the live mask needs one flag per entry of z");
+  std::vector<std::size_t> idx;  // live entries
+  for (std::size_t a = 0; a < K; ++a)
+    if (live[a]) idx.push_back(a);
+  const std::size_t k = idx.size();
+  const std::size_t n = k * (k + 1) / 2;
   design::DenseMatrix ops = design::DenseMatrix::zeros(n, n);
   std::vector<double> w(n, 0.0);
   std::vector<double> q(n, 0.0);
   double c = 0;
   double total = 0;
   double mean_period = 0;
+  // vech of the live block of an outcome's Σ minus the base's, weighted by p.
+  const auto add_column = [&](double pi, const Matrix<double, K, K>& s, const Matrix<double, K, K>& base, std::size_t col) {
+    std::size_t row = 0;
+    for (std::size_t r = 0; r < k; ++r)
+      for (std::size_t t = r; t < k; ++t, ++row) ops(row, col) += pi * (s(idx[r], idx[t]) - base(idx[r], idx[t]));
+  };
   for (std::size_t i = 0; i < p.size(); ++i) {
     if (!(p[i] >= 0) || !(period_s[i] > 0)) throw std::invalid_argument("stationary_cost: case " + std::to_string(i) + " has p < 0 or length <= 0");
     total += p[i];
@@ -72,24 +90,39 @@ StationaryCost stationary_cost(const std::vector<double>& p, const std::vector<d
     const PeriodOutcome<K> base = run(i, Matrix<double, K, K>{});
     c += p[i] * base.cost;
     std::size_t col = 0;
-    for (std::size_t a = 0; a < K; ++a) {
-      for (std::size_t b = a; b < K; ++b, ++col) {
+    for (std::size_t a = 0; a < k; ++a) {
+      for (std::size_t b = a; b < k; ++b, ++col) {
         Matrix<double, K, K> basis{};
-        basis(a, b) = 1;
-        basis(b, a) = 1;
+        basis(idx[a], idx[b]) = 1;
+        basis(idx[b], idx[a]) = 1;
         const PeriodOutcome<K> o = run(i, basis);
         q[col] += p[i] * (o.cost - base.cost);
-        std::size_t row = 0;
-        for (std::size_t r = 0; r < K; ++r)
-          for (std::size_t s = r; s < K; ++s, ++row) ops(row, col) += p[i] * (o.sigma(r, s) - base.sigma(r, s));
+        add_column(p[i], o.sigma, base.sigma, col);
       }
     }
     std::size_t row = 0;
-    for (std::size_t r = 0; r < K; ++r)
-      for (std::size_t s = r; s < K; ++s, ++row) w[row] += p[i] * base.sigma(r, s);
+    for (std::size_t r = 0; r < k; ++r)
+      for (std::size_t t = r; t < k; ++t, ++row) w[row] += p[i] * base.sigma(idx[r], idx[t]);
+    if (i == 0) {
+      for (std::size_t a = 0; a < K; ++a) {
+        if (live[a]) continue;
+        Matrix<double, K, K> basis{};
+        basis(a, a) = 1;
+        const PeriodOutcome<K> o = run(i, basis);
+        bool moved = o.cost != base.cost;
+        for (std::size_t r : idx)
+          for (std::size_t t : idx) moved = moved || o.sigma(r, t) != base.sigma(r, t);
+        if (moved) throw std::logic_error("stationary_cost: entry " + std::to_string(a) + " of z is declared dead but moves the loop");
+      }
+    }
   }
   if (!(total > 1 - 1e-9 && total < 1 + 1e-9)) throw std::invalid_argument("stationary_cost: probabilities sum to " + std::to_string(total) + ", not 1");
-  return solve_stationary(K, ops, w, q, c, mean_period);
+  StationaryCost r = solve_stationary(k, ops, w, q, c, mean_period);
+  design::DenseMatrix full = design::DenseMatrix::zeros(K, K);
+  for (std::size_t a = 0; a < k; ++a)
+    for (std::size_t b = 0; b < k; ++b) full(idx[a], idx[b]) = r.sigma(a, b);
+  r.sigma = full;
+  return r;
 }
 
 }  // namespace oneshot::engine
