@@ -116,7 +116,16 @@ DelayPmf uniform_sum_pmf(const std::vector<std::pair<std::int64_t, std::int64_t>
   for (std::size_t i = 0; i < pmf.size(); ++i) {
     if (pmf[i] <= 0) continue;
     const std::int64_t tau = lo + static_cast<std::int64_t>(i);
-    grid[(tau + grid_us / 2) / grid_us * grid_us] += pmf[i];
+    const std::int64_t below = tau / grid_us * grid_us;
+    const std::int64_t rem = tau - below;
+    if (2 * rem < grid_us) {
+      grid[below] += pmf[i];
+    } else if (2 * rem > grid_us) {
+      grid[below + grid_us] += pmf[i];
+    } else {  // a tie: half to each neighbour, so the grid keeps the mean
+      grid[below] += 0.5 * pmf[i];
+      grid[below + grid_us] += 0.5 * pmf[i];
+    }
   }
   DelayPmf r;
   for (const auto& [tau, p] : grid) {

@@ -9,7 +9,7 @@
 ///  - A: request at t_{k−1}, sample at t_{k−1} + τ_as, x̂_k predicted over h − τ_as, applied at t_k;
 ///  - IK: no delay (one case).
 /// The distribution is put on a grid of `grid_us` (each whole-µs value to the nearest grid
-/// point, mass kept); every grid point is a case of stationary_cost(), its period run by an
+/// point, a tie split between both, so mass and mean are kept); every grid point is a case of stationary_cost(), its period run by an
 /// AnalyticTracker on the node's own law or predictor (SK's filter first run to its stationary
 /// gain). AK, AKx, AKl are refused (the half Kalman's P, hence its gain, depends on the delay
 /// history: not a jump-linear system with i.i.d. modes), I too (it has no noise: cost 0).
@@ -36,7 +36,7 @@ struct DelayPmf {
 };
 
 /// The pmf of the sum of discrete uniforms U{lo_i … hi_i} (whole µs), exactly, then moved to
-/// the nearest multiple of `grid_us` (≥ 1).
+/// the nearest multiple of `grid_us` (≥ 1; ties split in halves).
 DelayPmf uniform_sum_pmf(const std::vector<std::pair<std::int64_t, std::int64_t>>& ranges, std::int64_t grid_us);
 
 /// The timing distribution of approach `a` on scenario `sc` (see the file comment).
