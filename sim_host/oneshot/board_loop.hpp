@@ -22,8 +22,8 @@
 
 #include "control_drivers.hpp"
 #include "oneshot/engine/kernel.hpp"
-#include "oneshot/sim/board_config.hpp"
-#include "oneshot/sim/simulation.hpp"
+#include "board_config.hpp"
+#include "simulation.hpp"
 
 namespace oneshot::sim {
 

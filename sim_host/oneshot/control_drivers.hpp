@@ -16,7 +16,7 @@
 #include "oneshot/app/pil_protocol.hpp"
 #include "oneshot/fixed_point.hpp"
 #include "oneshot/host/host_board.hpp"
-#include "oneshot/sim/approach.hpp"
+#include "approach.hpp"
 #include "oneshot/sim/pil_link.hpp"
 
 namespace oneshot::sim {

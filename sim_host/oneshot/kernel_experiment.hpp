@@ -21,7 +21,7 @@
 
 #include "oneshot/engine/cpu_task_set.hpp"
 #include "oneshot/engine/sweep.hpp"
-#include "oneshot/sim/experiments.hpp"
+#include "oneshot_experiments.hpp"
 
 namespace oneshot::sim {
 

@@ -9,7 +9,7 @@
 #include <vector>
 
 #include "oneshot/engine/sweep.hpp"
-#include "oneshot/sim/experiments.hpp"
+#include "oneshot_experiments.hpp"
 
 namespace oneshot::sim {
 

@@ -9,7 +9,7 @@
 #include <string>
 
 #include "fuzz_oracle.hpp"
-#include "oneshot/sim/jitter_model.hpp"
+#include "jitter_model.hpp"
 
 using namespace oneshot::sim;
 using oneshot::fuzz::require;

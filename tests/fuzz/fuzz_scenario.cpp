@@ -14,7 +14,7 @@
 
 #include "fuzz_oracle.hpp"
 #include "oneshot/design/plant_description.hpp"
-#include "oneshot/sim/scenario.hpp"
+#include "scenario.hpp"
 
 using namespace oneshot::sim;
 using oneshot::fuzz::require;

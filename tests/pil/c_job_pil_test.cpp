@@ -7,7 +7,7 @@
 
 #include <string>
 
-#include "oneshot/sim/experiments.hpp"
+#include "oneshot_experiments.hpp"
 #include "oneshot/sim/pil_link.hpp"
 
 namespace oneshot::sim {

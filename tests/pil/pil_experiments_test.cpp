@@ -10,7 +10,7 @@
 #include <tuple>
 #include <unistd.h>
 
-#include "oneshot/sim/experiments.hpp"
+#include "oneshot_experiments.hpp"
 #include "oneshot/sim/pil_link.hpp"
 #include "support/run_command.hpp"
 

@@ -22,11 +22,12 @@
 #include <vector>
 
 #include "oneshot/assert_handler.hpp"
-#include "oneshot/engine/board_plant.hpp"
 #include "oneshot/engine/cost.hpp"
 #include "oneshot/engine/exact_segment.hpp"
 #include "oneshot/engine/process_noise.hpp"
+#include "oneshot/engine/random_stream.hpp"
 #include "oneshot/engine/sim_time.hpp"
+#include "oneshot/engine/trace_sample.hpp"
 #include "oneshot/matrix.hpp"
 
 namespace oneshot::engine {

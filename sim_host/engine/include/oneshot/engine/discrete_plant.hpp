@@ -16,12 +16,14 @@
 #include <memory>
 #include <vector>
 
-#include "oneshot/engine/board_plant.hpp"
+#include "oneshot/assert_handler.hpp"
 #include "oneshot/engine/cost.hpp"
 #include "oneshot/engine/kernel.hpp"
 #include "oneshot/engine/psd_math.hpp"
 #include "oneshot/engine/quadratic_form.hpp"
+#include "oneshot/engine/random_stream.hpp"
 #include "oneshot/engine/sim_time.hpp"
+#include "oneshot/engine/trace_sample.hpp"
 #include "oneshot/matrix.hpp"
 
 namespace oneshot::engine {

@@ -9,7 +9,7 @@
 #include <sstream>
 
 #include "oneshot/util/file_io.hpp"
-#include "oneshot/sim/experiments.hpp"
+#include "oneshot_experiments.hpp"
 #include "oneshot/sim/study_report.hpp"
 #include "oneshot/util/output_files.hpp"
 #include "oneshot/util/parallel.hpp"

@@ -14,7 +14,7 @@
 /// W = blkdiag(Q1c, 0). A full PWM period is the affine map w ↦ S w on w = [e; 1] with cost
 /// wᵀ C w; n periods use S^(2^j) and C_(2^j) = C_j + S_jᵀ C_j S_j (binary powers), so a
 /// 50 ms interval costs about ten small products rather than 2000 edges, with the same
-/// result (tests/sim_host/engine/board_plant_test.cpp checks it edge by edge).
+/// result (tests/sim_host/oneshot/board_plant_test.cpp checks it edge by edge).
 ///
 /// advance_to() is a physical event: the interval since the last one receives one exact
 /// N(0, Q_d(Δ)) draw and its expected noise cost (process_noise.hpp). The input term of
@@ -34,6 +34,7 @@
 #include "oneshot/engine/exact_segment.hpp"
 #include "oneshot/engine/process_noise.hpp"
 #include "oneshot/engine/sim_time.hpp"
+#include "oneshot/engine/trace_sample.hpp"
 #include "oneshot/matrix.hpp"
 #include "oneshot/engine/random_stream.hpp"
 
@@ -65,15 +66,6 @@ struct CircuitConfig {
   Vector<double, P> adc_min;     ///< Voltage at code 0.
   Vector<double, P> adc_lsb;     ///< One code (V).
   bool process_noise = true;     ///< Inject process noise (off for deterministic tests).
-};
-
-/// One point of a recorded state trace (values just before the events of instant t).
-template <std::size_t N, std::size_t M, std::size_t P>
-struct TraceSample {
-  SimTime t{0};            ///< Instant.
-  Vector<double, N> x;     ///< True state.
-  Vector<double, P> r;     ///< Reference in force.
-  Vector<double, M> u;     ///< Commanded input in force.
 };
 
 /// Exact emulation of the PWM-driven circuit.

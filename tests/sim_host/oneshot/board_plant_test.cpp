@@ -6,7 +6,7 @@
 #include <random>
 
 #include "oneshot/design/controller_synthesis.hpp"
-#include "oneshot/sim/board_config.hpp"
+#include "board_config.hpp"
 #include "support/eigen_reference.hpp"
 
 namespace oneshot::sim {

@@ -13,7 +13,7 @@
 #include <vector>
 
 #include "oneshot/design/plant_description.hpp"
-#include "oneshot/sim/jitter_model.hpp"
+#include "jitter_model.hpp"
 
 namespace oneshot::sim {
 

@@ -8,7 +8,7 @@
 #include "oneshot/design/controller_synthesis.hpp"
 #include "oneshot/design/fixed_size.hpp"
 #include "oneshot/design/plant_description.hpp"
-#include "oneshot/engine/board_plant.hpp"
+#include "board_plant.hpp"
 #include "oneshot/sim/random_stream.hpp"
 
 namespace oneshot::sim {

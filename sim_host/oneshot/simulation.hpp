@@ -21,9 +21,9 @@
 #include "oneshot/design/controller_synthesis.hpp"
 #include "oneshot/design/plant_description.hpp"
 #include "oneshot/design/table_builder.hpp"
-#include "oneshot/sim/approach.hpp"
-#include "oneshot/sim/board_config.hpp"
-#include "oneshot/sim/scenario.hpp"
+#include "approach.hpp"
+#include "board_config.hpp"
+#include "scenario.hpp"
 
 namespace oneshot::sim {
 

@@ -1,6 +1,6 @@
 /// @file c_job_host.cpp
 /// @brief The host-compiled q15 C job (see c_job_host.hpp).
-#include "oneshot/sim/c_job_host.hpp"
+#include "c_job_host.hpp"
 
 #include <cstring>
 #include <stdexcept>

@@ -1,6 +1,6 @@
 /// @file scenario.cpp
 /// @brief Scenarios.
-#include "oneshot/sim/scenario.hpp"
+#include "scenario.hpp"
 
 #include <algorithm>
 #include <cmath>

@@ -12,7 +12,7 @@
 #include <unistd.h>
 
 #include "oneshot/util/output_files.hpp"
-#include "oneshot/sim/scenario.hpp"
+#include "scenario.hpp"
 #include "support/run_command.hpp"
 
 namespace oneshot::sim {

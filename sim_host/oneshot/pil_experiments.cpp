@@ -10,8 +10,8 @@
 #include <sstream>
 
 #include "oneshot/util/file_io.hpp"
-#include "oneshot/sim/c_job_host.hpp"
-#include "oneshot/sim/experiments.hpp"
+#include "c_job_host.hpp"
+#include "oneshot_experiments.hpp"
 #include "oneshot/util/output_files.hpp"
 #include "oneshot/sim/pil_link.hpp"
 #include "oneshot/util/progress_bar.hpp"

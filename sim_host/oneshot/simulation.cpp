@@ -1,6 +1,6 @@
 /// @file simulation.cpp
 /// @brief Closed-loop runs (see simulation.hpp).
-#include "oneshot/sim/simulation.hpp"
+#include "simulation.hpp"
 
 #include "board_loop.hpp"
 #include "c_job_driver.hpp"

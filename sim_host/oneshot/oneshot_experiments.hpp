@@ -9,8 +9,8 @@
 #include <vector>
 
 #include "oneshot/engine/sweep.hpp"
-#include "oneshot/sim/scenario.hpp"
-#include "oneshot/sim/simulation.hpp"
+#include "scenario.hpp"
+#include "simulation.hpp"
 
 namespace oneshot::sim {
 

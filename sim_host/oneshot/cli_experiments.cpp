@@ -13,7 +13,7 @@
 #include <sstream>
 
 #include "oneshot/sim/cli_commands.hpp"
-#include "oneshot/sim/experiments.hpp"
+#include "oneshot_experiments.hpp"
 #include "oneshot/util/output_files.hpp"
 #include "oneshot/util/parallel.hpp"
 #include "oneshot/sim/pil_link.hpp"

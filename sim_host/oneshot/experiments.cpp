@@ -1,6 +1,6 @@
 /// @file experiments.cpp
 /// @brief Experiments 1–5 of the brief, single runs and the benchmark.
-#include "oneshot/sim/experiments.hpp"
+#include "oneshot_experiments.hpp"
 
 #include <algorithm>
 #include <array>

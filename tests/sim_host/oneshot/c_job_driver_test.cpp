@@ -8,8 +8,8 @@
 #include <cmath>
 #include <cstdio>
 
-#include "oneshot/sim/scenario.hpp"
-#include "oneshot/sim/simulation.hpp"
+#include "scenario.hpp"
+#include "simulation.hpp"
 
 namespace oneshot::sim {
 namespace {

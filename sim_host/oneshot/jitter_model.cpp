@@ -1,6 +1,6 @@
 /// @file jitter_model.cpp
 /// @brief Jitter models.
-#include "oneshot/sim/jitter_model.hpp"
+#include "jitter_model.hpp"
 
 #include <algorithm>
 #include <cmath>

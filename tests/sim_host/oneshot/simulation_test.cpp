@@ -4,8 +4,8 @@
 
 #include <cmath>
 
-#include "oneshot/sim/scenario.hpp"
-#include "oneshot/sim/simulation.hpp"
+#include "scenario.hpp"
+#include "simulation.hpp"
 #include "oneshot/util/statistics.hpp"
 #include "support/run_command.hpp"
 
