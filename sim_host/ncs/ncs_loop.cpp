@@ -477,12 +477,8 @@ RunResult run_approach(const Context& ctx, Approach a, const Scenario& sc, std::
       return run_sampling(hs, law, [](Kalman& f) { return f.saturated(); });
     }
     case Approach::kSPlus: {
-      const auto g = delay_compensated_gain(ctx, ctx.mean_tau_io_us(sc));
-      Matrix<double, kM, kN> lx;
-      Matrix<double, kM, kM> lu;
-      for (std::size_t j = 0; j < kN; ++j) lx(0, j) = g[j];
-      lu(0, 0) = g[kN];
-      Compensated law{lx, lu, hs.u_min_, hs.u_max_, hs.ref_};
+      const SplitGain g = delay_compensated_split(ctx, ctx.mean_tau_io_us(sc));
+      Compensated law{g.lx, g.lu, hs.u_min_, hs.u_max_, hs.ref_};
       return run_sampling(hs, law, [](const Compensated& f) { return f.saturated; });
     }
   }

@@ -241,4 +241,12 @@ std::array<double, kN + kM> delay_compensated_gain(const Context& ctx, double ta
   return out;
 }
 
+SplitGain delay_compensated_split(const Context& ctx, double tau_us) {
+  const auto g = delay_compensated_gain(ctx, tau_us);
+  SplitGain s;
+  for (std::size_t j = 0; j < kN; ++j) s.lx(0, j) = g[j];
+  s.lu(0, 0) = g[kN];
+  return s;
+}
+
 }  // namespace oneshot::ncs

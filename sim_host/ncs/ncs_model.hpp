@@ -102,4 +102,12 @@ class Context {
 /// u_k = −[L_x, L_u] ξ. Returns the 1×3 gain.
 std::array<double, kN + kM> delay_compensated_gain(const Context& ctx, double tau_us);
 
+/// The S+ gain as the law takes it: u_k = −L_x x_k − L_u u_{k−1}.
+struct SplitGain {
+  Matrix<double, kM, kN> lx;  ///< L_x.
+  Matrix<double, kM, kM> lu;  ///< L_u.
+};
+/// delay_compensated_gain() at τ (µs), split into L_x and L_u.
+SplitGain delay_compensated_split(const Context& ctx, double tau_us);
+
 }  // namespace oneshot::ncs

@@ -182,12 +182,8 @@ StationaryRow stationary_row(const Context& ctx, const Scenario& sc, Approach a,
     case Approach::kS:
       return sampling_row(*tracker, node::StateFeedbackLaw<double, kN, kM, Ref>{d.l, u_min, u_max, ref}, pmf, h_us);
     case Approach::kSPlus: {
-      const auto g = delay_compensated_gain(ctx, ctx.mean_tau_io_us(sc));
-      Matrix<double, kM, kN> lx;
-      Matrix<double, kM, kM> lu;
-      for (std::size_t j = 0; j < kN; ++j) lx(0, j) = g[j];
-      lu(0, 0) = g[kN];
-      return sampling_row(*tracker, node::DelayCompensatedLaw<double, kN, kM, Ref>{lx, lu, u_min, u_max, ref}, pmf, h_us);
+      const SplitGain g = delay_compensated_split(ctx, ctx.mean_tau_io_us(sc));
+      return sampling_row(*tracker, node::DelayCompensatedLaw<double, kN, kM, Ref>{g.lx, g.lu, u_min, u_max, ref}, pmf, h_us);
     }
     case Approach::kSK:
     case Approach::kIK: {

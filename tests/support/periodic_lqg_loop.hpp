@@ -155,4 +155,13 @@ inline JumpLinearPlant<kN, kM> engine_plant(const Loop& p, bool noisy) {
   return e;
 }
 
+/// The designed loop, its noisy JumpLinearCost, its sampling event at reference zero and R.
+struct LqgSetup {
+  Loop p = designed();                   ///< Plant, gains, closed forms.
+  Jlc jl{engine_plant(p, true)};         ///< Propagation with process noise.
+  EventMap m = event_map(p, 0, 0);       ///< Sampling event, reference zero.
+  Matrix<double, 1, 1> r;                ///< Measurement variance.
+  LqgSetup() { r(0, 0) = p.r; }
+};
+
 }  // namespace oneshot::engine::lqg_fixture

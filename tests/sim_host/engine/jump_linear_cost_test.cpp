@@ -20,11 +20,11 @@ namespace {
 using namespace lqg_fixture;  // NOLINT: the fixture of this file
 
 TEST(JumpLinearCost, PeriodicLqgEqualsTheClosedFormStationaryCostRate) {
-  const Loop p = designed();
-  Jlc jl(engine_plant(p, true));
-  const EventMap m = event_map(p, 0, 0);
-  Matrix<double, 1, 1> r;
-  r(0, 0) = p.r;
+  LqgSetup setup;
+  const Loop& p = setup.p;
+  Jlc& jl = setup.jl;
+  const EventMap& m = setup.m;
+  const Matrix<double, 1, 1>& r = setup.r;
   const Duration h = from_us(100000);
   const auto periods = [&](int n) {
     for (int i = 0; i < n; ++i) {

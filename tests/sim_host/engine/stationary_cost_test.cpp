@@ -95,12 +95,11 @@ PeriodOutcome<kK> lqg_period(Jlc& jl, const EventMap& m, const Matrix<double, 1,
 }
 
 TEST(StationaryCost, PeriodicLqgEqualsTheClosedFormRate) {
-  const Loop p = designed();
-  Jlc jl(engine_plant(p, true));
-  const EventMap m = event_map(p, 0, 0);
-  Matrix<double, 1, 1> r;
-  r(0, 0) = p.r;
-  const auto run = [&](std::size_t, const Matrix<double, kK, kK>& s) { return lqg_period(jl, m, r, from_us(100000), s); };
+  LqgSetup setup;
+  const Loop& p = setup.p;
+  const auto run = [&](std::size_t, const Matrix<double, kK, kK>& s) {
+    return lqg_period(setup.jl, setup.m, setup.r, from_us(100000), s);
+  };
   const StationaryCost st = stationary_cost<kK>({1.0}, {p.h}, run);
   const MatX w = p.gc.bottomRightCorner(1, 1) + p.gamma.transpose() * p.s * p.gamma;
   const double closed = ((p.s * p.qd).trace() + (p.pf * p.l.transpose() * w * p.l).trace() + noise_path(p, p.h)) / p.h;
@@ -110,14 +109,9 @@ TEST(StationaryCost, PeriodicLqgEqualsTheClosedFormRate) {
 }
 
 /// Sampling intervals 0.8 h, h, 1.3 h with probabilities 0.3, 0.5, 0.2 (the filter and gain stay those of h).
-struct Jittered {
-  Loop p = designed();
-  Jlc jl{engine_plant(p, true)};
-  EventMap m = event_map(p, 0, 0);
-  Matrix<double, 1, 1> r;
+struct Jittered : LqgSetup {
   std::vector<double> prob = {0.3, 0.5, 0.2};
   std::vector<std::int64_t> len_us = {80000, 100000, 130000};
-  Jittered() { r(0, 0) = p.r; }
   PeriodOutcome<kK> period(std::size_t i, const Matrix<double, kK, kK>& s) { return lqg_period(jl, m, r, from_us(len_us[i]), s); }
   std::vector<double> lengths() const { return {0.08, 0.1, 0.13}; }
 };
