@@ -115,9 +115,9 @@ TEST(ActuatorValidation, OnArrivalModeRefusesNanAndFollowsARestartedController) 
 }
 
 struct Echo {
-  bool compute(const Message<VectorPayload<double, 1>>& m, bool fresh, McuInstant, V1& u) {
+  LawResult compute(const Message<VectorPayload<double, 1>>& m, bool fresh, McuInstant, V1& u) {
     u = m.payload.value;
-    return fresh;
+    return fresh ? LawResult::kSend : LawResult::kNone;
   }
 };
 
