@@ -92,17 +92,25 @@ constexpr S masked_dot(const Matrix<S, 1, N>& v, const Vector<S, N>& x) {
   return acc;
 }
 
+/// Σ_{j ∈ row(I)} A_Ij x_j of row I of A over Structure's row mask, unrolled, ascending j from
+/// a zero accumulator (the summation order every product below keeps). Forced inline: it is
+/// the inner loop of the M4F arrival, whose instruction count depends on straight-line code.
+template <typename Structure, std::size_t I, typename S, std::size_t N>
+[[gnu::always_inline]] constexpr S masked_row(const Matrix<S, N, N>& a, const Vector<S, N>& x) {
+  S acc = S(0);
+  Unrolled<0, N>::run([&](auto jc) {
+    constexpr std::size_t j = decltype(jc)::value;
+    if constexpr (((Structure::row(I) >> j) & 1U) != 0) acc = acc + a(I, j) * x[j];
+  });
+  return acc;
+}
+
 /// y = A x over Structure's rows, unrolled; returns the multiply-adds.
 template <typename Structure, typename S, std::size_t N>
 constexpr std::uint64_t masked_product(const Matrix<S, N, N>& a, const Vector<S, N>& x, Vector<S, N>& y) {
   Unrolled<0, N>::run([&](auto ic) {
     constexpr std::size_t i = decltype(ic)::value;
-    S acc = S(0);
-    Unrolled<0, N>::run([&](auto jc) {
-      constexpr std::size_t j = decltype(jc)::value;
-      if constexpr (((Structure::row(i) >> j) & 1U) != 0) acc = acc + a(i, j) * x[j];
-    });
-    y[i] = acc;
+    y[i] = masked_row<Structure, i>(a, x);
   });
   return structure_size<Structure, N>();
 }
@@ -114,11 +122,7 @@ constexpr std::uint64_t masked_step(const Matrix<S, N, N>& a, const Vector<S, N>
                                     Vector<S, N>& y) {
   Unrolled<0, N>::run([&](auto ic) {
     constexpr std::size_t i = decltype(ic)::value;
-    S acc = S(0);
-    Unrolled<0, N>::run([&](auto jc) {
-      constexpr std::size_t j = decltype(jc)::value;
-      if constexpr (((Structure::row(i) >> j) & 1U) != 0) acc = acc + a(i, j) * x[j];
-    });
+    S acc = masked_row<Structure, i>(a, x);
     if constexpr (((Structure::kB >> i) & 1U) != 0) acc = acc + b[i] * u;
     y[i] = acc;
   });
