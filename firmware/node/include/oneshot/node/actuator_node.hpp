@@ -108,11 +108,11 @@ class ActuatorNode {
   /// Counters.
   constexpr const ActuatorStatistics& statistics() const { return stats_; }
   /// Worst status of the frames the last on_receive() handled (kOk when none).
-  constexpr FrameStatus receive_status() const { return receive_status_; }
+  [[nodiscard]] constexpr FrameStatus receive_status() const { return receive_status_; }
 
  private:
   // Timer mode, d = seq − k_t: 1 … Slots waits in the buffer; ≤ 0 is late (stale); beyond is refused.
-  constexpr FrameStatus buffer_command(const Command& c) {
+  [[nodiscard]] constexpr FrameStatus buffer_command(const Command& c) {
     const SequenceNumber d = c.seq - timer_k_;
     if (!seq_newer(c.seq, timer_k_)) return FrameStatus::kStale;
     if (d > Slots) return FrameStatus::kRefusedSequence;

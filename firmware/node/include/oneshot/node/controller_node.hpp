@@ -96,9 +96,9 @@ class ControllerNode {
   /// Counters.
   constexpr const ControllerStatistics& statistics() const { return stats_; }
   /// Worst status of the frames the last on_receive() handled (kOk when none).
-  constexpr FrameStatus receive_status() const { return receive_status_; }
+  [[nodiscard]] constexpr FrameStatus receive_status() const { return receive_status_; }
   /// Result of the last command send (counted in statistics()).
-  constexpr SendResult last_send() const { return last_send_; }
+  [[nodiscard]] constexpr SendResult last_send() const { return last_send_; }
 
  private:
   void run(McuInstant now) {

@@ -51,7 +51,7 @@ class SequenceGate {
       : window_(window < 1 ? 1 : window), reacquire_(reacquire < 2 ? 2 : reacquire) {}
 
   /// Offers `seq`: the verdict; the base moves on kAccepted and kReacquired.
-  constexpr SequenceVerdict offer(SequenceNumber seq) {
+  [[nodiscard]] constexpr SequenceVerdict offer(SequenceNumber seq) {
     if (!any_) {
       take(seq);
       return SequenceVerdict::kAccepted;

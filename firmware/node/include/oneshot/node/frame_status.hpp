@@ -31,7 +31,7 @@ enum class [[nodiscard]] FrameStatus : std::uint8_t {
 constexpr bool accepted(FrameStatus s) { return s == FrameStatus::kOk || s == FrameStatus::kReacquired; }
 
 /// The more severe of a and b (a on ties).
-constexpr FrameStatus worst_of(FrameStatus a, FrameStatus b) {
+[[nodiscard]] constexpr FrameStatus worst_of(FrameStatus a, FrameStatus b) {
   return static_cast<std::uint8_t>(b) > static_cast<std::uint8_t>(a) ? b : a;
 }
 
@@ -47,7 +47,7 @@ struct FrameRefusals {
 };
 
 /// Adds s to the counter of its cause (kOk counts nothing); returns s.
-constexpr FrameStatus count_frame(FrameStatus s, FrameRefusals& r) {
+[[nodiscard]] constexpr FrameStatus count_frame(FrameStatus s, FrameRefusals& r) {
   switch (s) {
     case FrameStatus::kOk: break;
     case FrameStatus::kReacquired: ++r.reacquired; break;

@@ -91,11 +91,11 @@ class HeldMeasurementEstimator {
   }
 
  private:
-  constexpr Status reset_non_finite() {
+  [[nodiscard]] constexpr Status reset_non_finite() {
     core_.reset(x0_, p0_);
     return Status::kNonFinite;
   }
-  constexpr Status finite_or_reset() {
+  [[nodiscard]] constexpr Status finite_or_reset() {
     return all_finite(core_.state()) && all_finite(core_.covariance()) ? Status::kOk : reset_non_finite();
   }
 

@@ -229,7 +229,7 @@ class NumreEstimator {
   constexpr std::uint64_t macs() const { return macs_; }
 
  private:
-  constexpr Status reset_non_finite() {
+  [[nodiscard]] constexpr Status reset_non_finite() {
     x_ = x0_;
     p_ = p0_;
     g_ = State{};

@@ -225,9 +225,9 @@ class PetcController {
   /// The estimator.
   constexpr const Estimator& estimator() const { return est_; }
   /// Status of the last correction (kNonFinite: the NUMRE was reset).
-  constexpr Status last_status() const { return status_; }
+  [[nodiscard]] constexpr Status last_status() const { return status_; }
   /// Status of the last arrival's frame checks (refusals counted by cause in statistics()).
-  constexpr FrameStatus arrival_status() const { return arrival_status_; }
+  [[nodiscard]] constexpr FrameStatus arrival_status() const { return arrival_status_; }
   /// Counters.
   constexpr const PetcStatistics& statistics() const { return stats_; }
   /// Multiply-adds: estimator + cascades (model, law, observer).

@@ -59,9 +59,9 @@ class SyncActuatorNode {
   /// Requests the interface refused.
   constexpr std::uint32_t refused() const { return requests_.refused; }
   /// Result of the last request send.
-  constexpr SendResult last_request() const { return last_request_; }
+  [[nodiscard]] constexpr SendResult last_request() const { return last_request_; }
   /// Worst status of the frames the last on_receive() handled (kOk when none).
-  constexpr FrameStatus receive_status() const { return inner_.receive_status(); }
+  [[nodiscard]] constexpr FrameStatus receive_status() const { return inner_.receive_status(); }
 
  private:
   void request(SequenceNumber k, McuInstant t_k) {

@@ -119,9 +119,9 @@ class SyncControllerNode {
   /// Counters.
   constexpr const SyncControllerStatistics& statistics() const { return stats_; }
   /// Worst status of the frames the last on_receive() handled (kOk when none).
-  constexpr FrameStatus receive_status() const { return receive_status_; }
+  [[nodiscard]] constexpr FrameStatus receive_status() const { return receive_status_; }
   /// Result of the last command send (counted in statistics()).
-  constexpr SendResult last_send() const { return last_send_; }
+  [[nodiscard]] constexpr SendResult last_send() const { return last_send_; }
 
  private:
   // round(dt / h) (µs; in 64 bits: no overflow at any dt).

@@ -108,7 +108,7 @@ class SyncSensorNode {
   /// Counters.
   constexpr const SyncSensorStatistics& statistics() const { return stats_; }
   /// Worst status of the frames the last on_receive() handled (kOk when none).
-  constexpr FrameStatus receive_status() const { return receive_status_; }
+  [[nodiscard]] constexpr FrameStatus receive_status() const { return receive_status_; }
 
  private:
   std::uint8_t controller_;
