@@ -159,7 +159,7 @@ struct Nodes {
     require(all_finite(sod.estimate()) && all_finite(sod.covariance()), "send-on-delta estimate not finite");
     for (const auto& f : g_net.outbox) {
       Message<VectorPayload<double, 1>> m;
-      require(decode(f.bytes.data(), f.bytes.size(), m) && all_finite(m.payload.value), "controller node sent a non-finite command");
+      require(decode(f.bytes.data(), f.bytes.size(), m) == FrameStatus::kOk && all_finite(m.payload.value), "controller node sent a non-finite command");
     }
     g_net.outbox.clear();
   }
