@@ -43,19 +43,26 @@ static_assert(oneshot::hal::kHasNetwork<NullBoard>);
 template <typename S>
 struct ProportionalLaw {
   S gain;
-  bool compute(const oneshot::node::Message<oneshot::node::VectorPayload<S, 1>>& m, bool, oneshot::McuInstant,
-               oneshot::Vector<S, 1>& u) {
+  oneshot::node::LawResult compute(const oneshot::node::Message<oneshot::node::VectorPayload<S, 1>>& m, bool,
+                                    oneshot::McuInstant, oneshot::Vector<S, 1>& u) {
     u[0] = -(gain * m.payload.value[0]);
-    return true;
+    return oneshot::node::LawResult::kSend;
   }
 };
+
+/// A small threshold δ = 0.01 (1-vector) the exercises below share.
+template <typename S>
+oneshot::Vector<S, 1> small_delta() {
+  oneshot::Vector<S, 1> delta;
+  delta[0] = oneshot::ScalarTraits<S>::from_ratio(1, 100);
+  return delta;
+}
 
 template <typename S>
 void exercise() {
   using namespace oneshot::node;
   using V = oneshot::Vector<S, 1>;
-  V delta;
-  delta[0] = oneshot::ScalarTraits<S>::from_ratio(1, 100);
+  const V delta = small_delta<S>();
   SensorNode<NullBoard, SendOnDeltaTrigger<S, 1>, S, 1> sod(2, SendOnDeltaTrigger<S, 1>(delta, 5));
   SensorNode<NullBoard, PeriodicTrigger<S, 1>, S, 1> periodic(2, PeriodicTrigger<S, 1>(1));
   SensorNode<NullBoard, MtmTrigger<S, 1>, S, 1> mtm(2, MtmTrigger<S, 1>(delta[0], delta[0], 50, 3));
@@ -74,6 +81,7 @@ void exercise() {
   ctrl.on_timer(now);
   act.on_receive();
   act.on_timer(0);
+  static_cast<void>(ctrl.receive_status() == act.receive_status());
   V u;
   static_cast<void>(act.take_output(u));
   // The buffered intermittent filter (threshold buffer, anchor, re-run), 3 states, T_hold = 4.
@@ -115,7 +123,7 @@ void exercise_sync() {
   sensor.set_stamp_window(200000);
   sensor.set_sequence_window(64, 3);
   McuInstant at;
-  if (sensor.on_receive(now, at)) sensor.on_sample(at, Vector<S, 2>{});
+  if (sensor.on_receive(now, at)) static_cast<void>(sensor.on_sample(at, Vector<S, 2>{}) == ReportResult::kSent);
   SyncControllerNode<NullBoard, HalfKalmanEstimator<Fmt, Structure, Disc>, Ref, S, 2, 2, 1> ak(
       3, design.l, lo, hi, HalfKalmanEstimator<Fmt, Structure, Disc>(design, disc, NoiseModel::kExact), ref);
   ak.expect_source(2);
@@ -142,8 +150,7 @@ template <typename S>
 void exercise_sod() {
   using namespace oneshot::node;
   using V = oneshot::Vector<S, 1>;
-  V delta;
-  delta[0] = oneshot::ScalarTraits<S>::from_ratio(1, 100);
+  const V delta = small_delta<S>();
   // Receiver and estimator of send-on-delta nodes (two nodes, two states).
   using V2 = oneshot::Vector<S, 2>;
   using M2 = oneshot::Matrix<S, 2, 2>;
@@ -152,7 +159,7 @@ void exercise_sod() {
   dy[0] = delta[0];
   dy[1] = delta[0];
   HeldMeasurementReceiver<S, 2> rx(dy, dy, n_t, SilencePolicy::kHeld);
-  rx.on_packet(0, 0, delta[0]);
+  static_cast<void>(rx.on_packet(0, 0, delta[0]) == FrameStatus::kOk);
   M2 eye;
   eye(0, 0) = oneshot::ScalarTraits<S>::one();
   eye(1, 1) = oneshot::ScalarTraits<S>::one();
@@ -169,8 +176,7 @@ void exercise_sod() {
 template <typename S>
 void exercise_petc() {
   using namespace oneshot::node;
-  oneshot::Vector<S, 1> delta;
-  delta[0] = oneshot::ScalarTraits<S>::from_ratio(1, 100);
+  const oneshot::Vector<S, 1> delta = small_delta<S>();
   // PETC: NUMRE, interlaced law, both disturbance estimates, packet buffer.
   using Law = InterlacedController<S, 1, 2>;
   InterlacedConfig<S, 1, 2> lc{};
@@ -185,7 +191,7 @@ void exercise_petc() {
   PetcController<S, 4, 8, Law, Dob> petc_dob(model, NoiseAccumulation::kFrozen, Law(lc), Dob(oc), trig, delta[0]);
   static_cast<void>(petc_dob.on_arrival(0, delta[0]));
   PacketBuffer<S, 8> buffer;
-  static_cast<void>(buffer.accept(0, petc.packet()));
+  static_cast<void>(buffer.accept(0, petc.packet()) == FrameStatus::kOk);
   static_cast<void>(buffer.value(3));
 }
 

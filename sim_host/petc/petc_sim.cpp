@@ -206,7 +206,8 @@ std::vector<double> simulate(const PetcSetup& s, const CaseSpec& c, std::uint64_
   };
 
   engine::HandlerId on_rx = kernel.add_handler("actuator receive", [&](std::uint64_t k) {
-    actuator.accept(static_cast<std::uint32_t>(k), ctrl.packet());
+    // Without faults packets arrive in order: an older one is kept out (the one in force stays).
+    static_cast<void>(actuator.accept(static_cast<std::uint32_t>(k), ctrl.packet()));
     plant.set_input(scalar(actuator.value(static_cast<std::uint32_t>(k))));
   });
   engine::HandlerId on_rx_frame{};
@@ -216,7 +217,7 @@ std::vector<double> simulate(const PetcSetup& s, const CaseSpec& c, std::uint64_
       double u[kHorizon + 1];
       if (!engine::decode_sequenced_frame(ca_frames[i], k, u, kHorizon + 1)) return;  // every fault keeps the size
       if (!act_rx.accept(k, u, kHorizon + 1, period_now())) return;
-      actuator.accept(k, u);
+      static_cast<void>(actuator.accept(k, u));  // act_rx passed it: never older than the one in force
       plant.set_input(scalar(actuator.value(k)));
     });
   const auto arrive = [&](std::uint32_t kk, double y) {

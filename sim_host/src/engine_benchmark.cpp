@@ -24,9 +24,10 @@ using Board = host::HostNetwork;
 
 /// u = −L y (L stabilises the sampled double integrator for delays below h).
 struct Law {
-  bool compute(const node::Message<node::VectorPayload<float, 2>>& m, bool fresh, McuInstant, Vector<float, 1>& u) {
+  node::LawResult compute(const node::Message<node::VectorPayload<float, 2>>& m, bool fresh, McuInstant,
+                          Vector<float, 1>& u) {
     u[0] = -(0.1F * m.payload.value[0] - 0.4F * m.payload.value[1]);
-    return fresh;
+    return fresh ? node::LawResult::kSend : node::LawResult::kNone;
   }
 };
 

@@ -75,9 +75,9 @@ struct Nodes {
   SyncSensorNode<Net, double, 1, 1> sensor{kController, 0};
   SyncActuatorNode<Net, double, 1> act{kSensor, V1{}};
   struct Echo {
-    bool compute(const Message<VectorPayload<double, 1>>& m, bool fresh, McuInstant, V1& u) {
+    LawResult compute(const Message<VectorPayload<double, 1>>& m, bool fresh, McuInstant, V1& u) {
       u = m.payload.value;
-      return fresh;
+      return fresh ? LawResult::kSend : LawResult::kNone;
     }
   };
   ControllerNode<Net, Echo, double, 1, 1> generic{kActuator, ControllerMode::kOnArrival, Echo{}};
@@ -159,7 +159,7 @@ struct Nodes {
     require(all_finite(sod.estimate()) && all_finite(sod.covariance()), "send-on-delta estimate not finite");
     for (const auto& f : g_net.outbox) {
       Message<VectorPayload<double, 1>> m;
-      require(decode(f.bytes.data(), f.bytes.size(), m) && all_finite(m.payload.value), "controller node sent a non-finite command");
+      require(decode(f.bytes.data(), f.bytes.size(), m) == FrameStatus::kOk && all_finite(m.payload.value), "controller node sent a non-finite command");
     }
     g_net.outbox.clear();
   }

@@ -40,10 +40,10 @@ TEST(PetcPil, ArrivalInstructionsBoundedInMultiplicity) {
   const std::uint64_t one_span = insns("1") - insns("0");
   for (const auto& [n, v] : by_n.items()) EXPECT_LE(v.get<std::uint64_t>(), insns("0") + 2 * one_span) << "N = " << n;
   // Counts are stable (straight-line code over the HDD structure, same data): measured
-  // 48,213 (N = 0), 53,038 (1 and 2: one span), 57,348 (97 and 200: two spans), with the
-  // model in the block-diagonal basis of sim_host/petc/petc_modal.hpp (~205 instructions per
-  // cascade step). The target is 60,000 at every N ≤ 200.
-  EXPECT_LE(j.at("instructions_max").get<std::uint64_t>(), 59000U);
+  // 48,018 (N = 0), 51,446 (1 and 2: one span), 54,351 (97 and 200: two spans), with the
+  // model in the block-diagonal basis of sim_host/petc/petc_modal.hpp. The target is
+  // 60,000 at every N ≤ 200.
+  EXPECT_LE(j.at("instructions_max").get<std::uint64_t>(), 56000U);
 }
 
 TEST(PetcPil, ArrivalBitIdenticalToHostFloat) {

@@ -1,16 +1,20 @@
 /// @file actuator_controller_validation_test.cpp
 /// @brief The actuator never applies a non-finite or out-of-range command (holds the last
 ///        good one and counts), a forged sequence never blocks its buffer, and the generic
-///        controller node re-acquires a restarted sensor within R frames (issue 24).
+///        controller node re-acquires a restarted sensor within R frames (issue 24); every
+///        refused frame has the status of its cause (frame_status.hpp), counted by that cause.
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cstdint>
 #include <limits>
 
 #include "oneshot/host/host_network.hpp"
 #include "oneshot/node/actuator_node.hpp"
 #include "oneshot/node/controller_node.hpp"
+#include "oneshot/node/actuation_sync_messages.hpp"
 #include "oneshot/node/sync_actuator_node.hpp"
+#include "oneshot/node/sync_sensor_node.hpp"
 
 namespace oneshot::node {
 namespace {
@@ -27,14 +31,25 @@ V1 v1(double x) {
   return v;
 }
 
+/// The wire bytes of the one-scalar message (seq, value).
+std::vector<std::uint8_t> frame(SequenceNumber seq, double value) {
+  Message<VectorPayload<double, 1>> m;
+  m.seq = seq;
+  m.payload.value = v1(value);
+  std::uint8_t bytes[kMaxMessageBytes];
+  const std::size_t n = encode(m, bytes);
+  return {bytes, bytes + n};
+}
+
+/// A node's drop and refusal counters in the order of FrameRefusals.
+using Counts = std::array<std::uint32_t, 7>;
+Counts counts(const FrameRefusals& r) {
+  return {r.malformed, r.stale, r.refused_non_finite, r.refused_out_of_range, r.refused_source, r.refused_sequence, r.reacquired};
+}
+
 /// Delivers the command (seq, u) from `from` to `net`.
 void deliver(host::HostNetworkState& net, SequenceNumber seq, double u, std::uint8_t from = kController) {
-  Message<VectorPayload<double, 1>> c;
-  c.seq = seq;
-  c.payload.value = v1(u);
-  std::uint8_t bytes[kMaxMessageBytes];
-  const std::size_t n = encode(c, bytes);
-  net.deliver(host::Frame{from, net.address, std::vector<std::uint8_t>(bytes, bytes + n)});
+  net.deliver(host::Frame{from, net.address, frame(seq, u)});
 }
 
 TEST(ActuatorValidation, TimerModeHoldsTheLastGoodCommand) {
@@ -115,9 +130,9 @@ TEST(ActuatorValidation, OnArrivalModeRefusesNanAndFollowsARestartedController) 
 }
 
 struct Echo {
-  bool compute(const Message<VectorPayload<double, 1>>& m, bool fresh, McuInstant, V1& u) {
+  LawResult compute(const Message<VectorPayload<double, 1>>& m, bool fresh, McuInstant, V1& u) {
     u = m.payload.value;
-    return fresh;
+    return fresh ? LawResult::kSend : LawResult::kNone;
   }
 };
 
@@ -127,12 +142,7 @@ TEST(ControllerValidation, RestartedSensorReacquiredAndNanRefused) {
   ControllerNode<host::HostNetwork, Echo, double, 1, 1> ctrl(kActuator, ControllerMode::kOnArrival, Echo{});
   const host::ScopedHostNetwork cur(net);
   const auto sample = [&](SequenceNumber k, double y) {
-    Message<VectorPayload<double, 1>> m;
-    m.seq = k;
-    m.payload.value = v1(y);
-    std::uint8_t bytes[kMaxMessageBytes];
-    const std::size_t n = encode(m, bytes);
-    net.deliver(host::Frame{kSensor, kController, std::vector<std::uint8_t>(bytes, bytes + n)});
+    net.deliver(host::Frame{kSensor, kController, frame(k, y)});
     ctrl.on_receive(McuInstant(0));
   };
   for (SequenceNumber k = 0; k < 500; ++k) sample(k, 0.001 * k);
@@ -145,10 +155,84 @@ TEST(ControllerValidation, RestartedSensorReacquiredAndNanRefused) {
   for (SequenceNumber k = 0; k < 10; ++k) sample(k, 0.5);
   EXPECT_EQ(net.outbox.size(), 500U + 10U - (kDefaultReacquireFrames - 1));
   EXPECT_EQ(ctrl.latest().seq, 9U);
-  const auto& s = ctrl.statistics();
-  EXPECT_EQ(s.refused_non_finite, 1U);
-  EXPECT_EQ(s.refused_sequence, 1U);
-  EXPECT_EQ(s.reacquired, 1U);
+  // Per cause: malformed, stale, non-finite, out of range, source, sequence, re-acquired (the
+  // restarted sensor's first R − 1 frames are stale against the old base).
+  EXPECT_EQ(counts(ctrl.statistics()), (Counts{0, kDefaultReacquireFrames - 1, 1, 0, 0, 1, 1}));
+}
+
+TEST(FrameIo, EachRefusedFrameHasTheStatusOfItsCause) {
+  host::HostNetworkState net;
+  net.address = kController;
+  const host::ScopedHostNetwork cur(net);
+  ControllerNode<host::HostNetwork, Echo, double, 1, 1> ctrl(kActuator, ControllerMode::kOnArrival, Echo{});
+  ctrl.expect_source(kSensor);
+  ctrl.set_measurement_range(v1(-1), v1(1));
+  ctrl.set_sequence_window(16, 3);
+  const McuInstant now(0);
+  const auto offer = [&](std::uint8_t source, const std::vector<std::uint8_t>& b) {
+    return ctrl.on_frame(source, b.data(), b.size(), now);
+  };
+  EXPECT_EQ(offer(kSensor, frame(10, 0.5)), FrameStatus::kOk);
+  std::vector<std::uint8_t> short_frame = frame(11, 0.5);
+  short_frame.pop_back();
+  EXPECT_EQ(offer(kSensor, short_frame), FrameStatus::kMalformed);
+  EXPECT_EQ(offer(kActuator, frame(11, 0.5)), FrameStatus::kRefusedSource);
+  EXPECT_EQ(offer(kSensor, frame(11, std::numeric_limits<double>::quiet_NaN())), FrameStatus::kRefusedNonFinite);
+  EXPECT_EQ(offer(kSensor, frame(11, 1.5)), FrameStatus::kRefusedOutOfRange);
+  EXPECT_EQ(offer(kSensor, frame(10, 0.5)), FrameStatus::kStale);
+  EXPECT_EQ(offer(kSensor, frame(10 + 17, 0.5)), FrameStatus::kRefusedSequence);
+  EXPECT_EQ(offer(kSensor, frame(11, 0.25)), FrameStatus::kOk);
+  // The checks run in order: a wrong sender with a NaN payload is refused for its sender.
+  EXPECT_EQ(offer(kActuator, frame(12, std::numeric_limits<double>::quiet_NaN())), FrameStatus::kRefusedSource);
+  const ControllerStatistics& s = ctrl.statistics();
+  // Counted per cause: malformed, stale, non-finite, out of range, source, sequence, re-acquired.
+  EXPECT_EQ(counts(s), (Counts{1, 1, 1, 1, 2, 1, 0}));
+  EXPECT_EQ(s.received, 8U);  // every frame that decoded
+  EXPECT_EQ(s.sends, 2U);     // one command per accepted measurement
+  EXPECT_EQ(ctrl.last_send(), SendResult::kSent);
+  EXPECT_EQ(ctrl.latest().seq, 11U);
+}
+
+TEST(FrameIo, OnReceiveKeepsTheWorstStatusOfItsFrames) {
+  host::HostNetworkState net;
+  net.address = kActuator;
+  const host::ScopedHostNetwork cur(net);
+  ActuatorNode<host::HostNetwork, double, 1> act(ActuatorMode::kOnArrival, v1(0));
+  act.set_command_range(v1(-1), v1(1));
+  act.on_receive();
+  EXPECT_EQ(act.receive_status(), FrameStatus::kOk);  // nothing waited
+  deliver(net, 1, 0.5);
+  deliver(net, 1, 0.5);  // duplicate: stale
+  deliver(net, 2, 3.0);  // out of range
+  deliver(net, 3, -0.5);
+  act.on_receive();
+  EXPECT_EQ(act.receive_status(), FrameStatus::kRefusedOutOfRange);
+  EXPECT_EQ(act.applied()[0], -0.5);
+  EXPECT_EQ(counts(act.statistics()), (Counts{0, 1, 0, 1, 0, 0, 0}));
+  // A timer-mode actuator refuses a command beyond its Slots window as a sequence jump.
+  ActuatorNode<host::HostNetwork, double, 1, 4> timed(ActuatorMode::kOnTimer, v1(0));
+  const std::vector<std::uint8_t> far = frame(5, 0.1);
+  EXPECT_EQ(timed.on_frame(kController, far.data(), far.size()), FrameStatus::kRefusedSequence);
+  const std::vector<std::uint8_t> near = frame(4, 0.1);
+  EXPECT_EQ(timed.on_frame(kController, near.data(), near.size()), FrameStatus::kOk);
+}
+
+TEST(FrameIo, SyncSensorReportsWhatBecameOfItsSample) {
+  host::HostNetworkState net;
+  net.address = kSensor;
+  const host::ScopedHostNetwork cur(net);
+  SyncSensorNode<host::HostNetwork, double, 1, 1> sensor(kController, 0);
+  EXPECT_EQ(sensor.on_sample(McuInstant(0), v1(0.1)), ReportResult::kNoRequest);
+  ActuationRequest<double, 1> r;
+  r.k = 1;
+  r.t_k = McuInstant(100);
+  r.u_applied = v1(0.0);
+  std::uint8_t bytes[kMaxMessageBytes];
+  const std::size_t n = encode(r, bytes);
+  EXPECT_EQ(sensor.on_frame(kActuator, bytes, n, McuInstant(0)), FrameStatus::kOk);
+  EXPECT_EQ(sensor.on_sample(McuInstant(10), v1(0.1)), ReportResult::kSent);
+  EXPECT_EQ(sensor.statistics().sends, 1U);
+  EXPECT_EQ(sensor.on_frame(kActuator, bytes, n - 1, McuInstant(0)), FrameStatus::kMalformed);
 }
 
 }  // namespace

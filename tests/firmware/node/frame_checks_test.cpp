@@ -78,11 +78,11 @@ TEST(SequenceGate, RestartedPeerIsReacquiredOnItsRthFrame) {
 TEST(FrameChecks, SourceAndRangeCountedByCause) {
   FrameRefusals r;
   ExpectedSource any;
-  EXPECT_TRUE(any.check(7, r));
+  EXPECT_EQ(count_frame(any.check(7), r), FrameStatus::kOk);
   ExpectedSource src;
   src.set(2);
-  EXPECT_TRUE(src.check(2, r));
-  EXPECT_FALSE(src.check(3, r));
+  EXPECT_EQ(count_frame(src.check(2), r), FrameStatus::kOk);
+  EXPECT_EQ(count_frame(src.check(3), r), FrameStatus::kRefusedSource);
   EXPECT_EQ(r.refused_source, 1U);
   Vector<double, 2> lo, hi, v;
   lo[0] = -1;
@@ -92,15 +92,39 @@ TEST(FrameChecks, SourceAndRangeCountedByCause) {
   const ValueRange<double, 2> range(lo, hi);
   v[0] = 1;
   v[1] = 0;
-  EXPECT_TRUE(check_payload(v, range, r));  // bounds are inside
+  EXPECT_EQ(count_frame(check_payload(v, range), r), FrameStatus::kOk);  // bounds are inside
   v[1] = 5.000001;
-  EXPECT_FALSE(check_payload(v, range, r));
+  EXPECT_EQ(count_frame(check_payload(v, range), r), FrameStatus::kRefusedOutOfRange);
   EXPECT_EQ(r.refused_out_of_range, 1U);
   v[1] = std::numeric_limits<double>::quiet_NaN();
-  EXPECT_FALSE(check_payload(v, range, r));
-  EXPECT_FALSE(check_payload(v, ValueRange<double, 2>{}, r));  // unchecked range: still finite only
+  EXPECT_EQ(count_frame(check_payload(v, range), r), FrameStatus::kRefusedNonFinite);
+  // Unchecked range: still finite only.
+  EXPECT_EQ(count_frame(check_payload(v, ValueRange<double, 2>{}), r), FrameStatus::kRefusedNonFinite);
   EXPECT_EQ(r.refused_non_finite, 2U);
   EXPECT_EQ(r.refused_out_of_range, 1U);
+}
+
+TEST(FrameChecks, StatusOrderedBySeverityAndCountedPerCause) {
+  // The first check that fails names the frame; the worst of several frames is the most severe.
+  EXPECT_EQ(then_check(FrameStatus::kRefusedSource, [] { return FrameStatus::kRefusedNonFinite; }),
+            FrameStatus::kRefusedSource);
+  EXPECT_EQ(then_check(FrameStatus::kOk, [] { return FrameStatus::kStale; }), FrameStatus::kStale);
+  EXPECT_EQ(worst_of(FrameStatus::kStale, FrameStatus::kReacquired), FrameStatus::kStale);
+  EXPECT_EQ(worst_of(FrameStatus::kRefusedOutOfRange, FrameStatus::kMalformed), FrameStatus::kMalformed);
+  EXPECT_TRUE(accepted(FrameStatus::kReacquired));
+  EXPECT_FALSE(accepted(FrameStatus::kStale));
+  EXPECT_EQ(frame_status(SequenceVerdict::kJump), FrameStatus::kRefusedSequence);
+  // Every cause has its own counter, and kOk counts nothing.
+  FrameRefusals r;
+  for (const FrameStatus s : {FrameStatus::kOk, FrameStatus::kReacquired, FrameStatus::kStale, FrameStatus::kRefusedSequence,
+                              FrameStatus::kRefusedOutOfRange, FrameStatus::kRefusedNonFinite, FrameStatus::kRefusedSource,
+                              FrameStatus::kMalformed})
+    EXPECT_EQ(count_frame(s, r), s) << to_string(s);
+  EXPECT_EQ(r.reacquired + r.stale + r.refused_sequence + r.refused_out_of_range + r.refused_non_finite + r.refused_source +
+                r.malformed,
+            7U);
+  EXPECT_EQ(r.malformed, 1U);
+  EXPECT_EQ(r.stale, 1U);
 }
 
 }  // namespace

@@ -35,11 +35,11 @@ void round_trip(const Vector<S, P>& value) {
   EXPECT_EQ(n, (encoded_size<S, P>()));
   EXPECT_EQ(bytes[0], 0xFE);  // little-endian
   Message<VectorPayload<S, P>> back;
-  ASSERT_TRUE(decode(bytes, n, back));
+  ASSERT_EQ(decode(bytes, n, back), FrameStatus::kOk);
   EXPECT_EQ(back.seq, m.seq);
   EXPECT_EQ(back.stamp, m.stamp);
   for (std::size_t i = 0; i < P; ++i) EXPECT_EQ(ScalarTraits<S>::to_double(back.payload.value[i]), ScalarTraits<S>::to_double(value[i]));
-  EXPECT_FALSE(decode(bytes, n - 1, back));  // a short frame is refused
+  EXPECT_EQ(decode(bytes, n - 1, back), FrameStatus::kMalformed);  // a short frame is refused
 }
 
 TEST(Message, RoundTripsEveryScalarExactly) {
@@ -109,23 +109,23 @@ TEST(Triggers, MixedThresholdSafetyAndReferenceChange) {
 
 TEST(CommandBuffer, KeyedBySequenceNumberNewerKept) {
   CommandBuffer<double, 1, 4> b;
-  EXPECT_TRUE(b.store(10, v1(1)));
-  EXPECT_TRUE(b.store(11, v1(2)));
+  EXPECT_EQ(b.store(10, v1(1)), FrameStatus::kOk);
+  EXPECT_EQ(b.store(11, v1(2)), FrameStatus::kOk);
   V1 u;
   EXPECT_TRUE(b.find(10, u));
   EXPECT_EQ(u[0], 1);
   EXPECT_FALSE(b.find(14, u));    // same slot as 10, other number
-  EXPECT_TRUE(b.store(14, v1(5)));  // newer replaces 10
+  EXPECT_EQ(b.store(14, v1(5)), FrameStatus::kOk);  // newer replaces 10
   EXPECT_FALSE(b.find(10, u));
-  EXPECT_FALSE(b.store(10, v1(9)));  // older than the slot's 14: kept out
+  EXPECT_EQ(b.store(10, v1(9)), FrameStatus::kStale);  // older than the slot's 14: kept out
   EXPECT_TRUE(b.find(14, u));
   EXPECT_EQ(u[0], 5);
 }
 
 struct Echo {
-  bool compute(const Message<VectorPayload<double, 1>>& m, bool fresh, McuInstant, V1& u) {
+  LawResult compute(const Message<VectorPayload<double, 1>>& m, bool fresh, McuInstant, V1& u) {
     u = m.payload.value;
-    return fresh;
+    return fresh ? LawResult::kSend : LawResult::kNone;
   }
 };
 

@@ -55,7 +55,7 @@ struct GapLoop {
   double last_u() const {
     Message<VectorPayload<double, 1>> c;
     const auto& b = net.outbox.back().bytes;
-    EXPECT_TRUE(decode(b.data(), b.size(), c));
+    EXPECT_EQ(decode(b.data(), b.size(), c), FrameStatus::kOk);
     return c.payload.value[0];
   }
 };

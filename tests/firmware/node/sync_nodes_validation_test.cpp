@@ -50,7 +50,7 @@ struct Loop {
   SequenceNumber last_command_k() const {
     Message<VectorPayload<double, 1>> c;
     const auto& b = net.outbox.back().bytes;
-    EXPECT_TRUE(decode(b.data(), b.size(), c));
+    EXPECT_EQ(decode(b.data(), b.size(), c), FrameStatus::kOk);
     return c.seq;
   }
   bool estimate_finite() const {

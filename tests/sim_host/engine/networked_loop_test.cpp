@@ -52,10 +52,11 @@ Vector<double, 2> measure(const Plant& plant, RandomStream& rng) {
 
 struct Law {
   Matrix<double, 1, 2> l;
-  bool compute(const node::Message<node::VectorPayload<double, 2>>& m, bool fresh, McuInstant, Vector<double, 1>& u) {
-    if (!fresh) return false;
+  node::LawResult compute(const node::Message<node::VectorPayload<double, 2>>& m, bool fresh, McuInstant,
+                          Vector<double, 1>& u) {
+    if (!fresh) return node::LawResult::kNone;
     u = -(l * m.payload.value);
-    return true;
+    return node::LawResult::kSend;
   }
 };
 

@@ -110,7 +110,7 @@ TEST(NcsLiveUdp, DrivesTheFirmwareSensorNode) {
   Vector<double, kP> y;
   y[0] = 0.5;
   y[1] = -1.5;
-  ASSERT_TRUE(sensor.on_sample(McuInstant(210010), y));
+  ASSERT_EQ(sensor.on_sample(McuInstant(210010), y), node::ReportResult::kSent);
   ASSERT_TRUE(posix::wait_readable(relay.fd, monotonic_ns() + kWaitNs));
   std::uint8_t got[300];
   const ssize_t m = ::recv(relay.fd, got, sizeof got, 0);
@@ -118,7 +118,7 @@ TEST(NcsLiveUdp, DrivesTheFirmwareSensorNode) {
   EXPECT_EQ(got[0], kLiveSensor);
   EXPECT_EQ(got[1], kLiveController);
   node::SampleReport<double, kP, kM> rep;
-  ASSERT_TRUE(node::decode(got + 2, static_cast<std::size_t>(m - 2), rep));
+  ASSERT_EQ(node::decode(got + 2, static_cast<std::size_t>(m - 2), rep), node::FrameStatus::kOk);
   EXPECT_EQ(rep.k, 5u);
   EXPECT_EQ(rep.tau_us, 250000 - 210010);
   EXPECT_EQ(rep.y[1], -1.5);

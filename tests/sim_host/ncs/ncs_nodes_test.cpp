@@ -60,15 +60,15 @@ TEST(NcsMessages, RequestAndReportRoundTrip) {
   std::uint8_t b[node::kMaxMessageBytes];
   const std::size_t n = node::encode(r, b);
   Report d;
-  ASSERT_TRUE(node::decode(b, n, d));
+  ASSERT_EQ(node::decode(b, n, d), node::FrameStatus::kOk);
   EXPECT_EQ(d.k, r.k);
   EXPECT_EQ(d.t_s, r.t_s);
   EXPECT_EQ(d.tau_us, -17);
   EXPECT_TRUE(same_bits(d.y[1], r.y[1]));
   EXPECT_EQ(d.u_applied[0], -1.5);
   Request q;
-  EXPECT_FALSE(node::decode(b, n, q));  // a report is not a request
-  EXPECT_FALSE(node::decode(b, n - 1, d));
+  EXPECT_EQ(node::decode(b, n, q), node::FrameStatus::kMalformed);  // a report is not a request
+  EXPECT_EQ(node::decode(b, n - 1, d), node::FrameStatus::kMalformed);
 }
 
 /// The controller node's estimate is the core's half Kalman filter, bit for bit, on random
@@ -109,7 +109,7 @@ TEST(NcsNodes, ControllerEstimateIsTheCoreHalfKalmanBitForBit) {
       for (std::size_t i = 0; i < kN; ++i) ASSERT_TRUE(same_bits(ctrl.estimator().estimate()[i], core.prediction()[i])) << k;
       ASSERT_EQ(net.outbox.size(), 1U);
       Command c;
-      ASSERT_TRUE(node::decode(net.outbox[0].bytes.data(), net.outbox[0].bytes.size(), c));
+      ASSERT_EQ(node::decode(net.outbox[0].bytes.data(), net.outbox[0].bytes.size(), c), node::FrameStatus::kOk);
       net.outbox.clear();
       EXPECT_EQ(c.seq, k);
       Vector<double, kM> u = reference().input(k) - design.l * (core.prediction() - reference().state(k));
@@ -213,9 +213,9 @@ TEST(NcsNodes, SensorSamplesAtOnceOrLateAtTkMinusD) {
   EXPECT_EQ(when, McuInstant(217'000));  // t_k − D
   Vector<double, kP> y;
   y[0] = 0.1;
-  ASSERT_TRUE(late.on_sample(when, y));
+  ASSERT_EQ(late.on_sample(when, y), node::ReportResult::kSent);
   Report r;
-  ASSERT_TRUE(node::decode(net.outbox.back().bytes.data(), net.outbox.back().bytes.size(), r));
+  ASSERT_EQ(node::decode(net.outbox.back().bytes.data(), net.outbox.back().bytes.size(), r), node::FrameStatus::kOk);
   EXPECT_EQ(r.k, 5U);
   EXPECT_EQ(r.tau_us, 33'000);
   EXPECT_EQ(r.u_applied[0], 0.7);
@@ -241,7 +241,7 @@ TEST(NcsNodes, LateCommandIsHeldCountedAndItsEchoUsed) {
   };
   const auto last_request = [&]() {
     Request q;
-    EXPECT_TRUE(node::decode(act_net.outbox.back().bytes.data(), act_net.outbox.back().bytes.size(), q));
+    EXPECT_EQ(node::decode(act_net.outbox.back().bytes.data(), act_net.outbox.back().bytes.size(), q), node::FrameStatus::kOk);
     return q;
   };
   Vector<double, kM> out;

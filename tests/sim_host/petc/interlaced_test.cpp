@@ -155,14 +155,14 @@ TEST(PacketBuffer, AppliesEntryAndHoldsTheLast) {
   oneshot::node::PacketBuffer<double, 3> buf(0.5);
   EXPECT_EQ(buf.value(7), 0.5);
   const double p[4] = {1, 2, 3, 4};
-  ASSERT_TRUE(buf.accept(10, p));
+  ASSERT_EQ(buf.accept(10, p), oneshot::node::FrameStatus::kOk);
   EXPECT_EQ(buf.value(10), 1);
   EXPECT_EQ(buf.value(12), 3);
   EXPECT_EQ(buf.value(13), 4);
   EXPECT_FALSE(buf.exhausted(13));
   EXPECT_EQ(buf.value(40), 4);
   EXPECT_TRUE(buf.exhausted(14));
-  EXPECT_FALSE(buf.accept(9, p));  // older packet refused
+  EXPECT_EQ(buf.accept(9, p), oneshot::node::FrameStatus::kStale);  // older packet refused
 }
 
 }  // namespace

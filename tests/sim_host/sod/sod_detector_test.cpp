@@ -89,11 +89,11 @@ TEST(SodDetector, ReceiverBuildsHeldVarianceInClosedForm) {
   const std::uint32_t n_t[2] = {10, 0};
   oneshot::node::HeldMeasurementReceiver<double, 2> rx(dy, r, n_t, oneshot::node::SilencePolicy::kHeld);
   EXPECT_FALSE(rx.measurement(0, 0).present);  // nothing to hold yet
-  EXPECT_FALSE(rx.on_packet(0, 3, std::numeric_limits<double>::quiet_NaN()));  // refused, counted
+  EXPECT_EQ(rx.on_packet(0, 3, std::numeric_limits<double>::quiet_NaN()), oneshot::node::FrameStatus::kRefusedNonFinite);  // refused, counted
   EXPECT_FALSE(rx.measurement(0, 3).present);
   EXPECT_EQ(rx.refusals().refused_non_finite, 1U);
-  EXPECT_TRUE(rx.on_packet(0, 3, 1.5));
-  EXPECT_TRUE(rx.on_packet(1, 3, -2.0));
+  EXPECT_EQ(rx.on_packet(0, 3, 1.5), oneshot::node::FrameStatus::kOk);
+  EXPECT_EQ(rx.on_packet(1, 3, -2.0), oneshot::node::FrameStatus::kOk);
   auto m = rx.measurement(0, 3);
   EXPECT_TRUE(m.present && m.arrived);
   EXPECT_EQ(m.z, 1.5);
@@ -110,7 +110,7 @@ TEST(SodDetector, ReceiverBuildsHeldVarianceInClosedForm) {
     EXPECT_NEAR(m1.r_bar, 0.02 + 0.25 * 0.25 / 3, 1e-15);
   }
   oneshot::node::HeldMeasurementReceiver<double, 2> kf(dy, r, n_t, oneshot::node::SilencePolicy::kPredictOnly);
-  kf.on_packet(0, 3, 1.5);
+  ASSERT_EQ(kf.on_packet(0, 3, 1.5), oneshot::node::FrameStatus::kOk);
   EXPECT_TRUE(kf.measurement(0, 3).present);
   EXPECT_FALSE(kf.measurement(0, 4).present);
 }

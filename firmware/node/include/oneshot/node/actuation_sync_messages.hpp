@@ -59,14 +59,14 @@ std::size_t encode(const ActuationRequest<S, M>& m, std::uint8_t* out) {
   return request_size<S, M>();
 }
 
-/// Decodes a request; false (m untouched) when the size is not a request's.
+/// Decodes a request: kOk, or kMalformed (m untouched) when the size is not a request's.
 template <typename S, std::size_t M>
-bool decode(const std::uint8_t* in, std::size_t size, ActuationRequest<S, M>& m) {
-  if (size != request_size<S, M>()) return false;
+[[nodiscard]] FrameStatus decode(const std::uint8_t* in, std::size_t size, ActuationRequest<S, M>& m) {
+  if (size != request_size<S, M>()) return FrameStatus::kMalformed;
   m.k = static_cast<SequenceNumber>(detail::get_le(in, 4));
   m.t_k = McuInstant(static_cast<std::uint32_t>(detail::get_le(in + 4, 4)));
   for (std::size_t i = 0; i < M; ++i) m.u_applied[i] = detail::get_scalar<S>(in + kHeaderBytes + i * detail::scalar_bytes<S>());
-  return true;
+  return FrameStatus::kOk;
 }
 
 /// Encodes a report into `out`; returns the byte count.
@@ -82,10 +82,10 @@ std::size_t encode(const SampleReport<S, P, M>& m, std::uint8_t* out) {
   return report_size<S, P, M>();
 }
 
-/// Decodes a report; false (m untouched) when the size is not a report's.
+/// Decodes a report: kOk, or kMalformed (m untouched) when the size is not a report's.
 template <typename S, std::size_t P, std::size_t M>
-bool decode(const std::uint8_t* in, std::size_t size, SampleReport<S, P, M>& m) {
-  if (size != report_size<S, P, M>()) return false;
+[[nodiscard]] FrameStatus decode(const std::uint8_t* in, std::size_t size, SampleReport<S, P, M>& m) {
+  if (size != report_size<S, P, M>()) return FrameStatus::kMalformed;
   constexpr std::size_t kB = detail::scalar_bytes<S>();
   m.k = static_cast<SequenceNumber>(detail::get_le(in, 4));
   m.t_s = McuInstant(static_cast<std::uint32_t>(detail::get_le(in + 4, 4)));
@@ -95,7 +95,7 @@ bool decode(const std::uint8_t* in, std::size_t size, SampleReport<S, P, M>& m) 
   m.tau_us = tau_s;
   for (std::size_t i = 0; i < P; ++i) m.y[i] = detail::get_scalar<S>(in + 12 + i * kB);
   for (std::size_t i = 0; i < M; ++i) m.u_applied[i] = detail::get_scalar<S>(in + 12 + (P + i) * kB);
-  return true;
+  return FrameStatus::kOk;
 }
 
 }  // namespace oneshot::node

@@ -22,6 +22,7 @@
 #include "oneshot/matrix.hpp"
 #include "oneshot/node/command_buffer.hpp"
 #include "oneshot/node/frame_checks.hpp"
+#include "oneshot/node/frame_io.hpp"
 #include "oneshot/node/message.hpp"
 
 namespace oneshot::node {
@@ -32,11 +33,10 @@ enum class ActuatorMode : std::uint8_t {
   kOnTimer,    ///< At its timer, the command stamped with the timer's period.
 };
 
-/// Counters of an actuator node (refusals by cause in the FrameRefusals part).
+/// Counters of an actuator node (drops and refusals by cause in the FrameRefusals part; stale:
+/// not newer than the applied one, or its period already past).
 struct ActuatorStatistics : FrameRefusals {
   std::uint32_t received = 0;   ///< Commands decoded.
-  std::uint32_t stale = 0;      ///< Not newer than the applied one / its period already past (dropped).
-  std::uint32_t malformed = 0;  ///< Frames that did not decode.
   std::uint32_t applied = 0;    ///< Commands applied.
   std::uint32_t late = 0;       ///< Timer: no command for the period (previous value held).
 };
@@ -52,36 +52,23 @@ class ActuatorNode {
   /// Actuator in `mode` starting from the input `initial`.
   constexpr ActuatorNode(ActuatorMode mode, const Vector<S, M>& initial) : mode_(mode), applied_(initial) {}
 
-  /// Frames waiting at the interface: buffered, and applied at once in on-arrival mode.
+  /// Frames waiting at the interface: each one through on_frame().
   void on_receive() {
-    std::uint8_t bytes[kMaxMessageBytes];
-    std::uint8_t source = 0;
-    for (std::size_t n = Board::Net::receive(source, bytes, sizeof bytes); n != 0;
-         n = Board::Net::receive(source, bytes, sizeof bytes)) {
-      Command c;
-      if (!decode(bytes, n, c)) {
-        ++stats_.malformed;
-        continue;
-      }
-      ++stats_.received;
-      if (!source_.check(source, stats_) || !check_payload(c.payload.value, range_, stats_)) continue;
-      if (mode_ == ActuatorMode::kOnTimer) {
-        // d = seq − k_t: 1 … Slots waits in the buffer; ≤ 0 is late; beyond is refused.
-        const SequenceNumber d = c.seq - timer_k_;
-        if (!seq_newer(c.seq, timer_k_)) {
-          ++stats_.stale;
-        } else if (d > Slots) {
-          ++stats_.refused_sequence;
-        } else {
-          buffer_.replace(c.seq, c.payload.value);
-        }
-        continue;
-      }
-      const SequenceVerdict v = gate_.offer(c.seq);
-      if (v == SequenceVerdict::kStale) ++stats_.stale;
-      if (!count_sequence(v, stats_)) continue;
-      apply(c.seq, c.payload.value);
-    }
+    receive_status_ = drain_frames<Board>(
+        [&](std::uint8_t source, const std::uint8_t* bytes, std::size_t size) { return on_frame(source, bytes, size); });
+  }
+
+  /// One frame from `source`: a command is buffered (timer mode) or applied at once (on-arrival
+  /// mode); its status, counted by cause in statistics().
+  [[nodiscard]] FrameStatus on_frame(std::uint8_t source, const std::uint8_t* bytes, std::size_t size) {
+    return admit_frame<Command>(source, bytes, size, stats_.received, stats_, [&](const Command& c, std::uint8_t src) {
+      const FrameStatus s = then_check(source_.check(src), [&] { return check_payload(c.payload.value, range_); });
+      if (s != FrameStatus::kOk) return s;
+      if (mode_ == ActuatorMode::kOnTimer) return buffer_command(c);
+      const FrameStatus v = frame_status(gate_.offer(c.seq));
+      if (accepted(v)) apply(c.seq, c.payload.value);
+      return v;
+    });
   }
 
   /// The timer of period k (timer mode): applies the command stamped k, or holds.
@@ -120,8 +107,19 @@ class ActuatorNode {
   constexpr SequenceNumber applied_seq() const { return applied_seq_; }
   /// Counters.
   constexpr const ActuatorStatistics& statistics() const { return stats_; }
+  /// Worst status of the frames the last on_receive() handled (kOk when none).
+  [[nodiscard]] constexpr FrameStatus receive_status() const { return receive_status_; }
 
  private:
+  // Timer mode, d = seq − k_t: 1 … Slots waits in the buffer; ≤ 0 is late (stale); beyond is refused.
+  [[nodiscard]] constexpr FrameStatus buffer_command(const Command& c) {
+    const SequenceNumber d = c.seq - timer_k_;
+    if (!seq_newer(c.seq, timer_k_)) return FrameStatus::kStale;
+    if (d > Slots) return FrameStatus::kRefusedSequence;
+    buffer_.replace(c.seq, c.payload.value);
+    return FrameStatus::kOk;
+  }
+
   constexpr void apply(SequenceNumber seq, const Vector<S, M>& u) {
     applied_ = u;
     applied_seq_ = seq;
@@ -141,6 +139,7 @@ class ActuatorNode {
   ValueRange<S, M> range_{};
   CommandBuffer<S, M, Slots> buffer_{};
   ActuatorStatistics stats_{};
+  FrameStatus receive_status_ = FrameStatus::kOk;
 };
 
 }  // namespace oneshot::node

@@ -73,10 +73,10 @@ class BufferedKalman {
   }
 
   /// A packet arrived (stamp j, value y): see ThresholdBuffer::receive.
-  constexpr ArrivalVerdict receive(std::uint32_t stamp, const OutputVec& y) { return buffer_.receive(stamp, y); }
+  [[nodiscard]] constexpr ArrivalVerdict receive(std::uint32_t stamp, const OutputVec& y) { return buffer_.receive(stamp, y); }
 
   /// Step k: anchor to n = k − T_hold, re-run to k. Returns the first failure of the step.
-  constexpr Status step() {
+  [[nodiscard]] constexpr Status step() {
     const std::uint32_t k = step_;
     Status st = Status::kOk;
     corrections_ = 0;
@@ -134,7 +134,7 @@ class BufferedKalman {
   /// Steps taken (the next step's k).
   constexpr std::uint32_t steps() const { return step_; }
   /// First failure since reset.
-  constexpr Status status() const { return status_; }
+  [[nodiscard]] constexpr Status status() const { return status_; }
   /// The buffer (counters).
   constexpr const Buffer& buffer() const { return buffer_; }
 
@@ -150,7 +150,7 @@ class BufferedKalman {
     p = predict_covariance<Fmt, Structure>(model_->step, p, NoiseModel::kConstant, model_->q);
   }
 
-  constexpr Status correct_with(StateVec& x, Cov& p, const OutputVec& y) {
+  [[nodiscard]] constexpr Status correct_with(StateVec& x, Cov& p, const OutputVec& y) {
     ++corrections_;
     return correct<Fmt, Structure, CovarianceUpdate::kSymmetric>(x, p, y, model_->c, model_->r, gain_);
   }

@@ -21,15 +21,13 @@ class CommandBuffer {
   static_assert(Slots >= 1, "a command buffer needs at least one slot");
 
  public:
-  /// Stores u for sequence number seq (replaces an older entry of the same slot; false
-  /// when the slot holds a newer command, which is kept).
-  constexpr bool store(SequenceNumber seq, const Vector<S, M>& u) {
-    Slot& s = slots_[seq % Slots];
-    if (s.used && s.seq != seq && seq_newer(s.seq, seq)) return false;
-    s.used = true;
-    s.seq = seq;
-    s.u = u;
-    return true;
+  /// Stores u for sequence number seq (replaces an older entry of the same slot): kOk, or
+  /// kStale when the slot holds a newer command, which is kept.
+  [[nodiscard]] constexpr FrameStatus store(SequenceNumber seq, const Vector<S, M>& u) {
+    const Slot& s = slots_[seq % Slots];
+    if (s.used && s.seq != seq && seq_newer(s.seq, seq)) return FrameStatus::kStale;
+    replace(seq, u);
+    return FrameStatus::kOk;
   }
   /// Stores u for sequence number seq whatever the slot held (the caller has checked that
   /// seq is one of Slots consecutive numbers it waits for, which map to distinct slots).

@@ -3,8 +3,8 @@
 ///        arrival or on its own timer, and sends time-stamped commands.
 ///
 /// The law is a plug-in with
-///     bool compute(const Message<VectorPayload<S, P>>& latest, bool fresh, McuInstant now, Vector<S, M>& u)
-/// (fresh: a measurement arrived since the last computation); it returns true to send u.
+///     LawResult compute(const Message<VectorPayload<S, P>>& latest, bool fresh, McuInstant now, Vector<S, M>& u)
+/// (fresh: a measurement arrived since the last computation); it returns kSend to send u.
 /// A command carries the sequence number of the measurement it was computed from, so an
 /// actuator can match it to its period; older or repeated measurements are counted and
 /// dropped (reordering on the network never moves the estimate back in time). Measurements
@@ -19,6 +19,8 @@
 #include "oneshot/hal/network_contract.hpp"
 #include "oneshot/matrix.hpp"
 #include "oneshot/node/frame_checks.hpp"
+#include "oneshot/node/frame_io.hpp"
+#include "oneshot/node/law_result.hpp"
 #include "oneshot/node/message.hpp"
 
 namespace oneshot::node {
@@ -29,15 +31,12 @@ enum class ControllerMode : std::uint8_t {
   kOnTimer,    ///< On its timer (on_timer), with the newest measurement.
 };
 
-/// Counters of a controller node (refusals by cause in the FrameRefusals part).
-struct ControllerStatistics : FrameRefusals {
+/// Counters of a controller node (drops and refusals by cause in the FrameRefusals part,
+/// commands sent or refused by the interface in the SendCounters part).
+struct ControllerStatistics : FrameRefusals, SendCounters {
   std::uint32_t received = 0;      ///< Measurements decoded.
-  std::uint32_t stale = 0;         ///< Older than or equal to the newest one (dropped).
-  std::uint32_t malformed = 0;     ///< Frames that did not decode.
   std::uint32_t computations = 0;  ///< Law runs.
   std::uint32_t withheld = 0;      ///< Commands not sent: the law gave a non-finite value.
-  std::uint32_t sends = 0;         ///< Commands sent.
-  std::uint32_t refused = 0;       ///< Sends the interface refused.
 };
 
 /// Controller from P measured outputs to M commands in scalar S, on board `Board`.
@@ -53,27 +52,25 @@ class ControllerNode {
   constexpr ControllerNode(std::uint8_t destination, ControllerMode mode, const Law& law)
       : destination_(destination), mode_(mode), law_(law) {}
 
-  /// Frames waiting at the interface: decodes them; on-arrival mode computes for each newer one.
+  /// Frames waiting at the interface: each one through on_frame().
   void on_receive(McuInstant now) {
-    std::uint8_t bytes[kMaxMessageBytes];
-    std::uint8_t source = 0;
-    for (std::size_t n = Board::Net::receive(source, bytes, sizeof bytes); n != 0;
-         n = Board::Net::receive(source, bytes, sizeof bytes)) {
-      Measurement m;
-      if (!decode(bytes, n, m)) {
-        ++stats_.malformed;
-        continue;
-      }
-      ++stats_.received;
-      if (!source_.check(source, stats_) || !check_payload(m.payload.value, range_, stats_)) continue;
-      const SequenceVerdict v = gate_.offer(m.seq);
-      if (v == SequenceVerdict::kStale) ++stats_.stale;
-      if (!count_sequence(v, stats_)) continue;
+    receive_status_ = drain_frames<Board>(
+        [&](std::uint8_t source, const std::uint8_t* bytes, std::size_t size) { return on_frame(source, bytes, size, now); });
+  }
+
+  /// One frame from `source`: a measurement newer than the newest one is kept (on-arrival mode
+  /// computes); its status, counted by cause in statistics().
+  [[nodiscard]] FrameStatus on_frame(std::uint8_t source, const std::uint8_t* bytes, std::size_t size, McuInstant now) {
+    return admit_frame<Measurement>(source, bytes, size, stats_.received, stats_, [&](const Measurement& m, std::uint8_t src) {
+      const FrameStatus s = then_check(then_check(source_.check(src), [&] { return check_payload(m.payload.value, range_); }),
+                                       [&] { return frame_status(gate_.offer(m.seq)); });
+      if (!accepted(s)) return s;
       latest_ = m;
       have_ = true;
       fresh_ = true;
       if (mode_ == ControllerMode::kOnArrival) run(now);
-    }
+      return s;
+    });
   }
 
   /// The controller's timer: timer mode computes with the newest measurement.
@@ -98,27 +95,25 @@ class ControllerNode {
   constexpr const Measurement& latest() const { return latest_; }
   /// Counters.
   constexpr const ControllerStatistics& statistics() const { return stats_; }
+  /// Worst status of the frames the last on_receive() handled (kOk when none).
+  [[nodiscard]] constexpr FrameStatus receive_status() const { return receive_status_; }
+  /// Result of the last command send (counted in statistics()).
+  [[nodiscard]] constexpr SendResult last_send() const { return last_send_; }
 
  private:
   void run(McuInstant now) {
     ++stats_.computations;
     Command c;
-    const bool send = law_.compute(latest_, fresh_, now, c.payload.value);
+    const LawResult result = law_.compute(latest_, fresh_, now, c.payload.value);
     fresh_ = false;
-    if (!send) return;
+    if (result != LawResult::kSend) return;
     if (!all_finite(c.payload.value)) {
       ++stats_.withheld;
       return;
     }
     c.seq = latest_.seq;
     c.stamp = now;
-    std::uint8_t bytes[kMaxMessageBytes];
-    const std::size_t n = encode(c, bytes);
-    if (Board::Net::send(destination_, bytes, n)) {
-      ++stats_.sends;
-    } else {
-      ++stats_.refused;
-    }
+    last_send_ = send_message<Board>(destination_, c, stats_);
   }
 
   std::uint8_t destination_;
@@ -131,6 +126,8 @@ class ControllerNode {
   ExpectedSource source_{};
   ValueRange<S, P> range_{};
   ControllerStatistics stats_{};
+  FrameStatus receive_status_ = FrameStatus::kOk;
+  SendResult last_send_ = SendResult::kSent;
 };
 
 }  // namespace oneshot::node

@@ -1,7 +1,8 @@
 /// @file frame_checks.hpp
 /// @brief What a node checks before it uses a decoded frame (every frame is untrusted):
 ///        the sender, finite payload, payload in the design's range, and the sequence
-///        window with re-acquisition of a restarted peer; one counter per cause.
+///        window with re-acquisition of a restarted peer; each gives a FrameStatus
+///        (frame_status.hpp), counted per cause.
 ///
 /// Sequence window (docs/node_validation.md): with d = seq − last accepted (mod 2^32),
 ///     accepted     when 0 < d ≤ W                       (W = window, frames),
@@ -20,18 +21,10 @@
 
 #include "oneshot/finite.hpp"
 #include "oneshot/matrix.hpp"
+#include "oneshot/node/frame_status.hpp"
 #include "oneshot/node/message.hpp"
 
 namespace oneshot::node {
-
-/// Frames refused before use, by cause (every node that decodes frames keeps one).
-struct FrameRefusals {
-  std::uint32_t refused_non_finite = 0;    ///< A payload scalar was NaN or ±∞.
-  std::uint32_t refused_out_of_range = 0;  ///< A payload value outside the design's range.
-  std::uint32_t refused_source = 0;        ///< Sent by another node than the expected peer.
-  std::uint32_t refused_sequence = 0;      ///< Sequence jump beyond the window, or stamp outside its window.
-  std::uint32_t reacquired = 0;            ///< New sequence bases taken (restarted peer re-acquired).
-};
 
 /// Default forward window W (frames): a sender may skip up to W − 1 sequence numbers.
 inline constexpr std::uint32_t kDefaultSequenceWindow = 4096;
@@ -58,7 +51,7 @@ class SequenceGate {
       : window_(window < 1 ? 1 : window), reacquire_(reacquire < 2 ? 2 : reacquire) {}
 
   /// Offers `seq`: the verdict; the base moves on kAccepted and kReacquired.
-  constexpr SequenceVerdict offer(SequenceNumber seq) {
+  [[nodiscard]] constexpr SequenceVerdict offer(SequenceNumber seq) {
     if (!any_) {
       take(seq);
       return SequenceVerdict::kAccepted;
@@ -107,12 +100,15 @@ class SequenceGate {
   bool any_ = false;
 };
 
-/// Counts a sequence verdict into `r` (jump → refused_sequence, re-acquisition → reacquired);
-/// returns accepted(v). Stale frames are counted by the node's own `stale` counter.
-constexpr bool count_sequence(SequenceVerdict v, FrameRefusals& r) {
-  if (v == SequenceVerdict::kJump) ++r.refused_sequence;
-  if (v == SequenceVerdict::kReacquired) ++r.reacquired;
-  return accepted(v);
+/// The frame status of a sequence verdict (jump → kRefusedSequence).
+[[nodiscard]] constexpr FrameStatus frame_status(SequenceVerdict v) {
+  switch (v) {
+    case SequenceVerdict::kAccepted: return FrameStatus::kOk;
+    case SequenceVerdict::kReacquired: return FrameStatus::kReacquired;
+    case SequenceVerdict::kStale: return FrameStatus::kStale;
+    case SequenceVerdict::kJump: return FrameStatus::kRefusedSequence;
+  }
+  return FrameStatus::kRefusedSequence;
 }
 
 /// The peer a node expects frames from (any sender until set).
@@ -123,11 +119,9 @@ class ExpectedSource {
     address_ = address;
     set_ = true;
   }
-  /// True when `source` may send (counts refused_source into `r` otherwise).
-  constexpr bool check(std::uint8_t source, FrameRefusals& r) const {
-    if (!set_ || source == address_) return true;
-    ++r.refused_source;
-    return false;
+  /// kOk when `source` may send, kRefusedSource otherwise.
+  [[nodiscard]] constexpr FrameStatus check(std::uint8_t source) const {
+    return !set_ || source == address_ ? FrameStatus::kOk : FrameStatus::kRefusedSource;
   }
 
  private:
@@ -159,18 +153,17 @@ class ValueRange {
   bool set_ = false;
 };
 
-/// Finite-and-in-range check of a payload vector, counted into `r` by cause.
+/// Finite-and-in-range check of a payload vector: kOk, kRefusedNonFinite or kRefusedOutOfRange.
 template <typename S, std::size_t P>
-bool check_payload(const Vector<S, P>& v, const ValueRange<S, P>& range, FrameRefusals& r) {
-  if (!all_finite(v)) {
-    ++r.refused_non_finite;
-    return false;
-  }
-  if (!range.contains(v)) {
-    ++r.refused_out_of_range;
-    return false;
-  }
-  return true;
+[[nodiscard]] constexpr FrameStatus check_payload(const Vector<S, P>& v, const ValueRange<S, P>& range) {
+  if (!all_finite(v)) return FrameStatus::kRefusedNonFinite;
+  return range.contains(v) ? FrameStatus::kOk : FrameStatus::kRefusedOutOfRange;
+}
+
+/// s when it is a refusal, else next() (the checks of a frame in order, the first refusal wins).
+template <typename Next>
+[[nodiscard]] constexpr FrameStatus then_check(FrameStatus s, Next&& next) {
+  return s == FrameStatus::kOk ? next() : s;
 }
 
 }  // namespace oneshot::node

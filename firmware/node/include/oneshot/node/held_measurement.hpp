@@ -53,17 +53,14 @@ class HeldMeasurementReceiver {
   }
 
   /// Node i's packet of sample k with value y arrived (call before measurement(i, k)).
-  /// False (refused, counted, nothing changed) when y is not finite.
-  constexpr bool on_packet(std::size_t i, SequenceNumber k, S y) {
-    if (!is_finite(y)) {
-      ++refusals_.refused_non_finite;
-      return false;
-    }
+  /// kRefusedNonFinite (counted, nothing changed) when y is not finite, else kOk.
+  [[nodiscard]] constexpr FrameStatus on_packet(std::size_t i, SequenceNumber k, S y) {
+    if (!is_finite(y)) return count_frame(FrameStatus::kRefusedNonFinite, refusals_);
     y_rx_[i] = y;
     detector_[i].on_receive(k);
     arrived_k_[i] = k;
     arrived_[i] = true;
-    return true;
+    return FrameStatus::kOk;
   }
   /// Node i's measurement at step k: the packet that arrived at k, else the held value with
   /// R̄_ii = R_ii + ((d + 1) δy)²/3 (kHeld) or nothing (kPredictOnly).

@@ -13,6 +13,7 @@
 #include <type_traits>
 
 #include "oneshot/matrix.hpp"
+#include "oneshot/node/frame_status.hpp"
 #include "oneshot/time_us.hpp"
 
 namespace oneshot::node {
@@ -126,16 +127,17 @@ std::size_t encode(const Message<VectorPayload<S, P>>& m, std::uint8_t* out) {
   return encoded_size<S, P>();
 }
 
-/// Decodes `size` bytes into `m`; false (m untouched) when the size is not the encoded size.
+/// Decodes `size` bytes into `m`: kOk, or kMalformed (m untouched) when the size is not the
+/// encoded size.
 template <typename S, std::size_t P>
-bool decode(const std::uint8_t* in, std::size_t size, Message<VectorPayload<S, P>>& m) {
-  if (size != encoded_size<S, P>()) return false;
+[[nodiscard]] FrameStatus decode(const std::uint8_t* in, std::size_t size, Message<VectorPayload<S, P>>& m) {
+  if (size != encoded_size<S, P>()) return FrameStatus::kMalformed;
   m.seq = static_cast<SequenceNumber>(detail::get_le(in, 4));
   m.stamp = McuInstant(static_cast<std::uint32_t>(detail::get_le(in + 4, 4)));
   for (std::size_t i = 0; i < P; ++i) {
     m.payload.value[i] = detail::get_scalar<S>(in + kHeaderBytes + i * detail::scalar_bytes<S>());
   }
-  return true;
+  return FrameStatus::kOk;
 }
 
 }  // namespace oneshot::node

@@ -12,6 +12,7 @@
 #include <cstdint>
 
 #include "oneshot/matrix.hpp"
+#include "oneshot/node/last_sent.hpp"
 #include "oneshot/node/message.hpp"
 #include "oneshot/node/send_cause.hpp"
 
@@ -19,7 +20,7 @@ namespace oneshot::node {
 
 /// MTM trigger on P components with relative weight σ and absolute term δ.
 template <typename S, std::size_t P>
-class MtmTrigger {
+class MtmTrigger : public LastSent<S, P> {
  public:
   /// Thresholds σ, δ (≥ 0), safety after `k_max` samples (0: off), reference send
   /// `k_ref_max` samples after a notified reference change.
@@ -34,20 +35,17 @@ class MtmTrigger {
 
   /// Decision for sample k with value y.
   constexpr SendCause evaluate(SequenceNumber k, const Vector<S, P>& y) const {
-    if (!any_sent_) return SendCause::kFirst;
-    for (std::size_t i = 0; i < P; ++i) {
-      const S d = last_[i] - y[i];
-      if (sigma_ * y[i] * y[i] + delta_ < d * d) return SendCause::kDelta;
-    }
+    const SendCause c = this->first_or_delta(y, [&](S last, S yi, std::size_t) {
+      const S d = last - yi;
+      return sigma_ * yi * yi + delta_ < d * d;
+    });
+    if (c != SendCause::kNone) return c;
     if (ref_pending_ && k - k_ref_ == k_ref_max_) return SendCause::kReference;
-    if (k_max_ > 0 && k - k_last_ >= k_max_) return SendCause::kTime;
-    return SendCause::kNone;
+    return this->time_due(k, k_max_) ? SendCause::kTime : SendCause::kNone;
   }
-  /// Remembers the value and index of a send.
+  /// Remembers the value and index of a send (and ends a pending reference send).
   constexpr void on_sent(SequenceNumber k, const Vector<S, P>& y) {
-    last_ = y;
-    k_last_ = k;
-    any_sent_ = true;
+    LastSent<S, P>::on_sent(k, y);
     if (ref_pending_ && k - k_ref_ >= k_ref_max_) ref_pending_ = false;
   }
 
@@ -56,11 +54,8 @@ class MtmTrigger {
   S delta_;
   std::uint32_t k_max_;
   std::uint32_t k_ref_max_;
-  Vector<S, P> last_{};
-  SequenceNumber k_last_ = 0;
   SequenceNumber k_ref_ = 0;
   bool ref_pending_ = false;
-  bool any_sent_ = false;
 };
 
 }  // namespace oneshot::node

@@ -17,6 +17,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <type_traits>
+#include <utility>
 
 #include "oneshot/matrix.hpp"
 
@@ -38,7 +39,7 @@ template <std::size_t B, std::size_t E>
 struct Unrolled {
   /// Runs the loop.
   template <typename F>
-  static constexpr void run(F&& f) {
+  [[gnu::always_inline]] static constexpr void run(F&& f) {
     if constexpr (B < E) {
       f(std::integral_constant<std::size_t, B>{});
       Unrolled<B + 1, E>::run(f);
@@ -92,17 +93,26 @@ constexpr S masked_dot(const Matrix<S, 1, N>& v, const Vector<S, N>& x) {
   return acc;
 }
 
+/// Σ_{j ∈ row(I)} A_Ij x_j of row I of A over Structure's row mask, unrolled, ascending j from
+/// a zero accumulator (the summation order every product below keeps). Forced inline, with
+/// its column loop: it is the inner loop of the M4F arrival, whose instruction count depends
+/// on straight-line code.
+template <typename Structure, std::size_t I, typename S, std::size_t N>
+[[gnu::always_inline]] inline constexpr S masked_row(const Matrix<S, N, N>& a, const Vector<S, N>& x) {
+  S acc = S(0);
+  Unrolled<0, N>::run([&](auto jc) __attribute__((always_inline)) {
+    constexpr std::size_t j = decltype(jc)::value;
+    if constexpr (((Structure::row(I) >> j) & 1U) != 0) acc = acc + a(I, j) * x[j];
+  });
+  return acc;
+}
+
 /// y = A x over Structure's rows, unrolled; returns the multiply-adds.
 template <typename Structure, typename S, std::size_t N>
 constexpr std::uint64_t masked_product(const Matrix<S, N, N>& a, const Vector<S, N>& x, Vector<S, N>& y) {
-  Unrolled<0, N>::run([&](auto ic) {
+  Unrolled<0, N>::run([&](auto ic) __attribute__((always_inline)) {
     constexpr std::size_t i = decltype(ic)::value;
-    S acc = S(0);
-    Unrolled<0, N>::run([&](auto jc) {
-      constexpr std::size_t j = decltype(jc)::value;
-      if constexpr (((Structure::row(i) >> j) & 1U) != 0) acc = acc + a(i, j) * x[j];
-    });
-    y[i] = acc;
+    y[i] = masked_row<Structure, i>(a, x);
   });
   return structure_size<Structure, N>();
 }
@@ -112,13 +122,9 @@ constexpr std::uint64_t masked_product(const Matrix<S, N, N>& a, const Vector<S,
 template <typename Structure, typename S, std::size_t N>
 constexpr std::uint64_t masked_step(const Matrix<S, N, N>& a, const Vector<S, N>& b, const Vector<S, N>& x, S u,
                                     Vector<S, N>& y) {
-  Unrolled<0, N>::run([&](auto ic) {
+  Unrolled<0, N>::run([&](auto ic) __attribute__((always_inline)) {
     constexpr std::size_t i = decltype(ic)::value;
-    S acc = S(0);
-    Unrolled<0, N>::run([&](auto jc) {
-      constexpr std::size_t j = decltype(jc)::value;
-      if constexpr (((Structure::row(i) >> j) & 1U) != 0) acc = acc + a(i, j) * x[j];
-    });
+    S acc = masked_row<Structure, i>(a, x);
     if constexpr (((Structure::kB >> i) & 1U) != 0) acc = acc + b[i] * u;
     y[i] = acc;
   });

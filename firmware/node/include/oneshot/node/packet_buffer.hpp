@@ -8,6 +8,8 @@
 #include <cstddef>
 #include <cstdint>
 
+#include "oneshot/node/frame_status.hpp"
+
 namespace oneshot::node {
 
 /// Packet of H + 1 future inputs and the actuator logic around it.
@@ -19,14 +21,15 @@ class PacketBuffer {
   /// Empty buffer that applies u0.
   constexpr explicit PacketBuffer(S u0 = S(0)) : hold_(u0) {}
 
-  /// Takes the packet `u` (kEntries values) sent at period k; an older packet is refused.
-  constexpr bool accept(std::uint32_t k, const S* u) {
-    if (valid_ && static_cast<std::int32_t>(k - start_) < 0) return false;
+  /// Takes the packet `u` (kEntries values) sent at period k: kOk, or kStale (refused) for a
+  /// packet older than the one in force.
+  [[nodiscard]] constexpr FrameStatus accept(std::uint32_t k, const S* u) {
+    if (valid_ && static_cast<std::int32_t>(k - start_) < 0) return FrameStatus::kStale;
     for (std::size_t i = 0; i < kEntries; ++i) entries_[i] = u[i];
     start_ = k;
     valid_ = true;
     ++accepted_;
-    return true;
+    return FrameStatus::kOk;
   }
   /// Input to apply at period j (entry j − k, the last one beyond H, u0 before any packet).
   constexpr S value(std::uint32_t j) const {

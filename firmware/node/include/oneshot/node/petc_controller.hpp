@@ -73,9 +73,8 @@ struct LawStore<L, std::void_t<typename L::Modes>> {
   static constexpr void load(L& l, const Type& t) { l.set_modes(t); }
 };
 
-/// Counters of a PETC controller (refusals by cause in the FrameRefusals part).
+/// Counters of a PETC controller (drops and refusals by cause in the FrameRefusals part).
 struct PetcStatistics : FrameRefusals {
-  std::uint32_t stale = 0;             ///< Arrivals not newer than the last one (dropped).
   std::uint32_t estimator_resets = 0;  ///< Corrections that turned non-finite (NUMRE reset).
   std::uint32_t withheld = 0;          ///< Cascades with a non-finite entry (not sent).
 };
@@ -130,14 +129,12 @@ class PetcController {
   constexpr SendCause on_arrival(std::uint32_t k, S y) {
     Vector<S, 1> yv;
     yv[0] = y;
-    if (!check_payload(yv, range_, stats_)) return SendCause::kNone;
-    const SequenceVerdict v = gate_.offer(k);
-    if (v == SequenceVerdict::kStale) ++stats_.stale;
-    if (!count_sequence(v, stats_)) return SendCause::kNone;
-    if (v == SequenceVerdict::kReacquired) rebase_ = have_packet_;
+    arrival_status_ = count_frame(then_check(check_payload(yv, range_), [&] { return frame_status(gate_.offer(k)); }), stats_);
+    if (!accepted(arrival_status_)) return SendCause::kNone;
+    if (arrival_status_ == FrameStatus::kReacquired) rebase_ = have_packet_;
     // A re-acquired arrival (or one before the re-basing send) predicts nothing: the
     // interval since the last arrival is unknown, and the packet in force is in old periods.
-    if (arrivals_ > 0 && v == SequenceVerdict::kAccepted && !rebase_)
+    if (arrivals_ > 0 && arrival_status_ == FrameStatus::kOk && !rebase_)
       est_.predict_along(k - k_prev_, reference_state(k_prev_), reference_state(k));
     status_ = est_.correct(y);
     ++arrivals_;
@@ -173,7 +170,7 @@ class PetcController {
     d_hat_[0] = d_hat;
     trajectory_[0] = est_.state();
     trajectory_[1] = x;
-    if (!write_entries(k, 1, reference_, ls)) {
+    if (write_entries(k, 1, reference_, ls) != Status::kOk) {
       ++stats_.withheld;
       if (have_packet_) {
         regenerate();
@@ -228,7 +225,9 @@ class PetcController {
   /// The estimator.
   constexpr const Estimator& estimator() const { return est_; }
   /// Status of the last correction (kNonFinite: the NUMRE was reset).
-  constexpr Status last_status() const { return status_; }
+  [[nodiscard]] constexpr Status last_status() const { return status_; }
+  /// Status of the last arrival's frame checks (refusals counted by cause in statistics()).
+  [[nodiscard]] constexpr FrameStatus arrival_status() const { return arrival_status_; }
   /// Counters.
   constexpr const PetcStatistics& statistics() const { return stats_; }
   /// Multiply-adds: estimator + cascades (model, law, observer).
@@ -249,6 +248,7 @@ class PetcController {
   Vector<S, N> trajectory_[H + 2]{};
   std::uint64_t cascade_macs_ = 0;
   Status status_ = Status::kOk;
+  FrameStatus arrival_status_ = FrameStatus::kOk;
   SequenceGate gate_{};
   ValueRange<S, 1> range_{};
   PetcStatistics stats_{};
@@ -293,10 +293,10 @@ class PetcController {
 
   /// Entries l = from … H of the packet from period k (entry `from` from `ls` and the model
   /// state trajectory_[from]), written into the packet in force with their law states and
-  /// model trajectory (each step straight from trajectory_[l] into trajectory_[l + 1]). False
-  /// when an entry or the end state is non-finite (or their sum overflows): the buffer is then
-  /// overwritten with a packet that must not be used.
-  constexpr bool write_entries(std::uint32_t k, std::size_t from, S r, LawState& ls) {
+  /// model trajectory (each step straight from trajectory_[l] into trajectory_[l + 1]).
+  /// kNonFinite when an entry or the end state is non-finite (or their sum overflows): the
+  /// buffer is then overwritten with a packet that must not be used.
+  [[nodiscard]] constexpr Status write_entries(std::uint32_t k, std::size_t from, S r, LawState& ls) {
     const LawState ls0 = ls;
     S sum = S(0);  // non-finite when any entry is (NaN, ±∞ absorb under +), or it overflows
     for (std::size_t l = from; l <= H; ++l) {
@@ -311,13 +311,15 @@ class PetcController {
     cascade_macs_ += (H + 1 - from) * kStepMacs + (ls.law.macs() - ls0.law.macs()) +
                      (ls.obs.macs() - ls0.obs.macs());
     for (std::size_t i = 0; i < N; ++i) sum = sum + trajectory_[H + 1][i];
-    return is_finite(sum);
+    return is_finite(sum) ? Status::kOk : Status::kNonFinite;
   }
 
   /// Regenerates the packet in force from its seed (bit for bit: the same cascade).
   constexpr void regenerate() {
     LawState ls = restore(seed_state_);
     trajectory_[0] = seed_x_;
+    // The same cascade from the same seed gives the same bits, which were finite when the
+    // packet was sent: this cannot fail.
     static_cast<void>(write_entries(k_sent_, 0, seed_reference_, ls));
   }
 };

@@ -16,6 +16,7 @@
 #include <cstdint>
 
 #include "oneshot/finite.hpp"
+#include "oneshot/node/law_result.hpp"
 #include "oneshot/node/message.hpp"
 #include "oneshot/node/square_wave_reference.hpp"
 #include "oneshot/standard_kalman.hpp"
@@ -31,11 +32,11 @@ struct StateFeedbackLaw {
   Reference reference;        ///< Set-point per period.
   std::uint32_t saturated = 0;  ///< Commands clamped.
   /// u_k = u_ref − L (y_k − x_ref); sends on every fresh sample.
-  bool compute(const Message<VectorPayload<S, N>>& m, bool fresh, McuInstant, Vector<S, M>& u) {
-    if (!fresh) return false;
+  [[nodiscard]] LawResult compute(const Message<VectorPayload<S, N>>& m, bool fresh, McuInstant, Vector<S, M>& u) {
+    if (!fresh) return LawResult::kNone;
     u = reference.input(m.seq) - l * (m.payload.value - reference.state(m.seq));
     if (saturate(u, u_min, u_max)) ++saturated;
-    return true;
+    return LawResult::kSend;
   }
 };
 
@@ -60,18 +61,18 @@ class PeriodicKalmanLaw {
   /// Corrects with y_k (after predicting over h with the last command), u_k from x̂_k.
   /// A non-finite x̂ or P resets the filter to x̂ = 0, the design's P0, u = 0 (counted in
   /// resets()) and sends nothing for this sample.
-  bool compute(const Message<VectorPayload<S, kP>>& m, bool fresh, McuInstant, Vector<S, kM>& u) {
-    if (!fresh) return false;
+  [[nodiscard]] LawResult compute(const Message<VectorPayload<S, kP>>& m, bool fresh, McuInstant, Vector<S, kM>& u) {
+    if (!fresh) return LawResult::kNone;
     if (!is_exact(filter_.update(0, m.payload.value))) ++faults_;
     if (!all_finite(filter_.prediction()) || !all_finite(filter_.covariance())) {
       filter_.reset(Vector<S, kN>{}, design_->p0, Vector<S, kM>{});
       ++resets_;
-      return false;
+      return LawResult::kReset;
     }
     u = reference_.input(m.seq) - design_->l * (filter_.prediction() - reference_.state(m.seq));
     if (saturate(u, u_min_, u_max_)) ++saturated_;
     filter_.set_applied_input(u);
-    return true;
+    return LawResult::kSend;
   }
   /// Filter runs whose status was not exact.
   constexpr std::uint32_t faults() const { return faults_; }
@@ -100,12 +101,12 @@ struct DelayCompensatedLaw {
   Vector<S, M> u_prev{};      ///< u_{k−1}: the last command sent.
   std::uint32_t saturated = 0;  ///< Commands clamped.
   /// u_k = u_ref − L_x (y_k − x_ref) − L_u (u_{k−1} − u_ref).
-  bool compute(const Message<VectorPayload<S, N>>& m, bool fresh, McuInstant, Vector<S, M>& u) {
-    if (!fresh) return false;
+  [[nodiscard]] LawResult compute(const Message<VectorPayload<S, N>>& m, bool fresh, McuInstant, Vector<S, M>& u) {
+    if (!fresh) return LawResult::kNone;
     u = reference.input(m.seq) - lx * (m.payload.value - reference.state(m.seq)) - lu * (u_prev - reference.input(m.seq));
     if (saturate(u, u_min, u_max)) ++saturated;
     u_prev = u;
-    return true;
+    return LawResult::kSend;
   }
 };
 

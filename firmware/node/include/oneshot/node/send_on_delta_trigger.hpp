@@ -12,6 +12,7 @@
 #include <cstdint>
 
 #include "oneshot/matrix.hpp"
+#include "oneshot/node/last_sent.hpp"
 #include "oneshot/node/message.hpp"
 #include "oneshot/node/send_cause.hpp"
 #include "oneshot/scalar_traits.hpp"
@@ -20,34 +21,22 @@ namespace oneshot::node {
 
 /// Send-on-delta on P components with thresholds δy; time rule after n_t samples (0: off).
 template <typename S, std::size_t P>
-class SendOnDeltaTrigger {
+class SendOnDeltaTrigger : public LastSent<S, P> {
  public:
   /// Thresholds `delta` (per component, ≥ 0) and the time rule `n_t` in samples (0: plain SOD).
   constexpr SendOnDeltaTrigger(const Vector<S, P>& delta, std::uint32_t n_t) : delta_(delta), n_t_(n_t) {}
 
   /// Decision for sample k with value y: kFirst, kDelta (2a), kTime (2b) or kNone.
   constexpr SendCause evaluate(SequenceNumber k, const Vector<S, P>& y) const {
-    using T = ScalarTraits<S>;
-    if (!any_sent_) return SendCause::kFirst;
-    for (std::size_t i = 0; i < P; ++i) {
-      if (delta_[i] < T::abs(y[i] - last_[i])) return SendCause::kDelta;
-    }
-    if (n_t_ > 0 && k - k_last_ >= n_t_) return SendCause::kTime;
-    return SendCause::kNone;
-  }
-  /// Remembers the value and index of a send.
-  constexpr void on_sent(SequenceNumber k, const Vector<S, P>& y) {
-    last_ = y;
-    k_last_ = k;
-    any_sent_ = true;
+    const SendCause c = this->first_or_delta(
+        y, [&](S last, S yi, std::size_t i) { return delta_[i] < ScalarTraits<S>::abs(yi - last); });
+    if (c != SendCause::kNone) return c;
+    return this->time_due(k, n_t_) ? SendCause::kTime : SendCause::kNone;
   }
 
  private:
   Vector<S, P> delta_;
   std::uint32_t n_t_;
-  Vector<S, P> last_{};
-  SequenceNumber k_last_ = 0;
-  bool any_sent_ = false;
 };
 
 }  // namespace oneshot::node

@@ -13,16 +13,15 @@
 
 #include "oneshot/hal/network_contract.hpp"
 #include "oneshot/matrix.hpp"
+#include "oneshot/node/frame_io.hpp"
 #include "oneshot/node/message.hpp"
 #include "oneshot/node/send_cause.hpp"
 
 namespace oneshot::node {
 
-/// Counters of a sensor node.
-struct SensorStatistics {
+/// Counters of a sensor node (messages sent or refused by the interface in the SendCounters part).
+struct SensorStatistics : SendCounters {
   std::uint32_t samples = 0;        ///< Samples evaluated.
-  std::uint32_t sends = 0;          ///< Messages handed to the network.
-  std::uint32_t refused = 0;        ///< Sends the interface refused.
   std::uint32_t by_cause[6] = {};   ///< Sends per SendCause (index = cause).
 };
 
@@ -44,14 +43,7 @@ class SensorNode {
     m.seq = k;
     m.stamp = now;
     m.payload.value = y;
-    std::uint8_t bytes[kMaxMessageBytes];
-    const std::size_t n = encode(m, bytes);
-    if (Board::Net::send(destination_, bytes, n)) {
-      ++stats_.sends;
-      ++stats_.by_cause[static_cast<std::size_t>(cause)];
-    } else {
-      ++stats_.refused;
-    }
+    if (send_message<Board>(destination_, m, stats_) == SendResult::kSent) ++stats_.by_cause[static_cast<std::size_t>(cause)];
     trigger_.on_sent(k, y);  // no acknowledgement: the sender remembers what it tried to send
     return cause;
   }

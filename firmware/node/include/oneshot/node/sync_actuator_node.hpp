@@ -57,7 +57,11 @@ class SyncActuatorNode {
   /// Counters: applied commands, late periods (held value), refusals by cause, …
   constexpr const ActuatorStatistics& statistics() const { return inner_.statistics(); }
   /// Requests the interface refused.
-  constexpr std::uint32_t refused() const { return refused_; }
+  constexpr std::uint32_t refused() const { return requests_.refused; }
+  /// Result of the last request send.
+  [[nodiscard]] constexpr SendResult last_request() const { return last_request_; }
+  /// Worst status of the frames the last on_receive() handled (kOk when none).
+  [[nodiscard]] constexpr FrameStatus receive_status() const { return inner_.receive_status(); }
 
  private:
   void request(SequenceNumber k, McuInstant t_k) {
@@ -65,14 +69,13 @@ class SyncActuatorNode {
     r.k = k;
     r.t_k = t_k;
     r.u_applied = inner_.applied();
-    std::uint8_t bytes[kMaxMessageBytes];
-    const std::size_t n = encode(r, bytes);
-    if (!Board::Net::send(sensor_, bytes, n)) ++refused_;
+    last_request_ = send_message<Board>(sensor_, r, requests_);
   }
 
   std::uint8_t sensor_;
   ActuatorNode<Board, S, M, Slots> inner_;
-  std::uint32_t refused_ = 0;
+  SendCounters requests_{};
+  SendResult last_request_ = SendResult::kSent;
 };
 
 }  // namespace oneshot::node

@@ -34,24 +34,22 @@
 #include "oneshot/hal/network_contract.hpp"
 #include "oneshot/node/actuation_sync_messages.hpp"
 #include "oneshot/node/frame_checks.hpp"
+#include "oneshot/node/frame_io.hpp"
 #include "oneshot/node/square_wave_reference.hpp"
 #include "oneshot/status.hpp"
 
 namespace oneshot::node {
 
-/// Counters of a synchronized controller (refusals by cause in the FrameRefusals part).
-struct SyncControllerStatistics : FrameRefusals {
+/// Counters of a synchronized controller (drops and refusals by cause in the FrameRefusals
+/// part, commands sent or refused by the interface in the SendCounters part).
+struct SyncControllerStatistics : FrameRefusals, SendCounters {
   std::uint32_t received = 0;      ///< Reports decoded.
-  std::uint32_t stale = 0;         ///< Not newer than the last one (dropped).
-  std::uint32_t malformed = 0;     ///< Frames that did not decode.
   std::uint32_t computations = 0;  ///< Estimator runs.
   std::uint32_t faults = 0;        ///< Estimator runs whose status was not exact.
   std::uint32_t estimator_resets = 0;  ///< Estimator runs that turned non-finite (reset, no command).
   std::uint32_t withheld = 0;      ///< Commands not sent because they were not finite.
   std::uint32_t filled = 0;        ///< Periods without a report the estimator predicted over.
   std::uint32_t saturated = 0;     ///< Commands clamped to the actuator's range.
-  std::uint32_t sends = 0;         ///< Commands sent.
-  std::uint32_t refused = 0;       ///< Sends the interface refused.
 };
 
 /// Most periods without a report one report fills in (more: none, the estimator's correction alone).
@@ -72,30 +70,24 @@ class SyncControllerNode {
                                const Vector<S, M>& u_max, const Estimator& estimator, const Reference& reference)
       : actuator_(actuator), l_(l), u_min_(u_min), u_max_(u_max), estimator_(estimator), reference_(reference) {}
 
-  /// Frames waiting at the interface: each newer report gives one command.
+  /// Frames waiting at the interface: each one through on_frame().
   void on_receive(McuInstant now) {
-    std::uint8_t bytes[kMaxMessageBytes];
-    std::uint8_t source = 0;
-    for (std::size_t n = Board::Net::receive(source, bytes, sizeof bytes); n != 0;
-         n = Board::Net::receive(source, bytes, sizeof bytes)) {
-      Report r;
-      if (!decode(bytes, n, r)) {
-        ++stats_.malformed;
-        continue;
-      }
-      ++stats_.received;
-      if (!source_.check(source, stats_) || !check_payload(r.y, y_range_, stats_) ||
-          !check_payload(r.u_applied, echo_range_, stats_))
-        continue;
-      if (r.tau_us < tau_min_us_ || r.tau_us > tau_max_us_) {
-        ++stats_.refused_out_of_range;
-        continue;
-      }
-      const SequenceVerdict v = gate_.offer(r.k);
-      if (v == SequenceVerdict::kStale) ++stats_.stale;
-      if (!count_sequence(v, stats_)) continue;
-      compute(r, now);
-    }
+    receive_status_ = drain_frames<Board>(
+        [&](std::uint8_t source, const std::uint8_t* bytes, std::size_t size) { return on_frame(source, bytes, size, now); });
+  }
+
+  /// One frame from `source`: a newer report gives one command; its status, counted by cause
+  /// in statistics().
+  [[nodiscard]] FrameStatus on_frame(std::uint8_t source, const std::uint8_t* bytes, std::size_t size, McuInstant now) {
+    return admit_frame<Report>(source, bytes, size, stats_.received, stats_, [&](const Report& r, std::uint8_t src) {
+      FrameStatus s = then_check(source_.check(src), [&] {
+        return then_check(check_payload(r.y, y_range_), [&] { return check_payload(r.u_applied, echo_range_); });
+      });
+      if (s == FrameStatus::kOk && (r.tau_us < tau_min_us_ || r.tau_us > tau_max_us_)) s = FrameStatus::kRefusedOutOfRange;
+      s = then_check(s, [&] { return frame_status(gate_.offer(r.k)); });
+      if (accepted(s)) compute(r, now);
+      return s;
+    });
   }
 
   /// Accepts reports from `sensor` only.
@@ -126,6 +118,10 @@ class SyncControllerNode {
   constexpr const Vector<S, M>& last_command() const { return u_; }
   /// Counters.
   constexpr const SyncControllerStatistics& statistics() const { return stats_; }
+  /// Worst status of the frames the last on_receive() handled (kOk when none).
+  [[nodiscard]] constexpr FrameStatus receive_status() const { return receive_status_; }
+  /// Result of the last command send (counted in statistics()).
+  [[nodiscard]] constexpr SendResult last_send() const { return last_send_; }
 
  private:
   // round(dt / h) (µs; in 64 bits: no overflow at any dt).
@@ -136,8 +132,8 @@ class SyncControllerNode {
   }
 
   // Periods between the last report's t_k and this one's: predicts the estimator over the
-  // missing ones and moves the reference index by as many (false: the estimator was reset).
-  [[nodiscard]] bool fill_gap(const Report& r, McuInstant now) {
+  // missing ones and moves the reference index by as many (kNonFinite: the estimator was reset).
+  [[nodiscard]] Status fill_gap(const Report& r, McuInstant now) {
     const McuInstant t_k = r.t_s.plus(r.tau_us);
     const bool had = have_t_k_;
     const std::int32_t dt = t_k - last_t_k_;
@@ -147,7 +143,7 @@ class SyncControllerNode {
     have_t_k_ = true;
     if (period_us_ == 0 || !had) {
       ref_k_ = r.k;
-      return true;
+      return Status::kOk;
     }
     // The stamps give n exactly; the controller's own clock (jittered by the delays) checks
     // them: a stamp more than one period off its count is wrong, the own count is taken.
@@ -155,19 +151,19 @@ class SyncControllerNode {
     const std::int32_t n_own = periods(dt_own);
     if (n < 1 || n - n_own > 1 || n_own - n > 1) n = n_own < 1 ? 1 : n_own;
     ref_k_ += static_cast<SequenceNumber>(n);
-    if (n - 1 > kMaxFilledPeriods) return true;  // a long silence: the correction alone
+    if (n - 1 > kMaxFilledPeriods) return Status::kOk;  // a long silence: the correction alone
     for (std::int32_t i = 1; i < n; ++i) {
       if (estimator_.skip(r.u_applied) == Status::kNonFinite) {
         ++stats_.estimator_resets;
-        return false;
+        return Status::kNonFinite;
       }
       ++stats_.filled;
     }
-    return true;
+    return Status::kOk;
   }
 
   void compute(const Report& r, McuInstant now) {
-    if (!fill_gap(r, now)) return;
+    if (fill_gap(r, now) == Status::kNonFinite) return;
     ++stats_.computations;
     const Status st = estimator_.update(r.tau_us, r.y, r.u_applied);
     if (!is_exact(st)) ++stats_.faults;
@@ -186,13 +182,7 @@ class SyncControllerNode {
     c.seq = r.k;
     c.stamp = now;
     c.payload.value = u_;
-    std::uint8_t bytes[kMaxMessageBytes];
-    const std::size_t n = encode(c, bytes);
-    if (Board::Net::send(actuator_, bytes, n)) {
-      ++stats_.sends;
-    } else {
-      ++stats_.refused;
-    }
+    last_send_ = send_message<Board>(actuator_, c, stats_);
   }
 
   std::uint8_t actuator_;
@@ -214,6 +204,8 @@ class SyncControllerNode {
   ValueRange<S, P> y_range_{};
   ValueRange<S, M> echo_range_{};
   SyncControllerStatistics stats_{};
+  FrameStatus receive_status_ = FrameStatus::kOk;
+  SendResult last_send_ = SendResult::kSent;
 };
 
 }  // namespace oneshot::node

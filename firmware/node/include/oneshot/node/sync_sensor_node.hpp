@@ -17,16 +17,21 @@
 #include "oneshot/hal/network_contract.hpp"
 #include "oneshot/node/actuation_sync_messages.hpp"
 #include "oneshot/node/frame_checks.hpp"
+#include "oneshot/node/frame_io.hpp"
 
 namespace oneshot::node {
 
-/// Counters of a synchronized sensor (refusals by cause in the FrameRefusals part).
-struct SyncSensorStatistics : FrameRefusals {
+/// Counters of a synchronized sensor (drops and refusals by cause in the FrameRefusals part,
+/// reports sent or refused by the interface in the SendCounters part).
+struct SyncSensorStatistics : FrameRefusals, SendCounters {
   std::uint32_t requests = 0;   ///< Requests decoded.
-  std::uint32_t stale = 0;      ///< Requests not newer than the pending or last one (dropped).
-  std::uint32_t malformed = 0;  ///< Frames that did not decode.
-  std::uint32_t sends = 0;      ///< Reports sent.
-  std::uint32_t refused = 0;    ///< Reports the interface refused.
+};
+
+/// Outcome of SyncSensorNode::on_sample().
+enum class [[nodiscard]] ReportResult : std::uint8_t {
+  kSent,       ///< The report was handed to the interface.
+  kRefused,    ///< The interface refused the report (counted).
+  kNoRequest,  ///< No request was pending: nothing reported.
 };
 
 /// Sensor of P outputs (echoing M inputs) in scalar S on board `Board`.
@@ -41,29 +46,12 @@ class SyncSensorNode {
   /// Frames waiting at the interface. True when a sample is now due; `sample_at` is the
   /// instant to take it (now, or t_k − D when that is later).
   bool on_receive(McuInstant now, McuInstant& sample_at) {
-    std::uint8_t bytes[kMaxMessageBytes];
-    std::uint8_t source = 0;
     bool due = false;
-    for (std::size_t n = Board::Net::receive(source, bytes, sizeof bytes); n != 0;
-         n = Board::Net::receive(source, bytes, sizeof bytes)) {
-      ActuationRequest<S, M> r;
-      if (!decode(bytes, n, r)) {
-        ++stats_.malformed;
-        continue;
-      }
-      ++stats_.requests;
-      if (!source_.check(source, stats_) || !check_payload(r.u_applied, echo_range_, stats_)) continue;
-      if (lead_us_ >= 0 && r.t_k - now > lead_us_) {  // t_k too far ahead of the sensor's clock
-        ++stats_.refused_sequence;
-        continue;
-      }
-      const SequenceVerdict v = gate_.offer(r.k);
-      if (v == SequenceVerdict::kStale) ++stats_.stale;
-      if (!count_sequence(v, stats_)) continue;
-      pending_ = r;
-      have_pending_ = true;
-      due = true;
-    }
+    receive_status_ = drain_frames<Board>([&](std::uint8_t source, const std::uint8_t* bytes, std::size_t size) {
+      const FrameStatus s = on_frame(source, bytes, size, now);
+      due = due || accepted(s);
+      return s;
+    });
     if (!due) return false;
     sample_at = now;
     if (late_us_ > 0) {
@@ -73,9 +61,26 @@ class SyncSensorNode {
     return true;
   }
 
-  /// The sample y taken at `now` for the pending request: reports it (false when none).
-  bool on_sample(McuInstant now, const Vector<S, P>& y) {
-    if (!have_pending_) return false;
+  /// One frame from `source` at `now`: an accepted request becomes the pending one; its
+  /// status, counted by cause in statistics().
+  [[nodiscard]] FrameStatus on_frame(std::uint8_t source, const std::uint8_t* bytes, std::size_t size, McuInstant now) {
+    using Request = ActuationRequest<S, M>;
+    return admit_frame<Request>(source, bytes, size, stats_.requests, stats_, [&](const Request& r, std::uint8_t src) {
+      FrameStatus s = then_check(source_.check(src), [&] { return check_payload(r.u_applied, echo_range_); });
+      // t_k too far ahead of the sensor's clock: refused as a stamp outside its window.
+      if (s == FrameStatus::kOk && lead_us_ >= 0 && r.t_k - now > lead_us_) s = FrameStatus::kRefusedSequence;
+      s = then_check(s, [&] { return frame_status(gate_.offer(r.k)); });
+      if (accepted(s)) {
+        pending_ = r;
+        have_pending_ = true;
+      }
+      return s;
+    });
+  }
+
+  /// The sample y taken at `now` for the pending request: reports it (kNoRequest when none).
+  [[nodiscard]] ReportResult on_sample(McuInstant now, const Vector<S, P>& y) {
+    if (!have_pending_) return ReportResult::kNoRequest;
     have_pending_ = false;
     SampleReport<S, P, M> m;
     m.k = pending_.k;
@@ -83,14 +88,7 @@ class SyncSensorNode {
     m.tau_us = static_cast<std::int32_t>(pending_.t_k - now);
     m.y = y;
     m.u_applied = pending_.u_applied;
-    std::uint8_t bytes[kMaxMessageBytes];
-    const std::size_t n = encode(m, bytes);
-    if (Board::Net::send(controller_, bytes, n)) {
-      ++stats_.sends;
-    } else {
-      ++stats_.refused;
-    }
-    return true;
+    return send_message<Board>(controller_, m, stats_) == SendResult::kSent ? ReportResult::kSent : ReportResult::kRefused;
   }
 
   /// Accepts requests from `actuator` only.
@@ -109,6 +107,8 @@ class SyncSensorNode {
 
   /// Counters.
   constexpr const SyncSensorStatistics& statistics() const { return stats_; }
+  /// Worst status of the frames the last on_receive() handled (kOk when none).
+  [[nodiscard]] constexpr FrameStatus receive_status() const { return receive_status_; }
 
  private:
   std::uint8_t controller_;
@@ -120,6 +120,7 @@ class SyncSensorNode {
   ExpectedSource source_{};
   ValueRange<S, M> echo_range_{};
   SyncSensorStatistics stats_{};
+  FrameStatus receive_status_ = FrameStatus::kOk;
 };
 
 }  // namespace oneshot::node

@@ -54,7 +54,7 @@ class ThresholdBuffer {
   constexpr explicit ThresholdBuffer(std::uint32_t next_step = 0) : next_(next_step) {}
 
   /// Offers the packet stamped `stamp` with value `y` (between steps).
-  constexpr ArrivalVerdict receive(std::uint32_t stamp, const Y& y) {
+  [[nodiscard]] constexpr ArrivalVerdict receive(std::uint32_t stamp, const Y& y) {
     if (!all_finite(y)) {
       ++counts_.refused_non_finite;
       return ArrivalVerdict::kNonFinite;
