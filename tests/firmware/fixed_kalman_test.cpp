@@ -173,9 +173,9 @@ TEST_P(FixedVsDouble, StateWithinOneAdcLsbOverLongIrregularSequences) {
   const Deviation d = c.table ? run_pair(c.variant, tq, td, 20'000, 21) : run_pair(c.variant, gq, gd, 20'000, 21);
   std::cout << "[ measured ] fixed " << c.name << ": max state error " << d.state_lsb << " ADC LSB, max |dK| " << d.gain
             << ", P rel " << d.cov_rel << "\n";
-  EXPECT_LT(d.state_lsb, 1.0);   // stated bound: within one 12-bit LSB (0.8 mV)
-  EXPECT_LT(d.gain, 2e-3);       // K LSB is 2⁻¹³ = 1.2e-4
-  EXPECT_LT(d.cov_rel, 1e-2);
+  EXPECT_LT(d.state_lsb, 1.0);   // stated bound: within one 12-bit LSB (0.8 mV); measured 0.13 … 0.19
+  EXPECT_LT(d.gain, 5e-4);       // K LSB is 2⁻¹³ = 1.2e-4; measured 1.27e-4 … 1.42e-4 (≈ 1 LSB): 4 LSB
+  EXPECT_LT(d.cov_rel, 2e-3);    // measured 3.1e-4 … 3.8e-4: ~5× margin
 }
 
 INSTANTIATE_TEST_SUITE_P(Variants, FixedVsDouble,

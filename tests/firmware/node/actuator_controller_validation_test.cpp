@@ -11,6 +11,7 @@
 #include "oneshot/node/actuator_node.hpp"
 #include "oneshot/node/controller_node.hpp"
 #include "oneshot/node/sync_actuator_node.hpp"
+#include "support/node_fixtures.hpp"
 
 namespace oneshot::node {
 namespace {
@@ -21,11 +22,7 @@ constexpr std::uint8_t kController = 2;
 constexpr std::uint8_t kActuator = 3;
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
-V1 v1(double x) {
-  V1 v;
-  v[0] = x;
-  return v;
-}
+using test::v1;
 
 /// Delivers the command (seq, u) from `from` to `net`.
 void deliver(host::HostNetworkState& net, SequenceNumber seq, double u, std::uint8_t from = kController) {
@@ -114,17 +111,10 @@ TEST(ActuatorValidation, OnArrivalModeRefusesNanAndFollowsARestartedController) 
   EXPECT_EQ(act.statistics().reacquired, 1U);
 }
 
-struct Echo {
-  bool compute(const Message<VectorPayload<double, 1>>& m, bool fresh, McuInstant, V1& u) {
-    u = m.payload.value;
-    return fresh;
-  }
-};
-
 TEST(ControllerValidation, RestartedSensorReacquiredAndNanRefused) {
   host::HostNetworkState net;
   net.address = kController;
-  ControllerNode<host::HostNetwork, Echo, double, 1, 1> ctrl(kActuator, ControllerMode::kOnArrival, Echo{});
+  ControllerNode<host::HostNetwork, test::EchoLaw, double, 1, 1> ctrl(kActuator, ControllerMode::kOnArrival, test::EchoLaw{});
   const host::ScopedHostNetwork cur(net);
   const auto sample = [&](SequenceNumber k, double y) {
     Message<VectorPayload<double, 1>> m;

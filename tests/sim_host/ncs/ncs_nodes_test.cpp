@@ -9,7 +9,7 @@
 #include <cstring>
 #include <random>
 
-#include "ncs_model.hpp"
+#include "ncs_test_support.hpp"
 #include "oneshot/host/host_network.hpp"
 #include "oneshot/node/sync_actuator_node.hpp"
 #include "oneshot/node/sync_controller_node.hpp"
@@ -29,15 +29,20 @@ using Report = node::SampleReport<double, kP, kM>;
 using Request = node::ActuationRequest<double, kM>;
 using Command = node::Message<node::VectorPayload<double, kM>>;
 
-const Context& context() {
-  static const auto ctx = Context::load("");
-  return *ctx;
-}
-
 Ref reference() {
   Vector<double, kN> nx;
   nx[0] = 1;
   return Ref(0.5, 20, nx, Vector<double, kM>{});
+}
+
+/// The controller node (address 2, commanding the actuator at 3) with the design's gain,
+/// commands clamped to ±u_max and the reference() square wave.
+Ctrl controller(const Design& design, const HalfEst& est, double u_max) {
+  Vector<double, kM> lo;
+  Vector<double, kM> hi;
+  lo[0] = -u_max;
+  hi[0] = u_max;
+  return Ctrl(3, design.l, lo, hi, est, reference());
 }
 
 template <typename M>
@@ -84,11 +89,7 @@ TEST(NcsNodes, ControllerEstimateIsTheCoreHalfKalmanBitForBit) {
     est.reset(x0, design.p0, Vector<double, kM>{});
     HalfKalman<Fmt, Structure, Disc> core(design, disc, noise);
     core.reset(x0, design.p0, Vector<double, kM>{});
-    Vector<double, kM> lo;
-    Vector<double, kM> hi;
-    lo[0] = -1.65;
-    hi[0] = 1.65;
-    Ctrl ctrl(3, design.l, lo, hi, est, reference());
+    Ctrl ctrl = controller(design, est, 1.65);
     host::HostNetworkState net;
     net.address = 2;
     const host::ScopedHostNetwork scope(net);
@@ -276,11 +277,7 @@ TEST(NcsNodes, LateCommandIsHeldCountedAndItsEchoUsed) {
   with_echo.reset(Vector<double, kN>{}, design.p0, Vector<double, kM>{});
   HalfKalman<Fmt, Structure, Disc> with_own(design, disc, NoiseModel::kConstant);
   with_own.reset(Vector<double, kN>{}, design.p0, Vector<double, kM>{});
-  Vector<double, kM> lo;
-  Vector<double, kM> hi;
-  lo[0] = -2;
-  hi[0] = 2;
-  Ctrl ctrl(3, design.l, lo, hi, est, reference());
+  Ctrl ctrl = controller(design, est, 2);
   host::HostNetworkState ctrl_net;
   ctrl_net.address = 2;
   const host::ScopedHostNetwork scope(ctrl_net);

@@ -4,7 +4,6 @@
 ///        zero thresholds the closed loop's NUMRE is the standard Kalman filter.
 #include <gtest/gtest.h>
 
-#include <cstdio>
 #include <string>
 
 #include <Eigen/Dense>
@@ -12,15 +11,11 @@
 
 #include "oneshot/node/numre_estimator.hpp"
 #include "petc_sim.hpp"
+#include "support/measured_text.hpp"
 
 namespace {
 
-/// Measured error as text for the test report (%.3e).
-std::string sci(double x) {
-  char b[32];
-  std::snprintf(b, sizeof b, "%.3e", x);
-  return b;
-}
+using oneshot::test::sci;
 
 using namespace oneshot::sim::petc;
 using Mat = Eigen::MatrixXd;
