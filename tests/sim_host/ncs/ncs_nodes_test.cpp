@@ -35,14 +35,17 @@ Ref reference() {
   return Ref(0.5, 20, nx, Vector<double, kM>{});
 }
 
+/// The input vector with every entry `v`.
+Vector<double, kM> input_of(double v) {
+  Vector<double, kM> u;
+  for (std::size_t j = 0; j < kM; ++j) u[j] = v;
+  return u;
+}
+
 /// The controller node (address 2, commanding the actuator at 3) with the design's gain,
 /// commands clamped to ±u_max and the reference() square wave.
 Ctrl controller(const Design& design, const HalfEst& est, double u_max) {
-  Vector<double, kM> lo;
-  Vector<double, kM> hi;
-  lo[0] = -u_max;
-  hi[0] = u_max;
-  return Ctrl(3, design.l, lo, hi, est, reference());
+  return Ctrl(3, design.l, input_of(-u_max), input_of(u_max), est, reference());
 }
 
 template <typename M>
@@ -114,7 +117,7 @@ TEST(NcsNodes, ControllerEstimateIsTheCoreHalfKalmanBitForBit) {
       net.outbox.clear();
       EXPECT_EQ(c.seq, k);
       Vector<double, kM> u = reference().input(k) - design.l * (core.prediction() - reference().state(k));
-      node::saturate(u, lo, hi);
+      node::saturate(u, input_of(-1.65), input_of(1.65));
       EXPECT_TRUE(same_bits(c.payload.value[0], u[0]));
     }
     EXPECT_EQ(ctrl.statistics().computations, 300U);

@@ -100,7 +100,9 @@ TEST_P(PetcFaultKinds, AreRefusedAndCountedAndTheRunStaysFiniteAndBounded) {
       EXPECT_GT(f.run.counts.injected, 0) << p.spec;
       EXPECT_EQ(f.run.counts.*p.taken_by, f.run.counts.injected) << "case " << c.name << ", " << p.spec;
     }
-    if (p.changes_nothing) EXPECT_EQ(f.run.tracking_error, f.clean_tracking) << "case " << c.name << ", " << p.spec;
+    if (p.changes_nothing) {
+      EXPECT_EQ(f.run.tracking_error, f.clean_tracking) << "case " << c.name << ", " << p.spec;
+    }
     expect_finite_and_bounded(f, p.spec);
   }
 }
