@@ -157,7 +157,7 @@ TEST(NumreSpan, AdvanceEqualsHeldInputSteps) {
     worst = std::max(worst, d / sc);
   }
   RecordProperty("rel_diff", sci(worst));
-  EXPECT_LT(worst, 1e-12);
+  EXPECT_LT(worst, 3e-14);  // measured 4.9e-15
 }
 
 // A prediction over any N < 225 is at most two spans: its multiply-adds do not grow with N

@@ -121,8 +121,8 @@ TEST_P(NumreTest, NStepUpdateEqualsClosedForm) {
   const double ex = rel_err(xn, ref.x), ep = rel_err(pn, ref.p);
   RecordProperty("x_rel_err", sci(ex));
   RecordProperty("p_rel_err", sci(ep));
-  EXPECT_LT(ex, 1e-10);
-  EXPECT_LT(ep, 1e-10);
+  EXPECT_LT(ex, 1e-12);  // measured 1.6e-13 (sum), 2.1e-13 (frozen)
+  EXPECT_LT(ep, 1e-10);  // measured 5.7e-12, 1.0e-11
 }
 
 INSTANTIATE_TEST_SUITE_P(Accumulation, NumreTest, ::testing::Values(false, true));
