@@ -163,6 +163,24 @@ INSTANTIATE_TEST_SUITE_P(
                       Case{"complete_table_constant", Variant::kComplete, NoiseModel::kConstant, true}),
     [](const ::testing::TestParamInfo<Case>& param_info) { return std::string(param_info.param.name); });
 
+/// Random jobs for filters compared side by side (one stream per test, seeded): τ uniform
+/// in [tau_min, tau_max] µs, samples and applied inputs N(0, 0.1²), drawn in call order.
+class RandomJobs {
+ public:
+  RandomJobs(std::uint64_t seed, std::int32_t tau_min, std::int32_t tau_max) : rng_(seed), tau_(tau_min, tau_max) {}
+  std::int32_t tau() { return tau_(rng_); }
+  Vector<double, 1> value() {
+    Vector<double, 1> v;
+    v[0] = y_(rng_);
+    return v;
+  }
+
+ private:
+  std::mt19937_64 rng_;
+  std::uniform_int_distribution<std::int32_t> tau_;
+  std::normal_distribution<double> y_{0.0, 0.1};
+};
+
 TEST(KalmanFilters, HalfAndCompleteAreTheSameEstimator) {
   // Algebraically identical (brief §5): only the rounding differs.
   using K = PlantConstants<double>;
@@ -170,20 +188,16 @@ TEST(KalmanFilters, HalfAndCompleteAreTheSameEstimator) {
   for (NoiseModel noise : {NoiseModel::kExact, NoiseModel::kConstant}) {
     HalfKalman<K::Format, PlantStructure, decltype(table)> half(K::kDesign, table, noise);
     CompleteKalman<K::Format, PlantStructure, decltype(table)> complete(K::kDesign, table, noise);
-    std::mt19937_64 rng(7);
-    std::uniform_int_distribution<std::int32_t> tau(0, 50000);
-    std::normal_distribution<double> y(0.0, 0.1);
+    RandomJobs jobs(7, 0, 50000);
     for (int k = 0; k < 2000; ++k) {
-      const std::int32_t t = tau(rng);
-      Vector<double, 1> yk;
-      yk[0] = y(rng);
+      const std::int32_t t = jobs.tau();
+      const Vector<double, 1> yk = jobs.value();
       ASSERT_TRUE(is_exact(half.update(t, yk)));
       ASSERT_TRUE(is_exact(complete.update(t, yk)));
       EXPECT_LT(std::fabs(half.prediction()[0] - complete.prediction()[0]), 1e-12);
       EXPECT_LT(std::fabs(half.prediction()[1] - complete.prediction()[1]), 1e-12);
       EXPECT_LT(std::fabs(half.gain()[0] - complete.gain()[0]), 1e-12);
-      Vector<double, 1> u;
-      u[0] = y(rng);
+      const Vector<double, 1> u = jobs.value();
       half.set_applied_input(u);
       complete.set_applied_input(u);
     }
@@ -206,15 +220,12 @@ void expect_nearest_equals_exact_on_rounded_tau(std::uint64_t seed, std::int32_t
   HalfKalman<K::Format, PlantStructure, Exact> half_e(K::kDesign, exact, NoiseModel::kExact);
   CompleteKalman<K::Format, PlantStructure, Nearest> comp_n(K::kDesign, nearest, NoiseModel::kExact);
   CompleteKalman<K::Format, PlantStructure, Exact> comp_e(K::kDesign, exact, NoiseModel::kExact);
-  std::mt19937_64 rng(seed);
-  std::uniform_int_distribution<std::int32_t> tau(tau_min, tau_max);
-  std::normal_distribution<double> y(0.0, 0.1);
+  RandomJobs random(seed, tau_min, tau_max);
   for (int k = 0; k < jobs; ++k) {
     // WHEN the nearest filters get raw τ and the exact ones τ rounded to the grid
-    const std::int32_t t = tau(rng);
+    const std::int32_t t = random.tau();
     const std::int32_t rounded = t >= 0 ? ((t + g / 2) / g) * g : -(((-t) + g / 2) / g) * g;
-    Vector<double, 1> yk;
-    yk[0] = y(rng);
+    const Vector<double, 1> yk = random.value();
     // THEN no invariant fires, the statuses agree and the estimates are the same bits
     ASSERT_EQ(half_n.update(t, yk), half_e.update(rounded, yk)) << "job " << k;
     ASSERT_EQ(comp_n.update(t, yk), comp_e.update(rounded, yk)) << "job " << k;
@@ -222,8 +233,7 @@ void expect_nearest_equals_exact_on_rounded_tau(std::uint64_t seed, std::int32_t
       ASSERT_EQ(half_n.prediction()[i], half_e.prediction()[i]) << "job " << k;
       ASSERT_EQ(comp_n.prediction()[i], comp_e.prediction()[i]) << "job " << k;
     }
-    Vector<double, 1> u;
-    u[0] = y(rng);
+    const Vector<double, 1> u = random.value();
     half_n.set_applied_input(u);
     half_e.set_applied_input(u);
     comp_n.set_applied_input(u);
@@ -249,13 +259,10 @@ TEST(KalmanFilters, JosephAndSymmetricFormsAgree) {
                                                                                           NoiseModel::kExact);
   HalfKalman<K::Format, PlantStructure, decltype(table), CovarianceUpdate::kJoseph> jos(K::kDesign, table,
                                                                                        NoiseModel::kExact);
-  std::mt19937_64 rng(8);
-  std::uniform_int_distribution<std::int32_t> tau(0, 50000);
-  std::normal_distribution<double> y(0.0, 0.1);
+  RandomJobs jobs(8, 0, 50000);
   for (int k = 0; k < 1000; ++k) {
-    const std::int32_t t = tau(rng);
-    Vector<double, 1> yk;
-    yk[0] = y(rng);
+    const std::int32_t t = jobs.tau();
+    const Vector<double, 1> yk = jobs.value();
     ASSERT_EQ(sym.update(t, yk), jos.update(t, yk));
     EXPECT_LT(test::relative_error(test::to_eigen(sym.covariance()), test::to_eigen(jos.covariance())), 1e-12);
   }
