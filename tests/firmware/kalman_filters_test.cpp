@@ -14,6 +14,7 @@
 #include "oneshot/generated/plant_tables.hpp"
 #include "oneshot/half_kalman.hpp"
 #include "oneshot/standard_kalman.hpp"
+#include "filter_cases.hpp"
 #include "support/eigen_reference.hpp"
 #include "support/test_plants.hpp"
 
@@ -49,7 +50,7 @@ class TruePlant {
   test::VecX x_;
 };
 
-enum class Variant { kHalf, kComplete };
+using Variant = test::FilterVariant;
 
 struct Deviation {
   double state = 0;  // max |x̂ − x̂_ref| (V)
@@ -104,21 +105,14 @@ Deviation run_variant(const Disc& disc, Variant variant, NoiseModel noise, int j
   return run_against_reference(filter, variant, noise == NoiseModel::kExact, jobs, 42);
 }
 
-struct Case {
-  const char* name;
-  Variant variant;
-  NoiseModel noise;
-  bool table;
-};
+using test::FilterCase;
 
-void PrintTo(const Case& c, std::ostream* os) { *os << c.name; }
-
-class FilterVsEigen : public ::testing::TestWithParam<Case> {};
+class FilterVsEigen : public ::testing::TestWithParam<FilterCase> {};
 
 /// Case `c` in scalar S (double or float) against the Eigen reference over 3000 jobs; the
 /// measured deviation is printed for the test report.
 template <typename S>
-Deviation run_case(const Case& c, const char* scalar) {
+Deviation run_case(const FilterCase& c, const char* scalar) {
   using K = PlantConstants<S>;
   const TableDiscretizer<typename K::Format, PlantStructure, S> table(K::kTable);
   const GenericDiscretizer<typename K::Format, 2, 1> generic(K::kModel);
@@ -155,13 +149,13 @@ TEST_P(FilterVsEigen, FloatStaysWithinStatedBounds) {
 
 INSTANTIATE_TEST_SUITE_P(
     Variants, FilterVsEigen,
-    ::testing::Values(Case{"half_table_exact", Variant::kHalf, NoiseModel::kExact, true},
-                      Case{"half_generic_exact", Variant::kHalf, NoiseModel::kExact, false},
-                      Case{"half_table_constant", Variant::kHalf, NoiseModel::kConstant, true},
-                      Case{"complete_table_exact", Variant::kComplete, NoiseModel::kExact, true},
-                      Case{"complete_generic_exact", Variant::kComplete, NoiseModel::kExact, false},
-                      Case{"complete_table_constant", Variant::kComplete, NoiseModel::kConstant, true}),
-    [](const ::testing::TestParamInfo<Case>& param_info) { return std::string(param_info.param.name); });
+    ::testing::Values(FilterCase{"half_table_exact", Variant::kHalf, NoiseModel::kExact, true},
+                      FilterCase{"half_generic_exact", Variant::kHalf, NoiseModel::kExact, false},
+                      FilterCase{"half_table_constant", Variant::kHalf, NoiseModel::kConstant, true},
+                      FilterCase{"complete_table_exact", Variant::kComplete, NoiseModel::kExact, true},
+                      FilterCase{"complete_generic_exact", Variant::kComplete, NoiseModel::kExact, false},
+                      FilterCase{"complete_table_constant", Variant::kComplete, NoiseModel::kConstant, true}),
+    test::filter_case_name);
 
 /// Random jobs for filters compared side by side (one stream per test, seeded): τ uniform
 /// in [tau_min, tau_max] µs, samples and applied inputs N(0, 0.1²), drawn in call order.
