@@ -57,6 +57,8 @@ void write_json(const std::string& path, const nlohmann::json& j) {
 
 void write_text(const std::string& path, const std::string& text) { util::write_file_atomic(path, text); }
 
+std::string path_in(const std::string& dir, const std::string& name) { return (std::filesystem::path(dir) / name).string(); }
+
 void make_directory(const std::string& dir) { util::create_directories(dir); }
 
 std::string gnuplot_quote(const std::string& label) {
@@ -75,7 +77,7 @@ std::string gnuplot_quote(const std::string& label) {
 }
 
 void run_gnuplot(const std::string& dir, const std::string& script_name, const std::string& script) {
-  write_text((std::filesystem::path(dir) / script_name).string(), script);
+  write_text(path_in(dir, script_name), script);
   util::ProcessSpec spec;
   spec.argv = {"gnuplot", script_name};
   spec.working_dir = dir;
@@ -87,7 +89,7 @@ void run_gnuplot(const std::string& dir, const std::string& script_name, const s
                              e.what());
   }
   if (!r.status.success()) {
-    throw std::runtime_error("gnuplot failed on " + (std::filesystem::path(dir) / script_name).string() + " (" +
+    throw std::runtime_error("gnuplot failed on " + path_in(dir, script_name) + " (" +
                              r.status.describe() + "):\n" + r.output);
   }
 }

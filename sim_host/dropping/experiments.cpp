@@ -4,7 +4,6 @@
 
 #include <cmath>
 #include <cstdio>
-#include <filesystem>
 #include <sstream>
 #include <stdexcept>
 
@@ -22,16 +21,12 @@
 namespace oneshot::dropping {
 namespace {
 
-std::string path_in(const std::string& dir, const std::string& name) { return (std::filesystem::path(dir) / name).string(); }
+using util::path_in;
 
 nlohmann::json finish(const engine::SweepResults& r, const StudyOptions& opt, const std::string& experiment,
                       nlohmann::json (*outputs)(const engine::SweepResults&, const std::string&, bool)) {
+  if (!opt.shard.whole()) return engine::write_shard_file(r, opt.out_dir, experiment, opt.shard);
   util::make_directory(opt.out_dir);
-  if (!opt.shard.whole()) {
-    nlohmann::json j = engine::shard_to_json(r);
-    util::write_json(path_in(opt.out_dir, engine::shard_file_name(experiment, opt.shard)), j);
-    return j;
-  }
   return outputs(r, opt.out_dir, opt.plots);
 }
 

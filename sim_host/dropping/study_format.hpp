@@ -3,28 +3,20 @@
 #pragma once
 
 #include <cmath>
-#include <cstdio>
 #include <string>
 
 #include <nlohmann/json.hpp>
 
 #include "oneshot/engine/quantiles.hpp"
+#include "oneshot/util/number_text.hpp"
 
 namespace oneshot::dropping {
 
 /// %.4g (shortest readable form); "nan"/"inf" spelled out.
-inline std::string fmt_g(double v) {
-  char b[40];
-  std::snprintf(b, sizeof b, "%.4g", v);
-  return b;
-}
+inline std::string fmt_g(double v) { return util::format_g(v, 4); }
 
 /// Fixed with `digits` decimals.
-inline std::string fmt_f(double v, int digits) {
-  char b[48];
-  std::snprintf(b, sizeof b, "%.*f", digits, v);
-  return b;
-}
+inline std::string fmt_f(double v, int digits) { return util::format_f(v, digits); }
 
 /// A number for JSON (non-finite → null).
 inline nlohmann::json num(double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr); }

@@ -33,7 +33,7 @@
 
 namespace oneshot::ncs {
 
-/// Node addresses of the live loop (and of the replay).
+/// Node addresses of the live loop (and of the replay and the simulated loop).
 inline constexpr std::uint8_t kLiveSensor = 1;
 inline constexpr std::uint8_t kLiveController = 2;
 inline constexpr std::uint8_t kLiveActuator = 3;

@@ -46,12 +46,20 @@ void with_sync_estimator(const Context& ctx, const Scenario& sc, Approach a, con
   }
 }
 
+/// The actuator's range [lo, hi] of the design, per input.
+struct InputRange {
+  InputVec lo;  ///< u_min.
+  InputVec hi;  ///< u_max.
+};
+
 /// The actuator's range [u_min, u_max] from the design.
-inline void actuator_range(const Context& ctx, InputVec& u_min, InputVec& u_max) {
+inline InputRange actuator_range(const Context& ctx) {
+  InputRange r;
   for (std::size_t j = 0; j < kM; ++j) {
-    u_min[j] = ctx.design().u_min[j];
-    u_max[j] = ctx.design().u_max[j];
+    r.lo[j] = ctx.design().u_min[j];
+    r.hi[j] = ctx.design().u_max[j];
   }
+  return r;
 }
 
 /// Frame checks of the live sensor (docs/node_validation.md), the same in the process and
@@ -59,10 +67,9 @@ inline void actuator_range(const Context& ctx, InputVec& u_min, InputVec& u_max)
 /// periods ahead of the sensor's clock.
 template <typename Sensor>
 void check_requests(const Context& ctx, Sensor& sensor) {
-  InputVec u_min, u_max;
-  actuator_range(ctx, u_min, u_max);
+  const InputRange u = actuator_range(ctx);
   sensor.expect_source(kLiveActuator);
-  sensor.set_echo_range(u_min, u_max);
+  sensor.set_echo_range(u.lo, u.hi);
   sensor.set_stamp_window(4 * ctx.period_us());
 }
 
@@ -80,10 +87,9 @@ void check_reports(const Context& ctx, Controller& ctrl) {
 /// Frame checks of the live actuator: commands from the controller only, in its range.
 template <typename Actuator>
 void check_commands(const Context& ctx, Actuator& act) {
-  InputVec u_min, u_max;
-  actuator_range(ctx, u_min, u_max);
+  const InputRange u = actuator_range(ctx);
   act.expect_source(kLiveController);
-  act.set_command_range(u_min, u_max);
+  act.set_command_range(u.lo, u.hi);
 }
 
 /// Logs a node's refusal counters as two records: "refused" (non-finite, out of range,

@@ -10,6 +10,7 @@
 
 #include "ncs_analytic.hpp"
 #include "ncs_counters.hpp"
+#include "ncs_live_nodes.hpp"
 #include "oneshot/engine/continuous_plant.hpp"
 #include "oneshot/engine/kernel.hpp"
 #include "oneshot/engine/network.hpp"
@@ -40,9 +41,10 @@ using engine::SimTime;
 using InputVec = Vector<double, kM>;
 using OutputVec = Vector<double, kP>;
 
-constexpr std::uint8_t kSensor = 1;
-constexpr std::uint8_t kController = 2;
-constexpr std::uint8_t kActuator = 3;
+// The live run's addresses (ncs_live.hpp): the frame checks of ncs_live_nodes.hpp name them.
+constexpr std::uint8_t kSensor = kLiveSensor;
+constexpr std::uint8_t kController = kLiveController;
+constexpr std::uint8_t kActuator = kLiveActuator;
 
 /// What every loop shares: kernel, plant, network, set-point, noise and timing streams.
 class Harness {
@@ -188,21 +190,9 @@ RunResult run_synchronized(Harness& hs, Estimator est, std::int32_t late_us) {
   std::optional<Sensor> sensor(std::in_place, kController, late_us);
   std::optional<Ctrl> ctrl(std::in_place, kActuator, l, hs.u_min_, hs.u_max_, est, hs.ref_);
   // Frame checks as in the live run (ncs_live_nodes.hpp), again after every restart.
-  const auto check_sensor = [&]() {
-    sensor->expect_source(kActuator);
-    sensor->set_echo_range(hs.u_min_, hs.u_max_);
-    sensor->set_stamp_window(4 * hs.ctx_.period_us());
-  };
-  const auto check_ctrl = [&]() {
-    ctrl->expect_source(kSensor);
-    ctrl->check_echo_range();
-    ctrl->set_tau_range(0, hs.ctx_.period_us());
-    ctrl->set_period_us(hs.ctx_.period_us());
-  };
-  const auto check_act = [&]() {
-    act->expect_source(kController);
-    act->set_command_range(hs.u_min_, hs.u_max_);
-  };
+  const auto check_sensor = [&]() { live::check_requests(hs.ctx_, *sensor); };
+  const auto check_ctrl = [&]() { live::check_reports(hs.ctx_, *ctrl); };
+  const auto check_act = [&]() { live::check_commands(hs.ctx_, *act); };
   check_sensor();
   check_ctrl();
   check_act();
@@ -301,10 +291,7 @@ RunResult run_sampling(Harness& hs, Law law, Saturated saturated) {
   std::optional<Ctrl> ctrl(std::in_place, kActuator, node::ControllerMode::kOnArrival, law);
   std::optional<Act> act(std::in_place, node::ActuatorMode::kOnArrival, InputVec{});
   const auto check_ctrl = [&]() { ctrl->expect_source(kSensor); };  // samples: finite (the plant is not clamped)
-  const auto check_act = [&]() {
-    act->expect_source(kController);
-    act->set_command_range(hs.u_min_, hs.u_max_);
-  };
+  const auto check_act = [&]() { live::check_commands(hs.ctx_, *act); };
   check_ctrl();
   check_act();
   std::uint64_t sensor_n0 = 0;  // sample index of the sensor's power-on (its sequence = n − n0)

@@ -4,7 +4,6 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <filesystem>
 #include <fstream>
 #include <map>
 #include <sstream>
@@ -19,7 +18,7 @@
 namespace oneshot::ncs {
 namespace {
 
-std::string path_in(const std::string& dir, const std::string& name) { return (std::filesystem::path(dir) / name).string(); }
+using util::path_in;
 
 Scenario scenario_from(const nlohmann::json& j) {
   Scenario s;

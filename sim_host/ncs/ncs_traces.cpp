@@ -2,7 +2,6 @@
 /// @brief E1–E3 of study `ncs`: single runs traced every millisecond, written as CSV and
 ///        drawn by gnuplot (the brief's Figs. 6–8).
 #include <cmath>
-#include <filesystem>
 #include <sstream>
 #include <stdexcept>
 
@@ -15,7 +14,7 @@ namespace {
 
 constexpr double kTraceStep = 1e-3;
 
-std::string path_in(const std::string& dir, const std::string& name) { return (std::filesystem::path(dir) / name).string(); }
+using util::path_in;
 
 Scenario pick(const char* scenario_name, double duration_s) {
   for (Scenario s : default_scenarios()) {

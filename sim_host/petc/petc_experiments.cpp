@@ -3,11 +3,11 @@
 #include "petc_experiments.hpp"
 
 #include <cmath>
-#include <cstdio>
 #include <sstream>
 #include <stdexcept>
 
 #include "oneshot/engine/sweep_statistics.hpp"
+#include "oneshot/util/number_text.hpp"
 #include "oneshot/util/output_files.hpp"
 #include "oneshot/sim/sweep_faults.hpp"
 
@@ -17,15 +17,7 @@ namespace {
 
 const char* kPng = "set terminal pngcairo size 1100,700 font 'Sans,11' noenhanced\n";
 
-std::string join(const std::string& dir, const std::string& name) { return dir + "/" + name; }
-
-nlohmann::json mean_ci(const util::Summary& s) { return {{"mean", s.mean}, {"ci95", s.ci95}}; }
-
-std::string fmt(double x, int digits = 4) {
-  char buf[64];
-  std::snprintf(buf, sizeof buf, "%.*g", digits, x);
-  return buf;
-}
+std::string fmt(double x, int digits = 4) { return util::format_g(x, digits); }
 
 std::vector<double> log_grid(double lo, double hi, std::size_t n) {
   std::vector<double> v;
@@ -91,11 +83,7 @@ nlohmann::json run_table(const PetcSetup& setup, const SweepOptions& opt) {
         return v;
       },
       "petc table");
-  if (!opt.shard.whole()) {
-    const nlohmann::json j = engine::shard_to_json(r);
-    util::write_json(join(opt.out_dir, engine::shard_file_name("table", opt.shard)), j);
-    return j;
-  }
+  if (!opt.shard.whole()) return engine::write_shard_file(r, opt.out_dir, "table", opt.shard);
   return table_outputs(r, opt.out_dir, opt.plots);
 }
 
@@ -107,7 +95,7 @@ nlohmann::json table_outputs(const engine::SweepResults& r, const std::string& o
   nlohmann::json cases = nlohmann::json::array();
   for (std::size_t a = 0; a < spec.approaches.size(); ++a) {
     nlohmann::json metrics = nlohmann::json::object();
-    for (std::size_t m = 0; m < spec.metrics.size(); ++m) metrics[spec.metrics[m]] = mean_ci(sums[m].value[a]);
+    for (std::size_t m = 0; m < spec.metrics.size(); ++m) metrics[spec.metrics[m]] = util::mean_ci_json(sums[m].value[a]);
     nlohmann::json c = {{"case", spec.approaches[a]}, {"metrics", metrics}};
     if (spec.config.contains("cases")) c["setting"] = spec.config["cases"].at(spec.approaches[a]);
     if (spec.config.contains("inject")) c["faults"] = sim::fault_row(r, a, 0);
@@ -122,7 +110,7 @@ nlohmann::json table_outputs(const engine::SweepResults& r, const std::string& o
       if (p.b == p.a + 1) pm[spec.approaches[p.b] + " - " + spec.approaches[p.a]] = {{"mean", -p.diff.mean}, {"ci95", p.diff.ci95}};
     paired[name] = pm;
   }
-  write_runs_csv(r, join(out_dir, "table_runs.csv"));
+  write_runs_csv(r, util::path_in(out_dir, "table_runs.csv"));
   nlohmann::json j = {{"study", "petc"},        {"experiment", "table"},     {"seeds", spec.seeds},
                       {"first_seed", spec.first_seed}, {"n_tts", spec.config.value("steps", 0)},
                       {"config", spec.config},  {"cases", cases},          {"paired_differences_consecutive", paired}};
@@ -130,7 +118,7 @@ nlohmann::json table_outputs(const engine::SweepResults& r, const std::string& o
     j["inject"] = spec.config.at("inject");
     j["markdown_faults"] = sim::fault_markdown(r);
   }
-  util::write_json(join(out_dir, "table.json"), j);
+  util::write_json(util::path_in(out_dir, "table.json"), j);
   return j;
 }
 
@@ -187,11 +175,7 @@ nlohmann::json run_gpi(const PetcSetup& setup, const SweepOptions& opt, std::siz
   const engine::SweepResults r = finish(
       spec, opt, [&](std::size_t a, std::size_t, std::uint64_t seed) { return run_case(setup, cases[a], seed); },
       "petc gpi");
-  if (!opt.shard.whole()) {
-    const nlohmann::json j = engine::shard_to_json(r);
-    util::write_json(join(opt.out_dir, engine::shard_file_name("gpi", opt.shard)), j);
-    return j;
-  }
+  if (!opt.shard.whole()) return engine::write_shard_file(r, opt.out_dir, "gpi", opt.shard);
   return gpi_outputs(r, opt.out_dir, opt.plots);
 }
 
@@ -221,19 +205,19 @@ nlohmann::json gpi_outputs(const engine::SweepResults& r, const std::string& out
   for (std::size_t a = 0; a < na; ++a) {
     if (gpi.value[a].mean < gpi.value[best].mean) best = a;
     const double s = grid.at(a).at("sigma_s"), c = grid.at(a).at("sigma_c");
-    pts.push_back({{"sigma_s", s}, {"sigma_c", c}, {"GPI", mean_ci(gpi.value[a])}, {"U_c", mean_ci(uc.value[a])},
-                   {"U_a", mean_ci(ua.value[a])}, {"N_E", mean_ci(ne.value[a])},
+    pts.push_back({{"sigma_s", s}, {"sigma_c", c}, {"GPI", util::mean_ci_json(gpi.value[a])}, {"U_c", util::mean_ci_json(uc.value[a])},
+                   {"U_a", util::mean_ci_json(ua.value[a])}, {"N_E", util::mean_ci_json(ne.value[a])},
                    {"sensor_packets", nsc.value[a].mean}, {"actuator_packets", nca.value[a].mean},
                    {"pareto", static_cast<bool>(front[a])}});
     rows.push_back({s, c, gpi.value[a].mean, gpi.value[a].ci95, uc.value[a].mean, ua.value[a].mean, ne.value[a].mean,
                     front[a] ? 1.0 : 0.0});
   }
-  util::write_csv(join(out_dir, "gpi.csv"), {"sigma_s", "sigma_c", "gpi", "gpi_ci95", "u_c", "u_a", "n_e", "pareto"}, rows);
-  write_runs_csv(r, join(out_dir, "gpi_runs.csv"));
+  util::write_csv(util::path_in(out_dir, "gpi.csv"), {"sigma_s", "sigma_c", "gpi", "gpi_ci95", "u_c", "u_a", "n_e", "pareto"}, rows);
+  write_runs_csv(r, util::path_in(out_dir, "gpi_runs.csv"));
   nlohmann::json j = {{"study", "petc"}, {"experiment", "gpi"}, {"seeds", spec.seeds}, {"weights", {0.45, 0.45, 0.1}},
                       {"setting", "case 4 (noise, known-model disturbance); delta = sigma on both links"},
                       {"points", pts}, {"best", pts.at(best)}};
-  util::write_json(join(out_dir, "gpi.json"), j);
+  util::write_json(util::path_in(out_dir, "gpi.json"), j);
   if (plots) {
     std::ostringstream g;
     g << kPng << "set output 'gpi.png'\nset multiplot layout 1,2\n"
@@ -267,7 +251,7 @@ nlohmann::json run_traces(const PetcSetup& setup, std::uint64_t seed, const std:
       rows.push_back({static_cast<double>(k), t.y_true[k], t.u[k], t.d[k], t.d_hat[k],
                       static_cast<double>(t.sensor_sent[k]), static_cast<double>(t.actuator_sent[k]), n});
     }
-    util::write_csv(join(out_dir, "trace_case" + tag + ".csv"), {"k", "y", "u", "d", "d_hat", "sensor_sent", "actuator_sent", "N"},
+    util::write_csv(util::path_in(out_dir, "trace_case" + tag + ".csv"), {"k", "y", "u", "d", "d_hat", "sensor_sent", "actuator_sent", "N"},
               rows);
     j[c.name] = {{"seed", seed}, {"N_E", v[3]}, {"d_error_rms", v[17]}, {"d_rms", v[18]}, {"N_max", v[12]}};
     if (plots) {

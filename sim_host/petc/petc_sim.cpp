@@ -70,17 +70,7 @@ Law make_law(const PetcSetup& s) {
   return Law(cfg);
 }
 
-Dob make_dob(const PetcSetup& s) {
-  node::DisturbanceObserverConfig<double, kDobSections, kDobMaxDelay> cfg;
-  cfg.q = {s.dob.q.b0, s.dob.q.b1, s.dob.q.b2, s.dob.q.a1, s.dob.q.a2};
-  for (std::size_t i = 0; i < s.dob.inverse.size(); ++i) {
-    const Biquad& b = s.dob.inverse[i];
-    cfg.inverse[i] = {b.b0, b.b1, b.b2, b.a1, b.a2};
-  }
-  cfg.inverse_gain = s.dob.inverse_gain;
-  cfg.delay = static_cast<std::uint32_t>(s.dob.delay);
-  return Dob(cfg);
-}
+Dob make_dob(const PetcSetup& s) { return Dob(dob_config(s)); }
 
 /// NUMRE controller node wrapped for the loop, compiled for the model's `Structure` (the
 /// augmented model: the M4F image's HddStructure, so the multiply-adds are the image's).
@@ -371,6 +361,18 @@ std::vector<double> simulate(const PetcSetup& s, const CaseSpec& c, std::uint64_
 }
 
 }  // namespace
+
+node::DisturbanceObserverConfig<double, kDobSections, kDobMaxDelay> dob_config(const PetcSetup& s) {
+  node::DisturbanceObserverConfig<double, kDobSections, kDobMaxDelay> cfg;
+  cfg.q = {s.dob.q.b0, s.dob.q.b1, s.dob.q.b2, s.dob.q.a1, s.dob.q.a2};
+  for (std::size_t i = 0; i < s.dob.inverse.size(); ++i) {
+    const Biquad& b = s.dob.inverse[i];
+    cfg.inverse[i] = {b.b0, b.b1, b.b2, b.a1, b.a2};
+  }
+  cfg.inverse_gain = s.dob.inverse_gain;
+  cfg.delay = static_cast<std::uint32_t>(s.dob.delay);
+  return cfg;
+}
 
 const std::vector<std::string>& metric_names() {
   static const std::vector<std::string> names = {

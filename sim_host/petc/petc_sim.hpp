@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "oneshot/engine/fault_spec.hpp"
+#include "oneshot/node/disturbance_observer.hpp"
 #include "oneshot/node/numre_estimator.hpp"
 #include "oneshot/sim/sweep_faults.hpp"
 #include "petc_design.hpp"
@@ -100,6 +101,10 @@ struct FaultRun {
 
 /// Designs everything; std::invalid_argument naming what does not fit the compiled sizes.
 PetcSetup make_setup(const PetcOptions& opt);
+
+/// The DOB substitute's configuration from the setup's design: Q filter, inverse sections,
+/// inverse gain and delay (what ObserverKind::kDob runs, and what its tests drive open loop).
+node::DisturbanceObserverConfig<double, kDobSections, kDobMaxDelay> dob_config(const PetcSetup& setup);
 
 /// Per-period traces of one run (optional).
 struct RunTrace {

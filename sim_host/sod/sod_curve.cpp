@@ -3,12 +3,11 @@
 ///        packet budget) and E4 (error over time); see sod_experiments.hpp.
 #include <cmath>
 #include <limits>
-#include <cstdio>
-#include <filesystem>
 #include <sstream>
 
 #include "oneshot/engine/sweep.hpp"
 #include "oneshot/node/send_cause.hpp"
+#include "oneshot/util/number_text.hpp"
 #include "oneshot/util/output_files.hpp"
 #include "oneshot/util/statistics.hpp"
 #include "sod_experiments.hpp"
@@ -18,13 +17,9 @@ namespace {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
-std::string path_in(const std::string& dir, const std::string& name) { return (std::filesystem::path(dir) / name).string(); }
-std::string g4(double v) {
-  char b[48];
-  std::snprintf(b, sizeof b, "%g", v);
-  return b;
-}
-nlohmann::json ci(const util::Summary& s) { return {{"mean", s.mean}, {"ci95", s.ci95}}; }
+using util::path_in;
+std::string g6(double v) { return util::format_g(v, 6); }
+using util::mean_ci_json;
 
 }  // namespace
 
@@ -36,9 +31,9 @@ nlohmann::json run_curve(const SodModel& model, const StudyOptions& opt, const s
   engine::SweepSpec spec;
   spec.study = "sod";
   spec.experiment = "curve";
-  for (double dt : delta_ts) spec.approaches.push_back("msod dt=" + g4(dt));
+  for (double dt : delta_ts) spec.approaches.push_back("msod dt=" + g6(dt));
   spec.approaches.push_back("sod");
-  for (double xi : losses) spec.scenarios.push_back("xi=" + g4(xi));
+  for (double xi : losses) spec.scenarios.push_back("xi=" + g6(xi));
   spec.first_seed = opt.seed;
   spec.seeds = opt.seeds;
   spec.metrics = {"e1", "e2", "packets", "nees"};
@@ -99,7 +94,7 @@ nlohmann::json run_curve(const SodModel& model, const StudyOptions& opt, const s
         nlohmann::json part;
         for (std::size_t m = 0; m < 4; ++m) {
           const util::Summary x = stat(*r, a, s, m);
-          part[spec.metrics[m]] = ci(x);
+          part[spec.metrics[m]] = mean_ci_json(x);
           line.push_back(x.mean);
           line.push_back(x.ci95);
         }
@@ -108,7 +103,7 @@ nlohmann::json run_curve(const SodModel& model, const StudyOptions& opt, const s
       for (std::size_t m = 0; m < 2; ++m) {  // paired: event − periodic at the same seed
         std::vector<double> d;
         for (std::size_t k = 0; k < seeds; ++k) d.push_back(r1.at(a, s, k, m) - r2.at(a, s, k, m));
-        row["paired_event_minus_periodic"][spec.metrics[m]] = ci(util::summarize(d));
+        row["paired_event_minus_periodic"][spec.metrics[m]] = mean_ci_json(util::summarize(d));
       }
       j["rows"].push_back(row);
       csv.push_back(line);
@@ -144,13 +139,7 @@ nlohmann::json run_curve(const SodModel& model, const StudyOptions& opt, const s
 
 nlohmann::json run_traces(const SodModel& model, const StudyOptions& opt, double loss) {
   const MeanGap g = measure_mean_gap(model, opt, opt.delta_y);
-  DesignInputs in;
-  in.delta_y[0] = in.delta_y[1] = opt.delta_y;
-  in.loss[0] = in.loss[1] = loss;
-  in.mean_gap_s[0] = g.mean_s[0];
-  in.mean_gap_s[1] = g.mean_s[1];
-  in.mu = opt.mu;
-  const DeltaTDesign d = design_delta_t(model, in);
+  const DeltaTDesign d = design_at(model, opt, g, opt.delta_y, loss);
   const double T = model.period_s();
   const std::size_t per_bin = static_cast<std::size_t>(std::max(1.0, std::round(0.5 / T)));  // 0.5 s bins
   const std::size_t bins = static_cast<std::size_t>(opt.steps) / per_bin;
@@ -169,7 +158,7 @@ nlohmann::json run_traces(const SodModel& model, const StudyOptions& opt, double
   spec.study = "sod";
   spec.experiment = "traces";
   spec.approaches = {"sod-held", "msod"};
-  spec.scenarios = {"xi=" + g4(loss)};
+  spec.scenarios = {"xi=" + g6(loss)};
   spec.first_seed = opt.seed;
   spec.seeds = opt.seeds;
   for (int i = 1; i <= 2; ++i)

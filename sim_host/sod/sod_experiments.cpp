@@ -108,6 +108,16 @@ nlohmann::json design_json(const DeltaTDesign& d, double loss) {
 
 }  // namespace
 
+DeltaTDesign design_at(const SodModel& model, const StudyOptions& opt, const MeanGap& g, double delta_y, double loss) {
+  DesignInputs in;
+  in.delta_y[0] = in.delta_y[1] = delta_y;
+  in.loss[0] = in.loss[1] = loss;
+  in.mean_gap_s[0] = g.mean_s[0];
+  in.mean_gap_s[1] = g.mean_s[1];
+  in.mu = opt.mu;
+  return design_delta_t(model, in);
+}
+
 nlohmann::json run_design(const SodModel& model, const StudyOptions& opt) {
   const MeanGap g = measure_mean_gap(model, opt, opt.delta_y);
   nlohmann::json j = {{"experiment", "design"}, {"plant", model.plant_name}, {"delta_y", opt.delta_y}, {"mu", opt.mu},
@@ -116,13 +126,7 @@ nlohmann::json run_design(const SodModel& model, const StudyOptions& opt) {
   double lo[kNodes] = {INFINITY, INFINITY}, hi[kNodes] = {0, 0};
   bool any_bounded[kNodes] = {false, false};
   for (double xi : opt.design_losses) {
-    DesignInputs in;
-    in.delta_y[0] = in.delta_y[1] = opt.delta_y;
-    in.loss[0] = in.loss[1] = xi;
-    in.mean_gap_s[0] = g.mean_s[0];
-    in.mean_gap_s[1] = g.mean_s[1];
-    in.mu = opt.mu;
-    const DeltaTDesign d = design_delta_t(model, in);
+    const DeltaTDesign d = design_at(model, opt, g, opt.delta_y, xi);
     j["p0_diag"] = {d.p0_diag[0], d.p0_diag[1]};
     j["per_loss"].push_back(design_json(d, xi));
     for (std::size_t i = 0; i < kNodes; ++i) {
@@ -146,13 +150,7 @@ nlohmann::json run_grid(const SodModel& model, const StudyOptions& opt, const st
     const MeanGap g = measure_mean_gap(model, opt, dy);
     nlohmann::json row = {{"delta_y", dy}, {"mean_gap_s", {g.mean_s[0], g.mean_s[1]}}};
     for (double xi : losses) {
-      DesignInputs in;
-      in.delta_y[0] = in.delta_y[1] = dy;
-      in.loss[0] = in.loss[1] = xi;
-      in.mean_gap_s[0] = g.mean_s[0];
-      in.mean_gap_s[1] = g.mean_s[1];
-      in.mu = opt.mu;
-      const DeltaTDesign d = design_delta_t(model, in);
+      const DeltaTDesign d = design_at(model, opt, g, dy, xi);
       row["per_loss"].push_back(design_json(d, xi));
       rows.push_back({dy, xi, d.node[0].bounded ? d.node[0].delta_t_s : kNaN, d.node[1].bounded ? d.node[1].delta_t_s : kNaN,
                       g.mean_s[0], g.mean_s[1]});

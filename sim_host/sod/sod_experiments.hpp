@@ -43,6 +43,10 @@ struct MeanGap {
 /// Measures ΔT at `delta_y` over opt.seeds seeds.
 MeanGap measure_mean_gap(const SodModel& model, const StudyOptions& opt, double delta_y);
 
+/// Δt* of both nodes at threshold `delta_y` and loss rate `loss`: the design inputs from
+/// the measured mean gaps `g` and the options' bound μ.
+DeltaTDesign design_at(const SodModel& model, const StudyOptions& opt, const MeanGap& g, double delta_y, double loss);
+
 /// E1: ΔT for each δy.
 nlohmann::json run_mean_gap(const SodModel& model, const StudyOptions& opt, const std::vector<double>& delta_ys);
 /// `design`: P0, δt* per node and ξ, the active constraint, δt*·ξ.

@@ -42,6 +42,7 @@ SodModel load_sod_model(const std::string& path) {
   m.phi = s.phi;
   m.qd = s.qd;
   m.cm = plant.c;
+  m.discrete = {s.phi, s.gamma, {}, plant.c, s.qd, {}, {}, engine::from_us(plant.period_us)};
   return m;
 }
 

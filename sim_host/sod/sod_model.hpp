@@ -7,6 +7,7 @@
 #include <string>
 
 #include "oneshot/design/dense_matrix.hpp"
+#include "oneshot/engine/plant_model.hpp"
 #include "oneshot/matrix.hpp"
 
 namespace oneshot::sod {
@@ -26,6 +27,7 @@ struct SodModel {
   Matrix<double, kNodes, kStates> c;           ///< C (node i reads output i).
   Vector<double, kNodes> r_diag;               ///< R_ii per sample.
   design::DenseMatrix phi, qd, cm;             ///< The same, run-time sized, for the design step.
+  engine::DiscreteModel discrete;              ///< Φ = A_d, Γ = B_d, C, Q = Q_d per T: the engine's plant.
   /// T in seconds.
   double period_s() const { return period_us * 1e-6; }
 };

@@ -2,19 +2,15 @@
 /// @brief The send-on-delta report section (see sod_report.hpp).
 #include "sod_report.hpp"
 
-#include <cstdio>
 #include <sstream>
 
+#include "oneshot/util/number_text.hpp"
 #include "sod_experiments.hpp"
 
 namespace oneshot::sod {
 namespace {
 
-std::string g4(double v) {
-  char b[48];
-  std::snprintf(b, sizeof b, "%.4g", v);
-  return b;
-}
+std::string g4(double v) { return util::format_g(v, 4); }
 std::string maybe(const nlohmann::json& v) { return v.is_null() ? "unbounded" : g4(v.get<double>()); }
 std::string ci(const nlohmann::json& v) { return g4(v.at("mean").get<double>()) + " ± " + g4(v.at("ci95").get<double>()); }
 

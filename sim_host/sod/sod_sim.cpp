@@ -3,7 +3,6 @@
 #include "sod_sim.hpp"
 
 #include <cmath>
-#include <cstring>
 #include <limits>
 #include <optional>
 #include <stdexcept>
@@ -13,6 +12,7 @@
 #include "oneshot/engine/kernel.hpp"
 #include "oneshot/engine/link.hpp"
 #include "oneshot/engine/random_stream.hpp"
+#include "oneshot/engine/sequenced_frame.hpp"
 #include "oneshot/node/held_measurement.hpp"
 #include "oneshot/node/held_measurement_estimator.hpp"
 #include "oneshot/node/periodic_trigger.hpp"
@@ -45,22 +45,6 @@ NodeRule make_rule(const RunConfig& cfg, std::size_t i) {
                   node::PeriodicTrigger<double, 1>(cfg.every[i])};
 }
 
-/// A packet on the wire under faults: k (u32, little-endian) then y (IEEE 754 double).
-constexpr engine::FrameLayout kFrameLayout{0, 4, 4, 8};
-
-std::vector<std::uint8_t> encode_frame(node::SequenceNumber k, double y) {
-  std::vector<std::uint8_t> b(12);
-  for (std::size_t j = 0; j < 4; ++j) b[j] = static_cast<std::uint8_t>(k >> (8 * j));
-  std::memcpy(b.data() + 4, &y, sizeof y);
-  return b;
-}
-
-void decode_frame(const std::vector<std::uint8_t>& b, node::SequenceNumber& k, double& y) {
-  k = 0;
-  for (std::size_t j = 0; j < 4; ++j) k |= static_cast<node::SequenceNumber>(b[j]) << (8 * j);
-  std::memcpy(&y, b.data() + 4, sizeof y);
-}
-
 void check(const RunConfig& cfg) {
   if (!(cfg.loss >= 0 && cfg.loss <= 1)) throw std::invalid_argument("sod: loss rate must lie in [0, 1]");
   if (cfg.steps < 1 || cfg.steps > (std::int64_t{1} << 31)) throw std::invalid_argument("sod: steps must lie in [1, 2^31]");
@@ -81,12 +65,7 @@ RunResult simulate_run(const SodModel& model, const RunConfig& cfg, std::uint64_
   const engine::SimTime end{period.count() * cfg.steps};
   engine::Kernel kernel(seed);
 
-  engine::DiscretePlantConfig<kStates, kInputs, kNodes, 1> pc;
-  pc.phi = model.a_d;
-  pc.gamma = model.b_d;
-  pc.c = model.c;
-  pc.q = model.q_d;
-  pc.period = period;
+  auto pc = engine::make_discrete_config<kStates, kInputs, kNodes, 1>(model.discrete, "sod");
   pc.process_noise = cfg.noise;
   engine::DiscretePlant<kStates, kInputs, kNodes, 1> plant(pc, kernel.stream("process"));
   Vector<double, kInputs> u;
@@ -110,7 +89,7 @@ RunResult simulate_run(const SodModel& model, const RunConfig& cfg, std::uint64_
   const bool faulted = !cfg.faults.empty();
   std::optional<engine::LinkFaults> faults[kNodes];
   if (faulted)
-    for (std::size_t i = 0; i < kNodes; ++i) faults[i].emplace(cfg.faults, kNodeNames[i], kFrameLayout, seed);
+    for (std::size_t i = 0; i < kNodes; ++i) faults[i].emplace(cfg.faults, kNodeNames[i], engine::kSequencedFrameLayout, seed);
   std::vector<std::vector<std::uint8_t>> frames;  // delivered by "sod frame" (arg: index << 1 | node)
 
   Vector<double, kNodes> dy, r;
@@ -149,7 +128,7 @@ RunResult simulate_run(const SodModel& model, const RunConfig& cfg, std::uint64_
       const std::size_t i = arg & 1u;
       node::SequenceNumber k = 0;
       double y = 0;
-      decode_frame(frames[arg >> 1], k, y);
+      if (!engine::decode_sequenced_frame(frames[arg >> 1], k, &y, 1)) return;  // every fault keeps the size
       if (std::int64_t{k} != step_now) {  // no delay on the link: only the current sample is genuine
         res.refused_sequence += 1;
         return;
@@ -224,7 +203,7 @@ RunResult simulate_run(const SodModel& model, const RunConfig& cfg, std::uint64_
       res.sends[i] += 1;
       if (cause == node::SendCause::kTime) res.time_sends[i] += 1;
       if (faulted) {
-        std::vector<std::uint8_t> bytes = encode_frame(k, y);
+        std::vector<std::uint8_t> bytes = engine::encode_sequenced_frame(k, &y, 1);
         std::vector<std::vector<std::uint8_t>> extra;
         faults[i]->apply(kernel.now(), bytes, extra);
         const std::optional<engine::SimTime> at = link[i]->transmit(kernel.now());

@@ -3,13 +3,12 @@
 ///        sod_experiments.hpp), shardable and merged by the registered summarizer.
 #include <array>
 #include <cmath>
-#include <cstdio>
-#include <filesystem>
 #include <fstream>
 #include <sstream>
 
 #include "oneshot/engine/random_stream.hpp"
 #include "oneshot/engine/sweep_statistics.hpp"
+#include "oneshot/util/number_text.hpp"
 #include "oneshot/util/output_files.hpp"
 #include "oneshot/util/statistics.hpp"
 #include "sod_experiments.hpp"
@@ -37,13 +36,9 @@ const std::vector<std::string> kMetrics = {"e1", "e2", "e1_tail", "e2_tail", "ne
 /// Per-run counters of a faulted table (RunResult): faults injected, frames refused, estimator resets.
 const std::vector<std::string> kFaultMetrics = {"injected", "refused_non_finite", "refused_sequence", "estimator_resets"};
 
-std::string path_in(const std::string& dir, const std::string& name) { return (std::filesystem::path(dir) / name).string(); }
-std::string f4(double v) {
-  char b[48];
-  std::snprintf(b, sizeof b, "%.4g", v);
-  return b;
-}
-nlohmann::json ci(const util::Summary& s) { return {{"mean", s.mean}, {"ci95", s.ci95}}; }
+using util::path_in;
+std::string f4(double v) { return util::format_g(v, 4); }
+using util::mean_ci_json;
 
 }  // namespace
 
@@ -61,13 +56,7 @@ nlohmann::json run_table(const SodModel& model, const StudyOptions& opt) {
     std::array<std::uint32_t, kNodes> nt{0, 0};
     nlohmann::json s = {{"loss", xi}};
     if (xi > 0) {
-      DesignInputs in;
-      in.delta_y[0] = in.delta_y[1] = opt.delta_y;
-      in.loss[0] = in.loss[1] = xi;
-      in.mean_gap_s[0] = g.mean_s[0];
-      in.mean_gap_s[1] = g.mean_s[1];
-      in.mu = opt.mu;
-      const DeltaTDesign d = design_delta_t(model, in);
+      const DeltaTDesign d = design_at(model, opt, g, opt.delta_y, xi);
       for (std::size_t i = 0; i < kNodes; ++i) nt[i] = d.node[i].bounded ? d.node[i].n_t : 0;
     }
     for (std::size_t i = 0; i < kNodes; ++i) s["n_t"].push_back(nt[i]);
@@ -106,12 +95,7 @@ nlohmann::json run_table(const SodModel& model, const StudyOptions& opt) {
                              x.estimator_resets});
         return v;
       }, "sod table");
-  if (!opt.shard.whole()) {
-    util::make_directory(opt.out_dir);
-    const nlohmann::json j = engine::shard_to_json(r);
-    util::write_json(path_in(opt.out_dir, engine::shard_file_name("table", opt.shard)), j);
-    return j;
-  }
+  if (!opt.shard.whole()) return engine::write_shard_file(r, opt.out_dir, "table", opt.shard);
   return table_outputs(r, opt.out_dir, opt.plots);
 }
 
@@ -139,16 +123,16 @@ nlohmann::json table_outputs(const engine::SweepResults& results, const std::str
       if (kConfigurations[a].sender == SenderKind::kModifiedSod) row["n_t"] = spec.config.at("scenarios").at(s).at("n_t");
       for (int i = 1; i <= 2; ++i) {
         const std::string n = std::to_string(i);
-        row["packets"].push_back(ci(stat(a, s, "sends" + n)));
-        row["time_rule_sends"].push_back(ci(stat(a, s, "time_sends" + n)));
-        row["losses"].push_back(ci(stat(a, s, "lost" + n)));
-        row["detected_losses"].push_back(ci(stat(a, s, "detected" + n)));
-        row["e"].push_back(ci(stat(a, s, "e" + n)));
-        row["e_tail_20_50s"].push_back(ci(stat(a, s, "e" + n + "_tail")));
+        row["packets"].push_back(mean_ci_json(stat(a, s, "sends" + n)));
+        row["time_rule_sends"].push_back(mean_ci_json(stat(a, s, "time_sends" + n)));
+        row["losses"].push_back(mean_ci_json(stat(a, s, "lost" + n)));
+        row["detected_losses"].push_back(mean_ci_json(stat(a, s, "detected" + n)));
+        row["e"].push_back(mean_ci_json(stat(a, s, "e" + n)));
+        row["e_tail_20_50s"].push_back(mean_ci_json(stat(a, s, "e" + n + "_tail")));
       }
-      row["nees"] = ci(stat(a, s, "nees"));
+      row["nees"] = mean_ci_json(stat(a, s, "nees"));
       if (spec.config.contains("inject"))
-        for (const auto& m : kFaultMetrics) row["faults"][m] = ci(stat(a, s, m));
+        for (const auto& m : kFaultMetrics) row["faults"][m] = mean_ci_json(stat(a, s, m));
       j["rows"].push_back(row);
       const auto e1 = stat(a, s, "e1"), e2 = stat(a, s, "e2"), t1 = stat(a, s, "e1_tail"), nees = stat(a, s, "nees");
       md << "| " << spec.approaches[a] << " | " << xi << " | " << f4(stat(a, s, "sends1").mean) << " | "
@@ -176,7 +160,7 @@ nlohmann::json table_outputs(const engine::SweepResults& results, const std::str
         std::vector<double> d(x.size());
         for (std::size_t k = 0; k < x.size(); ++k) d[k] = x[k] - y[k];
         const util::Summary sd = util::summarize(d);
-        e[m] = ci(sd);
+        e[m] = mean_ci_json(sd);
         pd << " | " << f4(sd.mean) << " ± " << f4(sd.ci95);
       }
       pd << " |\n";

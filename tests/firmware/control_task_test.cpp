@@ -34,6 +34,22 @@ struct Schedule {
   }
 };
 
+/// The host board of this thread for one test: ADC code 2048, set-point queries to a
+/// Schedule switching at `switch_us`.
+struct ScheduledBoard {
+  explicit ScheduledBoard(std::uint64_t switch_us) : schedule{switch_us, {}}, hb(state(schedule)), scope(hb) {}
+  static host::HostBoardState state(Schedule& s) {
+    host::HostBoardState b;
+    b.adc_codes.assign(1, 2048);
+    b.setpoint_at = &Schedule::at;
+    b.setpoint_context = &s;
+    return b;
+  }
+  Schedule schedule;
+  host::HostBoardState hb;
+  const host::ScopedHostBoard scope;
+};
+
 TEST(ControlTask, CrossesThe32BitMicrosecondWrapAndTracksTheRightSetpoint) {
   // GIVEN a one-shot task whose jobs run around 2^32 µs, the set-point switching 2 periods after it
   const Disc disc(K::kTable);
@@ -41,12 +57,9 @@ TEST(ControlTask, CrossesThe32BitMicrosecondWrapAndTracksTheRightSetpoint) {
   app::ControlTask<host::HostBoard, Ctrl, app::TaskModel::kOneShot> task(ctrl);
   const std::uint64_t h = static_cast<std::uint64_t>(K::kDesign.period_us);
   const std::uint64_t wrap = std::uint64_t{1} << 32;
-  Schedule schedule{wrap + 2 * h, {}};
-  host::HostBoardState hb;
-  hb.adc_codes.assign(1, 2048);
-  hb.setpoint_at = &Schedule::at;
-  hb.setpoint_context = &schedule;
-  const host::ScopedHostBoard scope(hb);
+  ScheduledBoard board(wrap + 2 * h);
+  Schedule& schedule = board.schedule;
+  host::HostBoardState& hb = board.hb;
   // WHEN jobs sample 7 ms before each actuation from 5 periods before the wrap to 5 after
   for (std::int64_t k = -5; k <= 5; ++k) {
     const std::uint64_t t_k = wrap + static_cast<std::uint64_t>(k * static_cast<std::int64_t>(h)) + 1234;
@@ -70,12 +83,8 @@ TEST(ControlTask, GarbageTimerValuesAreRefusedByRangeNotOverflowed) {
   const Disc disc(K::kTable);
   Ctrl ctrl(K::kDesign, Est(K::kDesign, disc, NoiseModel::kExact));
   app::ControlTask<host::HostBoard, Ctrl, app::TaskModel::kOneShot> task(ctrl);
-  Schedule schedule{0, {}};
-  host::HostBoardState hb;
-  hb.adc_codes.assign(1, 2048);
-  hb.setpoint_at = &Schedule::at;
-  hb.setpoint_context = &schedule;
-  const host::ScopedHostBoard scope(hb);
+  ScheduledBoard board(0);
+  host::HostBoardState& hb = board.hb;
   hb.now_us = 1000;
   hb.next_actuation_us = 1000 + (std::uint64_t{1} << 40);
   // WHEN the job runs THEN τ is bounded to kMaxTauUs and the job reports kOutOfRange
@@ -98,12 +107,8 @@ TEST(ControlTask, FixedPointSaturationReachesTheJobAsAStatus) {
   const FixedDisc disc(KQ::kTable);
   FixedCtrl ctrl(KQ::kDesign, FixedEst(KQ::kDesign, disc, NoiseModel::kExact));
   app::ControlTask<host::HostBoard, FixedCtrl, app::TaskModel::kOneShot> task(ctrl);
-  Schedule schedule{0, {}};
-  host::HostBoardState hb;
-  hb.adc_codes.assign(1, 2048);
-  hb.setpoint_at = &Schedule::at;
-  hb.setpoint_context = &schedule;
-  const host::ScopedHostBoard scope(hb);
+  ScheduledBoard board(0);
+  host::HostBoardState& hb = board.hb;
   hb.now_us = 10'000;
   hb.next_actuation_us = 20'000;
   // A normal job first: exact, no saturation.

@@ -53,7 +53,7 @@ void run_million(const char* name) {
   }
   std::cout << "[ measured ] " << name << ": after 1e6 float32 jobs, max rel |P_f - P_d| " << worst_rel
             << ", min eigenvalue ratio " << min_eig << "\n";
-  EXPECT_LT(worst_rel, 1e-3);
+  EXPECT_LT(worst_rel, 2e-6);  // measured 2.1e-7 … 3.2e-7 over the three forms: ~6× margin
 }
 
 TEST(CovarianceStability, HalfSymmetricFormMillionFloatJobs) {

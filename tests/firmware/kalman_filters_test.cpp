@@ -14,6 +14,7 @@
 #include "oneshot/generated/plant_tables.hpp"
 #include "oneshot/half_kalman.hpp"
 #include "oneshot/standard_kalman.hpp"
+#include "filter_cases.hpp"
 #include "support/eigen_reference.hpp"
 #include "support/test_plants.hpp"
 
@@ -49,7 +50,7 @@ class TruePlant {
   test::VecX x_;
 };
 
-enum class Variant { kHalf, kComplete };
+using Variant = test::FilterVariant;
 
 struct Deviation {
   double state = 0;  // max |x̂ − x̂_ref| (V)
@@ -104,65 +105,75 @@ Deviation run_variant(const Disc& disc, Variant variant, NoiseModel noise, int j
   return run_against_reference(filter, variant, noise == NoiseModel::kExact, jobs, 42);
 }
 
-struct Case {
-  const char* name;
-  Variant variant;
-  NoiseModel noise;
-  bool table;
-};
+using test::FilterCase;
 
-void PrintTo(const Case& c, std::ostream* os) { *os << c.name; }
+class FilterVsEigen : public ::testing::TestWithParam<FilterCase> {};
 
-class FilterVsEigen : public ::testing::TestWithParam<Case> {};
-
-TEST_P(FilterVsEigen, DoubleAgreesToRounding) {
-  const Case c = GetParam();
-  using K = PlantConstants<double>;
-  const TableDiscretizer<K::Format, PlantStructure, double> table(K::kTable);
-  const GenericDiscretizer<K::Format, 2, 1> generic(K::kModel);
+/// Case `c` in scalar S (double or float) against the Eigen reference over 3000 jobs; the
+/// measured deviation is printed for the test report.
+template <typename S>
+Deviation run_case(const FilterCase& c, const char* scalar) {
+  using K = PlantConstants<S>;
+  const TableDiscretizer<typename K::Format, PlantStructure, S> table(K::kTable);
+  const GenericDiscretizer<typename K::Format, 2, 1> generic(K::kModel);
   Deviation d;
   if (c.variant == Variant::kHalf) {
-    d = c.table ? run_variant<double, HalfKalman>(table, c.variant, c.noise, 3000)
-                : run_variant<double, HalfKalman>(generic, c.variant, c.noise, 3000);
+    d = c.table ? run_variant<S, HalfKalman>(table, c.variant, c.noise, 3000)
+                : run_variant<S, HalfKalman>(generic, c.variant, c.noise, 3000);
   } else {
-    d = c.table ? run_variant<double, CompleteKalman>(table, c.variant, c.noise, 3000)
-                : run_variant<double, CompleteKalman>(generic, c.variant, c.noise, 3000);
+    d = c.table ? run_variant<S, CompleteKalman>(table, c.variant, c.noise, 3000)
+                : run_variant<S, CompleteKalman>(generic, c.variant, c.noise, 3000);
   }
-  EXPECT_LT(d.state, 1e-10);
-  EXPECT_LT(d.cov, 1e-9);
-  EXPECT_LT(d.gain, 1e-10);
+  std::cout << "[ measured ] " << scalar << " " << c.name << ": max |dx| " << d.state << " V, P rel " << d.cov
+            << ", |dK| " << d.gain << "\n";
+  return d;
+}
+
+TEST_P(FilterVsEigen, DoubleAgreesToRounding) {
+  const Deviation d = run_case<double>(GetParam(), "double");
+  // Measured over the six cases: |dx| 1.8e-16 … 2.4e-16 V, P rel 6.2e-16 … 6.4e-16,
+  // |dK| 1.7e-16 … 2.2e-16 (a few ulps): bounds ~10× that.
+  EXPECT_LT(d.state, 2e-15);
+  EXPECT_LT(d.cov, 6e-15);
+  EXPECT_LT(d.gain, 2e-15);
 }
 
 TEST_P(FilterVsEigen, FloatStaysWithinStatedBounds) {
-  const Case c = GetParam();
-  using K = PlantConstants<float>;
-  const TableDiscretizer<K::Format, PlantStructure, float> table(K::kTable);
-  const GenericDiscretizer<K::Format, 2, 1> generic(K::kModel);
-  Deviation d;
-  if (c.variant == Variant::kHalf) {
-    d = c.table ? run_variant<float, HalfKalman>(table, c.variant, c.noise, 3000)
-                : run_variant<float, HalfKalman>(generic, c.variant, c.noise, 3000);
-  } else {
-    d = c.table ? run_variant<float, CompleteKalman>(table, c.variant, c.noise, 3000)
-                : run_variant<float, CompleteKalman>(generic, c.variant, c.noise, 3000);
-  }
-  std::cout << "[ measured ] float " << c.name << ": max |dx| " << d.state << " V, P rel " << d.cov << ", |dK| "
-            << d.gain << "\n";
-  // One 12-bit ADC LSB over ±1.65 V is 0.8 mV: float stays three orders below it.
-  EXPECT_LT(d.state, 1e-6);
-  EXPECT_LT(d.cov, 1e-4);
-  EXPECT_LT(d.gain, 1e-5);
+  const Deviation d = run_case<float>(GetParam(), "float");
+  // One 12-bit ADC LSB over ±1.65 V is 0.8 mV: float stays four orders below it. Measured over
+  // the six cases: |dx| 4.8e-8 … 6.7e-8 V, P rel 2.2e-7 … 3.1e-7, |dK| 7.0e-8 … 9.1e-8.
+  EXPECT_LT(d.state, 4e-7);
+  EXPECT_LT(d.cov, 2e-6);
+  EXPECT_LT(d.gain, 5e-7);
 }
 
 INSTANTIATE_TEST_SUITE_P(
     Variants, FilterVsEigen,
-    ::testing::Values(Case{"half_table_exact", Variant::kHalf, NoiseModel::kExact, true},
-                      Case{"half_generic_exact", Variant::kHalf, NoiseModel::kExact, false},
-                      Case{"half_table_constant", Variant::kHalf, NoiseModel::kConstant, true},
-                      Case{"complete_table_exact", Variant::kComplete, NoiseModel::kExact, true},
-                      Case{"complete_generic_exact", Variant::kComplete, NoiseModel::kExact, false},
-                      Case{"complete_table_constant", Variant::kComplete, NoiseModel::kConstant, true}),
-    [](const ::testing::TestParamInfo<Case>& param_info) { return std::string(param_info.param.name); });
+    ::testing::Values(FilterCase{"half_table_exact", Variant::kHalf, NoiseModel::kExact, true},
+                      FilterCase{"half_generic_exact", Variant::kHalf, NoiseModel::kExact, false},
+                      FilterCase{"half_table_constant", Variant::kHalf, NoiseModel::kConstant, true},
+                      FilterCase{"complete_table_exact", Variant::kComplete, NoiseModel::kExact, true},
+                      FilterCase{"complete_generic_exact", Variant::kComplete, NoiseModel::kExact, false},
+                      FilterCase{"complete_table_constant", Variant::kComplete, NoiseModel::kConstant, true}),
+    test::filter_case_name);
+
+/// Random jobs for filters compared side by side (one stream per test, seeded): τ uniform
+/// in [tau_min, tau_max] µs, samples and applied inputs N(0, 0.1²), drawn in call order.
+class RandomJobs {
+ public:
+  RandomJobs(std::uint64_t seed, std::int32_t tau_min, std::int32_t tau_max) : rng_(seed), tau_(tau_min, tau_max) {}
+  std::int32_t tau() { return tau_(rng_); }
+  Vector<double, 1> value() {
+    Vector<double, 1> v;
+    v[0] = y_(rng_);
+    return v;
+  }
+
+ private:
+  std::mt19937_64 rng_;
+  std::uniform_int_distribution<std::int32_t> tau_;
+  std::normal_distribution<double> y_{0.0, 0.1};
+};
 
 TEST(KalmanFilters, HalfAndCompleteAreTheSameEstimator) {
   // Algebraically identical (brief §5): only the rounding differs.
@@ -171,27 +182,27 @@ TEST(KalmanFilters, HalfAndCompleteAreTheSameEstimator) {
   for (NoiseModel noise : {NoiseModel::kExact, NoiseModel::kConstant}) {
     HalfKalman<K::Format, PlantStructure, decltype(table)> half(K::kDesign, table, noise);
     CompleteKalman<K::Format, PlantStructure, decltype(table)> complete(K::kDesign, table, noise);
-    std::mt19937_64 rng(7);
-    std::uniform_int_distribution<std::int32_t> tau(0, 50000);
-    std::normal_distribution<double> y(0.0, 0.1);
+    RandomJobs jobs(7, 0, 50000);
     for (int k = 0; k < 2000; ++k) {
-      const std::int32_t t = tau(rng);
-      Vector<double, 1> yk;
-      yk[0] = y(rng);
+      const std::int32_t t = jobs.tau();
+      const Vector<double, 1> yk = jobs.value();
       ASSERT_TRUE(is_exact(half.update(t, yk)));
       ASSERT_TRUE(is_exact(complete.update(t, yk)));
       EXPECT_LT(std::fabs(half.prediction()[0] - complete.prediction()[0]), 1e-12);
       EXPECT_LT(std::fabs(half.prediction()[1] - complete.prediction()[1]), 1e-12);
       EXPECT_LT(std::fabs(half.gain()[0] - complete.gain()[0]), 1e-12);
-      Vector<double, 1> u;
-      u[0] = y(rng);
+      const Vector<double, 1> u = jobs.value();
       half.set_applied_input(u);
       complete.set_applied_input(u);
     }
   }
 }
 
-TEST(KalmanFilters, NearestPolicyFilterEqualsTheExactFilterOnRoundedTau) {
+/// Filters over the nearest-grid-point table fed raw τ ∈ [tau_min, tau_max] against filters
+/// over the exact table fed τ rounded to the nearest grid point (half away from zero): the
+/// statuses agree and the estimates are the same bits, job by job.
+void expect_nearest_equals_exact_on_rounded_tau(std::uint64_t seed, std::int32_t tau_min, std::int32_t tau_max,
+                                                int jobs) {
   // GIVEN filters over the nearest-grid-point table and over the exact table
   using K = PlantConstants<double>;
   using Exact = TableDiscretizer<K::Format, PlantStructure, double>;
@@ -203,53 +214,12 @@ TEST(KalmanFilters, NearestPolicyFilterEqualsTheExactFilterOnRoundedTau) {
   HalfKalman<K::Format, PlantStructure, Exact> half_e(K::kDesign, exact, NoiseModel::kExact);
   CompleteKalman<K::Format, PlantStructure, Nearest> comp_n(K::kDesign, nearest, NoiseModel::kExact);
   CompleteKalman<K::Format, PlantStructure, Exact> comp_e(K::kDesign, exact, NoiseModel::kExact);
-  std::mt19937_64 rng(11);
-  std::uniform_int_distribution<std::int32_t> tau(0, K::kDesign.period_us);
-  std::normal_distribution<double> y(0.0, 0.1);
-  for (int k = 0; k < 2000; ++k) {
+  RandomJobs random(seed, tau_min, tau_max);
+  for (int k = 0; k < jobs; ++k) {
     // WHEN the nearest filters get raw τ and the exact ones τ rounded to the grid
-    const std::int32_t t = tau(rng);
-    const std::int32_t rounded = ((t + g / 2) / g) * g;
-    Vector<double, 1> yk;
-    yk[0] = y(rng);
-    ASSERT_EQ(half_n.update(t, yk), half_e.update(rounded, yk));
-    ASSERT_EQ(comp_n.update(t, yk), comp_e.update(rounded, yk));
-    // THEN they are the same computation
-    for (std::size_t i = 0; i < 2; ++i) {
-      ASSERT_EQ(half_n.prediction()[i], half_e.prediction()[i]) << "job " << k;
-      ASSERT_EQ(comp_n.prediction()[i], comp_e.prediction()[i]) << "job " << k;
-    }
-    Vector<double, 1> u;
-    u[0] = y(rng);
-    half_n.set_applied_input(u);
-    half_e.set_applied_input(u);
-    comp_n.set_applied_input(u);
-    comp_e.set_applied_input(u);
-  }
-}
-
-TEST(KalmanFilters, NearestPolicyRoundsNegativeOffGridTauLikeTheExactFilterOnRoundedTau) {
-  // GIVEN filters over the nearest-grid-point table and over the exact table
-  using K = PlantConstants<double>;
-  using Exact = TableDiscretizer<K::Format, PlantStructure, double>;
-  using Nearest = TableDiscretizer<K::Format, PlantStructure, double, OutOfRange::kExtend, SubGrid::kNearest>;
-  const Exact exact(K::kTable);
-  const Nearest nearest(K::kTable);
-  const std::int32_t g = K::kTable.granularity_us;
-  HalfKalman<K::Format, PlantStructure, Nearest> half_n(K::kDesign, nearest, NoiseModel::kExact);
-  HalfKalman<K::Format, PlantStructure, Exact> half_e(K::kDesign, exact, NoiseModel::kExact);
-  CompleteKalman<K::Format, PlantStructure, Nearest> comp_n(K::kDesign, nearest, NoiseModel::kExact);
-  CompleteKalman<K::Format, PlantStructure, Exact> comp_e(K::kDesign, exact, NoiseModel::kExact);
-  std::mt19937_64 rng(12);
-  // τ < 0 (sample after the actuation: a scheduling fault), off the grid
-  std::uniform_int_distribution<std::int32_t> tau(-5 * g - g / 2, -1);
-  std::normal_distribution<double> y(0.0, 0.1);
-  for (int k = 0; k < 500; ++k) {
-    // WHEN the nearest filters get raw negative τ and the exact ones τ rounded away from zero
-    const std::int32_t t = tau(rng);
-    const std::int32_t rounded = -(((-t) + g / 2) / g) * g;
-    Vector<double, 1> yk;
-    yk[0] = y(rng);
+    const std::int32_t t = random.tau();
+    const std::int32_t rounded = t >= 0 ? ((t + g / 2) / g) * g : -(((-t) + g / 2) / g) * g;
+    const Vector<double, 1> yk = random.value();
     // THEN no invariant fires, the statuses agree and the estimates are the same bits
     ASSERT_EQ(half_n.update(t, yk), half_e.update(rounded, yk)) << "job " << k;
     ASSERT_EQ(comp_n.update(t, yk), comp_e.update(rounded, yk)) << "job " << k;
@@ -257,13 +227,23 @@ TEST(KalmanFilters, NearestPolicyRoundsNegativeOffGridTauLikeTheExactFilterOnRou
       ASSERT_EQ(half_n.prediction()[i], half_e.prediction()[i]) << "job " << k;
       ASSERT_EQ(comp_n.prediction()[i], comp_e.prediction()[i]) << "job " << k;
     }
-    Vector<double, 1> u;
-    u[0] = y(rng);
+    const Vector<double, 1> u = random.value();
     half_n.set_applied_input(u);
     half_e.set_applied_input(u);
     comp_n.set_applied_input(u);
     comp_e.set_applied_input(u);
   }
+}
+
+TEST(KalmanFilters, NearestPolicyFilterEqualsTheExactFilterOnRoundedTau) {
+  using K = PlantConstants<double>;
+  expect_nearest_equals_exact_on_rounded_tau(11, 0, K::kDesign.period_us, 2000);
+}
+
+TEST(KalmanFilters, NearestPolicyRoundsNegativeOffGridTauLikeTheExactFilterOnRoundedTau) {
+  // τ < 0 (sample after the actuation: a scheduling fault), off the grid
+  const std::int32_t g = PlantConstants<double>::kTable.granularity_us;
+  expect_nearest_equals_exact_on_rounded_tau(12, -5 * g - g / 2, -1, 500);
 }
 
 TEST(KalmanFilters, JosephAndSymmetricFormsAgree) {
@@ -273,13 +253,10 @@ TEST(KalmanFilters, JosephAndSymmetricFormsAgree) {
                                                                                           NoiseModel::kExact);
   HalfKalman<K::Format, PlantStructure, decltype(table), CovarianceUpdate::kJoseph> jos(K::kDesign, table,
                                                                                        NoiseModel::kExact);
-  std::mt19937_64 rng(8);
-  std::uniform_int_distribution<std::int32_t> tau(0, 50000);
-  std::normal_distribution<double> y(0.0, 0.1);
+  RandomJobs jobs(8, 0, 50000);
   for (int k = 0; k < 1000; ++k) {
-    const std::int32_t t = tau(rng);
-    Vector<double, 1> yk;
-    yk[0] = y(rng);
+    const std::int32_t t = jobs.tau();
+    const Vector<double, 1> yk = jobs.value();
     ASSERT_EQ(sym.update(t, yk), jos.update(t, yk));
     EXPECT_LT(test::relative_error(test::to_eigen(sym.covariance()), test::to_eigen(jos.covariance())), 1e-12);
   }

@@ -32,6 +32,8 @@
 #include "oneshot/node/sync_sensor_node.hpp"
 #include "oneshot/node/threshold_buffer.hpp"
 #include "oneshot/table_discretizer.hpp"
+#include "support/node_fixtures.hpp"
+#include "support/numre_test_model.hpp"
 
 namespace {
 
@@ -48,11 +50,7 @@ using V1 = Vector<double, 1>;
 constexpr std::uint8_t kSensor = 1, kController = 2, kActuator = 3;
 constexpr double kU = 1.65;  // actuator range ±kU (the reference board's PWM levels)
 
-V1 v1(double x) {
-  V1 v;
-  v[0] = x;
-  return v;
-}
+using oneshot::test::v1;
 
 double f64(const std::uint8_t* p) {
   double v = 0;
@@ -74,13 +72,7 @@ struct Nodes {
   std::uint32_t ctrl_clock_us = 0;  ///< The controller's receive clock (µs).
   SyncSensorNode<Net, double, 1, 1> sensor{kController, 0};
   SyncActuatorNode<Net, double, 1> act{kSensor, V1{}};
-  struct Echo {
-    LawResult compute(const Message<VectorPayload<double, 1>>& m, bool fresh, McuInstant, V1& u) {
-      u = m.payload.value;
-      return fresh ? LawResult::kSend : LawResult::kNone;
-    }
-  };
-  ControllerNode<Net, Echo, double, 1, 1> generic{kActuator, ControllerMode::kOnArrival, Echo{}};
+  ControllerNode<Net, oneshot::test::EchoLaw, double, 1, 1> generic{kActuator, ControllerMode::kOnArrival, {}};
   ActuatorNode<Net, double, 1> on_arrival{ActuatorMode::kOnArrival, V1{}};
   using Law = InterlacedController<double, 1, 2>;
   PetcController<double, 2, 8, Law, ModelDisturbance<double>> petc;
@@ -93,18 +85,6 @@ struct Nodes {
     Est e(K::kDesign, d, NoiseModel::kExact);
     e.reset(Vector<double, 2>{}, K::kDesign.p0, V1{});
     return e;
-  }
-  static NumreModel<double, 2> numre() {
-    NumreModel<double, 2> m{};
-    m.a(0, 0) = 0.9;
-    m.a(0, 1) = 0.1;
-    m.a(1, 1) = 0.8;
-    m.b[1] = 0.1;
-    m.b_w[1] = 1;
-    m.c[0] = 1;
-    m.w = 1e-4;
-    m.v = 1e-3;
-    return m;
   }
   static Matrix<double, 2, 2> eye() { return Matrix<double, 2, 2>::identity(); }
   static Vector<double, 2> two(double v) {
@@ -121,7 +101,7 @@ struct Nodes {
 
   Nodes()
       : ctrl(kActuator, K::kDesign.l, v1(-kU), v1(kU), estimator(disc), Ref(0.5, 50, Vector<double, 2>{}, V1{})),
-        petc(numre(), NoiseAccumulation::kSum, law(),
+        petc(oneshot::test::small_numre_model(), NoiseAccumulation::kSum, law(),
              ModelDisturbance<double>{}, MtmTrigger<double, 1>(0.01, 1e-4, 8, 0), 0.0),
         rx(two(0.05), two(1e-3), kNt, SilencePolicy::kHeld),
         sod(eye(), Matrix<double, 2, 1>{}, eye(), eye()) {
@@ -164,46 +144,44 @@ struct Nodes {
     g_net.outbox.clear();
   }
 
+  /// Delivers the frame (src, b[0..n)) to `net` and runs `on_frame` as the node behind it.
+  template <typename F>
+  static void receive(host::HostNetworkState& net, std::uint8_t src, const std::uint8_t* b, std::size_t n,
+                      F&& on_frame) {
+    deliver(net, src, b, n);
+    const host::ScopedHostNetwork cur(net);
+    on_frame();
+  }
+
   void run(std::uint8_t op, std::uint8_t src, const std::uint8_t* b, std::size_t n) {
     switch (op % 9) {
-      case 0: {
-        deliver(c_net, src, b, n);
-        const host::ScopedHostNetwork cur(c_net);
-        ctrl_clock_us += 50'000U;  // one period per invocation: any stamp may open a gap
-        ctrl.on_receive(McuInstant(ctrl_clock_us));
+      case 0:
+        receive(c_net, src, b, n, [&] {
+          ctrl_clock_us += 50'000U;  // one period per invocation: any stamp may open a gap
+          ctrl.on_receive(McuInstant(ctrl_clock_us));
+        });
         break;
-      }
-      case 1: {
-        deliver(s_net, src, b, n);
-        const host::ScopedHostNetwork cur(s_net);
-        McuInstant at;
-        if (sensor.on_receive(McuInstant(n > 4 ? u32(b) : 0U), at)) static_cast<void>(sensor.on_sample(at, v1(0.1)));
+      case 1:
+        receive(s_net, src, b, n, [&] {
+          McuInstant at;
+          if (sensor.on_receive(McuInstant(n > 4 ? u32(b) : 0U), at)) static_cast<void>(sensor.on_sample(at, v1(0.1)));
+        });
         break;
-      }
-      case 2: {
-        deliver(a_net, src, b, n);
-        const host::ScopedHostNetwork cur(a_net);
-        act.on_receive();
+      case 2:
+        receive(a_net, src, b, n, [&] { act.on_receive(); });
         break;
-      }
       case 3: {
         const host::ScopedHostNetwork cur(a_net);
         ++timer_k;
         act.on_timer(timer_k, McuInstant(timer_k * 50'000U));
         break;
       }
-      case 4: {
-        deliver(g_net, src, b, n);
-        const host::ScopedHostNetwork cur(g_net);
-        generic.on_receive(McuInstant(0));
+      case 4:
+        receive(g_net, src, b, n, [&] { generic.on_receive(McuInstant(0)); });
         break;
-      }
-      case 5: {
-        deliver(o_net, src, b, n);
-        const host::ScopedHostNetwork cur(o_net);
-        on_arrival.on_receive();
+      case 5:
+        receive(o_net, src, b, n, [&] { on_arrival.on_receive(); });
         break;
-      }
       case 6:
         if (n >= 12) static_cast<void>(petc.on_arrival(u32(b), f64(b + 4)));
         break;

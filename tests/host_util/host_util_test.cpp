@@ -14,6 +14,7 @@
 #include "oneshot/util/file_io.hpp"
 #include "oneshot/util/strict_json.hpp"
 #include "support/temp_files.hpp"
+#include "support/expect_error.hpp"
 
 namespace oneshot::util {
 namespace {
@@ -23,14 +24,7 @@ namespace fs = std::filesystem;
 /// A fresh empty folder `name` (any characters) for one test.
 std::string fresh_dir(const std::string& name) { return test::made_dir("oneshot_host_util", name); }
 
-std::string message_of(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const std::exception& e) {
-    return e.what();
-  }
-  return "(no exception)";
-}
+using test::message_of;
 
 TEST(BoundedRead, DevZeroIsRefusedAtTheLimitInsteadOfFillingMemory) {
   const std::string m = message_of([] { read_text_file("/dev/zero", "scenario file", std::size_t{1} << 20); });

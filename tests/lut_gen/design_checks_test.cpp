@@ -11,6 +11,7 @@
 #include "oneshot/design/controller_synthesis.hpp"
 #include "oneshot/design/fixed_size.hpp"
 #include "support/test_plants.hpp"
+#include "support/expect_error.hpp"
 
 namespace oneshot::design {
 namespace {
@@ -63,24 +64,15 @@ TEST(DesignChecks, EstimationOnlyPlantHasNoLqrAndTheHarnessSaysSo) {
   const DesignResult d = synthesize(p);
   EXPECT_FALSE(d.lqr_available);
   EXPECT_NE(d.lqr_unavailable_reason.find("no cost"), std::string::npos);
-  try {
-    controller_design<double, 2, 1, 2>(p, d);
-    FAIL();
-  } catch (const DesignError& e) {
-    EXPECT_NE(std::string(e.what()).find("no LQR gain"), std::string::npos) << e.what();
-  }
+  test::expect_error_naming<DesignError>([&] { controller_design<double, 2, 1, 2>(p, d); }, {"no LQR gain"});
   EXPECT_THROW(require_continuous_board_and_table(p, "the harness"), PlantError);
 }
 
 TEST(DesignChecks, DiscretePlantHasNoContinuousModel) {
   const PlantDescription p = parse_plant(plant_text("sinopoli_dropping.json"), "sinopoli");
   const DesignResult d = synthesize(p);
-  try {
-    continuous_model_per_us<double, 3, 1>(p, d);
-    FAIL();
-  } catch (const DesignError& e) {
-    EXPECT_NE(std::string(e.what()).find("needs a continuous plant"), std::string::npos) << e.what();
-  }
+  test::expect_error_naming<DesignError>([&] { continuous_model_per_us<double, 3, 1>(p, d); },
+                                         {"needs a continuous plant"});
 }
 
 TEST(DesignChecks, LiteralHddDisturbanceHasNoSteadyStateKalmanFilter) {
@@ -110,13 +102,8 @@ TEST(DesignChecks, CostOnExogenousDisturbanceStatesIsRefused) {
 
 TEST(DesignChecks, ToolsWithFixedSizesNameTheirLimit) {
   const PlantDescription p = parse_plant(plant_text("hdd_numre.json"), "hdd");
-  try {
-    require_continuous_board_and_table(p, "lut_gen");
-    FAIL();
-  } catch (const PlantError& e) {
-    EXPECT_NE(std::string(e.what()).find("lut_gen needs a continuous plant (this one is sections)"), std::string::npos)
-        << e.what();
-  }
+  test::expect_error_naming<PlantError>([&] { require_continuous_board_and_table(p, "lut_gen"); },
+                                        {"lut_gen needs a continuous plant (this one is sections)"});
 }
 
 }  // namespace

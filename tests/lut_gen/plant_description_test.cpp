@@ -10,6 +10,8 @@
 #include "oneshot/design/plant_description.hpp"
 #include "support/run_command.hpp"
 #include "support/test_plants.hpp"
+#include "support/expect_error.hpp"
+#include "support/param_names.hpp"
 
 namespace oneshot::design {
 namespace {
@@ -129,12 +131,7 @@ INSTANTIATE_TEST_SUITE_P(
         BadCase{"ADC bits", "/board/adc_bits", "40", "field 'board.adc_bits'"},
         BadCase{"state name not an identifier", "/states", "[\"v 1\", \"v2\"]", "field 'states[0]'"},
         BadCase{"duplicate state name", "/states", "[\"v\", \"v\"]", "field 'states[1]': duplicate"}),
-    [](const ::testing::TestParamInfo<BadCase>& param_info) {
-      std::string s = param_info.param.what;
-      for (char& ch : s)
-        if (!std::isalnum(static_cast<unsigned char>(ch))) ch = '_';
-      return s;
-    });
+    [](const ::testing::TestParamInfo<BadCase>& param_info) { return test::param_name(param_info.param.what); });
 
 TEST(PlantDescription, InvalidJsonIsRefused) {
   EXPECT_THROW(parse_plant("{\"A\": [[0, 1e999]]}", "x.json"), PlantError);
@@ -144,12 +141,8 @@ TEST(PlantDescription, InvalidJsonIsRefused) {
 }
 
 TEST(PlantDescription, UnreadableFileIsRefused) {
-  try {
-    load_plant_file("/nonexistent/plant.json");
-    FAIL();
-  } catch (const PlantError& e) {
-    EXPECT_NE(std::string(e.what()).find("/nonexistent/plant.json: cannot read"), std::string::npos);
-  }
+  test::expect_error_naming<PlantError>([&] { load_plant_file("/nonexistent/plant.json"); },
+                                        {"/nonexistent/plant.json: cannot read"});
   const std::string dir = test::write_temp_file("is_a_dir_probe", "");
   EXPECT_THROW(load_plant_file(dir.substr(0, dir.rfind('/'))), PlantError);  // a directory
 }
@@ -163,12 +156,7 @@ std::string read_text(const std::string& path) {
 
 /// The message of the PlantError that parsing `text` throws ("" when it parses).
 std::string error_of(const std::string& text) {
-  try {
-    parse_plant(text, "case.json");
-  } catch (const PlantError& e) {
-    return e.what();
-  }
-  return "";
+  return test::message_of<PlantError>([&] { parse_plant(text, "case.json"); }, "");
 }
 
 TEST(PlantDescription, DuplicateKeysAreRefusedNamingTheField) {
@@ -195,28 +183,14 @@ TEST(PlantDescription, NonFiniteNumbersAreRefused) {
 }
 
 TEST(PlantDescription, DevicesDirectoriesAndHugeFilesAreRefusedWithoutReadingThem) {
-  try {
-    load_plant_file("/dev/zero");  // would read until memory runs out
-    FAIL();
-  } catch (const PlantError& e) {
-    EXPECT_NE(std::string(e.what()).find("/dev/zero: is not a regular file"), std::string::npos) << e.what();
-  }
+  // /dev/zero would be read until memory runs out
+  test::expect_error_naming<PlantError>([&] { load_plant_file("/dev/zero"); }, {"/dev/zero: is not a regular file"});
   const std::string probe = test::write_temp_file("dir_probe.json", "{}");
   const std::string dir = probe.substr(0, probe.rfind('/'));
-  try {
-    load_plant_file(dir);
-    FAIL();
-  } catch (const PlantError& e) {
-    EXPECT_NE(std::string(e.what()).find("is a directory"), std::string::npos) << e.what();
-    EXPECT_EQ(std::string(e.what()).find("not valid JSON"), std::string::npos) << e.what();
-  }
+  const std::string what = test::expect_error_naming<PlantError>([&] { load_plant_file(dir); }, {"is a directory"});
+  EXPECT_EQ(what.find("not valid JSON"), std::string::npos) << what;
   const std::string big = test::write_temp_file("big.json", reference_plant_json() + std::string(1u << 20, ' '));
-  try {
-    load_plant_file(big);
-    FAIL();
-  } catch (const PlantError& e) {
-    EXPECT_NE(std::string(e.what()).find("more than the limit of 1048576"), std::string::npos) << e.what();
-  }
+  test::expect_error_naming<PlantError>([&] { load_plant_file(big); }, {"more than the limit of 1048576"});
 }
 
 const char* const kDiscrete = R"({"form": "discrete", "Phi": [[1.25, 1, 0], [0, 0.9, 7], [0, 0, 0.6]],

@@ -5,6 +5,7 @@
 #include "oneshot/design/structure_analysis.hpp"
 #include "oneshot/design/table_builder.hpp"
 #include "support/test_plants.hpp"
+#include "support/expect_error.hpp"
 
 namespace oneshot::design {
 namespace {
@@ -51,13 +52,7 @@ TEST(TableBuilder, EntriesCoverEveryGridPointByTheirDigits) {
 }
 
 TEST(TableBuilder, TooSmallBudgetIsRefusedWithTheNeededSize) {
-  try {
-    reference_table(64);
-    FAIL();
-  } catch (const DesignError& e) {
-    EXPECT_NE(std::string(e.what()).find("table.max_bytes"), std::string::npos) << e.what();
-    EXPECT_NE(std::string(e.what()).find("needs"), std::string::npos) << e.what();
-  }
+  test::expect_error_naming<DesignError>([&] { reference_table(64); }, {"table.max_bytes", "needs"});
 }
 
 }  // namespace

@@ -5,7 +5,27 @@
 #include <nlohmann/json.hpp>
 #include <unistd.h>
 
+#include <vector>
+
 namespace oneshot::test {
+
+namespace {
+
+/// The n × n matrix s I as a JSON array of rows.
+nlohmann::json scaled_identity(std::size_t n, double s) {
+  nlohmann::json rows = nlohmann::json::array();
+  for (std::size_t i = 0; i < n; ++i) {
+    nlohmann::json row = nlohmann::json::array();
+    for (std::size_t k = 0; k < n; ++k) row.push_back(i == k ? s : 0.0);
+    rows.push_back(row);
+  }
+  return rows;
+}
+
+/// The vector [v, ..., v] of n entries as a JSON array.
+nlohmann::json filled(std::size_t n, double v) { return nlohmann::json(std::vector<double>(n, v)); }
+
+}  // namespace
 
 std::string plant_json(const std::string& a, const std::string& b, const std::string& c, const std::string& extra) {
   nlohmann::json j = nlohmann::json::parse(design::reference_plant_json());
@@ -15,49 +35,18 @@ std::string plant_json(const std::string& a, const std::string& b, const std::st
   const std::size_t n = j["A"].size();
   const std::size_t m = j["B"][0].size();
   const std::size_t p = j["C"].size();
-  nlohmann::json eye_n = nlohmann::json::array();
-  nlohmann::json qn = nlohmann::json::array();
-  for (std::size_t i = 0; i < n; ++i) {
-    nlohmann::json row = nlohmann::json::array();
-    nlohmann::json qrow = nlohmann::json::array();
-    for (std::size_t k = 0; k < n; ++k) {
-      row.push_back(i == k ? 1.0 : 0.0);
-      qrow.push_back(i == k ? 2e-7 : 0.0);
-    }
-    eye_n.push_back(row);
-    qn.push_back(qrow);
-  }
   j.erase("states");
   j.erase("inputs");
   j.erase("outputs");
-  j["cost"]["Q1c"] = eye_n;
-  j["noise"]["process_covariance_per_period"] = qn;
-  nlohmann::json r = nlohmann::json::array();
-  nlohmann::json umin = nlohmann::json::array();
-  nlohmann::json umax = nlohmann::json::array();
-  nlohmann::json q2 = nlohmann::json::array();
-  for (std::size_t i = 0; i < p; ++i) {
-    nlohmann::json row = nlohmann::json::array();
-    for (std::size_t k = 0; k < p; ++k) row.push_back(i == k ? 8e-5 : 0.0);
-    r.push_back(row);
-    umin.push_back(-1.65);
-    umax.push_back(1.65);
-  }
-  j["noise"]["measurement_covariance"] = r;
-  j["board"]["adc_min_volts"] = umin;
-  j["board"]["adc_max_volts"] = umax;
-  nlohmann::json low = nlohmann::json::array();
-  nlohmann::json high = nlohmann::json::array();
-  for (std::size_t i = 0; i < m; ++i) {
-    nlohmann::json row = nlohmann::json::array();
-    for (std::size_t k = 0; k < m; ++k) row.push_back(i == k ? 1.0 : 0.0);
-    q2.push_back(row);
-    low.push_back(-1.65);
-    high.push_back(1.65);
-  }
-  j["cost"]["Q2c"] = q2;
-  j["board"]["pwm_low_volts"] = low;
-  j["board"]["pwm_high_volts"] = high;
+  j["cost"]["Q1c"] = scaled_identity(n, 1.0);
+  j["noise"]["process_covariance_per_period"] = scaled_identity(n, 2e-7);
+  // Per output: R = 8e-5 I and the ADC range ±1.65 V; per input: Q2c = I and the PWM levels ±1.65 V.
+  j["noise"]["measurement_covariance"] = scaled_identity(p, 8e-5);
+  j["board"]["adc_min_volts"] = filled(p, -1.65);
+  j["board"]["adc_max_volts"] = filled(p, 1.65);
+  j["cost"]["Q2c"] = scaled_identity(m, 1.0);
+  j["board"]["pwm_low_volts"] = filled(m, -1.65);
+  j["board"]["pwm_high_volts"] = filled(m, 1.65);
   j["table"]["max_bytes"] = 2048;  // room for 3-state and double tables
   j.merge_patch(nlohmann::json::parse(extra));
   return j.dump();

@@ -126,6 +126,17 @@ DelayModel parse_delay_model(const nlohmann::json& j, const std::string& field, 
   const auto us = [&](const char* key, bool optional, double fallback) {
     return Duration{std::llround(1000 * number_in(j, field, key, 0, kMaxDelayUs, optional, fallback))};
   };
+  // A heavy tail: a scale (µs, stored in ns), a shape parameter in [shape_min, shape_max],
+  // an optional shift_us and cap_us (cap > shift is checked below).
+  const auto heavy_tail = [&](DelayModel::Kind kind, const char* scale_key, double& scale_ns, const char* shape_key,
+                              double shape_min, double shape_max, double& shape) {
+    require_keys(j, field, {"model", scale_key, shape_key, "shift_us", "cap_us"});
+    d.kind = kind;
+    scale_ns = 1000 * number_in(j, field, scale_key, 1e-3, kMaxDelayUs);
+    shape = number_in(j, field, shape_key, shape_min, shape_max);
+    d.shift = us("shift_us", true, 0);
+    d.cap = us("cap_us", true, kMaxDelayUs);
+  };
   if (model == "constant") {
     require_keys(j, field, {"model", "delay_us"});
     d.kind = DelayModel::Kind::kConstant;
@@ -163,19 +174,9 @@ DelayModel parse_delay_model(const nlohmann::json& j, const std::string& field, 
     }
     d.trace = parse_delay_trace(text, d.trace_path);
   } else if (model == "lognormal") {
-    require_keys(j, field, {"model", "median_us", "sigma", "shift_us", "cap_us"});
-    d.kind = DelayModel::Kind::kLognormal;
-    d.median_ns = 1000 * number_in(j, field, "median_us", 1e-3, kMaxDelayUs);
-    d.sigma = number_in(j, field, "sigma", 0, 10);
-    d.shift = us("shift_us", true, 0);
-    d.cap = us("cap_us", true, kMaxDelayUs);
+    heavy_tail(DelayModel::Kind::kLognormal, "median_us", d.median_ns, "sigma", 0, 10, d.sigma);
   } else if (model == "pareto") {
-    require_keys(j, field, {"model", "scale_us", "alpha", "shift_us", "cap_us"});
-    d.kind = DelayModel::Kind::kPareto;
-    d.scale_ns = 1000 * number_in(j, field, "scale_us", 1e-3, kMaxDelayUs);
-    d.alpha = number_in(j, field, "alpha", 0.05, 100);
-    d.shift = us("shift_us", true, 0);
-    d.cap = us("cap_us", true, kMaxDelayUs);
+    heavy_tail(DelayModel::Kind::kPareto, "scale_us", d.scale_ns, "alpha", 0.05, 100, d.alpha);
   } else {
     throw InputError("field '" + field + ".model': unknown delay model '" + model +
                      "' (constant, uniform, poisson_periods, trace, lognormal, pareto)");

@@ -6,6 +6,7 @@
 #include <limits>
 #include <stdexcept>
 
+#include "oneshot/util/output_files.hpp"
 #include "oneshot/util/parallel.hpp"
 #include "oneshot/util/progress_bar.hpp"
 
@@ -226,6 +227,14 @@ SweepResults merge_shards(const std::vector<SweepResults>& shards) {
 
 std::string shard_file_name(const std::string& experiment, const Shard& shard) {
   return experiment + ".shard-" + std::to_string(shard.index) + "-of-" + std::to_string(shard.count) + ".json";
+}
+
+nlohmann::json write_shard_file(const SweepResults& results, const std::string& out_dir, const std::string& experiment,
+                                const Shard& shard) {
+  util::make_directory(out_dir);
+  nlohmann::json j = shard_to_json(results);
+  util::write_json(util::path_in(out_dir, shard_file_name(experiment, shard)), j);
+  return j;
 }
 
 }  // namespace oneshot::engine

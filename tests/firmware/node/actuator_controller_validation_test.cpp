@@ -15,6 +15,7 @@
 #include "oneshot/node/actuation_sync_messages.hpp"
 #include "oneshot/node/sync_actuator_node.hpp"
 #include "oneshot/node/sync_sensor_node.hpp"
+#include "support/node_fixtures.hpp"
 
 namespace oneshot::node {
 namespace {
@@ -25,11 +26,7 @@ constexpr std::uint8_t kController = 2;
 constexpr std::uint8_t kActuator = 3;
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
-V1 v1(double x) {
-  V1 v;
-  v[0] = x;
-  return v;
-}
+using test::v1;
 
 /// The wire bytes of the one-scalar message (seq, value).
 std::vector<std::uint8_t> frame(SequenceNumber seq, double value) {
@@ -129,17 +126,10 @@ TEST(ActuatorValidation, OnArrivalModeRefusesNanAndFollowsARestartedController) 
   EXPECT_EQ(act.statistics().reacquired, 1U);
 }
 
-struct Echo {
-  LawResult compute(const Message<VectorPayload<double, 1>>& m, bool fresh, McuInstant, V1& u) {
-    u = m.payload.value;
-    return fresh ? LawResult::kSend : LawResult::kNone;
-  }
-};
-
 TEST(ControllerValidation, RestartedSensorReacquiredAndNanRefused) {
   host::HostNetworkState net;
   net.address = kController;
-  ControllerNode<host::HostNetwork, Echo, double, 1, 1> ctrl(kActuator, ControllerMode::kOnArrival, Echo{});
+  ControllerNode<host::HostNetwork, test::EchoLaw, double, 1, 1> ctrl(kActuator, ControllerMode::kOnArrival, test::EchoLaw{});
   const host::ScopedHostNetwork cur(net);
   const auto sample = [&](SequenceNumber k, double y) {
     net.deliver(host::Frame{kSensor, kController, frame(k, y)});

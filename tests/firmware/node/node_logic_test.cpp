@@ -12,17 +12,14 @@
 #include "oneshot/node/periodic_trigger.hpp"
 #include "oneshot/node/send_on_delta_trigger.hpp"
 #include "oneshot/node/sensor_node.hpp"
+#include "support/node_fixtures.hpp"
 
 namespace oneshot::node {
 namespace {
 
 using V1 = Vector<double, 1>;
 
-V1 v1(double x) {
-  V1 v;
-  v[0] = x;
-  return v;
-}
+using test::v1;
 
 template <typename S, std::size_t P>
 void round_trip(const Vector<S, P>& value) {
@@ -122,13 +119,6 @@ TEST(CommandBuffer, KeyedBySequenceNumberNewerKept) {
   EXPECT_EQ(u[0], 5);
 }
 
-struct Echo {
-  LawResult compute(const Message<VectorPayload<double, 1>>& m, bool fresh, McuInstant, V1& u) {
-    u = m.payload.value;
-    return fresh ? LawResult::kSend : LawResult::kNone;
-  }
-};
-
 TEST(Nodes, SensorControllerActuatorOnTheHostPort) {
   host::HostNetworkState s_if;
   s_if.address = 1;
@@ -137,7 +127,7 @@ TEST(Nodes, SensorControllerActuatorOnTheHostPort) {
   host::HostNetworkState a_if;
   a_if.address = 3;
   SensorNode<host::HostNetwork, PeriodicTrigger<double, 1>, double, 1> sensor(2, PeriodicTrigger<double, 1>(1));
-  ControllerNode<host::HostNetwork, Echo, double, 1, 1> ctrl(3, ControllerMode::kOnArrival, Echo{});
+  ControllerNode<host::HostNetwork, test::EchoLaw, double, 1, 1> ctrl(3, ControllerMode::kOnArrival, test::EchoLaw{});
   ActuatorNode<host::HostNetwork, double, 1> act(ActuatorMode::kOnTimer, v1(-1));
   const auto hop = [](host::HostNetworkState& from, host::HostNetworkState& to, std::size_t index) {
     to.deliver(from.outbox.at(index));

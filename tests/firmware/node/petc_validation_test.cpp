@@ -11,6 +11,7 @@
 #include "oneshot/node/disturbance_observer.hpp"
 #include "oneshot/node/interlaced_controller.hpp"
 #include "oneshot/node/petc_controller.hpp"
+#include "support/numre_test_model.hpp"
 
 namespace oneshot::node {
 namespace {
@@ -18,24 +19,11 @@ namespace {
 using Law = InterlacedController<double, 1, 2>;
 using Petc = PetcController<double, 2, 8, Law, ModelDisturbance<double>>;
 
-NumreModel<double, 2> model() {
-  NumreModel<double, 2> m{};
-  m.a(0, 0) = 0.9;
-  m.a(0, 1) = 0.1;
-  m.a(1, 1) = 0.8;
-  m.b[1] = 0.1;
-  m.b_w[1] = 1;
-  m.c[0] = 1;
-  m.w = 1e-4;
-  m.v = 1e-3;
-  return m;
-}
-
 Petc make() {
   InterlacedConfig<double, 1, 2> c{};
   c.feedthrough = 0.5;
   c.ratio = 2;
-  return Petc(model(), NoiseAccumulation::kSum, Law(c), ModelDisturbance<double>{},
+  return Petc(test::small_numre_model(), NoiseAccumulation::kSum, Law(c), ModelDisturbance<double>{},
               MtmTrigger<double, 1>(0.01, 1e-4, 4, 0), 0.3);
 }
 
@@ -83,7 +71,7 @@ TEST(PetcValidation, ForgedFuturePeriodAndRestartedSensor) {
 
 TEST(PetcValidation, NonFiniteCorrectionResetsTheNumre) {
   // GIVEN a NUMRE whose gain turns a huge (finite) measurement into an overflow
-  NumreModel<double, 2> m = model();
+  NumreModel<double, 2> m = test::small_numre_model();
   m.c[0] = 1e-3;  // K ≈ 1/c = 1000: K (y − C x̂) overflows for y ≈ 1.7e308
   m.v = 1e-12;
   NumreEstimator<double, 2> est(m, NoiseAccumulation::kSum);
@@ -101,9 +89,9 @@ TEST(PetcValidation, NonFiniteCorrectionResetsTheNumre) {
 
 using Petc200 = PetcController<double, 2, 200, Law, ModelDisturbance<double>>;
 
-/// The overflow fixture: model() with a_11 = 10 (×10 per period over H = 200 periods), reference r.
+/// The overflow fixture: the small NUMRE model with a_11 = 10 (×10 per period over H = 200 periods), reference r.
 Petc200 unstable(double r) {
-  NumreModel<double, 2> m = model();
+  NumreModel<double, 2> m = test::small_numre_model();
   m.a(1, 1) = 10.0;
   InterlacedConfig<double, 1, 2> c{};
   c.feedthrough = 0.5;
@@ -164,7 +152,7 @@ TEST(PetcValidation, ReacquiredArrivalPredictsNothingAndRebasesThePacket) {
   InterlacedConfig<double, 1, 2> c{};
   c.feedthrough = 0.5;
   c.ratio = 2;
-  Petc p(model(), NoiseAccumulation::kSum, Law(c), ModelDisturbance<double>{}, MtmTrigger<double, 1>(0.01, 1e-4, 0, 0), 0.3);
+  Petc p(test::small_numre_model(), NoiseAccumulation::kSum, Law(c), ModelDisturbance<double>{}, MtmTrigger<double, 1>(0.01, 1e-4, 0, 0), 0.3);
   for (std::uint32_t k = 1000; k < 1010; ++k) static_cast<void>(p.on_arrival(k, 0.05));
   EXPECT_EQ(p.estimator().last_multiplicity(), 1U);
   // WHEN the sensor restarts (periods from 0)

@@ -4,7 +4,6 @@
 ///        the noise-free invariants.
 #include <gtest/gtest.h>
 
-#include <cstdio>
 #include <random>
 #include <string>
 #include <vector>
@@ -14,6 +13,7 @@
 #include "oneshot/node/buffered_kalman.hpp"
 #include "oneshot/standard_kalman.hpp"
 #include "support/eigen_reference.hpp"
+#include "support/measured_text.hpp"
 
 // Step indices are signed here (n = k − T_hold is negative at first); they index vectors.
 #pragma GCC diagnostic ignored "-Wsign-conversion"
@@ -21,12 +21,7 @@
 namespace oneshot::dropping {
 namespace {
 
-std::string sci(double v) {
-  char b[32];
-  std::snprintf(b, sizeof b, "%.3e", v);
-  return b;
-}
-
+using test::sci;
 using Fmt = UniformFormat<double>;
 using Structure = DenseStructure<kN, kM, kP>;
 using test::MatX;

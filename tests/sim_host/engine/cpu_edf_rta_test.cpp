@@ -119,8 +119,7 @@ TEST(CpuEdfRta, RandomSetsStayWithinBounds) {
     const std::int64_t nt = r.uniform_int(2, 6);
     const double u = r.uniform(0.3, 1.0);
     for (std::int64_t i = 0; i < nt; ++i) {
-      const std::int64_t p = periods[r.uniform_int(0, 7)];
-      const std::int64_t w = std::max<std::int64_t>(1, std::llround(u / static_cast<double>(nt) * static_cast<double>(p)));
+      const auto [p, w] = test_support::random_share(r, periods, u, nt, 1);
       const std::int64_t d = std::max<std::int64_t>(w, std::llround(static_cast<double>(p) * r.uniform(0.5, 2.0)));
       TaskSpec t = edf_task("t" + std::to_string(i), p, w, std::max<std::int64_t>(1, std::llround(static_cast<double>(w) * r.uniform(0.2, 1.0))), d,
                             static_cast<int>(r.uniform_int(1, 3)));
@@ -136,19 +135,17 @@ TEST(CpuEdfRta, RandomSetsStayWithinBounds) {
       isr.exec.kind = ExecModel::Kind::kUniform;
       s.isrs.push_back(isr);
     }
-    const Analysis a = analyze(s);
-    const std::vector<CpuTaskStats> st = run(s, from_us(400'000), static_cast<std::uint64_t>(n));
-    for (std::size_t i = 0; i < s.tasks.size(); ++i) {
-      const TaskBound& b = a.tasks[i];
-      if (!b.bounded || st[i].finished == 0) continue;
-      ++checked;
-      ASSERT_LE(st[i].response_max, b.wcrt) << "set " << n << " " << b.name << "\n" << task_set_json(s).dump();
-      ASSERT_GE(st[i].response_min, b.bcrt) << "set " << n << " " << b.name << "\n" << task_set_json(s).dump();
-      ASSERT_LE(st[i].start_max, b.sampling_latency_max) << "set " << n << " " << b.name;
-      if (a.schedulable) {
-        ASSERT_EQ(st[i].deadline_misses, 0U) << "set " << n << " " << b.name;
-      }
-    }
+    checked += test_support::check_bounded_tasks(
+        s, from_us(400'000), static_cast<std::uint64_t>(n),
+        [&](const CpuTaskStats& st, const TaskBound& b, const Analysis& a) {
+          ASSERT_LE(st.response_max, b.wcrt) << "set " << n << " " << b.name << "\n" << task_set_json(s).dump();
+          ASSERT_GE(st.response_min, b.bcrt) << "set " << n << " " << b.name << "\n" << task_set_json(s).dump();
+          ASSERT_LE(st.start_max, b.sampling_latency_max) << "set " << n << " " << b.name;
+          if (a.schedulable) {
+            ASSERT_EQ(st.deadline_misses, 0U) << "set " << n << " " << b.name;
+          }
+        });
+    if (HasFatalFailure()) return;
   }
   EXPECT_GT(checked, 1200U);
 }

@@ -103,8 +103,7 @@ TEST(CpuSampling, RandomSetsStayWithinLatencyBounds) {
     const std::int64_t nt = r.uniform_int(2, 5);
     const double u = r.uniform(0.3, 0.9);
     for (std::int64_t i = 0; i < nt; ++i) {
-      const std::int64_t p = periods[r.uniform_int(0, 5)];
-      const std::int64_t w = std::max<std::int64_t>(2, std::llround(u / static_cast<double>(nt) * static_cast<double>(p)));
+      const auto [p, w] = test_support::random_share(r, periods, u, nt, 2);
       TaskSpec t = task("t" + std::to_string(i), p, w, std::max<std::int64_t>(1, w / 3), static_cast<int>(i) + 1);
       t.offset = from_us(r.uniform_int(0, p - 1));
       JobPoint a = fraction(r.uniform(0.5, 1.0)), b = fraction(r.uniform(0.0, 0.5));
@@ -118,20 +117,17 @@ TEST(CpuSampling, RandomSetsStayWithinLatencyBounds) {
       s.tasks.push_back(t);
     }
     if (r.bernoulli(0.5)) s.isrs.push_back(task("isr", 1000, r.uniform_int(1, 20), 1, 1));
-    const Analysis an = analyze(s);
-    const std::vector<CpuTaskStats> st = run(s, from_us(200'000), static_cast<std::uint64_t>(n));
-    for (std::size_t i = 0; i < s.tasks.size(); ++i) {
-      const TaskBound& b = an.tasks[i];
-      if (!b.bounded || st[i].finished == 0) continue;
-      ++checked;
-      const std::string m = "set " + std::to_string(n) + " " + b.name + "\n" + task_set_json(s).dump();
-      ASSERT_GE(st[i].sample_min, b.sampling_latency_min) << m;
-      ASSERT_LE(st[i].sample_max, b.sampling_latency_max) << m;
-      ASSERT_GE(st[i].actuate_min, b.actuation_latency_min) << m;
-      ASSERT_LE(st[i].actuate_max, b.actuation_latency_max) << m;
-      ASSERT_GE(st[i].io_min, b.io_latency_min) << m;
-      ASSERT_LE(st[i].io_max, b.io_latency_max) << m;
-    }
+    checked += test_support::check_bounded_tasks(
+        s, from_us(200'000), static_cast<std::uint64_t>(n), [&](const CpuTaskStats& st, const TaskBound& b, const Analysis&) {
+          const std::string m = "set " + std::to_string(n) + " " + b.name + "\n" + task_set_json(s).dump();
+          ASSERT_GE(st.sample_min, b.sampling_latency_min) << m;
+          ASSERT_LE(st.sample_max, b.sampling_latency_max) << m;
+          ASSERT_GE(st.actuate_min, b.actuation_latency_min) << m;
+          ASSERT_LE(st.actuate_max, b.actuation_latency_max) << m;
+          ASSERT_GE(st.io_min, b.io_latency_min) << m;
+          ASSERT_LE(st.io_max, b.io_latency_max) << m;
+        });
+    if (HasFatalFailure()) return;
   }
   EXPECT_GT(checked, 700U);
 }

@@ -81,21 +81,18 @@ TEST(Cpu, RandomSetsStayWithinAnalysisBounds) {
     const double u = r.uniform(0.3, 0.99);
     const SchedulerKind sched = n % 3 == 0 ? SchedulerKind::kFixedPriorityNonPreemptive : SchedulerKind::kFixedPriority;
     const TaskSet s = random_set(r, u, sched, n % 2 == 1);
-    const Analysis a = analyze(s);
     const std::int64_t h = hyperperiod_us(s);
     const SimTime duration = from_us(std::min<std::int64_t>(4 * h, 2'000'000) + 60'000);
-    const std::vector<CpuTaskStats> st = simulate(s, duration, static_cast<std::uint64_t>(n));
     ++checked_sets;
-    for (std::size_t i = 0; i < s.tasks.size(); ++i) {
-      const TaskBound& b = a.tasks[i];
-      if (!b.bounded || st[i].finished == 0) continue;
-      ++checked_tasks;
-      ASSERT_LE(st[i].response_max, b.wcrt) << "set " << n << " task " << b.name << " U " << u;
-      ASSERT_GE(st[i].response_min, b.bcrt) << "set " << n << " task " << b.name << " U " << u << "\n"
-                                            << oneshot::engine::cpu::task_set_json(s).dump();
-      ASSERT_LE(st[i].start_max, b.sampling_latency_max) << "set " << n << " task " << b.name;
-      if (st[i].response_max == b.wcrt) ++exact;
-    }
+    checked_tasks += test_support::check_bounded_tasks(
+        s, duration, static_cast<std::uint64_t>(n), [&](const CpuTaskStats& st, const TaskBound& b, const Analysis&) {
+          ASSERT_LE(st.response_max, b.wcrt) << "set " << n << " task " << b.name << " U " << u;
+          ASSERT_GE(st.response_min, b.bcrt) << "set " << n << " task " << b.name << " U " << u << "\n"
+                                             << oneshot::engine::cpu::task_set_json(s).dump();
+          ASSERT_LE(st.start_max, b.sampling_latency_max) << "set " << n << " task " << b.name;
+          if (st.response_max == b.wcrt) ++exact;
+        });
+    if (HasFatalFailure()) return;
   }
   EXPECT_EQ(checked_sets, 1200U);
   EXPECT_GT(checked_tasks, 3000U);
@@ -120,8 +117,7 @@ TEST(Cpu, StressedSetsStayWithinAnalysisBounds) {
     const std::int64_t nt = r.uniform_int(1, 6);
     const double u = r.uniform(0.2, 1.3);
     for (std::int64_t i = 0; i < nt; ++i) {
-      const std::int64_t p = periods[r.uniform_int(0, 11)];
-      const std::int64_t w = std::max<std::int64_t>(1, std::llround(u / static_cast<double>(nt) * static_cast<double>(p)));
+      const auto [p, w] = test_support::random_share(r, periods, u, nt, 1);
       TaskSpec t = task("t" + std::to_string(i), p, w, std::max<std::int64_t>(1, std::llround(static_cast<double>(w) * r.uniform(0.1, 1.0))),
                         static_cast<int>(r.uniform_int(1, 4)));
       t.exec.kind = ExecModel::Kind::kUniform;

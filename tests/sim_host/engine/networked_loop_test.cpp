@@ -43,6 +43,15 @@ Matrix<double, 1, 2> gain() {
   return Matrix<double, 1, 2>(l);
 }
 
+/// The board plant on the run's "process" stream, started at x = (0.2, 0).
+Plant started_plant(Kernel& k) {
+  Plant plant(board_plant(), k.stream("process"));
+  Vector<double, 2> x0;
+  x0[0] = 0.2;
+  plant.set_state(x0);
+  return plant;
+}
+
 /// Measurement y = C x + v, v ~ N(0, 1e-6 I), from the run's "measurement" stream.
 Vector<double, 2> measure(const Plant& plant, RandomStream& rng) {
   Vector<double, 2> y = plant.output();
@@ -73,10 +82,7 @@ struct Outcome {
 /// a CAN bus → actuator (3) → plant.
 Outcome networked(std::uint64_t seed, LinkConfig sc, LinkConfig ca, bool ca_on_can) {
   Kernel k(seed);
-  Plant plant(board_plant(), k.stream("process"));
-  Vector<double, 2> x0;
-  x0[0] = 0.2;
-  plant.set_state(x0);
+  Plant plant = started_plant(k);
   RandomStream noise = k.stream("measurement");
   Network net(k);
   node::SensorNode<Board, node::PeriodicTrigger<double, 2>, double, 2> sensor(2, node::PeriodicTrigger<double, 2>(1));
@@ -118,10 +124,7 @@ Outcome networked(std::uint64_t seed, LinkConfig sc, LinkConfig ca, bool ca_on_c
 /// The same loop computed directly: u = −L y applied `delay` after each sample.
 double direct(std::uint64_t seed, Duration delay) {
   Kernel k(seed);
-  Plant plant(board_plant(), k.stream("process"));
-  Vector<double, 2> x0;
-  x0[0] = 0.2;
-  plant.set_state(x0);
+  Plant plant = started_plant(k);
   RandomStream noise = k.stream("measurement");
   std::vector<Vector<double, 1>> pending;
   const HandlerId act = k.add_handler("act", [&](std::uint64_t i) {

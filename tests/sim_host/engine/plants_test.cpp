@@ -8,6 +8,7 @@
 #include "oneshot/engine/discrete_plant.hpp"
 #include "oneshot/engine/plant_model.hpp"
 #include "support/eigen_reference.hpp"
+#include "support/expect_error.hpp"
 
 namespace oneshot::engine {
 namespace {
@@ -168,13 +169,8 @@ TEST(PlantModel, DimensionsMustMatchTheStudy) {
   m.b = DenseMatrix::zeros(3, 1);
   m.c = DenseMatrix::zeros(1, 3);
   m.qc = DenseMatrix::zeros(3, 3);
-  try {
-    make_continuous_config<2, 1, 2, 1>(m, "ncs");
-    FAIL();
-  } catch (const std::invalid_argument& e) {
-    EXPECT_NE(std::string(e.what()).find("plant has n = 3, m = 1, p = 1"), std::string::npos) << e.what();
-    EXPECT_NE(std::string(e.what()).find("study 'ncs' expects n = 2, m = 1, p = 2"), std::string::npos) << e.what();
-  }
+  test::expect_error_naming<std::invalid_argument>([&] { make_continuous_config<2, 1, 2, 1>(m, "ncs"); },
+                                                   {"plant has n = 3, m = 1, p = 1", "study 'ncs' expects n = 2, m = 1, p = 2"});
   const auto c = make_continuous_config<3, 1, 1, 1>(m, "x");  // B_w absent: zero
   EXPECT_EQ(c.bw(2, 0), 0.0);
 }

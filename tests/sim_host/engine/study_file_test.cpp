@@ -7,6 +7,7 @@
 #include <sstream>
 
 #include "oneshot/engine/study_file.hpp"
+#include "support/expect_error.hpp"
 
 namespace oneshot::engine {
 namespace {
@@ -156,12 +157,7 @@ TEST(StudyFile, DiscretePlantsAndDimensionLimits) {
       "C": [[1, 0], [0, 1]],
       "Q_c": [[4e-6, 0], [0, 4e-6]],)",
                                   "\"A\": " + a.str() + ", \"B\": " + b.str() + ", \"C\": " + c.str() + ", \"Q_c\": " + a.str() + ",");
-  try {
-    parse_study(huge, "h.json", nullptr);
-    FAIL();
-  } catch (const InputError& e) {
-    EXPECT_NE(std::string(e.what()).find("kMaxStates"), std::string::npos) << e.what();
-  }
+  test::expect_error_naming<InputError>([&] { parse_study(huge, "h.json", nullptr); }, {"kMaxStates"});
 }
 
 }  // namespace

@@ -9,7 +9,7 @@
 #include <cstring>
 #include <random>
 
-#include "ncs_model.hpp"
+#include "ncs_test_support.hpp"
 #include "oneshot/host/host_network.hpp"
 #include "oneshot/node/sync_actuator_node.hpp"
 #include "oneshot/node/sync_controller_node.hpp"
@@ -29,15 +29,23 @@ using Report = node::SampleReport<double, kP, kM>;
 using Request = node::ActuationRequest<double, kM>;
 using Command = node::Message<node::VectorPayload<double, kM>>;
 
-const Context& context() {
-  static const auto ctx = Context::load("");
-  return *ctx;
-}
-
 Ref reference() {
   Vector<double, kN> nx;
   nx[0] = 1;
   return Ref(0.5, 20, nx, Vector<double, kM>{});
+}
+
+/// The input vector with every entry `v`.
+Vector<double, kM> input_of(double v) {
+  Vector<double, kM> u;
+  for (std::size_t j = 0; j < kM; ++j) u[j] = v;
+  return u;
+}
+
+/// The controller node (address 2, commanding the actuator at 3) with the design's gain,
+/// commands clamped to ±u_max and the reference() square wave.
+Ctrl controller(const Design& design, const HalfEst& est, double u_max) {
+  return Ctrl(3, design.l, input_of(-u_max), input_of(u_max), est, reference());
 }
 
 template <typename M>
@@ -84,11 +92,7 @@ TEST(NcsNodes, ControllerEstimateIsTheCoreHalfKalmanBitForBit) {
     est.reset(x0, design.p0, Vector<double, kM>{});
     HalfKalman<Fmt, Structure, Disc> core(design, disc, noise);
     core.reset(x0, design.p0, Vector<double, kM>{});
-    Vector<double, kM> lo;
-    Vector<double, kM> hi;
-    lo[0] = -1.65;
-    hi[0] = 1.65;
-    Ctrl ctrl(3, design.l, lo, hi, est, reference());
+    Ctrl ctrl = controller(design, est, 1.65);
     host::HostNetworkState net;
     net.address = 2;
     const host::ScopedHostNetwork scope(net);
@@ -113,7 +117,7 @@ TEST(NcsNodes, ControllerEstimateIsTheCoreHalfKalmanBitForBit) {
       net.outbox.clear();
       EXPECT_EQ(c.seq, k);
       Vector<double, kM> u = reference().input(k) - design.l * (core.prediction() - reference().state(k));
-      node::saturate(u, lo, hi);
+      node::saturate(u, input_of(-1.65), input_of(1.65));
       EXPECT_TRUE(same_bits(c.payload.value[0], u[0]));
     }
     EXPECT_EQ(ctrl.statistics().computations, 300U);
@@ -276,11 +280,7 @@ TEST(NcsNodes, LateCommandIsHeldCountedAndItsEchoUsed) {
   with_echo.reset(Vector<double, kN>{}, design.p0, Vector<double, kM>{});
   HalfKalman<Fmt, Structure, Disc> with_own(design, disc, NoiseModel::kConstant);
   with_own.reset(Vector<double, kN>{}, design.p0, Vector<double, kM>{});
-  Vector<double, kM> lo;
-  Vector<double, kM> hi;
-  lo[0] = -2;
-  hi[0] = 2;
-  Ctrl ctrl(3, design.l, lo, hi, est, reference());
+  Ctrl ctrl = controller(design, est, 2);
   host::HostNetworkState ctrl_net;
   ctrl_net.address = 2;
   const host::ScopedHostNetwork scope(ctrl_net);

@@ -14,19 +14,17 @@
 #include "oneshot/util/output_files.hpp"
 #include "scenario.hpp"
 #include "support/run_command.hpp"
+#include "support/expect_error.hpp"
 
 namespace oneshot::sim {
 namespace {
 
 namespace fs = std::filesystem;
 
-std::string error_of(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const std::exception& e) {
-    return e.what();
-  }
-  return "(accepted)";
+/// The message of the error `f` throws, "(accepted)" if none.
+template <typename F>
+std::string error_of(F&& f) {
+  return test::message_of(f, "(accepted)");
 }
 
 std::string scenarios_error(const std::string& text) {

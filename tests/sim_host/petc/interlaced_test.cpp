@@ -5,7 +5,6 @@
 ///        sampled on its schedule), and the actuator's packet buffer.
 #include <gtest/gtest.h>
 
-#include <cstdio>
 #include <string>
 
 #include <cmath>
@@ -15,15 +14,11 @@
 #include "oneshot/node/interlaced_controller.hpp"
 #include "oneshot/node/packet_buffer.hpp"
 #include "petc_design.hpp"
+#include "support/measured_text.hpp"
 
 namespace {
 
-/// Measured error as text for the test report (%.3e).
-std::string sci(double x) {
-  char b[32];
-  std::snprintf(b, sizeof b, "%.3e", x);
-  return b;
-}
+using oneshot::test::sci;
 
 using namespace oneshot::sim::petc;
 using Law = oneshot::node::InterlacedController<double, 1, 2>;

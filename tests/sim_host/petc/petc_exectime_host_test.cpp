@@ -6,24 +6,20 @@
 #include <algorithm>
 
 #include "petc_exectime.hpp"
+#include "petc_test_support.hpp"
 
 namespace oneshot::sim::petc {
 namespace {
 
-const PetcSetup& setup() {
-  static const PetcSetup s = make_setup(PetcOptions{});
-  return s;
-}
-
 TEST(PetcExectimeHost, MultiplicitiesComeFromTheStudy) {
-  const ArrivalPlan plan = plan_arrivals(setup(), ExectimeOptions{});
+  const ArrivalPlan plan = plan_arrivals(default_setup(), ExectimeOptions{});
   // The largest N equals the study's N_max metric over cases 3, 4, 5 at the same seed.
   double n_max = 0;
   const std::vector<std::string>& names = metric_names();
   const std::size_t at = static_cast<std::size_t>(std::find(names.begin(), names.end(), "N_max") - names.begin());
   ASSERT_LT(at, names.size());
   for (const CaseSpec& c : default_cases())
-    if (c.name == "3" || c.name == "4" || c.name == "5") n_max = std::max(n_max, run_case(setup(), c, 1).at(at));
+    if (c.name == "3" || c.name == "4" || c.name == "5") n_max = std::max(n_max, run_case(default_setup(), c, 1).at(at));
   EXPECT_EQ(plan.n_max, static_cast<std::uint32_t>(n_max));
   EXPECT_GE(plan.n_typical, 1U);
   EXPECT_LE(plan.n_typical, plan.n_max);
@@ -36,13 +32,13 @@ TEST(PetcExectimeHost, MultiplicitiesComeFromTheStudy) {
   for (std::uint32_t n : {1U, 2U, 97U, static_cast<std::uint32_t>(kHorizon), plan.n_max, plan.n_typical})
     EXPECT_NE(std::find(ns.begin(), ns.end(), n), ns.end()) << n;
   EXPECT_TRUE(std::is_sorted(ns.begin(), ns.end()));
-  EXPECT_THROW(plan_arrivals(setup(), ExectimeOptions{"2", 1, {}, "", ""}), std::invalid_argument);
-  EXPECT_THROW(plan_arrivals(setup(), ExectimeOptions{"4", 1, {400}, "", ""}), std::invalid_argument);
+  EXPECT_THROW(plan_arrivals(default_setup(), ExectimeOptions{"2", 1, {}, "", ""}), std::invalid_argument);
+  EXPECT_THROW(plan_arrivals(default_setup(), ExectimeOptions{"4", 1, {400}, "", ""}), std::invalid_argument);
 }
 
 TEST(PetcExectimeHost, FloatNodeFollowsDouble) {
-  const ArrivalPlan plan = plan_arrivals(setup(), ExectimeOptions{});
-  const std::vector<HostArrival> h = host_arrivals(setup(), plan);
+  const ArrivalPlan plan = plan_arrivals(default_setup(), ExectimeOptions{});
+  const std::vector<HostArrival> h = host_arrivals(default_setup(), plan);
   ASSERT_EQ(h.size(), plan.k.size());
   double worst = 0;
   for (std::size_t a = 0; a < h.size(); ++a) {

@@ -8,22 +8,19 @@
 
 #include <cmath>
 #include <cstring>
+#include <ostream>
 #include <string>
 #include <vector>
 
 #include "oneshot/engine/fault_spec.hpp"
 #include "oneshot/engine/json_fields.hpp"
-#include "petc_sim.hpp"
+#include "petc_test_support.hpp"
+#include "support/param_names.hpp"
 
 namespace {
 
 using namespace oneshot::sim::petc;
 using oneshot::engine::parse_fault_spec;
-
-const PetcSetup& setup() {
-  static const PetcSetup s = make_setup(PetcOptions{});
-  return s;
-}
 
 /// Case "2" (hold, no estimator) and case "4" (NUMRE, noise): the two controller kinds.
 std::vector<CaseSpec> cases() {
@@ -40,9 +37,9 @@ struct Faulted {
 Faulted run(const CaseSpec& c, const char* spec, std::uint64_t seed) {
   Faulted f;
   f.run.spec = parse_fault_spec(spec);
-  f.metrics = run_case(setup(), c, seed, nullptr, &f.run);
+  f.metrics = run_case(default_setup(), c, seed, nullptr, &f.run);
   FaultRun clean;
-  static_cast<void>(run_case(setup(), c, seed, nullptr, &clean));
+  static_cast<void>(run_case(default_setup(), c, seed, nullptr, &clean));
   f.clean_tracking = clean.tracking_error;
   return f;
 }
@@ -59,10 +56,10 @@ void expect_finite_and_bounded(const Faulted& f, const char* what) {
 
 TEST(PetcFaults, EmptySpecIsTheCleanRunBitForBit) {
   for (const CaseSpec& c : default_cases()) {
-    const std::vector<double> a = run_case(setup(), c, 3);
+    const std::vector<double> a = run_case(default_setup(), c, 3);
     FaultRun none;
     none.spec = parse_fault_spec("");
-    const std::vector<double> b = run_case(setup(), c, 3, nullptr, &none);
+    const std::vector<double> b = run_case(default_setup(), c, 3, nullptr, &none);
     ASSERT_EQ(a.size(), b.size());
     EXPECT_EQ(std::memcmp(a.data(), b.data(), a.size() * sizeof(double)), 0) << "case " << c.name;
     EXPECT_EQ(none.counts.injected, 0);
@@ -81,53 +78,56 @@ TEST(PetcFaults, ASpecThatNeverFiresChangesNothing) {
   }
 }
 
-TEST(PetcFaults, NanIsRefusedOnBothLinks) {
-  for (const CaseSpec& c : cases())
-    for (const char* spec : {"nan:link=sc,rate=0.05", "nan:link=ca,rate=0.05"}) {
-      const Faulted f = run(c, spec, 7);
-      EXPECT_GT(f.run.counts.injected, 0) << spec;
-      EXPECT_EQ(f.run.counts.refused_non_finite, f.run.counts.injected) << "case " << c.name << ", " << spec;
-      expect_finite_and_bounded(f, spec);
+/// One injected fault and what must become of it.
+struct InjectedCase {
+  const char* spec;
+  /// The counter that must take every injected frame; nullptr for a node restart (injected
+  /// once, refused by nobody).
+  double oneshot::sim::RunFaultCounts::*taken_by;
+  bool changes_nothing;  ///< Stale frames: the tracking error is the clean run's, bit for bit.
+};
+void PrintTo(const InjectedCase& c, std::ostream* os) { *os << c.spec; }
+
+class PetcFaultKinds : public ::testing::TestWithParam<InjectedCase> {};
+
+TEST_P(PetcFaultKinds, AreRefusedAndCountedAndTheRunStaysFiniteAndBounded) {
+  const InjectedCase& p = GetParam();
+  for (const CaseSpec& c : cases()) {
+    const Faulted f = run(c, p.spec, 7);
+    if (p.taken_by == nullptr) {
+      EXPECT_EQ(f.run.counts.injected, 1) << p.spec;
+    } else {
+      EXPECT_GT(f.run.counts.injected, 0) << p.spec;
+      EXPECT_EQ(f.run.counts.*p.taken_by, f.run.counts.injected) << "case " << c.name << ", " << p.spec;
     }
+    if (p.changes_nothing) {
+      EXPECT_EQ(f.run.tracking_error, f.clean_tracking) << "case " << c.name << ", " << p.spec;
+    }
+    expect_finite_and_bounded(f, p.spec);
+  }
 }
 
-TEST(PetcFaults, ForgedSequenceIsRefusedOnBothLinks) {
-  for (const CaseSpec& c : cases())
-    for (const char* spec : {"forge_seq:link=sc,at_s=0.002", "forge_seq:link=ca,at_s=0.002", "forge_seq:rate=0.02"}) {
-      const Faulted f = run(c, spec, 7);
-      EXPECT_GE(f.run.counts.injected, 1) << spec;
-      EXPECT_EQ(f.run.counts.refused_sequence, f.run.counts.injected) << "case " << c.name << ", " << spec;
-      expect_finite_and_bounded(f, spec);
-    }
-}
-
-TEST(PetcFaults, ReplaysAndDuplicatesAreStaleAndChangeNothing) {
-  for (const CaseSpec& c : cases())
-    for (const char* spec : {"replay:age_ms=1,rate=0.05", "dup:rate=0.05"}) {
-      const Faulted f = run(c, spec, 7);
-      EXPECT_GT(f.run.counts.injected, 0) << spec;
-      EXPECT_EQ(f.run.counts.stale, f.run.counts.injected) << "case " << c.name << ", " << spec;
-      EXPECT_EQ(f.run.tracking_error, f.clean_tracking) << "case " << c.name << ", " << spec;
-      expect_finite_and_bounded(f, spec);
-    }
-}
-
-TEST(PetcFaults, RestartedNodesRunOn) {
-  for (const CaseSpec& c : cases())
-    for (const char* spec : {"restart:node=sensor,at_s=0.004", "restart:node=controller,at_s=0.004",
-                             "restart:node=actuator,at_s=0.004"}) {
-      const Faulted f = run(c, spec, 7);
-      EXPECT_EQ(f.run.counts.injected, 1) << spec;
-      expect_finite_and_bounded(f, spec);
-    }
-}
+using Counts = oneshot::sim::RunFaultCounts;
+INSTANTIATE_TEST_SUITE_P(
+    OnBothLinks, PetcFaultKinds,
+    ::testing::Values(InjectedCase{"nan:link=sc,rate=0.05", &Counts::refused_non_finite, false},
+                      InjectedCase{"nan:link=ca,rate=0.05", &Counts::refused_non_finite, false},
+                      InjectedCase{"forge_seq:link=sc,at_s=0.002", &Counts::refused_sequence, false},
+                      InjectedCase{"forge_seq:link=ca,at_s=0.002", &Counts::refused_sequence, false},
+                      InjectedCase{"forge_seq:rate=0.02", &Counts::refused_sequence, false},
+                      InjectedCase{"replay:age_ms=1,rate=0.05", &Counts::stale, true},
+                      InjectedCase{"dup:rate=0.05", &Counts::stale, true},
+                      InjectedCase{"restart:node=sensor,at_s=0.004", nullptr, false},
+                      InjectedCase{"restart:node=controller,at_s=0.004", nullptr, false},
+                      InjectedCase{"restart:node=actuator,at_s=0.004", nullptr, false}),
+    [](const ::testing::TestParamInfo<InjectedCase>& i) { return oneshot::test::param_name(i.param.spec); });
 
 TEST(PetcFaults, UnknownTargetsAreRefused) {
   FaultRun f;
   f.spec = parse_fault_spec("restart:node=plant,at_s=0.001");
-  EXPECT_THROW(static_cast<void>(run_case(setup(), default_cases()[0], 1, nullptr, &f)), oneshot::engine::InputError);
+  EXPECT_THROW(static_cast<void>(run_case(default_setup(), default_cases()[0], 1, nullptr, &f)), oneshot::engine::InputError);
   f.spec = parse_fault_spec("nan:link=as,rate=0.1");
-  EXPECT_THROW(static_cast<void>(run_case(setup(), default_cases()[0], 1, nullptr, &f)), oneshot::engine::InputError);
+  EXPECT_THROW(static_cast<void>(run_case(default_setup(), default_cases()[0], 1, nullptr, &f)), oneshot::engine::InputError);
 }
 
 }  // namespace

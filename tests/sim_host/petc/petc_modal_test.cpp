@@ -7,23 +7,19 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
 #include <stdexcept>
 #include <string>
 
 #include "oneshot/design/dense_ops.hpp"
 #include "petc_modal.hpp"
 #include "petc_sim.hpp"
+#include "support/measured_text.hpp"
 
 namespace {
 
 using namespace oneshot::sim::petc;
 
-std::string sci(double x) {
-  char b[32];
-  std::snprintf(b, sizeof b, "%.3e", x);
-  return b;
-}
+using oneshot::test::sci;
 
 /// max_k |r A^k c − r' A'^k c'| / max_k |r A^k c|, k = 0 … steps − 1.
 double markov_error(const DenseMatrix& a, const DenseMatrix& r, const DenseMatrix& c, const DenseMatrix& a2,

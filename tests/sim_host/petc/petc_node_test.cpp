@@ -8,22 +8,18 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
 #include <memory>
 #include <string>
 #include <vector>
 
 #include "oneshot/app/petc_pil.hpp"
 #include "petc_exectime.hpp"
+#include "support/measured_text.hpp"
 
 namespace oneshot::sim::petc {
 namespace {
 
-std::string sci(double x) {
-  char b[32];
-  std::snprintf(b, sizeof b, "%.3e", x);
-  return b;
-}
+using oneshot::test::sci;
 
 namespace pp = app::petc;
 using Law = pp::Law<float>;

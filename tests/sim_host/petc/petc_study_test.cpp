@@ -4,58 +4,37 @@
 ///        facts of the plant, and the case table's counts.
 #include <gtest/gtest.h>
 
-#include <cstdio>
 #include <string>
 
 #include <algorithm>
 #include <cmath>
 
 #include "oneshot/node/disturbance_observer.hpp"
-#include "petc_sim.hpp"
+#include "petc_test_support.hpp"
+#include "support/measured_text.hpp"
 
 namespace {
 
-/// Measured error as text for the test report (%.3e).
-std::string sci(double x) {
-  char b[32];
-  std::snprintf(b, sizeof b, "%.3e", x);
-  return b;
-}
+using oneshot::test::sci;
 
 using namespace oneshot::sim::petc;
 
-const PetcSetup& setup() {
-  static const PetcSetup s = [] {
-    PetcOptions o;
-    return make_setup(o);
-  }();
-  return s;
-}
-
 TEST(PetcDesign, PlantFacts) {
-  const PlantFacts& p = setup().plant;
+  const PlantFacts& p = default_setup().plant;
   EXPECT_NEAR(p.dc_gain, 7.0, 0.05);  // brief: ≈ 7.0 (measured 7.014)
   EXPECT_EQ(p.relative_degree, 1U);
   EXPECT_EQ(p.zeros.size() + p.relative_degree, p.poles.size());
   ASSERT_FALSE(p.zeros.empty());
   EXPECT_NEAR(p.zeros[0].real(), -46.4, 0.05);
-  EXPECT_EQ(setup().dob.replaced_zeros.size(), 2U);  // −46.4 and −4.17 lie outside the unit circle
-  EXPECT_EQ(setup().dob.delay, 3U);                  // ρ of G_s: 10 poles, 7 kept zeros
+  EXPECT_EQ(default_setup().dob.replaced_zeros.size(), 2U);  // −46.4 and −4.17 lie outside the unit circle
+  EXPECT_EQ(default_setup().dob.delay, 3U);                  // ρ of G_s: 10 poles, 7 kept zeros
 }
 
 // Open loop, u = 0, a constant input disturbance d: the DOB (fed with the noise-free plant
 // output) is within 1 % of d after 100 periods.
 TEST(PetcObserver, DobEstimatesConstantDisturbanceIn100Steps) {
-  const PetcSetup& s = setup();
-  oneshot::node::DisturbanceObserverConfig<double, kDobSections, kDobMaxDelay> cfg;
-  cfg.q = {s.dob.q.b0, s.dob.q.b1, s.dob.q.b2, s.dob.q.a1, s.dob.q.a2};
-  for (std::size_t i = 0; i < s.dob.inverse.size(); ++i) {
-    const Biquad& b = s.dob.inverse[i];
-    cfg.inverse[i] = {b.b0, b.b1, b.b2, b.a1, b.a2};
-  }
-  cfg.inverse_gain = s.dob.inverse_gain;
-  cfg.delay = static_cast<std::uint32_t>(s.dob.delay);
-  oneshot::node::DisturbanceObserver<double, kDobSections, kDobMaxDelay> dob(cfg);
+  const PetcSetup& s = default_setup();
+  oneshot::node::DisturbanceObserver<double, kDobSections, kDobMaxDelay> dob(dob_config(s));
   const std::size_t n = s.plant.phi_p.rows;
   std::vector<double> x(n, 0.0);
   const double d = 0.1;
@@ -81,7 +60,7 @@ TEST(PetcObserver, DobEstimatesConstantDisturbanceIn100Steps) {
 // arrival (σ_c = δ_c = 0) the sensor's safety (k_max = H) guarantees that, and the PETC loop
 // reproduces case 1's output with far fewer sensor packets.
 TEST(PetcInvariant, NoiseFreeNumreReproducesTts) {
-  const PetcSetup& s = setup();
+  const PetcSetup& s = default_setup();
   const auto& names = metric_names();
   auto idx = [&](const char* n) { return static_cast<std::size_t>(std::find(names.begin(), names.end(), n) - names.begin()); };
   const std::vector<double> tts = run_case(s, default_cases()[0], 1);

@@ -33,6 +33,9 @@ void write_json(const std::string& path, const nlohmann::json& j);
 /// Writes `text` to `path`.
 void write_text(const std::string& path, const std::string& text);
 
+/// The path of the file `name` in the folder `dir` (dir / name).
+std::string path_in(const std::string& dir, const std::string& name);
+
 /// Creates `dir` (and parents); std::runtime_error naming it when impossible.
 void make_directory(const std::string& dir);
 

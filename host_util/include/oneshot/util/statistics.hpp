@@ -5,6 +5,8 @@
 #include <cstddef>
 #include <vector>
 
+#include <nlohmann/json.hpp>
+
 namespace oneshot::util {
 
 /// Mean and the half-width of its 95 % confidence interval.
@@ -20,5 +22,8 @@ double student_t975(std::size_t dof);
 
 /// Summary of `samples`.
 Summary summarize(const std::vector<double>& samples);
+
+/// {"mean": s.mean, "ci95": s.ci95}: how the study outputs give a mean with its interval.
+inline nlohmann::json mean_ci_json(const Summary& s) { return {{"mean", s.mean}, {"ci95", s.ci95}}; }
 
 }  // namespace oneshot::util

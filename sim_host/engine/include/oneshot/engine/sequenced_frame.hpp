@@ -2,7 +2,7 @@
 /// @brief The byte form of a study message that is a sequence number and values:
 ///        [seq: u32 little-endian][v₀ … v_{n−1}: IEEE 754 binary64], and its FrameLayout.
 ///
-/// Studies whose nodes pass values on the engine (dropping, petc) send each message in this
+/// Studies whose nodes pass values on the engine (dropping, petc, sod) send each message in this
 /// form through their links' LinkFaults, so a fault can turn a value NaN, flip bits, forge
 /// the sequence number, duplicate or replay the frame; the receiver decodes it and checks
 /// it like any untrusted frame. Host byte order is little-endian (x86-64, AArch64).

@@ -96,4 +96,9 @@ SweepResults merge_shards(const std::vector<SweepResults>& shards);
 /// Canonical file name of shard i/N of an experiment: "<experiment>.shard-<i>-of-<N>.json".
 std::string shard_file_name(const std::string& experiment, const Shard& shard);
 
+/// Writes the shard file of `results` (shard_to_json) as out_dir/shard_file_name(experiment,
+/// shard), creating the folder, and returns its JSON.
+nlohmann::json write_shard_file(const SweepResults& results, const std::string& out_dir, const std::string& experiment,
+                                const Shard& shard);
+
 }  // namespace oneshot::engine

@@ -1,0 +1,24 @@
+/// @file number_text.hpp
+/// @brief Numbers as text for tables, labels and reports: the printf forms in one place.
+#pragma once
+
+#include <cstdio>
+#include <string>
+
+namespace oneshot::util {
+
+/// `v` with `significant` significant digits, shortest form (printf "%.*g"; "nan", "inf").
+inline std::string format_g(double v, int significant = 6) {
+  char b[48];
+  std::snprintf(b, sizeof b, "%.*g", significant, v);
+  return b;
+}
+
+/// `v` fixed-point with `decimals` decimals (printf "%.*f").
+inline std::string format_f(double v, int decimals) {
+  char b[48];
+  std::snprintf(b, sizeof b, "%.*f", decimals, v);
+  return b;
+}
+
+}  // namespace oneshot::util
