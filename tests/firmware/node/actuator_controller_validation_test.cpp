@@ -154,7 +154,7 @@ TEST(FrameIo, EachRefusedFrameHasTheStatusOfItsCause) {
   host::HostNetworkState net;
   net.address = kController;
   const host::ScopedHostNetwork cur(net);
-  ControllerNode<host::HostNetwork, Echo, double, 1, 1> ctrl(kActuator, ControllerMode::kOnArrival, Echo{});
+  ControllerNode<host::HostNetwork, test::EchoLaw, double, 1, 1> ctrl(kActuator, ControllerMode::kOnArrival, test::EchoLaw{});
   ctrl.expect_source(kSensor);
   ctrl.set_measurement_range(v1(-1), v1(1));
   ctrl.set_sequence_window(16, 3);
