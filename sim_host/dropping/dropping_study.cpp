@@ -77,10 +77,6 @@ double seconds_since(std::chrono::steady_clock::time_point t0) {
 
 std::string section(const dropping::DroppingPlant& plant, const StudyReportContext& ctx, nlohmann::json& out);
 
-}  // namespace
-
-namespace {
-
 /// lambda-c, the arrival, closed-loop and hold sweeps, and the single traced run.
 void add_dropping_commands(CLI::App* study) {
   {

@@ -103,10 +103,6 @@ StudyReportResult report_section(const StudyReportContext& rc) {
   return r;
 }
 
-}  // namespace
-
-namespace {
-
 /// table, the e1–e3 experiments, analytic-benchmark, the live run and the faults sweep.
 void add_ncs_commands(CLI::App* study) {
   {

@@ -123,10 +123,6 @@ StudyReportResult report_section(const StudyReportContext& ctx) {
   return {md.str(), {{"design", design}, {"table", table}, {"gpi", gpi}, {"traces", traces}, {"exectime", exectime}}};
 }
 
-}  // namespace
-
-namespace {
-
 /// The experiments of the PETC study.
 void add_petc_commands(CLI::App* study) {
   auto cli = std::make_shared<Cli>();

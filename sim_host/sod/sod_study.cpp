@@ -45,13 +45,8 @@ sod::SodModel model_of(Cli& c) {
   return sod::load_sod_model(c.opt.plant_path);
 }
 
-}  // namespace
-
-namespace {
-
 /// The experiments of the send-on-delta study.
 void add_sod_commands(CLI::App* study) {
-
   {
     auto c = std::make_shared<Cli>();
     CLI::App* cmd = study->add_subcommand("table", "E3 (a)-(c): packets, (2b) sends, losses, e_i and NEES per configuration and loss rate");
