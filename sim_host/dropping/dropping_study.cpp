@@ -10,8 +10,7 @@
 #include "closed_loop.hpp"
 #include "experiments.hpp"
 #include "lambda_c.hpp"
-#include "oneshot/engine/sweep_registry.hpp"
-#include "oneshot/sim/cli_commands.hpp"
+#include "oneshot/sim/study_descriptor.hpp"
 #include "oneshot/util/output_files.hpp"
 #include "oneshot/sim/study_report.hpp"
 #include "study_format.hpp"
@@ -78,13 +77,8 @@ double seconds_since(std::chrono::steady_clock::time_point t0) {
 
 std::string section(const dropping::DroppingPlant& plant, const StudyReportContext& ctx, nlohmann::json& out);
 
-}  // namespace
-
-void register_dropping_study(CLI::App& app) {
-  CLI::App* study = app.add_subcommand(
-      "dropping", "Study 002: Kalman filtering over a delaying network, dropping over-delayed packets "
-                  "(threshold buffer, critical arrival probability)");
-  study->require_subcommand(1);
+/// lambda-c, the arrival, closed-loop and hold sweeps, and the single traced run.
+void add_dropping_commands(CLI::App* study) {
   {
     auto c = std::make_shared<DroppingCli>();
     auto lc = std::make_shared<dropping::LambdaCOptions>();
@@ -202,21 +196,26 @@ void register_dropping_study(CLI::App& app) {
       if (!c->json.empty()) util::write_json(c->json, j);
     });
   }
-  engine::register_summarizer("dropping", "arrival", [](const engine::SweepResults& r, const std::string& out, bool plots) {
-    return dropping::arrival_outputs(r, out, plots);
-  });
-  engine::register_summarizer("dropping", "closed-loop", [](const engine::SweepResults& r, const std::string& out, bool plots) {
-    return dropping::closed_loop_outputs(r, out, plots);
-  });
-  engine::register_summarizer("dropping", "hold", [](const engine::SweepResults& r, const std::string& out, bool plots) {
-    return dropping::hold_outputs(r, out, plots);
-  });
-  add_study_report_section({"dropping", [](const StudyReportContext& ctx) {
-                              StudyReportResult res;
-                              const auto plant = dropping::load_dropping_plant("");
-                              res.markdown = section(plant, ctx, res.json);
-                              return res;
-                            }});
+}
+
+StudyReportResult report_section(const StudyReportContext& ctx) {
+  StudyReportResult res;
+  const auto plant = dropping::load_dropping_plant("");
+  res.markdown = section(plant, ctx, res.json);
+  return res;
+}
+
+}  // namespace
+
+StudyDescriptor dropping_study() {
+  return {"dropping",
+          "Study 002: Kalman filtering over a delaying network, dropping over-delayed packets "
+          "(threshold buffer, critical arrival probability)",
+          add_dropping_commands,
+          {{"arrival", dropping::arrival_outputs},
+           {"closed-loop", dropping::closed_loop_outputs},
+           {"hold", dropping::hold_outputs}},
+          StudyReportSection{"dropping", report_section}};
 }
 
 namespace {

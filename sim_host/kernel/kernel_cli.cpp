@@ -9,7 +9,7 @@
 
 #include "oneshot/engine/cpu.hpp"
 #include "oneshot/engine/cpu_analysis.hpp"
-#include "oneshot/sim/cli_commands.hpp"
+#include "oneshot/sim/study_descriptor.hpp"
 #include "oneshot/util/output_files.hpp"
 #include "kernel_gantt.hpp"
 
@@ -101,11 +101,11 @@ nlohmann::json kernel_simulate(const TaskSet& set, double duration_s, std::uint6
   return j;
 }
 
-void register_kernel_study(CLI::App& app) {
+namespace {
+
+/// `analyze` and `simulate` of a task file.
+void add_kernel_commands(CLI::App* group) {
   auto c = std::make_shared<KernelCli>();
-  CLI::App* group = app.add_subcommand("kernel", "A CPU with a real-time kernel: task sets, schedulers (fixed priority, "
-                                                  "non-preemptive, EDF), response-time analysis and simulation");
-  group->require_subcommand(1);
   CLI::App* an = group->add_subcommand("analyze", "worst- and best-case response times, jitter bounds, schedulability");
   an->add_option("--tasks", c->tasks, "task file (JSON, docs/kernel.md)")->required();
   an->add_option("--json", c->json, "write the analysis to PATH ('-': standard output)");
@@ -158,6 +158,15 @@ void register_kernel_study(CLI::App& app) {
                 << " per second, one core)\n";
     }
   });
+}
+
+}  // namespace
+
+StudyDescriptor kernel_study() {
+  return {"kernel",
+          "A CPU with a real-time kernel: task sets, schedulers (fixed priority, "
+          "non-preemptive, EDF), response-time analysis and simulation",
+          add_kernel_commands, {}, std::nullopt};
 }
 
 }  // namespace oneshot::sim

@@ -13,8 +13,7 @@
 #include "ncs_experiments.hpp"
 #include "ncs_faults.hpp"
 #include "ncs_live.hpp"
-#include "oneshot/engine/sweep_registry.hpp"
-#include "oneshot/sim/cli_commands.hpp"
+#include "oneshot/sim/study_descriptor.hpp"
 #include "oneshot/util/output_files.hpp"
 #include "oneshot/sim/study_report.hpp"
 
@@ -104,13 +103,8 @@ StudyReportResult report_section(const StudyReportContext& rc) {
   return r;
 }
 
-}  // namespace
-
-void register_ncs_study(CLI::App& app) {
-  CLI::App* study = app.add_subcommand(
-      "ncs", "Study 001: networked control synchronized at the actuation instants with a half Kalman filter "
-             "(approaches I, S, A, AK, AKx, AKl, SK, S+, IK)");
-  study->require_subcommand(1);
+/// table, the e1–e3 experiments, analytic-benchmark, the live run and the faults sweep.
+void add_ncs_commands(CLI::App* study) {
   {
     auto c = std::make_shared<NcsCli>();
     auto t = std::make_shared<ncs::TableOptions>();
@@ -205,10 +199,15 @@ void register_ncs_study(CLI::App& app) {
   add_ncs_live_commands(study);
   add_ncs_faults_command(study);
   add_ncs_stationary_command(study);
-  engine::register_summarizer("ncs", "table", [](const engine::SweepResults& r, const std::string& out, bool plots) {
-    return ncs::table_outputs(r, out, plots);
-  });
-  add_study_report_section({"ncs", report_section});
+}
+
+}  // namespace
+
+StudyDescriptor ncs_study() {
+  return {"ncs",
+          "Study 001: networked control synchronized at the actuation instants with a half Kalman filter "
+          "(approaches I, S, A, AK, AKx, AKl, SK, S+, IK)",
+          add_ncs_commands, {{"table", ncs::table_outputs}}, StudyReportSection{"ncs", report_section}};
 }
 
 }  // namespace oneshot::sim

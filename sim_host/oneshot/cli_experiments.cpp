@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
+#include <functional>
 #include <fstream>
 #include <iostream>
 #include <map>
@@ -133,6 +134,22 @@ void write_timing(const CommonOptions& o, const std::string& experiment, double 
              {{"experiment", experiment}, {"wall_time_s", wall_time_s}, {"threads", util::worker_count(o.threads)}});
 }
 
+/// What an experiment does with its options and the plant they name.
+using ExperimentRun = std::function<void(const CliCommon& c, const SimContext& ctx)>;
+
+/// Adds experiment `name` with the common options (`default_out`, the noise model
+/// `noise`: exact unless given) and a callback that loads the plant and calls `run`.
+/// Returns the command, for the experiment's own options.
+CLI::App* add_experiment(CLI::App& app, const std::string& name, const std::string& help,
+                         const std::string& default_out, ExperimentRun run, const std::string& noise = "") {
+  auto c = std::make_shared<CliCommon>();
+  c->noise = noise;
+  CLI::App* cmd = app.add_subcommand(name, help);
+  add_common(cmd, *c, default_out);
+  cmd->callback([c, run]() { run(*c, *SimContext::load(c->plant)); });
+  return cmd;
+}
+
 std::vector<Scenario> scenarios_from(const std::string& path) { return path.empty() ? default_scenarios() : load_scenarios(path); }
 
 std::string self_path() {
@@ -145,41 +162,32 @@ std::string self_path() {
 
 void register_experiment_commands(CLI::App& app) {
   {
-    auto c = std::make_shared<CliCommon>();
     auto duration = std::make_shared<double>(5.0);
-    CLI::App* cmd = app.add_subcommand("noise", "Experiment 1: noisy measured v1 beside the estimated states");
-    add_common(cmd, *c, "out/noise");
+    CLI::App* cmd = add_experiment(app, "noise", "Experiment 1: noisy measured v1 beside the estimated states", "out/noise",
+                                   [duration](const CliCommon& c, const SimContext& ctx) {
+                                     emit(c, run_noise_experiment(ctx, c.resolve(), *duration));
+                                   });
     cmd->add_option("--duration", *duration, "simulated seconds")->check(finite_in(0.1, 3600.0))->capture_default_str();
-    cmd->callback([c, duration]() {
-      const auto ctx = SimContext::load(c->plant);
-      emit(*c, run_noise_experiment(*ctx, c->resolve(), *duration));
-    });
   }
   {
-    auto c = std::make_shared<CliCommon>();
     auto duration = std::make_shared<double>(6.0);
     auto jitter = std::make_shared<std::int32_t>(20'000);
-    CLI::App* cmd = app.add_subcommand("jitter", "Experiment 2: one-shot + half Kalman against standard controllers under jitter");
-    add_common(cmd, *c, "out/jitter");
+    CLI::App* cmd = add_experiment(app, "jitter", "Experiment 2: one-shot + half Kalman against standard controllers under jitter",
+                                   "out/jitter", [duration, jitter](const CliCommon& c, const SimContext& ctx) {
+                                     emit(c, run_jitter_experiment(ctx, c.resolve(), *duration, *jitter));
+                                   });
     cmd->add_option("--duration", *duration, "simulated seconds")->check(finite_in(0.1, 3600.0))->capture_default_str();
     cmd->add_option("--jitter-us", *jitter, "largest release delay of the job (us)")->check(CLI::Range(0, 10'000'000))->capture_default_str();
-    cmd->callback([c, duration, jitter]() {
-      const auto ctx = SimContext::load(c->plant);
-      emit(*c, run_jitter_experiment(*ctx, c->resolve(), *duration, *jitter));
-    });
   }
   {
-    auto c = std::make_shared<CliCommon>();
     auto duration = std::make_shared<double>(3.0);
     auto p0 = std::make_shared<double>(100.0);
-    CLI::App* cmd = app.add_subcommand("gain", "Experiment 3: first Kalman gain element over time");
-    add_common(cmd, *c, "out/gain");
+    CLI::App* cmd = add_experiment(app, "gain", "Experiment 3: first Kalman gain element over time", "out/gain",
+                                   [duration, p0](const CliCommon& c, const SimContext& ctx) {
+                                     emit(c, run_gain_experiment(ctx, c.resolve(), *duration, *p0));
+                                   });
     cmd->add_option("--duration", *duration, "simulated seconds")->check(finite_in(0.1, 3600.0))->capture_default_str();
     cmd->add_option("--p0-scale", *p0, "initial covariance as a multiple of the steady state")->check(finite_in(0.0, 1e12, true))->capture_default_str();
-    cmd->callback([c, duration, p0]() {
-      const auto ctx = SimContext::load(c->plant);
-      emit(*c, run_gain_experiment(*ctx, c->resolve(), *duration, *p0));
-    });
   }
   {
     auto c = std::make_shared<CliCommon>();
@@ -303,17 +311,12 @@ void register_experiment_commands(CLI::App& app) {
     });
   }
   {
-    auto c = std::make_shared<CliCommon>();
     auto variant = std::make_shared<std::string>();
-    c->noise = "constant";
-    CLI::App* cmd = app.add_subcommand("exectime-probe", "(internal) replay one variant for callgrind");
+    CLI::App* cmd = add_experiment(
+        app, "exectime-probe", "(internal) replay one variant for callgrind", "out/exectime",
+        [variant](const CliCommon& c, const SimContext& ctx) { run_exectime_probe(ctx, c.resolve(), *variant); }, "constant");
     cmd->group("");  // hidden
-    add_common(cmd, *c, "out/exectime");
     cmd->add_option("--variant", *variant, "half_table, half_generic, complete_table or complete_generic")->required();
-    cmd->callback([c, variant]() {
-      const auto ctx = SimContext::load(c->plant);
-      run_exectime_probe(*ctx, c->resolve(), *variant);
-    });
   }
   {
     auto c = std::make_shared<CliCommon>();
@@ -362,17 +365,14 @@ void register_experiment_commands(CLI::App& app) {
     });
   }
   {
-    auto c = std::make_shared<CliCommon>();
     auto seconds = std::make_shared<double>(200.0);
-    CLI::App* cmd = app.add_subcommand("benchmark", "Simulated seconds per wall second of the board emulation (one core)");
-    add_common(cmd, *c, "out/benchmark");
+    CLI::App* cmd = add_experiment(app, "benchmark", "Simulated seconds per wall second of the board emulation (one core)",
+                                   "out/benchmark", [seconds](const CliCommon& c, const SimContext& ctx) {
+                                     const nlohmann::json j = run_benchmark(ctx, c.resolve(), *seconds);
+                                     if (c.json != "-") util::write_json("-", j);
+                                     if (!c.json.empty()) util::write_json(c.json, j);
+                                   });
     cmd->add_option("--simulated-seconds", *seconds, "simulated time per measurement")->check(finite_in(1.0, 1e5))->capture_default_str();
-    cmd->callback([c, seconds]() {
-      const auto ctx = SimContext::load(c->plant);
-      const nlohmann::json j = run_benchmark(*ctx, c->resolve(), *seconds);
-      if (c->json != "-") util::write_json("-", j);
-      if (!c->json.empty()) util::write_json(c->json, j);
-    });
   }
   {
     auto c = std::make_shared<CliCommon>();

@@ -57,6 +57,24 @@ const TracePoint& trace_at(const RunResult& r, double t_s, std::int32_t step_us)
 
 const char* png_terminal() { return "set terminal pngcairo size 1100,700 font 'Sans,11' noenhanced\n"; }
 
+/// One curve of a gnuplot `plot`: columns of `file` ('' repeats the previous file), style, title.
+struct PlotSeries {
+  const char* file;
+  const char* using_columns;
+  const char* with;
+  const char* title;
+};
+
+/// `plot <series>, <series>...` on one line (every file has a header row to skip).
+std::string plot_command(const std::vector<PlotSeries>& series) {
+  std::string p;
+  for (const PlotSeries& c : series) {
+    p += (p.empty() ? "plot '" : ", '") + std::string(c.file) + "' using " + c.using_columns + " skip 1 with " + c.with +
+         " title '" + c.title + "'";
+  }
+  return p + "\n";
+}
+
 }  // namespace
 
 RunOptions run_options(const CommonOptions& opt, Approach a) {
@@ -159,11 +177,11 @@ nlohmann::json run_jitter_experiment(const SimContext& ctx, const CommonOptions&
     g << png_terminal() << "set output 'jitter.png'\nset datafile separator ','\nset key top left box opaque\nset grid\n"
       << "set title 'Response under jitter (release 0-" << jitter_us / 1000.0 << " ms): one-shot + half Kalman vs standard controllers'\n"
       << "set xlabel 'time (s)'\nset ylabel " << util::gnuplot_quote(v + " (V)") << "\n"
-      << "plot 'jitter.csv' using 1:2 skip 1 with lines dt 2 lw 1.5 lc rgb 'black' title 'set-point', "
-      << "'' using 1:3 skip 1 with lines lw 3 lc rgb '#bbbbbb' title 'A: standard + Kalman, no jitter', "
-      << "'' using 1:4 skip 1 with lines lw 1.5 lc rgb '#d62728' title 'B: one-shot + half Kalman', "
-      << "'' using 1:5 skip 1 with lines lw 1.5 lc rgb '#1f77b4' title 'D: standard + Kalman', "
-      << "'' using 1:6 skip 1 with lines lw 1.5 lc rgb '#2ca02c' title 'E: standard, no Kalman'\n";
+      << plot_command({{"jitter.csv", "1:2", "lines dt 2 lw 1.5 lc rgb 'black'", "set-point"},
+                       {"", "1:3", "lines lw 3 lc rgb '#bbbbbb'", "A: standard + Kalman, no jitter"},
+                       {"", "1:4", "lines lw 1.5 lc rgb '#d62728'", "B: one-shot + half Kalman"},
+                       {"", "1:5", "lines lw 1.5 lc rgb '#1f77b4'", "D: standard + Kalman"},
+                       {"", "1:6", "lines lw 1.5 lc rgb '#2ca02c'", "E: standard, no Kalman"}});
     util::run_gnuplot(opt.out_dir, "jitter.gp", g.str());
   }
   nlohmann::json j = common_json(ctx, opt);
@@ -212,9 +230,9 @@ nlohmann::json run_gain_experiment(const SimContext& ctx, const CommonOptions& o
     g << png_terminal() << "set output 'gain.png'\nset datafile separator ','\nset key top right box opaque\nset grid\n"
       << "set title 'First Kalman gain element over time (P0 = " << p0_scale << " x steady state)'\n"
       << "set xlabel 'time (s)'\nset ylabel 'K(1)'\n"
-      << "plot 'gain.csv' using 2:3 skip 1 with linespoints pt 7 ps 0.6 lw 1.5 lc rgb '#d62728' title 'half Kalman (one-shot, jitter)', "
-      << "'' using 4:5 skip 1 with linespoints pt 6 ps 0.9 lw 1 dt 2 lc rgb '#9467bd' title 'complete Kalman (one-shot, jitter)', "
-      << "'' using 6:7 skip 1 with linespoints pt 5 ps 0.5 lw 1.5 lc rgb '#1f77b4' title 'standard controller + Kalman, no jitter'\n";
+      << plot_command({{"gain.csv", "2:3", "linespoints pt 7 ps 0.6 lw 1.5 lc rgb '#d62728'", "half Kalman (one-shot, jitter)"},
+                       {"", "4:5", "linespoints pt 6 ps 0.9 lw 1 dt 2 lc rgb '#9467bd'", "complete Kalman (one-shot, jitter)"},
+                       {"", "6:7", "linespoints pt 5 ps 0.5 lw 1.5 lc rgb '#1f77b4'", "standard controller + Kalman, no jitter"}});
     util::run_gnuplot(opt.out_dir, "gain.gp", g.str());
   }
   nlohmann::json j = common_json(ctx, opt);

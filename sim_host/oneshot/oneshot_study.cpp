@@ -7,8 +7,8 @@
 #include <memory>
 
 #include "kernel_experiment.hpp"
-#include "oneshot/engine/sweep_registry.hpp"
 #include "oneshot/sim/cli_commands.hpp"
+#include "oneshot/sim/study_descriptor.hpp"
 #include "oneshot/util/output_files.hpp"
 #include "oneshot/sim/study_report.hpp"
 #include "table1.hpp"
@@ -93,23 +93,22 @@ StudyReportResult kernel_report_section(const StudyReportContext& r) {
   return {md, j};
 }
 
-}  // namespace
-
-void register_oneshot_study(CLI::App& app) {
-  CLI::App* study = app.add_subcommand(
-      "oneshot", "Study 000: the one-shot task model with an embedded Kalman filter on the reference board "
-                 "(approaches A-E; the same commands are also available at the top level)");
-  study->require_subcommand(1);
+/// design, the experiments (also at the top level) and the kernel experiment.
+void add_oneshot_commands(CLI::App* study) {
   register_design_command(*study);
   register_experiment_commands(*study);
   register_kernel_experiment(*study);
-  engine::register_summarizer("oneshot", "table1", [](const engine::SweepResults& r, const std::string& out, bool plots) {
-    return table1_outputs(r, out, plots);
-  });
-  engine::register_summarizer("oneshot", "kernel", [](const engine::SweepResults& r, const std::string& out, bool plots) {
-    return kernel_outputs(r, out, plots);
-  });
-  add_study_report_section({"kernel", kernel_report_section});
+}
+
+}  // namespace
+
+StudyDescriptor oneshot_study() {
+  // Its Table I and the other experiments open the report (report.cpp); this is the kernel section.
+  return {"oneshot",
+          "Study 000: the one-shot task model with an embedded Kalman filter on the reference board "
+          "(approaches A-E; the same commands are also available at the top level)",
+          add_oneshot_commands, {{"table1", table1_outputs}, {"kernel", kernel_outputs}},
+          StudyReportSection{"kernel", kernel_report_section}};
 }
 
 }  // namespace oneshot::sim

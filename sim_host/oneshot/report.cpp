@@ -262,20 +262,12 @@ nlohmann::json run_report(const SimContext& ctx, const CommonOptions& o, const R
   targets_section(table1, lut, mcu, bench, targets, md);
 
   // The networked and event-based studies, each on its built-in defaults (study_report.hpp).
-  nlohmann::json studies = nlohmann::json::object();
-  for (const StudyReportSection& section : study_report_sections()) {
-    std::cerr << "report: " << section.study << "\n";
-    StudyReportContext sc;
-    sc.out_dir = (std::filesystem::path(o.out_dir) / section.study).string();
-    sc.rel_dir = section.study;
-    sc.threads = o.threads;
-    sc.seed = o.seed;
-    sc.plots = o.plots;
-    util::make_directory(sc.out_dir);
-    StudyReportResult res = section.run(sc);
-    md << res.markdown << "\n";
-    studies[section.study] = std::move(res.json);
-  }
+  StudyReportContext sections;
+  sections.out_dir = o.out_dir;
+  sections.threads = o.threads;
+  sections.seed = o.seed;
+  sections.plots = o.plots;
+  const nlohmann::json studies = run_study_report_sections(sections, md);
 
   nlohmann::json all = {{"noise", noise},         {"jitter", jitter},     {"gain", gain},
                         {"table1", table1},       {"formats", formats},   {"exectime", exectime},

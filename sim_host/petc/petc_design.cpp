@@ -63,7 +63,7 @@ std::vector<std::pair<double, double>> quadratic_factors(std::vector<Complex> ro
 
 }  // namespace
 
-std::string default_plant_path() { return ONESHOT_PETC_PLANT_FILE; }
+std::string default_plant_path() { return ONESHOT_STUDY_PLANT_FILE; }
 
 PlantFacts load_plant_facts(const std::string& path) {
   PlantFacts f;

@@ -6,8 +6,7 @@
 #include <sstream>
 
 #include "oneshot/engine/frame_faults.hpp"
-#include "oneshot/engine/sweep_registry.hpp"
-#include "oneshot/sim/cli_commands.hpp"
+#include "oneshot/sim/study_descriptor.hpp"
 #include "oneshot/util/output_files.hpp"
 #include "oneshot/sim/pil_link.hpp"
 #include "oneshot/sim/study_report.hpp"
@@ -124,13 +123,8 @@ StudyReportResult report_section(const StudyReportContext& ctx) {
   return {md.str(), {{"design", design}, {"table", table}, {"gpi", gpi}, {"traces", traces}, {"exectime", exectime}}};
 }
 
-}  // namespace
-
-void register_petc_study(CLI::App& app) {
-  CLI::App* study = app.add_subcommand(
-      "petc", "Study 003: periodic event-triggered control of an HDD servo with a non-uniform multi-rate "
-              "estimator (NUMRE), packets of future inputs and an interlaced controller (MRCI)");
-  study->require_subcommand(1);
+/// The experiments of the PETC study.
+void add_petc_commands(CLI::App* study) {
   auto cli = std::make_shared<Cli>();
 
   CLI::App* design = study->add_subcommand("design", "MRCI slow modes, fast part, CS; plant DC gain, zeros, relative degree; DOB");
@@ -199,14 +193,16 @@ void register_petc_study(CLI::App& app) {
     if (cli->json != "-") std::cout << exectime_markdown(j);
     emit(*cli, j);
   });
+}
 
-  engine::register_summarizer("petc", "table", [](const engine::SweepResults& r, const std::string& out, bool plots) {
-    return table_outputs(r, out, plots);
-  });
-  engine::register_summarizer("petc", "gpi", [](const engine::SweepResults& r, const std::string& out, bool plots) {
-    return gpi_outputs(r, out, plots);
-  });
-  add_study_report_section({"petc", report_section});
+}  // namespace
+
+StudyDescriptor petc_study() {
+  return {"petc",
+          "Study 003: periodic event-triggered control of an HDD servo with a non-uniform multi-rate "
+          "estimator (NUMRE), packets of future inputs and an interlaced controller (MRCI)",
+          add_petc_commands, {{"table", table_outputs}, {"gpi", gpi_outputs}},
+          StudyReportSection{"petc", report_section}};
 }
 
 }  // namespace oneshot::sim

@@ -9,7 +9,7 @@
 
 namespace oneshot::sod {
 
-std::string default_sod_plant_path() { return ONESHOT_SOD_PLANT_PATH; }
+std::string default_sod_plant_path() { return ONESHOT_STUDY_PLANT_FILE; }
 
 SodModel load_sod_model(const std::string& path) {
   const design::PlantDescription plant = design::load_plant_file(path);

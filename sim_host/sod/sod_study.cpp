@@ -6,8 +6,7 @@
 #include <memory>
 #include <sstream>
 
-#include "oneshot/engine/sweep_registry.hpp"
-#include "oneshot/sim/cli_commands.hpp"
+#include "oneshot/sim/study_descriptor.hpp"
 #include "oneshot/util/output_files.hpp"
 #include "oneshot/sim/study_report.hpp"
 #include "sod_experiments.hpp"
@@ -46,13 +45,8 @@ sod::SodModel model_of(Cli& c) {
   return sod::load_sod_model(c.opt.plant_path);
 }
 
-}  // namespace
-
-void register_sod_study(CLI::App& app) {
-  CLI::App* study = app.add_subcommand(
-      "sod", "Study 004: estimation over a lossy link with send-on-delta and modified send-on-delta sensor nodes");
-  study->require_subcommand(1);
-
+/// The experiments of the send-on-delta study.
+void add_sod_commands(CLI::App* study) {
   {
     auto c = std::make_shared<Cli>();
     CLI::App* cmd = study->add_subcommand("table", "E3 (a)-(c): packets, (2b) sends, losses, e_i and NEES per configuration and loss rate");
@@ -147,10 +141,14 @@ void register_sod_study(CLI::App& app) {
       sod::emit_json(r.json, c->json);
     });
   }
-  engine::register_summarizer("sod", "table", [](const engine::SweepResults& r, const std::string& out, bool plots) {
-    return sod::table_outputs(r, out, plots);
-  });
-  add_study_report_section({"sod", [](const StudyReportContext& ctx) { return sod::report_section(ctx); }});
+}
+
+}  // namespace
+
+StudyDescriptor sod_study() {
+  return {"sod",
+          "Study 004: estimation over a lossy link with send-on-delta and modified send-on-delta sensor nodes",
+          add_sod_commands, {{"table", sod::table_outputs}}, StudyReportSection{"sod", sod::report_section}};
 }
 
 }  // namespace oneshot::sim

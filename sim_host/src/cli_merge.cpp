@@ -5,10 +5,10 @@
 #include <sstream>
 
 #include "oneshot/engine/sweep.hpp"
-#include "oneshot/engine/sweep_registry.hpp"
 #include "oneshot/util/file_io.hpp"
 #include "oneshot/util/strict_json.hpp"
 #include "oneshot/sim/cli_commands.hpp"
+#include "oneshot/sim/study_descriptor.hpp"
 #include "oneshot/util/output_files.hpp"
 
 namespace oneshot::sim {
@@ -54,7 +54,7 @@ void register_merge_command(CLI::App& app) {
     std::vector<engine::SweepResults> shards;
     for (const std::string& f : o->files) shards.push_back(read_shard(f));
     const engine::SweepResults all = engine::merge_shards(shards);
-    const auto& summarize = engine::find_summarizer(all.spec.study, all.spec.experiment);
+    const auto& summarize = find_summarizer(all.spec.study, all.spec.experiment);
     const nlohmann::json j = summarize(all, o->out, !o->no_plots);
     if (!o->json.empty()) util::write_json(o->json, j);
     if (o->json != "-") {

@@ -1,23 +1,43 @@
 /// @file studies.cpp
-/// @brief The registration point of the studies: one line per study.
+/// @brief The one list of the studies built into oneshot-sim, and what the CLI, `merge` and
+///        `report` take from it.
 ///
-/// A study lives in its own folder sim_host/<study>/ (its plant and scenario files, its
-/// approaches, experiments and plots), is built into oneshot-sim by sim_host/CMakeLists.txt
-/// (ONESHOT_STUDIES), and registers its commands under `oneshot-sim <study> <experiment>`
-/// here, together with the summarizers that let `oneshot-sim merge` finish its sweeps.
-/// The engine (sim_host/engine/) knows no study. Upcoming: ncs (seed 001), dropping
-/// (seed 002), petc (seed 003), sod (seed 004).
+/// A study lives in its own folder sim_host/<study>/ (sources, plant and scenario files,
+/// experiments, plots, its CMakeLists.txt with oneshot_study()), defines its StudyDescriptor
+/// once there, and is listed here. The engine (sim_host/engine/) knows no study.
+#include <map>
+#include <stdexcept>
+
 #include "oneshot/sim/cli_commands.hpp"
+#include "oneshot/sim/study_descriptor.hpp"
 
 namespace oneshot::sim {
 
+const std::vector<StudyDescriptor>& studies() {
+  static const std::vector<StudyDescriptor> all = {oneshot_study(), ncs_study(),  dropping_study(),
+                                                   sod_study(),     petc_study(), kernel_study()};
+  return all;
+}
+
 void register_studies(CLI::App& app) {
-  register_oneshot_study(app);  // sim_host/oneshot/: seed 000, the one-shot task model
-  register_ncs_study(app);       // sim_host/ncs/:      networked actuation sync (issue 12)
-  register_dropping_study(app);  // sim_host/dropping/: over-delay dropping Kalman (issue 13)
-  register_sod_study(app);       // sim_host/sod/:      send-on-delta estimation (issue 14)
-  register_petc_study(app);      // sim_host/petc/:     NUMRE periodic event-triggered control (issue 15)
-  register_kernel_study(app);    // sim_host/kernel/:   CPUs, schedulers, response-time analysis (issue 22)
+  for (const StudyDescriptor& s : studies()) {
+    CLI::App* group = app.add_subcommand(s.name, s.summary);
+    group->require_subcommand(1);
+    s.add_commands(group);
+  }
+}
+
+const SweepSummarizer& find_summarizer(const std::string& study, const std::string& experiment) {
+  std::map<std::string, const SweepSummarizer*> known;  // "study experiment", sorted for the message
+  for (const StudyDescriptor& s : studies()) {
+    for (const auto& [name, summarizer] : s.summarizers) known[s.name + " " + name] = &summarizer;
+  }
+  const auto it = known.find(study + " " + experiment);
+  if (it != known.end()) return *it->second;
+  std::string list;
+  for (const auto& [k, v] : known) list += (list.empty() ? "" : ", ") + k;
+  throw std::invalid_argument("no study experiment '" + study + " " + experiment + "' can merge sweeps (known: " + list +
+                              ")");
 }
 
 }  // namespace oneshot::sim

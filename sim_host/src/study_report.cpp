@@ -1,28 +1,31 @@
 /// @file study_report.cpp
-/// @brief Registry of the studies' report sections (see study_report.hpp).
+/// @brief The studies' sections of the main report (see study_report.hpp).
 #include "oneshot/sim/study_report.hpp"
 
-#include <stdexcept>
+#include <filesystem>
+#include <iostream>
 #include <utility>
 
+#include "oneshot/sim/study_descriptor.hpp"
+#include "oneshot/util/output_files.hpp"
+
 namespace oneshot::sim {
-namespace {
 
-std::vector<StudyReportSection>& sections() {
-  static std::vector<StudyReportSection> s;
-  return s;
-}
-
-}  // namespace
-
-void add_study_report_section(StudyReportSection section) {
-  if (section.study.empty() || !section.run) throw std::invalid_argument("study report section needs a name and a function");
-  for (const StudyReportSection& s : sections()) {
-    if (s.study == section.study) throw std::invalid_argument("study report section registered twice: " + section.study);
+nlohmann::json run_study_report_sections(const StudyReportContext& report, std::ostream& md) {
+  nlohmann::json sections = nlohmann::json::object();
+  for (const StudyDescriptor& study : studies()) {
+    if (!study.report) continue;
+    const StudyReportSection& section = *study.report;
+    std::cerr << "report: " << section.study << "\n";
+    StudyReportContext sc = report;
+    sc.out_dir = (std::filesystem::path(report.out_dir) / section.study).string();
+    sc.rel_dir = section.study;
+    util::make_directory(sc.out_dir);
+    StudyReportResult res = section.run(sc);
+    md << res.markdown << "\n";
+    sections[section.study] = std::move(res.json);
   }
-  sections().push_back(std::move(section));
+  return sections;
 }
-
-const std::vector<StudyReportSection>& study_report_sections() { return sections(); }
 
 }  // namespace oneshot::sim

@@ -7,6 +7,8 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <functional>
+#include <vector>
 
 #include "scenario.hpp"
 #include "simulation.hpp"
@@ -20,6 +22,23 @@ RunOptions options(Approach a, NumberFormat f) {
   o.format = f;
   o.noise = NoiseModel::kExact;
   return o;
+}
+
+/// A one-second run of the j20-a0.2-p1 scenario.
+Scenario one_second() {
+  Scenario s = default_scenarios()[3];
+  s.duration_s = 1;
+  return s;
+}
+
+/// simulate() refuses B in `format` after each of `changes` to its options.
+void expect_refused(const SimContext& ctx, NumberFormat format,
+                    const std::vector<std::function<void(RunOptions&)>>& changes) {
+  for (std::size_t i = 0; i < changes.size(); ++i) {
+    RunOptions o = options(Approach::kB, format);
+    changes[i](o);
+    EXPECT_THROW(simulate(ctx, one_second(), 1, o), std::invalid_argument) << "change " << i;
+  }
 }
 
 TEST(Q15CJob, TableICostMatchesDoubleInEveryScenario) {
@@ -62,22 +81,15 @@ TEST(Q15CJob, OtherApproachesRunInDouble) {
 
 TEST(Q15CJob, NeedsTheCompiledPlantExactNoiseAndTheTable) {
   const auto ctx = SimContext::reference();
-  Scenario s = default_scenarios()[3];
-  s.duration_s = 1;
-  RunOptions o = options(Approach::kB, NumberFormat::kQ15);
-  o.noise = NoiseModel::kConstant;
-  EXPECT_THROW(simulate(*ctx, s, 1, o), std::invalid_argument);
-  o = options(Approach::kB, NumberFormat::kQ15);
-  o.discretizer = DiscretizerKind::kGeneric;
-  EXPECT_THROW(simulate(*ctx, s, 1, o), std::invalid_argument);
-  o = options(Approach::kB, NumberFormat::kQ15);
-  o.p0_scale = 2.0;
-  EXPECT_THROW(simulate(*ctx, s, 1, o), std::invalid_argument);
+  expect_refused(*ctx, NumberFormat::kQ15,
+                 {[](RunOptions& o) { o.noise = NoiseModel::kConstant; },
+                  [](RunOptions& o) { o.discretizer = DiscretizerKind::kGeneric; },
+                  [](RunOptions& o) { o.p0_scale = 2.0; }});
   const auto runtime = SimContext::from_plant(design::reference_plant());
-  EXPECT_THROW(simulate(*runtime, s, 1, options(Approach::kB, NumberFormat::kQ15)), std::invalid_argument);
-  o = options(Approach::kB, NumberFormat::kQ15);
+  expect_refused(*runtime, NumberFormat::kQ15, {[](RunOptions&) {}});
+  RunOptions o = options(Approach::kB, NumberFormat::kQ15);
   o.discretizer = DiscretizerKind::kNearest;
-  EXPECT_GT(simulate(*ctx, s, 1, o).jobs, 10U);
+  EXPECT_GT(simulate(*ctx, one_second(), 1, o).jobs, 10U);
 }
 
 TEST(FloatPolyCJob, TableICostMatchesDoubleInEveryScenario) {
@@ -103,14 +115,10 @@ TEST(FloatPolyCJob, TableICostMatchesDoubleInEveryScenario) {
 
 TEST(FloatPolyCJob, NeedsExactNoiseAndTheTableDiscretizer) {
   const auto ctx = SimContext::reference();
-  Scenario s = default_scenarios()[3];
-  s.duration_s = 1;
-  RunOptions o = options(Approach::kB, NumberFormat::kFloatPoly);
-  o.noise = NoiseModel::kConstant;
-  EXPECT_THROW(simulate(*ctx, s, 1, o), std::invalid_argument);
-  o = options(Approach::kB, NumberFormat::kFloatPoly);
-  o.discretizer = DiscretizerKind::kNearest;
-  EXPECT_THROW(simulate(*ctx, s, 1, o), std::invalid_argument);
+  expect_refused(*ctx, NumberFormat::kFloatPoly,
+                 {[](RunOptions& o) { o.noise = NoiseModel::kConstant; },
+                  [](RunOptions& o) { o.discretizer = DiscretizerKind::kNearest; }});
+  const Scenario s = one_second();
   const double d = simulate(*ctx, s, 2, options(Approach::kA, NumberFormat::kDouble)).cost.total();
   EXPECT_EQ(simulate(*ctx, s, 2, options(Approach::kA, NumberFormat::kFloatPoly)).cost.total(), d);
 }

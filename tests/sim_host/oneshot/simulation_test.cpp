@@ -19,10 +19,21 @@ Scenario short_scenario(std::int32_t jitter_us) {
   return s;
 }
 
+/// Options of approach `a`, the rest at their defaults.
+RunOptions options(Approach a) {
+  RunOptions o;
+  o.approach = a;
+  return o;
+}
+
+/// Total cost of a run of the short scenario (20 ms release jitter).
+double short_cost(const SimContext& ctx, const RunOptions& o, std::uint64_t seed) {
+  return simulate(ctx, short_scenario(20'000), seed, o).cost.total();
+}
+
 TEST(Simulation, OneShotTauIsTheTimeFromSampleToActuation) {
   const auto ctx = SimContext::reference();
-  RunOptions o;
-  o.approach = Approach::kB;
+  RunOptions o = options(Approach::kB);
   o.record_jobs = true;
   const RunResult r = simulate(*ctx, short_scenario(20'000), 3, o);
   ASSERT_EQ(r.job_records.size(), 60U);
@@ -39,8 +50,7 @@ TEST(Simulation, OneShotTauIsTheTimeFromSampleToActuation) {
 
 TEST(Simulation, StandardTaskAssumesZeroDelayAndSamplesOnTheJitteredInstant) {
   const auto ctx = SimContext::reference();
-  RunOptions o;
-  o.approach = Approach::kD;
+  RunOptions o = options(Approach::kD);
   o.record_jobs = true;
   const RunResult r = simulate(*ctx, short_scenario(20'000), 3, o);
   bool some_late = false;
@@ -58,8 +68,7 @@ TEST(Simulation, StandardTaskAssumesZeroDelayAndSamplesOnTheJitteredInstant) {
 
 TEST(Simulation, ApproachAIgnoresTheScenarioJitter) {
   const auto ctx = SimContext::reference();
-  RunOptions o;
-  o.approach = Approach::kA;
+  RunOptions o = options(Approach::kA);
   o.record_jobs = true;
   const RunResult r = simulate(*ctx, short_scenario(20'000), 3, o);
   for (std::size_t k = 0; k < r.job_records.size(); ++k)
@@ -69,32 +78,29 @@ TEST(Simulation, ApproachAIgnoresTheScenarioJitter) {
 TEST(Simulation, HalfAndCompleteCostTheSame) {
   const auto ctx = SimContext::reference();
   for (std::uint64_t seed : {1U, 2U}) {
-    RunOptions o;
-    o.approach = Approach::kB;
-    const double b = simulate(*ctx, short_scenario(20'000), seed, o).cost.total();
+    RunOptions o = options(Approach::kB);
+    const double b = short_cost(*ctx, o, seed);
     o.approach = Approach::kC;
-    const double c = simulate(*ctx, short_scenario(20'000), seed, o).cost.total();
+    const double c = short_cost(*ctx, o, seed);
     EXPECT_NEAR(b, c, 1e-6 * b);
   }
 }
 
 TEST(Simulation, GenericAndTableGiveTheSameLoop) {
   const auto ctx = SimContext::reference();
-  RunOptions o;
-  o.approach = Approach::kB;
-  const double table = simulate(*ctx, short_scenario(20'000), 4, o).cost.total();
+  RunOptions o = options(Approach::kB);
+  const double table = short_cost(*ctx, o, 4);
   o.discretizer = DiscretizerKind::kGeneric;
-  const double generic = simulate(*ctx, short_scenario(20'000), 4, o).cost.total();
+  const double generic = short_cost(*ctx, o, 4);
   EXPECT_NEAR(table, generic, 1e-5 * table);
 }
 
 TEST(Simulation, SameSeedSameResultDifferentSeedDifferent) {
   const auto ctx = SimContext::reference();
-  RunOptions o;
-  o.approach = Approach::kE;
-  const double a = simulate(*ctx, short_scenario(20'000), 9, o).cost.total();
-  const double b = simulate(*ctx, short_scenario(20'000), 9, o).cost.total();
-  const double c = simulate(*ctx, short_scenario(20'000), 10, o).cost.total();
+  RunOptions o = options(Approach::kE);
+  const double a = short_cost(*ctx, o, 9);
+  const double b = short_cost(*ctx, o, 9);
+  const double c = short_cost(*ctx, o, 10);
   EXPECT_EQ(a, b);
   EXPECT_NE(a, c);
 }
@@ -103,11 +109,10 @@ TEST(Simulation, RuntimePlantMatchesTheGeneratedConstants) {
   // The reference loaded as a plant file (dense structure, run-time table) runs the same loop.
   const auto generated = SimContext::reference();
   const auto runtime = SimContext::from_plant(design::reference_plant());
-  RunOptions o;
-  o.approach = Approach::kB;
+  RunOptions o = options(Approach::kB);
   o.format = NumberFormat::kDouble;
-  const double g = simulate(*generated, short_scenario(20'000), 5, o).cost.total();
-  const double r = simulate(*runtime, short_scenario(20'000), 5, o).cost.total();
+  const double g = short_cost(*generated, o, 5);
+  const double r = short_cost(*runtime, o, 5);
   EXPECT_NEAR(g, r, 1e-9 * g);
 }
 
@@ -137,9 +142,9 @@ TEST(Simulation, FixedPointCostMatchesDouble) {
     RunOptions o;
     o.approach = a;
     o.format = NumberFormat::kDouble;
-    const double d = simulate(*ctx, short_scenario(20'000), 6, o).cost.total();
+    const double d = short_cost(*ctx, o, 6);
     o.format = NumberFormat::kFixed;
-    const double q = simulate(*ctx, short_scenario(20'000), 6, o).cost.total();
+    const double q = short_cost(*ctx, o, 6);
     EXPECT_NEAR(q, d, 0.01 * d) << info(a).letter;
   }
 }
@@ -161,9 +166,9 @@ TEST(Simulation, PwmUpdateAtThePeriodStartsFromTheInitialInput) {
   for (const auto& [a, tolerance] : {std::pair{Approach::kB, 0.003}, std::pair{Approach::kD, 0.02}}) {
     RunOptions o;
     o.approach = a;
-    const double immediate = simulate(*ctx, short_scenario(20'000), 2, o).cost.total();
+    const double immediate = short_cost(*ctx, o, 2);
     o.board.update = PwmUpdate::kNextPeriod;
-    const double period = simulate(*ctx, short_scenario(20'000), 2, o).cost.total();
+    const double period = short_cost(*ctx, o, 2);
     EXPECT_NEAR(period, immediate, tolerance * immediate) << info(a).letter;
   }
 }
@@ -191,8 +196,7 @@ TEST(Simulation, TheTraceAtASamplingInstantIsTheSampledState) {
   // the job sampled (same deterministic path, the interval's own noise draw), up to the
   // rounding of the piecewise walk (measured ≤ 2.6e-15 V over 19 seeds).
   const auto ctx = SimContext::reference();
-  RunOptions o;
-  o.approach = Approach::kA;
+  RunOptions o = options(Approach::kA);
   o.record_jobs = true;
   o.trace_step_us = 1000;
   const RunResult r = simulate(*ctx, short_scenario(20'000), 7, o);

@@ -1,15 +1,16 @@
 /// @file study_report.hpp
 /// @brief The studies' sections of the main report (`oneshot-sim report`).
 ///
-/// Each study registers one section when it registers its commands
-/// (register_<study>_study in sim_host/src/studies.cpp). `report` runs study 000 first,
-/// then every registered section in registration order on its built-in defaults, each
-/// writing its files under OUTDIR/<study>/ and returning its markdown and JSON.
+/// A study names its section in its descriptor (study_descriptor.hpp). `report` runs study
+/// 000 first, then every study's section in the order of sim_host/src/studies.cpp on its
+/// built-in defaults, each writing its files under OUTDIR/<study>/ and returning its
+/// markdown and JSON.
 #pragma once
 
 #include <cstddef>
 #include <cstdint>
 #include <functional>
+#include <ostream>
 #include <string>
 #include <vector>
 
@@ -38,10 +39,8 @@ struct StudyReportSection {
   std::function<StudyReportResult(const StudyReportContext&)> run;  ///< Runs the study's defaults.
 };
 
-/// Adds a section (called from register_<study>_study); a second section for the same study is refused.
-void add_study_report_section(StudyReportSection section);
-
-/// The registered sections, in registration order.
-const std::vector<StudyReportSection>& study_report_sections();
+/// Runs every study's section in order, each in `report.out_dir`/<study>/ (created) with the
+/// other fields of `report`; appends each markdown to `md` and returns {study: its JSON}.
+nlohmann::json run_study_report_sections(const StudyReportContext& report, std::ostream& md);
 
 }  // namespace oneshot::sim
