@@ -161,13 +161,7 @@ std::vector<JobTiming> parse_jitter_trace(const std::string& text, const std::st
 }
 
 std::vector<JobTiming> load_jitter_trace(const std::string& path) {
-  std::string text;
-  try {
-    text = util::read_text_file(path, "jitter trace");
-  } catch (const util::FileError& e) {
-    throw ScenarioError(e.what());
-  }
-  return parse_jitter_trace(text, path);
+  return parse_jitter_trace(util::read_text_file_as<ScenarioError>(path, "jitter trace"), path);
 }
 
 }  // namespace oneshot::sim

@@ -132,12 +132,7 @@ std::vector<Scenario> parse_scenarios(const std::string& text, const std::string
 }
 
 std::vector<Scenario> load_scenarios(const std::string& path) {
-  std::string text;
-  try {
-    text = util::read_text_file(path, "scenario file");
-  } catch (const util::FileError& e) {
-    throw ScenarioError(e.what());
-  }
+  const std::string text = util::read_text_file_as<ScenarioError>(path, "scenario file");
   return parse_scenarios(text, path, std::filesystem::path(path).parent_path().string());
 }
 

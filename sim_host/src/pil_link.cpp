@@ -28,12 +28,7 @@ std::string firmware_image_path(const PilOptions& o) {
 }
 
 std::uint32_t elf_symbol_address(const std::string& path, const std::string& name) {
-  std::string data;
-  try {
-    data = util::read_text_file(path, "firmware image", kMaxImageBytes);
-  } catch (const util::FileError& e) {
-    throw PilError(e.what());
-  }
+  const std::string data = util::read_text_file_as<PilError>(path, "firmware image", {}, kMaxImageBytes);
   const auto u16 = [&](std::size_t off) {
     if (off + 2 > data.size()) throw PilError(path + ": truncated ELF");
     return static_cast<std::uint32_t>(static_cast<unsigned char>(data[off]) | static_cast<unsigned char>(data[off + 1]) << 8);

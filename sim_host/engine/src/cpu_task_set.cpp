@@ -315,12 +315,7 @@ TaskSet parse_task_set(const std::string& text, const std::string& source, const
 }
 
 TaskSet load_task_set(const std::string& path) {
-  std::string text;
-  try {
-    text = util::read_text_file(path, "task file");
-  } catch (const util::FileError& e) {
-    throw InputError(e.what());
-  }
+  const std::string text = util::read_text_file_as<InputError>(path, "task file");
   return parse_task_set(text, path, std::filesystem::path(path).parent_path().string());
 }
 

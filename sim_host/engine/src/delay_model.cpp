@@ -166,12 +166,8 @@ DelayModel parse_delay_model(const nlohmann::json& j, const std::string& field, 
     if (!std::filesystem::is_regular_file(path, ec)) {
       throw InputError("field '" + field + ".file': " + d.trace_path + " is not a readable regular file");
     }
-    std::string text;
-    try {
-      text = util::read_text_file(d.trace_path, "delay trace", std::size_t{1} << 28);  // bounded: 256 MiB
-    } catch (const util::FileError& e) {
-      throw InputError("field '" + field + ".file': " + e.what());
-    }
+    const std::string text =
+        util::read_text_file_as<InputError>(d.trace_path, "delay trace", "field '" + field + ".file': ", std::size_t{1} << 28);
     d.trace = parse_delay_trace(text, d.trace_path);
   } else if (model == "lognormal") {
     heavy_tail(DelayModel::Kind::kLognormal, "median_us", d.median_ns, "sigma", 0, 10, d.sigma);

@@ -306,12 +306,7 @@ StudyFile parse_study(const std::string& text, const std::string& source, const 
 StudyFile load_study(const std::string& path, const StudySchema* schema) {
   std::error_code ec;
   if (!std::filesystem::is_regular_file(path, ec)) throw InputError(path + ": not a readable regular file");
-  std::string text;
-  try {
-    text = util::read_text_file(path, "study file", std::size_t{1} << 26);  // bounded: 64 MiB
-  } catch (const util::FileError& e) {
-    throw InputError(e.what());
-  }
+  const std::string text = util::read_text_file_as<InputError>(path, "study file", {}, std::size_t{1} << 26);  // 64 MiB
   return parse_study(text, path, schema, std::filesystem::path(path).parent_path().string());
 }
 

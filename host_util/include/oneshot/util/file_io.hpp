@@ -28,6 +28,18 @@ inline constexpr std::size_t kMaxInputFileBytes = std::size_t{16} << 20;
 std::string read_text_file(const std::string& path, const std::string& what,
                            std::size_t max_bytes = kMaxInputFileBytes);
 
+/// read_text_file() whose FileError is rethrown as the caller's error type `Error` (the
+/// study's input error), its message prefixed by `prefix` (e.g. "field 'links[0].file': ").
+template <typename Error>
+std::string read_text_file_as(const std::string& path, const std::string& what, const std::string& prefix = {},
+                              std::size_t max_bytes = kMaxInputFileBytes) {
+  try {
+    return read_text_file(path, what, max_bytes);
+  } catch (const FileError& e) {
+    throw Error(prefix + e.what());
+  }
+}
+
 /// Writes `bytes` to `path` atomically: temporary file in the same folder, every write,
 /// fsync and close checked, then rename. Missing parent folders are created. An existing
 /// non-regular target (a device such as /dev/null or /dev/stdout, a pipe) is written in
