@@ -52,7 +52,7 @@ template <typename Fmt, typename Structure, CovarianceUpdate kForm, std::size_t 
   }
   add_gain_times<Fmt>(x, k, innovation<Fmt, CP>(y, c, x));
   if constexpr (kForm == CovarianceUpdate::kSymmetric) {
-    fill_symmetric(p, [&](std::size_t i, std::size_t j) {  // P = P⁻ − K (P⁻Cᵀ)ᵀ
+    fill_symmetric(p, [&](std::size_t i, std::size_t j) __attribute__((always_inline)) {  // P = P⁻ − K (P⁻Cᵀ)ᵀ
       Accumulator<Cov> acc;
       acc.add(p(i, j));
       for (std::size_t o = 0; o < P; ++o) acc.sub_product(k(i, o), pct(j, o));
@@ -66,7 +66,7 @@ template <typename Fmt, typename Structure, CovarianceUpdate kForm, std::size_t 
         a(i, j) = i == j ? ScalarTraits<Gain>::one() - a(i, j) : -a(i, j);
     const Matrix<Cov, N, N> apa = congruence<Cov, Dense<N, N>>(a, p);
     const Matrix<Cov, N, P> kr = product<Cov, Dense<N, P>, Dense<P, P>>(k, r);
-    fill_symmetric(p, [&](std::size_t i, std::size_t j) {  // A P Aᵀ + (K R) Kᵀ
+    fill_symmetric(p, [&](std::size_t i, std::size_t j) __attribute__((always_inline)) {  // A P Aᵀ + (K R) Kᵀ
       Accumulator<Cov> acc;
       acc.add(apa(i, j));
       for (std::size_t o = 0; o < P; ++o) acc.add_product(kr(i, o), k(j, o));

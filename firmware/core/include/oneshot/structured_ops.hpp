@@ -35,7 +35,7 @@ constexpr void accumulate_term(Accumulator<Out>& acc, bool a_zero, bool a_one, c
 
 /// acc += Q(i, j), Q with pattern PQ (a structural one adds 1, a structural zero nothing).
 template <typename PQ, typename Out, typename SQ, std::size_t N>
-constexpr void add_patterned(Accumulator<Out>& acc, const Matrix<SQ, N, N>& q, std::size_t i, std::size_t j) {
+[[gnu::always_inline]] constexpr void add_patterned(Accumulator<Out>& acc, const Matrix<SQ, N, N>& q, std::size_t i, std::size_t j) {
   if (PQ::is_one(i, j)) {
     acc.add(ScalarTraits<Out>::one());
   } else if (!PQ::is_zero(i, j)) {
@@ -56,7 +56,7 @@ enum class RowSign : bool { kAdd, kSubtract };
 /// acc ± Σ_k A(r, k)·v_k, A with pattern PA: a structural zero is skipped, a structural one
 /// adds (subtracts) v_k itself.
 template <typename PA, RowSign kSign, typename Out, typename SA, typename SV, std::size_t R, std::size_t K>
-constexpr void accumulate_row(Accumulator<Out>& acc, const Matrix<SA, R, K>& a, std::size_t r,
+[[gnu::always_inline]] constexpr void accumulate_row(Accumulator<Out>& acc, const Matrix<SA, R, K>& a, std::size_t r,
                               const Vector<SV, K>& v) {
   for (std::size_t k = 0; k < K; ++k) {
     if (PA::is_zero(r, k)) continue;
@@ -136,7 +136,7 @@ constexpr Matrix<Out, N, N> congruence_impl(const Matrix<SA, N, N>& a, const Mat
       t(i, j) = acc.value();
     }
   Matrix<Out, N, N> out{NoInit{}};  // upper triangle written, lower mirrored
-  fill_symmetric(out, [&](std::size_t i, std::size_t j) {
+  fill_symmetric(out, [&](std::size_t i, std::size_t j) __attribute__((always_inline)) {
     Accumulator<Out> acc;
     for (std::size_t k = 0; k < N; ++k)
       detail::accumulate_term(acc, false, false, t(i, k), PA::is_zero(j, k), PA::is_one(j, k), a(j, k));
@@ -165,7 +165,7 @@ template <typename Out, typename PQ, typename SP, typename SQ, std::size_t N>
 constexpr Matrix<Out, N, N> symmetric_add(const Matrix<SP, N, N>& p, const Matrix<SQ, N, N>& q) {
   detail::check_pattern_shape<PQ, N, N>();
   Matrix<Out, N, N> out{NoInit{}};  // upper triangle written, lower mirrored
-  fill_symmetric(out, [&](std::size_t i, std::size_t j) {
+  fill_symmetric(out, [&](std::size_t i, std::size_t j) __attribute__((always_inline)) {
     Accumulator<Out> acc;
     acc.add(p(i, j));
     detail::add_patterned<PQ>(acc, q, i, j);
