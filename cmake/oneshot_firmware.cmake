@@ -111,14 +111,40 @@ function(oneshot_firmware_image image)
   add_custom_command(TARGET ${image} POST_BUILD ${post} COMMENT "size of ${image}")
 endfunction()
 
+# The defines of firmware/app/mcu/main.cpp for <format> (float, fixed) and <disc> (table,
+# nearest, generic), into <out>: the number format, the discretizer, and the generated C jobs
+# of approaches 5 (this format and sub-grid policy) and 6 (its own-arithmetic twin: q15 for
+# fixed, float_poly for the float table), each as its variant and the header's HAS macro.
+function(oneshot_main_defines format disc out)
+  set(defs ONESHOT_FW_FIXED=$<STREQUAL:${format},fixed>
+           ONESHOT_FW_DISC=$<IF:$<STREQUAL:${disc},generic>,1,$<IF:$<STREQUAL:${disc},nearest>,2,0>>)
+  set(main)
+  set(own_arith)
+  if(NOT disc STREQUAL "generic")
+    set(main ${format}_${disc})
+    if(format STREQUAL "fixed")
+      set(own_arith q15_${disc})
+    elseif(disc STREQUAL "table")
+      set(own_arith float_poly)
+    endif()
+  endif()
+  foreach(job MAIN OWN_ARITH)
+    string(TOLOWER ${job} var)
+    if(${var})
+      string(TOUPPER ${${var}} upper)
+      list(APPEND defs ONESHOT_CJOB_${job}_VARIANT=${${var}} ONESHOT_CJOB_${job}_HAS=ONESHOT_JOB_HAS_${upper})
+    endif()
+  endforeach()
+  set(${out} ${defs} PARENT_SCOPE)
+endfunction()
+
 # The PIL images, oneshot-<target>-<float|fixed>-<table|nearest|generic>.elf, each with every
 # approach (firmware/app/mcu/main.cpp).
 foreach(format float fixed)
   foreach(disc table nearest generic)
+    oneshot_main_defines(${format} ${disc} main_defines)
     oneshot_firmware_image(oneshot-${ONESHOT_FIRMWARE_TARGET}-${format}-${disc} C_JOB PIL
-      SOURCES firmware/app/mcu/main.cpp
-      DEFINES ONESHOT_FW_FIXED=$<STREQUAL:${format},fixed>
-              ONESHOT_FW_DISC=$<IF:$<STREQUAL:${disc},generic>,1,$<IF:$<STREQUAL:${disc},nearest>,2,0>>)
+      SOURCES firmware/app/mcu/main.cpp DEFINES ${main_defines})
   endforeach()
 endforeach()
 
@@ -152,8 +178,9 @@ endforeach()
 # test builds it and checks its symbols (tests/pil/og_no_floating_point.cmake).
 set(og_options ${fw_common_options})
 list(REMOVE_ITEM og_options ${ONESHOT_FIRMWARE_OPT} -Werror)
+oneshot_main_defines(fixed table og_defines)
 oneshot_firmware_image(oneshot-og-probe-${ONESHOT_FIRMWARE_TARGET} EXCLUDE_FROM_ALL C_JOB PIL
-  SOURCES firmware/app/mcu/main.cpp OPTIONS ${og_options} -Og DEFINES ONESHOT_FW_FIXED=1 ONESHOT_FW_DISC=0)
+  SOURCES firmware/app/mcu/main.cpp OPTIONS ${og_options} -Og DEFINES ${og_defines})
 
 # The petc image (Cortex-M4F only: the node with H = 200 needs ~49 KB of RAM, the nRF51 has 16 KB):
 # the PETC controller node behind the PIL link, one NUMRE arrival per request between the

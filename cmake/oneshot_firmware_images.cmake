@@ -1,5 +1,6 @@
 # From the host build: cross-build the firmware images of both targets as external
-# projects that use this build's lut_gen. Sets ONESHOT_FIRMWARE_DIRS (target → build dir).
+# projects that use this build's lut_gen, in <build>/firmware-<target>/. Sets
+# ONESHOT_FIRMWARE_AVAILABLE.
 find_program(ONESHOT_ARM_GXX arm-none-eabi-g++)
 option(ONESHOT_REQUIRE_FIRMWARE "Fail the configuration when the firmware cannot be cross-built" OFF)
 set(ONESHOT_FIRMWARE_AVAILABLE OFF)
@@ -18,7 +19,6 @@ if(ONESHOT_BUILD_FIRMWARE AND ONESHOT_ARM_GXX)
       BUILD_ALWAYS ON
       DEPENDS lut_gen)
   endforeach()
-  set(ONESHOT_FIRMWARE_DIR ${PROJECT_BINARY_DIR} CACHE INTERNAL "")
 elseif(ONESHOT_BUILD_FIRMWARE AND ONESHOT_REQUIRE_FIRMWARE)
   message(FATAL_ERROR "ONESHOT_REQUIRE_FIRMWARE is ON but arm-none-eabi-g++ was not found "
                       "(apt-get install gcc-arm-none-eabi libstdc++-arm-none-eabi-newlib qemu-system-arm)")

@@ -1,11 +1,4 @@
 # Cross toolchain: Cortex-M0 (ARMv6-M, no FPU, soft float), QEMU machine microbit (nRF51822).
-set(CMAKE_SYSTEM_NAME Generic)
-set(CMAKE_SYSTEM_PROCESSOR arm)
-set(CMAKE_C_COMPILER arm-none-eabi-gcc)
-set(CMAKE_CXX_COMPILER arm-none-eabi-g++)
-set(CMAKE_TRY_COMPILE_TARGET_TYPE STATIC_LIBRARY)
 set(ONESHOT_FIRMWARE_TARGET cortex-m0)
 set(ONESHOT_CPU_FLAGS "-mcpu=cortex-m0 -mthumb -mfloat-abi=soft")
-set(CMAKE_C_FLAGS_INIT "${ONESHOT_CPU_FLAGS}")
-set(CMAKE_CXX_FLAGS_INIT "${ONESHOT_CPU_FLAGS}")
-set(CMAKE_EXE_LINKER_FLAGS_INIT "${ONESHOT_CPU_FLAGS}")
+include(${CMAKE_CURRENT_LIST_DIR}/arm-none-eabi-common.cmake)

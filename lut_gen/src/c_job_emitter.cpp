@@ -17,7 +17,9 @@ namespace {
 
 using cjob::CodeWriter;
 
-cjob::TableText fixed_text(const TableData<BlockFixedStorage>& t) {
+/// The layout both stored forms share; the values and residual coefficients are the caller's.
+template <typename Stored>
+cjob::TableText layout_text(const TableData<Stored>& t, const char* value_ctype) {
   cjob::TableText x;
   x.granularity_us = t.granularity_us;
   x.range_us = t.range_us;
@@ -28,42 +30,35 @@ cjob::TableText fixed_text(const TableData<BlockFixedStorage>& t) {
   x.phi_slot = t.phi_slot;
   x.gamma_slot = t.gamma_slot;
   x.qd_slot = t.qd_slot;
-  x.value_ctype = "int16_t";
+  x.value_ctype = value_ctype;
+  x.low = t.residual_low;
+  x.high = t.residual_high;
+  return x;
+}
+
+/// Slot s's residual coefficients low … high, each through `to`.
+template <typename Stored, typename To>
+auto residual_of(const TableData<Stored>& t, std::size_t s, To to) {
+  std::vector<decltype(to(t.residual_coefficients[0]))> c;
+  for (std::size_t k = 0; k <= static_cast<std::size_t>(t.residual_high[s] - t.residual_low[s]); ++k)
+    c.push_back(to(t.residual_coefficients[t.residual_offset[s] + k]));
+  return c;
+}
+
+cjob::TableText fixed_text(const TableData<BlockFixedStorage>& t) {
+  cjob::TableText x = layout_text(t, "int16_t");
   for (const Mantissa16& v : t.values) x.values.push_back(cjob::int_literal(v.raw, 16));
   for (std::int8_t f : t.value_frac) x.value_frac.push_back(f);
   for (std::int8_t f : t.residual_frac) x.residual_frac.push_back(f);
-  x.low = t.residual_low;
-  x.high = t.residual_high;
-  for (std::size_t s = 0; s < t.slots; ++s) {
-    std::vector<long long> c;
-    for (std::size_t k = 0; k <= static_cast<std::size_t>(t.residual_high[s] - t.residual_low[s]); ++k)
-      c.push_back(t.residual_coefficients[t.residual_offset[s] + k].raw);
-    x.coeff_raw.push_back(c);
-  }
+  for (std::size_t s = 0; s < t.slots; ++s)
+    x.coeff_raw.push_back(residual_of(t, s, [](const auto& c) { return static_cast<long long>(c.raw); }));
   return x;
 }
 
 cjob::TableText float_text(const TableData<float>& t) {
-  cjob::TableText x;
-  x.granularity_us = t.granularity_us;
-  x.range_us = t.range_us;
-  x.radix = t.radix;
-  x.level_offset = t.level_offset;
-  x.entries = t.entry_time_us.size();
-  x.slots = t.slots;
-  x.phi_slot = t.phi_slot;
-  x.gamma_slot = t.gamma_slot;
-  x.qd_slot = t.qd_slot;
-  x.value_ctype = "float";
+  cjob::TableText x = layout_text(t, "float");
   for (float v : t.values) x.values.push_back(cjob::float_literal(v));
-  x.low = t.residual_low;
-  x.high = t.residual_high;
-  for (std::size_t s = 0; s < t.slots; ++s) {
-    std::vector<float> c;
-    for (std::size_t k = 0; k <= static_cast<std::size_t>(t.residual_high[s] - t.residual_low[s]); ++k)
-      c.push_back(t.residual_coefficients[t.residual_offset[s] + k]);
-    x.coeff_float.push_back(c);
-  }
+  for (std::size_t s = 0; s < t.slots; ++s) x.coeff_float.push_back(residual_of(t, s, [](float c) { return c; }));
   return x;
 }
 

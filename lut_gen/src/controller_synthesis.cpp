@@ -12,13 +12,18 @@
 #include "synthesis_parts.hpp"
 
 namespace oneshot::design {
-namespace {
+namespace detail {
 
-std::string sci(double v) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.6g", v);
+std::string significant(double v, int digits) {
+  char buf[48];
+  std::snprintf(buf, sizeof buf, "%.*g", digits, v);
   return buf;
 }
+
+}  // namespace detail
+namespace {
+
+std::string sci(double v) { return detail::significant(v, 6); }
 
 /// LQR on the plant states (all states, or the leading n − exogenous ones), then the
 /// input-disturbance cancellation L_d = C_d for an exogenous model.

@@ -19,6 +19,15 @@ nlohmann::json matrix_json(const DenseMatrix& m) {
 
 nlohmann::json flat_json(const DenseMatrix& m) { return nlohmann::json(m.values); }
 
+namespace {
+/// j[available_key] and, when it is false, j[<what>_unavailable_reason].
+void put_availability(nlohmann::json& j, const std::string& what, const std::string& available_key, bool available,
+                      const std::string& reason) {
+  j[available_key] = available;
+  if (!available) j[what + "_unavailable_reason"] = reason;
+}
+}  // namespace
+
 nlohmann::json design_json(const PlantDescription& plant, const DesignResult& d) {
   nlohmann::json j;
   j["plant"] = plant.name;
@@ -35,8 +44,7 @@ nlohmann::json design_json(const PlantDescription& plant, const DesignResult& d)
   j["Q1"] = matrix_json(d.q1);
   j["Q12"] = matrix_json(d.q12);
   j["Q2"] = matrix_json(d.q2);
-  j["lqr_available"] = d.lqr_available;
-  if (!d.lqr_available) j["lqr_unavailable_reason"] = d.lqr_unavailable_reason;
+  put_availability(j, "lqr", "lqr_available", d.lqr_available, d.lqr_unavailable_reason);
   j["riccati_S"] = matrix_json(d.riccati);
   j["lqr_riccati_residual"] = d.lqr_residual;
   j["closed_loop_spectral_radius"] = d.closed_loop_radius;
@@ -46,15 +54,13 @@ nlohmann::json design_json(const PlantDescription& plant, const DesignResult& d)
   j["kalman_posterior_P"] = matrix_json(d.kalman_posterior);
   j["estimator_spectral_radius"] = d.estimator_radius;
   j["kalman_riccati_residual"] = d.kalman_residual;
-  j["setpoint_tracking"] = d.tracking;
-  if (!d.tracking) j["setpoint_tracking_unavailable_reason"] = d.tracking_unavailable_reason;
+  put_availability(j, "setpoint_tracking", "setpoint_tracking", d.tracking, d.tracking_unavailable_reason);
   nlohmann::json tracked = nlohmann::json::array();
   for (std::size_t o : d.tracked_outputs) tracked.push_back(plant.outputs[o]);
   j["tracked_outputs"] = tracked;
   j["Nx"] = matrix_json(d.nx);
   j["Nu"] = matrix_json(d.nu);
-  j["deadbeat_available"] = d.deadbeat;
-  if (!d.deadbeat) j["deadbeat_unavailable_reason"] = d.deadbeat_unavailable_reason;
+  put_availability(j, "deadbeat", "deadbeat_available", d.deadbeat, d.deadbeat_unavailable_reason);
   j["deadbeat_gain"] = flat_json(d.deadbeat_gain);
   j["deadbeat_residual"] = d.deadbeat_residual;
   j["P0"] = matrix_json(d.p0);

@@ -11,11 +11,7 @@
 namespace oneshot::design::detail {
 namespace {
 
-std::string sci(double v) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.3g", v);
-  return buf;
-}
+std::string sci(double v) { return significant(v, 3); }
 
 }  // namespace
 

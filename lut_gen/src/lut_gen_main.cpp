@@ -33,12 +33,14 @@ nlohmann::json table_json(const oneshot::design::TableData<S>& t, const oneshot:
   j["granularity_us"] = t.granularity_us;
   j["range_us"] = t.range_us;
   j["max_abs_error"] = a.max_abs_error;
-  j["phi_max_abs_error"] = a.phi_abs;
-  j["gamma_max_abs_error"] = a.gamma_abs;
-  j["qd_max_abs_error"] = a.qd_abs;
-  j["phi_max_rel_error"] = a.phi_rel;
-  j["gamma_max_rel_error"] = a.gamma_rel;
-  j["qd_max_rel_error"] = a.qd_rel;
+  const struct {
+    const char* member;
+    double abs, rel;
+  } per_member[] = {{"phi", a.phi_abs, a.phi_rel}, {"gamma", a.gamma_abs, a.gamma_rel}, {"qd", a.qd_abs, a.qd_rel}};
+  for (const auto& m : per_member) {
+    j[std::string(m.member) + "_max_abs_error"] = m.abs;
+    j[std::string(m.member) + "_max_rel_error"] = m.rel;
+  }
   j["points_compared"] = a.points;
   return j;
 }

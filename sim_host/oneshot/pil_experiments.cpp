@@ -113,7 +113,7 @@ Comparison compare(const RunResult& host, const RunResult& mcu) {
 
 /// Approach ids of the generated C99 jobs in the firmware (main.cpp).
 constexpr std::uint32_t kCJobApproach = app::pil::kCJobApproach;
-constexpr std::uint32_t kCJobQ15Approach = app::pil::kCJobQ15Approach;
+constexpr std::uint32_t kCJobOwnArithApproach = app::pil::kCJobOwnArithApproach;
 
 /// u[0], x[0..n), k[0] of a job reply (the firmware's raw values), empty when malformed.
 std::vector<std::int32_t> reply_values(const app::pil::Frame& reply, std::size_t n) {
@@ -345,7 +345,7 @@ nlohmann::json run_exectime_target(const SimContext& ctx, const CommonOptions& o
       // Float table images: approach 6 is float_poly, likewise its own oracle.
       const bool poly = c_job && std::string(format) == "float" && std::string(disc) == "table" &&
                         HostCJobFloatPoly::available();
-      if (q15 || poly) approaches.push_back(kCJobQ15Approach);
+      if (q15 || poly) approaches.push_back(kCJobOwnArithApproach);
       std::vector<std::vector<std::uint8_t>> replies_b;
       std::size_t c_job_identical = 0;
       std::size_t q15_identical = 0;
@@ -359,10 +359,10 @@ nlohmann::json run_exectime_target(const SimContext& ctx, const CommonOptions& o
         link.request(app::pil::Type::kConfig, cfg);
         std::unique_ptr<HostCJobQ15> host_q15;
         std::unique_ptr<HostCJobFloatPoly> host_poly;
-        if (a == kCJobQ15Approach && poly) {
+        if (a == kCJobOwnArithApproach && poly) {
           host_poly = std::make_unique<HostCJobFloatPoly>(
               static_cast<std::uint16_t>(std::lround(-ctx.design().u_min[0] * ctx.design().steps_per_volt[0])));
-        } else if (a == kCJobQ15Approach) {
+        } else if (a == kCJobOwnArithApproach) {
           host_q15 = std::make_unique<HostCJobQ15>(
               std::string(disc) == "nearest",
               static_cast<std::uint16_t>(std::lround(-ctx.design().u_min[0] * ctx.design().steps_per_volt[0])));
@@ -399,7 +399,7 @@ nlohmann::json run_exectime_target(const SimContext& ctx, const CommonOptions& o
         const util::Summary s = util::summarize(per_job);
         double total = 0;
         for (double x : per_job) total += x;
-        const bool is_q15 = approaches[v] == kCJobQ15Approach;
+        const bool is_q15 = approaches[v] == kCJobOwnArithApproach;
         const std::string name = std::string(v == 0 ? "half" : v == 1 ? "complete" : "c99_half") + "_" + disc + "_" +
                                  (is_q15 ? (poly ? "float_poly" : "q15") : format);
         j["variants"][name] = {{"instructions_per_job", s.mean},
@@ -420,7 +420,7 @@ nlohmann::json run_exectime_target(const SimContext& ctx, const CommonOptions& o
           j["variants"][name]["jobs"] = jobs.size();
           j["variants"][name]["job_only_image"] = c_job_only_image(base, "float_poly");
           j["variants"][name]["soft_float_calls"] = soft_float_calls(
-              img, kCJobQ15Approach, opt.noise == NoiseModel::kExact,
+              img, kCJobOwnArithApproach, opt.noise == NoiseModel::kExact,
               static_cast<std::uint16_t>(std::lround(-ctx.design().u_min[0] * ctx.design().steps_per_volt[0])), jobs);
           j["variants"][name]["instructions_target"] = 6000;  // Cortex-M0
         } else if (is_q15) {

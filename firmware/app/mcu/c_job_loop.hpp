@@ -27,7 +27,7 @@ struct CJobLoop {
     volatile std::int32_t prepared = 0;  // shared with the interrupt
     volatile bool ready = false;
     app::TaskStatistics stats{};
-    Status run_job() {
+    [[nodiscard]] Status run_job() {
       const auto time = Board::Time::snapshot();
       const auto t_apply = time.next_actuation;
       DurationUs tau_us = 0;

@@ -123,49 +123,39 @@ struct Loop {
   }
 };
 
-// The generated C99 jobs: approach 5 is the job of this image's format and sub-grid policy
-// (B's job behind the same task interface, for instruction counts and the comparison with the
-// C++ job on the MCU), approach 6 its own-arithmetic twin (q15 in fixed-point images, float_poly in float table images).
-#define ONESHOT_CJOB_TRAITS(Name, prefix, fixed)                                             \
-  struct Name {                                                                              \
-    using State = prefix##t;                                                                 \
-    static constexpr bool kFixed = fixed;                                                    \
-    static void init(State* s, std::uint16_t code) { prefix##init(s, code); }                \
-    static std::uint16_t run(State* s, std::int32_t tau, std::uint16_t adc, std::uint16_t sp) { \
-      return prefix##run(s, tau, adc, sp);                                                   \
-    }                                                                                        \
+// The generated C99 jobs, named by the image's build (cmake/oneshot_firmware.cmake): approach 5
+// is the job of this image's format and sub-grid policy, ONESHOT_CJOB_MAIN_VARIANT (B's job
+// behind the same task interface, for instruction counts and the comparison with the C++ job
+// on the MCU); approach 6 its own-arithmetic twin, ONESHOT_CJOB_OWN_ARITH_VARIANT (q15 in
+// fixed-point images; float_poly, Φ, Γ, Q_d as one polynomial in τ per entry, in float table
+// images), whose oracle is the same C compiled on the host. Each *_HAS names the generated
+// header's ONESHOT_JOB_HAS_<VARIANT>: 0 when the plant lacks that variant.
+#define ONESHOT_CJOB_CAT2(a, b) a##b
+#define ONESHOT_CJOB_CAT(a, b) ONESHOT_CJOB_CAT2(a, b)
+#define ONESHOT_CJOB_FN(variant, name) ONESHOT_CJOB_CAT(ONESHOT_CJOB_CAT(oneshot_job_, variant), name)
+#define ONESHOT_CJOB_TRAITS(Name, variant)                                                       \
+  struct Name {                                                                                  \
+    using State = ONESHOT_CJOB_FN(variant, _t);                                                  \
+    static constexpr bool kFixed = ONESHOT_FW_FIXED;                                             \
+    static void init(State* s, std::uint16_t code) { ONESHOT_CJOB_FN(variant, _init)(s, code); } \
+    static std::uint16_t run(State* s, std::int32_t tau, std::uint16_t adc, std::uint16_t sp) {  \
+      return ONESHOT_CJOB_FN(variant, _run)(s, tau, adc, sp);                                    \
+    }                                                                                            \
   };
-#if ONESHOT_FW_FIXED && ONESHOT_FW_DISC == 2 && defined(ONESHOT_JOB_HAS_FIXED_NEAREST)
+#if defined(ONESHOT_CJOB_MAIN_VARIANT) && ONESHOT_CJOB_MAIN_HAS
 #define ONESHOT_CJOB 1
-ONESHOT_CJOB_TRAITS(CJobMain, oneshot_job_fixed_nearest_, true)
-#elif ONESHOT_FW_FIXED && ONESHOT_FW_DISC == 0 && defined(ONESHOT_JOB_HAS_FIXED_TABLE)
-#define ONESHOT_CJOB 1
-ONESHOT_CJOB_TRAITS(CJobMain, oneshot_job_fixed_table_, true)
-#elif !ONESHOT_FW_FIXED && ONESHOT_FW_DISC == 2 && defined(ONESHOT_JOB_HAS_FLOAT_NEAREST)
-#define ONESHOT_CJOB 1
-ONESHOT_CJOB_TRAITS(CJobMain, oneshot_job_float_nearest_, false)
-#elif !ONESHOT_FW_FIXED && ONESHOT_FW_DISC == 0 && defined(ONESHOT_JOB_HAS_FLOAT_TABLE)
-#define ONESHOT_CJOB 1
-ONESHOT_CJOB_TRAITS(CJobMain, oneshot_job_float_table_, false)
+ONESHOT_CJOB_TRAITS(CJobMain, ONESHOT_CJOB_MAIN_VARIANT)
 #endif
-#if ONESHOT_FW_FIXED && ONESHOT_FW_DISC == 2 && defined(ONESHOT_JOB_HAS_Q15_NEAREST)
-#define ONESHOT_CJOB_Q15 1
-ONESHOT_CJOB_TRAITS(CJobQ15, oneshot_job_q15_nearest_, true)
-#elif ONESHOT_FW_FIXED && ONESHOT_FW_DISC == 0 && defined(ONESHOT_JOB_HAS_Q15_TABLE)
-#define ONESHOT_CJOB_Q15 1
-ONESHOT_CJOB_TRAITS(CJobQ15, oneshot_job_q15_table_, true)
-#elif !ONESHOT_FW_FIXED && ONESHOT_FW_DISC == 0 && defined(ONESHOT_JOB_HAS_FLOAT_POLY)
-// Float table images: approach 6 is float_poly, the float job with its own arithmetic (Φ, Γ,
-// Q_d as one polynomial in τ per entry), whose oracle is the same C compiled on the host.
-#define ONESHOT_CJOB_Q15 1
-ONESHOT_CJOB_TRAITS(CJobQ15, oneshot_job_float_poly_, false)
+#if defined(ONESHOT_CJOB_OWN_ARITH_VARIANT) && ONESHOT_CJOB_OWN_ARITH_HAS
+#define ONESHOT_CJOB_OWN_ARITH 1
+ONESHOT_CJOB_TRAITS(CJobOwnArith, ONESHOT_CJOB_OWN_ARITH_VARIANT)
 #endif
 static_assert(kM == 1 && kP == 1, "the C job adapter serves one input and one output");
 #ifdef ONESHOT_CJOB
 mcu::CJobLoop<CJobMain, PilBoard, kN> g_cjob;
 #endif
-#ifdef ONESHOT_CJOB_Q15
-mcu::CJobLoop<CJobQ15, PilBoard, kN> g_cjob_q15;
+#ifdef ONESHOT_CJOB_OWN_ARITH
+mcu::CJobLoop<CJobOwnArith, PilBoard, kN> g_cjob_own_arith;
 #endif
 
 using HalfEst = HalfKalman<Fmt, Structure, Disc>;
@@ -202,8 +192,8 @@ decltype(auto) with_loop(F&& f) {
 #ifdef ONESHOT_CJOB
     case 5: return f(g_cjob);
 #endif
-#ifdef ONESHOT_CJOB_Q15
-    case 6: return f(g_cjob_q15);
+#ifdef ONESHOT_CJOB_OWN_ARITH
+    case 6: return f(g_cjob_own_arith);
 #endif
     default: return f(g_standard);
   }
@@ -235,8 +225,8 @@ void handle(const pil::Frame& q, pil::Frame& r) {
 #ifndef ONESHOT_CJOB
       if (c.approach == pil::kCJobApproach) return malformed(r);  // no generated C job in this image
 #endif
-#ifndef ONESHOT_CJOB_Q15
-      if (c.approach == pil::kCJobQ15Approach) return malformed(r);  // no q15 C job in this image
+#ifndef ONESHOT_CJOB_OWN_ARITH
+      if (c.approach == pil::kCJobOwnArithApproach) return malformed(r);  // no own-arithmetic twin in this image
 #endif
       const NoiseModel noise = c.exact_noise ? NoiseModel::kExact : NoiseModel::kConstant;
       g_approach = c.approach;
@@ -247,8 +237,8 @@ void handle(const pil::Frame& q, pil::Frame& r) {
 #ifdef ONESHOT_CJOB
       g_cjob.configure(c.codes);
 #endif
-#ifdef ONESHOT_CJOB_Q15
-      g_cjob_q15.configure(c.codes);
+#ifdef ONESHOT_CJOB_OWN_ARITH
+      g_cjob_own_arith.configure(c.codes);
 #endif
       clear_saturation_flag();
       w.u(g_approach, 1);

@@ -17,18 +17,8 @@
 
 namespace oneshot::posix {
 namespace {
-thread_local UdpNetworkState* g_current = nullptr;
-
 [[noreturn]] void fail(const char* call) { throw std::runtime_error(std::string(call) + ": " + std::strerror(errno)); }
 }  // namespace
-
-ScopedUdpNetwork::ScopedUdpNetwork(UdpNetworkState& state) : previous_(g_current) { g_current = &state; }
-ScopedUdpNetwork::~ScopedUdpNetwork() { g_current = previous_; }
-
-UdpNetworkState& current_udp_network() {
-  ONESHOT_ASSERT(g_current != nullptr);
-  return *g_current;
-}
 
 bool udp_send(std::uint8_t destination, const std::uint8_t* data, std::size_t size) {
   UdpNetworkState& n = current_udp_network();

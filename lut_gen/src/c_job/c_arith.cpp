@@ -52,9 +52,9 @@ QFormat format_of(const FixedFormats& f, Qty q) {
   throw std::logic_error("unknown quantity");
 }
 
-QFormat FixedArith::fmt(Qty q) const { return format_of(f_, q); }
+QFormat IntegerArith::fmt(Qty q) const { return format_of(f_, q); }
 
-long long FixedArith::one_raw(QFormat f, bool& saturates) {
+long long IntegerArith::one_raw(QFormat f, bool& saturates) {
   // As ScalarTraits<Fixed>::from_double(1.0).
   const double r = std::ldexp(1.0, f.frac) + 0.5;
   const double max = std::ldexp(1.0, f.bits - 1) - 1;
@@ -71,9 +71,9 @@ long long FixedArith::one_raw(QFormat f, bool& saturates) {
   return static_cast<long long>(r);
 }
 
-std::string FixedArith::one(Qty q, bool& saturates) const { return int_literal(one_raw(fmt(q), saturates), fmt(q).bits); }
+std::string IntegerArith::one(Qty q, bool& saturates) const { return int_literal(one_raw(fmt(q), saturates), fmt(q).bits); }
 
-Val FixedArith::constant(Qty q, double v, const std::string& what) const {
+Val IntegerArith::constant(Qty q, double v, const std::string& what) const {
   const QFormat f = fmt(q);
   return Val::of(int_literal(f.raw_of(v, what), f.bits), f);
 }
@@ -258,6 +258,20 @@ std::string FixedArith::slot_to(Qty q, const std::string& raw, int frac, int raw
   return saturate(e, wide, t.bits, bound);
 }
 
+namespace {
+/// static inline int<out>_t name(int<in>_t v, uint8_t *sat): v clamped to int<out>_t, the
+/// sticky flag raised when it was out of range (detail::saturate).
+void emit_clamp(CodeWriter& w, const std::string& name, int out_bits, int in_bits) {
+  const std::string out = std::to_string(out_bits);
+  const std::string in = "int" + std::to_string(in_bits) + "_t";
+  w.open("static inline int" + out + "_t " + name + "(" + in + " v, uint8_t *sat) {")
+      .open("if (v > (" + in + ")INT" + out + "_MAX) {").line("*sat = 1u;").line("return INT" + out + "_MAX;").close()
+      .open("if (v < (" + in + ")INT" + out + "_MIN) {").line("*sat = 1u;").line("return INT" + out + "_MIN;").close()
+      .line("return (int" + out + "_t)v;")
+      .close();
+}
+}  // namespace
+
 void FixedArith::emit_helpers(CodeWriter& w) {
   w.line("/* Exact products (detail::wide_product): 16x16->32 multiplies only, so that 16-bit");
   w.line("   targets use their native multiplier and ARMv6-M needs no 64-bit multiply routine. */");
@@ -283,16 +297,8 @@ void FixedArith::emit_helpers(CodeWriter& w) {
       .line("return (int64_t)(ah * bh) * INT64_C(4294967296) + middle * INT64_C(65536) + (int64_t)(al * bl);")
       .close();
   w.line("/* Saturation (detail::saturate): clamps and raises the sticky flag. */");
-  w.open("static inline int32_t os_sat32(int64_t v, uint8_t *sat) {")
-      .open("if (v > (int64_t)INT32_MAX) {").line("*sat = 1u;").line("return INT32_MAX;").close()
-      .open("if (v < (int64_t)INT32_MIN) {").line("*sat = 1u;").line("return INT32_MIN;").close()
-      .line("return (int32_t)v;")
-      .close();
-  w.open("static inline int16_t os_sat16(int32_t v, uint8_t *sat) {")
-      .open("if (v > (int32_t)INT16_MAX) {").line("*sat = 1u;").line("return INT16_MAX;").close()
-      .open("if (v < (int32_t)INT16_MIN) {").line("*sat = 1u;").line("return INT16_MIN;").close()
-      .line("return (int16_t)v;")
-      .close();
+  emit_clamp(w, "os_sat32", 32, 64);
+  emit_clamp(w, "os_sat16", 16, 32);
   w.line("/* 16x16->32 product of the q15 variants: operands in 16-bit range held in int_fast16_t (a");
   w.line("   register-width int on 32-bit cores, int16_t on 16- and 8-bit ones). */");
   w.open("static inline int32_t os_q15_m(int_fast16_t a, int_fast16_t b) {").line("return (int32_t)a * (int32_t)b;").close();
@@ -303,11 +309,7 @@ void FixedArith::emit_helpers(CodeWriter& w) {
       .open("if ((int32_t)t != v) {").line("*sat = 1u;").line("return v > 0 ? INT16_MAX : INT16_MIN;").close()
       .line("return t;")
       .close();
-  w.open("static inline int16_t os_sat16_64(int64_t v, uint8_t *sat) {")
-      .open("if (v > (int64_t)INT16_MAX) {").line("*sat = 1u;").line("return INT16_MAX;").close()
-      .open("if (v < (int64_t)INT16_MIN) {").line("*sat = 1u;").line("return INT16_MIN;").close()
-      .line("return (int16_t)v;")
-      .close();
+  emit_clamp(w, "os_sat16_64", 16, 64);
 }
 
 void FixedArith::emit_division_helpers(CodeWriter& w) {

@@ -12,6 +12,7 @@
 #pragma once
 
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "c_job/c_writer.hpp"
@@ -93,28 +94,35 @@ class Arith {
   Val val(Qty q, const std::string& expr) const { return Val::of(expr, fmt(q)); }
 };
 
-/// The fixed-point formats the design step chose; saturations set `*sat`.
-class FixedArith final : public Arith {
+/// Integer arithmetic on a set of fixed-point formats (FixedArith, Q15Arith): the formats,
+/// the constants and one() as raw literals of each quantity's format; saturations set `*sat`.
+class IntegerArith : public Arith {
  public:
-  explicit FixedArith(const FixedFormats& f) : f_(f) {}
+  explicit IntegerArith(FixedFormats f) : f_(std::move(f)) {}
   bool fixed() const override { return true; }
-  std::string ctype(Qty q) const override { return fmt(q).bits == 16 ? "int16_t" : "int32_t"; }
   QFormat fmt(Qty q) const override;
-  void accumulate(CodeWriter& w, const std::string& dest, Qty out, const std::vector<Term>& terms) const override;
-  void mul(CodeWriter& w, const std::string& dest, Qty to, const Val& a, const Val& b) const override;
   Val constant(Qty q, double v, const std::string& what) const override;
   std::string one(Qty q, bool& saturates) const override;
   std::string zero(Qty) const override { return "0"; }
-  std::string slot_to(Qty q, const std::string& raw, int frac, int raw_bits) const override;
   /// ScalarTraits<Fixed<bits, frac>>::from_double(1.0) as a raw value.
   static long long one_raw(QFormat f, bool& saturates);
+
+ private:
+  FixedFormats f_;
+};
+
+/// The fixed-point formats the design step chose (16- and 32-bit).
+class FixedArith final : public IntegerArith {
+ public:
+  using IntegerArith::IntegerArith;
+  std::string ctype(Qty q) const override { return fmt(q).bits == 16 ? "int16_t" : "int32_t"; }
+  void accumulate(CodeWriter& w, const std::string& dest, Qty out, const std::vector<Term>& terms) const override;
+  void mul(CodeWriter& w, const std::string& dest, Qty to, const Val& a, const Val& b) const override;
+  std::string slot_to(Qty q, const std::string& raw, int frac, int raw_bits) const override;
   /// Helper functions the fixed code calls (emitted once per file).
   static void emit_helpers(CodeWriter& w);
   /// The division-free exact quotient and bit length used by the reciprocal (emitted once).
   static void emit_division_helpers(CodeWriter& w);
-
- private:
-  const FixedFormats& f_;
 };
 
 /// IEEE single precision throughout (the firmware's float format).

@@ -5,6 +5,7 @@
 #include <stdexcept>
 
 #include "c_job/c_job_variant.hpp"
+#include "c_job/q15_poly_table.hpp"
 #include "oneshot/table_view.hpp"
 
 namespace oneshot::design::cjob {
@@ -32,6 +33,17 @@ VariantEmitter::VariantEmitter(const PlantDescription& plant, const DesignResult
                       " us) to be a multiple of the table granularity (" +
                       std::to_string(spec_.table.granularity_us) + " us)");
   }
+}
+
+std::vector<Q15Member> VariantEmitter::free_members() const {
+  std::vector<Q15Member> members;
+  const auto add = [&](const char* name, const std::vector<std::pair<std::size_t, std::size_t>>& free, Qty q) {
+    for (std::size_t k = 0; k < free.size(); ++k) members.push_back({name, k, free[k].first, free[k].second, q});
+  };
+  add("phi", phi_free_, Qty::kTransition);
+  add("gamma", gamma_free_, Qty::kInputGain);
+  add("qd", qd_free_, Qty::kCovariance);
+  return members;
 }
 
 std::int32_t VariantEmitter::tau_bound_us() const {

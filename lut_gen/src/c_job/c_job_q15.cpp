@@ -18,15 +18,8 @@ std::string pow2_literal(int k) { return int_literal(static_cast<long long>(1) <
 }  // namespace
 
 void VariantEmitter::emit_q15_table(CodeWriter& w) {
-  std::vector<Q15Member> members;
-  for (std::size_t k = 0; k < phi_free_.size(); ++k)
-    members.push_back({"phi", k, phi_free_[k].first, phi_free_[k].second, Qty::kTransition});
-  for (std::size_t k = 0; k < gamma_free_.size(); ++k)
-    members.push_back({"gamma", k, gamma_free_[k].first, gamma_free_[k].second, Qty::kInputGain});
-  for (std::size_t k = 0; k < qd_free_.size(); ++k)
-    members.push_back({"qd", k, qd_free_[k].first, qd_free_[k].second, Qty::kCovariance});
   q15_table_ = std::make_shared<Q15PolyTable>(design_q15_poly_table(plant_, design_, ar(), spec_.table.granularity_us,
-                                                                    spec_.table.range_us, members, !spec_.exact_subgrid));
+                                                                    spec_.table.range_us, free_members(), !spec_.exact_subgrid));
   const Q15PolyTable& t = *q15_table_;
   const std::int32_t g = spec_.table.granularity_us;
   std::string layout;

@@ -21,6 +21,7 @@ namespace oneshot::design::cjob {
 
 struct Q15PolyTable;  // q15_poly_table.hpp
 struct FloatPoly;     // float_poly.hpp
+struct Q15Member;     // q15_poly_table.hpp
 
 /// A table as the generated code stores it: layout, and the values as C literals.
 struct TableText {
@@ -90,6 +91,8 @@ class VariantEmitter {
   Val design_const(Qty q, const DenseMatrix& m, const PatternMask& pat, std::size_t i, std::size_t j,
                    const std::string& what) const;
   static std::size_t upper_index(std::size_t n, std::size_t i, std::size_t j);
+  // The free entries of Φ, Γ, Q_d (upper) in triple order: what the polynomial variants fit.
+  std::vector<Q15Member> free_members() const;
 
   // Pieces of the discretizer (c_job_discretizer.cpp).
   void emit_table(CodeWriter& w) const;

@@ -18,36 +18,6 @@ constexpr int kMaxDegree = 6;
 constexpr int kFitPoints = 257;
 constexpr int kCheckPoints = 2001;
 
-/// Least-squares a_e (e ∈ exps) of y on the basis s^e (normal equations, Gauss-Jordan with
-/// partial pivoting); s = t/T ∈ [0, 1] keeps them well conditioned up to degree 6.
-std::vector<double> least_squares(const std::vector<double>& s, const std::vector<double>& y, const std::vector<int>& exps) {
-  const std::size_t n = exps.size();
-  std::vector<std::vector<double>> a(n, std::vector<double>(n + 1, 0.0));
-  for (std::size_t k = 0; k < s.size(); ++k) {
-    std::vector<double> b(n);
-    for (std::size_t p = 0; p < n; ++p) b[p] = std::pow(s[k], exps[p]);
-    for (std::size_t p = 0; p < n; ++p) {
-      for (std::size_t q = 0; q < n; ++q) a[p][q] += b[p] * b[q];
-      a[p][n] += b[p] * y[k];
-    }
-  }
-  for (std::size_t p = 0; p < n; ++p) {
-    std::size_t best = p;
-    for (std::size_t q = p + 1; q < n; ++q)
-      if (std::fabs(a[q][p]) > std::fabs(a[best][p])) best = q;
-    std::swap(a[p], a[best]);
-    if (a[p][p] == 0.0) continue;
-    for (std::size_t q = 0; q < n; ++q) {
-      if (q == p) continue;
-      const double f = a[q][p] / a[p][p];
-      for (std::size_t k = p; k <= n; ++k) a[q][k] -= f * a[p][k];
-    }
-  }
-  std::vector<double> c(n, 0.0);
-  for (std::size_t p = 0; p < n; ++p) c[p] = a[p][p] == 0.0 ? 0.0 : a[p][n] / a[p][p];
-  return c;
-}
-
 /// c0 + Σ c_e t^e in double, with the float coefficients the job uses.
 double eval(float c0, const std::vector<int>& exps, const std::vector<float>& c, double t) {
   double v = c0;
@@ -158,14 +128,7 @@ std::optional<FloatPoly> design_float_poly(const PlantDescription& plant, const 
 
 bool VariantEmitter::available() {
   if (!spec_.polynomial) return true;
-  std::vector<Q15Member> members;
-  for (std::size_t k = 0; k < phi_free_.size(); ++k)
-    members.push_back({"phi", k, phi_free_[k].first, phi_free_[k].second, Qty::kTransition});
-  for (std::size_t k = 0; k < gamma_free_.size(); ++k)
-    members.push_back({"gamma", k, gamma_free_[k].first, gamma_free_[k].second, Qty::kInputGain});
-  for (std::size_t k = 0; k < qd_free_.size(); ++k)
-    members.push_back({"qd", k, qd_free_[k].first, qd_free_[k].second, Qty::kCovariance});
-  auto p = design_float_poly(plant_, design_, members, 4 * spec_.table.range_us);
+  auto p = design_float_poly(plant_, design_, free_members(), 4 * spec_.table.range_us);
   if (!p) return false;
   float_poly_ = std::make_shared<FloatPoly>(std::move(*p));
   return true;

@@ -80,15 +80,6 @@ FixedFormats q15_formats(const FixedFormats& fixed) {
   return f;
 }
 
-QFormat Q15Arith::fmt(Qty q) const { return format_of(f_, q); }
-
-std::string Q15Arith::one(Qty q, bool& saturates) const { return int_literal(FixedArith::one_raw(fmt(q), saturates), 16); }
-
-Val Q15Arith::constant(Qty q, double v, const std::string& what) const {
-  const QFormat f = fmt(q);
-  return Val::of(int_literal(f.raw_of(v, what), 16), f);
-}
-
 void Q15Arith::accumulate(CodeWriter& w, const std::string& dest, Qty out, const std::vector<Term>& terms) const {
   const QFormat o = fmt(out);
   if (terms.empty()) {
@@ -100,7 +91,7 @@ void Q15Arith::accumulate(CodeWriter& w, const std::string& dest, Qty out, const
   for (const Term& t : terms) {
     if (t.kind == Term::Kind::kOne) {
       bool sat = false;
-      const long long one = FixedArith::one_raw(o, sat);
+      const long long one = IntegerArith::one_raw(o, sat);
       if (sat) w.line("*sat = 1u;  /* one() does not fit this format */");
       raws.push_back(Raw{int_literal(one, 16), o.frac, std::fabs(static_cast<double>(one))});
     } else if (t.kind == Term::Kind::kValue) {

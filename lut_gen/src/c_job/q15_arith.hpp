@@ -32,24 +32,16 @@ namespace oneshot::design::cjob {
 FixedFormats q15_formats(const FixedFormats& fixed);
 
 /// 16-bit storage, 32-bit accumulation (see the file comment).
-class Q15Arith final : public Arith {
+class Q15Arith final : public IntegerArith {
  public:
-  explicit Q15Arith(const FixedFormats& f) : f_(f) {}
-  bool fixed() const override { return true; }
+  using IntegerArith::IntegerArith;
   bool q15() const override { return true; }
   std::string ctype(Qty) const override { return "int16_t"; }
   /// 16-bit values in a register-width int where that is faster (32-bit cores).
   std::string scratch_ctype(Qty) const override { return "int_fast16_t"; }
-  QFormat fmt(Qty q) const override;
   void accumulate(CodeWriter& w, const std::string& dest, Qty out, const std::vector<Term>& terms) const override;
   void mul(CodeWriter& w, const std::string& dest, Qty to, const Val& a, const Val& b) const override;
-  Val constant(Qty q, double v, const std::string& what) const override;
-  std::string one(Qty q, bool& saturates) const override;
-  std::string zero(Qty) const override { return "0"; }
   std::string slot_to(Qty q, const std::string& raw, int frac, int raw_bits) const override;
-
- private:
-  FixedFormats f_;
 };
 
 }  // namespace oneshot::design::cjob

@@ -35,19 +35,39 @@ std::vector<std::vector<double>> exact_of(const PlantDescription& plant, const D
   return out;
 }
 
-/// Least-squares c_1 … c_D of y(r) − c_0 on the basis r, …, r^D (normal equations, D ≤ 6).
+/// Least-squares c_1 … c_D of y(r) − c_0 on the basis r, …, r^D (D ≤ 6); c_0 first.
 std::vector<double> fit(const std::vector<double>& r, const std::vector<double>& y, double c0, int degree) {
-  std::vector<double> c(static_cast<std::size_t>(degree) + 1, 0.0);
-  c[0] = c0;
+  std::vector<double> c{c0};
   if (degree == 0) return c;
-  const auto n = static_cast<std::size_t>(degree);
+  std::vector<int> exps;
+  for (int e = 1; e <= degree; ++e) exps.push_back(e);
+  std::vector<double> y0;
+  for (double v : y) y0.push_back(v - c0);
+  const std::vector<double> a = least_squares(r, y0, exps);
+  c.insert(c.end(), a.begin(), a.end());
+  return c;
+}
+
+double horner(const std::vector<double>& c, double r) {
+  double v = 0;
+  for (std::size_t k = c.size(); k-- > 0;) v = v * r + c[k];
+  return v;
+}
+
+}  // namespace
+
+std::vector<double> least_squares(const std::vector<double>& s, const std::vector<double>& y,
+                                  const std::vector<int>& exps) {
+  const std::size_t n = exps.size();
   std::vector<std::vector<double>> a(n, std::vector<double>(n + 1, 0.0));
-  for (std::size_t s = 0; s < r.size(); ++s)
+  for (std::size_t k = 0; k < s.size(); ++k) {
+    std::vector<double> b(n);
+    for (std::size_t p = 0; p < n; ++p) b[p] = std::pow(s[k], exps[p]);
     for (std::size_t p = 0; p < n; ++p) {
-      const double bp = std::pow(r[s], static_cast<double>(p + 1));
-      for (std::size_t q = 0; q < n; ++q) a[p][q] += bp * std::pow(r[s], static_cast<double>(q + 1));
-      a[p][n] += bp * (y[s] - c0);
+      for (std::size_t q = 0; q < n; ++q) a[p][q] += b[p] * b[q];
+      a[p][n] += b[p] * y[k];
     }
+  }
   for (std::size_t p = 0; p < n; ++p) {  // Gauss-Jordan with partial pivoting
     std::size_t best = p;
     for (std::size_t q = p + 1; q < n; ++q)
@@ -60,17 +80,10 @@ std::vector<double> fit(const std::vector<double>& r, const std::vector<double>&
       for (std::size_t k = p; k <= n; ++k) a[q][k] -= f * a[p][k];
     }
   }
-  for (std::size_t p = 0; p < n; ++p) c[p + 1] = a[p][p] == 0.0 ? 0.0 : a[p][n] / a[p][p];
+  std::vector<double> c(n, 0.0);
+  for (std::size_t p = 0; p < n; ++p) c[p] = a[p][p] == 0.0 ? 0.0 : a[p][n] / a[p][p];
   return c;
 }
-
-double horner(const std::vector<double>& c, double r) {
-  double v = 0;
-  for (std::size_t k = c.size(); k-- > 0;) v = v * r + c[k];
-  return v;
-}
-
-}  // namespace
 
 std::vector<std::vector<double>> exact_member_values(const PlantDescription& plant, const DesignResult& design,
                                                      const std::vector<Q15Member>& members,

@@ -52,6 +52,12 @@ std::vector<std::vector<double>> exact_member_values(const PlantDescription& pla
                                                      const std::vector<Q15Member>& members,
                                                      const std::vector<double>& t_us);
 
+/// Least-squares a_e (e ∈ exps) of y(s) on the basis s^e: normal equations solved by
+/// Gauss-Jordan with partial pivoting (a singular column gives 0). Keep s in [0, 1] so that
+/// they stay well conditioned up to degree 6. Shared by the q15 table and float_poly.
+std::vector<double> least_squares(const std::vector<double>& s, const std::vector<double>& y,
+                                  const std::vector<int>& exps);
+
 /// Designs the table for intervals k = 0 … range/g (the last one is used at r = 0 only).
 Q15PolyTable design_q15_poly_table(const PlantDescription& plant, const DesignResult& design, const Arith& ar,
                                    std::int32_t g_us, std::int32_t range_us, std::vector<Q15Member> members,

@@ -20,7 +20,6 @@
 #include <cstdint>
 
 #include "oneshot/kalman_filter_base.hpp"
-#include "oneshot/time_us.hpp"
 
 namespace oneshot {
 
@@ -28,43 +27,41 @@ namespace oneshot {
 /// P_s,k (corrected at the last sample).
 template <typename Fmt, typename Structure, typename Disc,
           CovarianceUpdate kForm = CovarianceUpdate::kSymmetric>
-class CompleteKalman : public KalmanFilterBase<Fmt, Structure, kForm> {
- public:
-  using Base = KalmanFilterBase<Fmt, Structure, kForm>;
-  using Base::kM, Base::kN;
-  using typename Base::Core, typename Base::Cov, typename Base::Design;
-  using typename Base::InputVec, typename Base::OutputVec, typename Base::StateVec;
+class CompleteKalman : public DiscretizedFilterBase<Fmt, Structure, Disc, kForm> {
+  using Base = DiscretizedFilterBase<Fmt, Structure, Disc, kForm>;
 
+ public:
   /// Filter over `design` and `disc` (both must outlive it).
-  constexpr CompleteKalman(const Design& design, const Disc& disc, NoiseModel noise)
-      : Base(design, noise), disc_(&disc) {
-    reset(StateVec{}, design.p0, InputVec{});
+  constexpr CompleteKalman(const typename Base::Design& design, const Disc& disc, NoiseModel noise)
+      : Base(design, disc, noise) {
+    reset({}, design.p0, {});
   }
 
   /// Estimate x0 with covariance p0 at an actuation instant, input u0 applied there
   /// (treated as a sample with τ = 0: a zero-length segment of u0, then u0).
-  constexpr void reset(const StateVec& x0, const Cov& p0, const InputVec& u0) {
+  constexpr void reset(const typename Base::StateVec& x0, const typename Base::Cov& p0,
+                       const typename Base::InputVec& u0) {
     this->core_.reset(x0, p0);
     x_ = x0;
     inputs_.reset(u0);
-    (void)inputs_.push(0, u0);
-    gamma_a_ = typename Core::InputGain{};
+    (void)inputs_.push(0, u0);  // cannot fail: one change after a reset
+    gamma_a_ = {};
     tau_prev_us_ = 0;
     first_job_ = true;
   }
 
   /// Job with sample y taken tau_us before the next actuation instant (bounded to
   /// ±kMaxTauUs first: kClamped beyond).
-  constexpr Status update(std::int32_t tau_us, const OutputVec& y) {
-    Status status = bound_tau(tau_us);
-    tau_us = disc_->quantize(tau_us);  // the discretizer's sub-grid policy
-    const std::int32_t b_us = this->design_->period_us - tau_us;
-    if (inputs_.size() == 1) (void)inputs_.push(tau_prev_us_, inputs_.latest());  // no new input at t_k
-    status = worst_of(status, this->core_.predict_across(*disc_, b_us + tau_prev_us_, inputs_, this->noise_,
-                                                   this->design_->q_constant, &gamma_a_, !first_job_));
-    status = worst_of(status, this->core_.correct_all(y, this->design_->c, this->design_->r));
+  [[nodiscard]] constexpr Status update(std::int32_t tau_us, const typename Base::OutputVec& y) {
+    Status status = this->job_tau(tau_us);
+    const auto& d = *this->design_;
+    const std::int32_t b_us = d.period_us - tau_us;
+    if (inputs_.size() == 1) (void)inputs_.push(tau_prev_us_, inputs_.latest());  // no new input at t_k; cannot fail
+    status = worst_of(status, this->core_.predict_across(*this->disc_, b_us + tau_prev_us_, inputs_, this->noise_,
+                                                         d.q_constant, &gamma_a_, !first_job_));
+    status = worst_of(status, this->core_.correct_all(y, d.c, d.r));
     typename Disc::Triple c{NoInit{}};
-    status = worst_of(status, disc_->discretize(tau_us, c, WithQd::kNo));
+    status = worst_of(status, this->disc_->discretize(tau_us, c, WithQd::kNo));
     x_ = predict_state<Fmt, Structure>(c, this->core_.state(), inputs_.latest());
     gamma_a_ = c.gamma;
     tau_prev_us_ = tau_us < 0 ? 0 : tau_us;
@@ -74,18 +71,17 @@ class CompleteKalman : public KalmanFilterBase<Fmt, Structure, kForm> {
   }
 
   /// The input applied at the actuation instant the last update predicted to.
-  constexpr void set_applied_input(const InputVec& u) {
+  constexpr void set_applied_input(const typename Base::InputVec& u) {
     if (inputs_.size() > 1) inputs_.reset(inputs_.latest());  // a second call: the previous input came before
     (void)inputs_.push(tau_prev_us_, u);  // cannot fail: one change after a reset
   }
   /// x̂_k: the estimate at the next actuation instant.
-  constexpr const StateVec& prediction() const { return x_; }
+  constexpr const typename Base::StateVec& prediction() const { return x_; }
 
  private:
-  const Disc* disc_;
-  StateVec x_{};                                 // prediction to the next actuation
-  InputHistory<typename Fmt::Input, kM, 2> inputs_{};  // u_{k−1} from the sample, u_k from t_k
-  typename Core::InputGain gamma_a_{};           // Γ(τ_k)
+  typename Base::StateVec x_{};                              // prediction to the next actuation
+  InputHistory<typename Fmt::Input, Base::kM, 2> inputs_{};  // u_{k−1} from the sample, u_k from t_k
+  typename Base::Core::InputGain gamma_a_{};                 // Γ(τ_k)
   std::int32_t tau_prev_us_ = 0;
   bool first_job_ = true;
 };

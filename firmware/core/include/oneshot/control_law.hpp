@@ -13,6 +13,7 @@
 #include "oneshot/accumulator.hpp"
 #include "oneshot/controller_design.hpp"
 #include "oneshot/matrix.hpp"
+#include "oneshot/structured_ops.hpp"
 
 namespace oneshot {
 
@@ -24,39 +25,18 @@ constexpr Vector<typename Fmt::Input, M> control_law(const ControllerDesign<Fmt,
   using NxP = typename Structure::StateFeedforwardPattern;
   using NuP = typename Structure::InputFeedforwardPattern;
   using LP = typename Structure::FeedbackPattern;
-  Vector<typename Fmt::State, N> error;
+  Vector<typename Fmt::State, N> error;  // x̂ − N_x r
   for (std::size_t i = 0; i < N; ++i) {
     Accumulator<typename Fmt::State> acc;
     acc.add(x[i]);
-    for (std::size_t o = 0; o < P; ++o) {
-      if (NxP::is_zero(i, o)) continue;
-      if (NxP::is_one(i, o)) {
-        acc.sub(setpoint[o]);
-      } else {
-        acc.sub_product(design.nx(i, o), setpoint[o]);
-      }
-    }
+    accumulate_row<NxP, RowSign::kSubtract>(acc, design.nx, i, setpoint);
     error[i] = acc.value();
   }
   Vector<typename Fmt::Input, M> u;
   for (std::size_t j = 0; j < M; ++j) {
     Accumulator<typename Fmt::Input> acc;
-    for (std::size_t o = 0; o < P; ++o) {
-      if (NuP::is_zero(j, o)) continue;
-      if (NuP::is_one(j, o)) {
-        acc.add(setpoint[o]);
-      } else {
-        acc.add_product(design.nu(j, o), setpoint[o]);
-      }
-    }
-    for (std::size_t i = 0; i < N; ++i) {
-      if (LP::is_zero(j, i)) continue;
-      if (LP::is_one(j, i)) {
-        acc.sub(error[i]);
-      } else {
-        acc.sub_product(design.l(j, i), error[i]);
-      }
-    }
+    accumulate_row<NuP, RowSign::kAdd>(acc, design.nu, j, setpoint);
+    accumulate_row<LP, RowSign::kSubtract>(acc, design.l, j, error);
     u[j] = acc.value();
   }
   return u;

@@ -15,29 +15,24 @@ namespace oneshot {
 
 /// Control job around an estimator (HalfKalman, CompleteKalman, StandardKalman, DeadbeatObserver).
 template <typename Fmt, typename Structure, typename Estimator>
-class Controller {
+class Controller : public StructureTypes<Fmt, Structure> {
+  using Types = StructureTypes<Fmt, Structure>;
+
  public:
-  static constexpr std::size_t kN = Structure::kStates;
-  static constexpr std::size_t kM = Structure::kInputs;
-  static constexpr std::size_t kP = Structure::kOutputs;
-  using Design = ControllerDesign<Fmt, kN, kM, kP>;
-  using OutputVec = Vector<typename Fmt::State, kP>;
-  using InputVec = Vector<typename Fmt::Input, kM>;
-  using StateVec = Vector<typename Fmt::State, kN>;
-  using CovScalar = typename Fmt::Covariance;
-  using EstimatorType = Estimator;
+  using CovScalar = typename Fmt::Covariance;  ///< Scalar of P (the fixed-point checks).
+  using EstimatorType = Estimator;             ///< The estimator it drives.
 
   /// Controller over `design` and an estimator built on the same design.
-  constexpr Controller(const Design& design, const Estimator& estimator)
+  constexpr Controller(const typename Types::Design& design, const Estimator& estimator)
       : design_(&design), estimator_(estimator) {}
 
   /// Job: sample y taken tau_us before the actuation instant it prepares, set-point r.
   /// Writes the actuator codes to `codes` and returns the estimator's status.
-  constexpr Status job(std::int32_t tau_us, const OutputVec& y, const OutputVec& setpoint,
-                       std::int32_t (&codes)[kM]) {
+  [[nodiscard]] constexpr Status job(std::int32_t tau_us, const typename Types::OutputVec& y,
+                                     const typename Types::OutputVec& setpoint, std::int32_t (&codes)[Types::kM]) {
     const Status status = estimator_.update(tau_us, y);
-    const InputVec u = control_law<Fmt, Structure>(*design_, estimator_.prediction(), setpoint);
-    for (std::size_t j = 0; j < kM; ++j) {
+    const typename Types::InputVec u = control_law<Fmt, Structure>(*design_, estimator_.prediction(), setpoint);
+    for (std::size_t j = 0; j < Types::kM; ++j) {
       codes[j] = quantize_input(design_->actuator, j, u[j]);
       applied_[j] = input_of_code(design_->actuator, j, codes[j]);
     }
@@ -50,14 +45,14 @@ class Controller {
   /// Mutable estimator access (reset).
   constexpr Estimator& estimator() { return estimator_; }
   /// The design constants.
-  constexpr const Design& design() const { return *design_; }
+  constexpr const typename Types::Design& design() const { return *design_; }
   /// The input realised by the last job's codes.
-  constexpr const InputVec& applied_input() const { return applied_; }
+  constexpr const typename Types::InputVec& applied_input() const { return applied_; }
 
  private:
-  const Design* design_;
+  const typename Types::Design* design_;
   Estimator estimator_;
-  InputVec applied_{};
+  typename Types::InputVec applied_{};
 };
 
 }  // namespace oneshot

@@ -55,4 +55,17 @@ struct ControllerDesign {
   SensorModel<Fmt, P> sensor;                            ///< ADC code to volts.
 };
 
+/// The dimensions and vectors of a plant with the patterns of Structure in format Fmt: the
+/// public types of the controller and of every estimator it drives.
+template <typename Fmt, typename Structure>
+struct StructureTypes {
+  static constexpr std::size_t kN = Structure::kStates;   ///< n.
+  static constexpr std::size_t kM = Structure::kInputs;   ///< m.
+  static constexpr std::size_t kP = Structure::kOutputs;  ///< p.
+  using Design = ControllerDesign<Fmt, kN, kM, kP>;       ///< Gains, noise and model at h.
+  using StateVec = Vector<typename Fmt::State, kN>;       ///< x̂.
+  using OutputVec = Vector<typename Fmt::State, kP>;      ///< y.
+  using InputVec = Vector<typename Fmt::Input, kM>;       ///< u.
+};
+
 }  // namespace oneshot

@@ -19,29 +19,24 @@ namespace oneshot {
 
 /// Deadbeat current observer on the nominal discrete model.
 template <typename Fmt, typename Structure>
-class DeadbeatObserver {
+class DeadbeatObserver : public StructureTypes<Fmt, Structure> {
+  using Types = StructureTypes<Fmt, Structure>;
+
  public:
-  static constexpr std::size_t kN = Structure::kStates;
-  static constexpr std::size_t kM = Structure::kInputs;
-  static constexpr std::size_t kP = Structure::kOutputs;
-  using Design = ControllerDesign<Fmt, kN, kM, kP>;
-  using StateVec = Vector<typename Fmt::State, kN>;
-  using OutputVec = Vector<typename Fmt::State, kP>;
-  using InputVec = Vector<typename Fmt::Input, kM>;
-  using Cov = Matrix<typename Fmt::Covariance, kN, kN>;
+  using Cov = Matrix<typename Fmt::Covariance, Types::kN, Types::kN>;  ///< P (not kept).
 
   /// Observer over `design` (must outlive it).
-  constexpr explicit DeadbeatObserver(const Design& design) : design_(&design) {}
+  constexpr explicit DeadbeatObserver(const typename Types::Design& design) : design_(&design) {}
 
   /// Estimate x0 at the first sampling instant (covariance ignored).
-  constexpr void reset(const StateVec& x0, const Cov& /*p0*/, const InputVec& u0) {
+  constexpr void reset(const typename Types::StateVec& x0, const Cov& /*p0*/, const typename Types::InputVec& u0) {
     x_ = x0;
     u_ = u0;
     first_ = true;
   }
 
   /// Job with sample y; the sampling delay argument is ignored (assumed zero).
-  constexpr Status update(std::int32_t /*tau_us*/, const OutputVec& y) {
+  [[nodiscard]] constexpr Status update(std::int32_t /*tau_us*/, const typename Types::OutputVec& y) {
     if (!first_) {
       x_ = affine<typename Fmt::State, typename Structure::PhiPattern, typename Structure::GammaPattern>(
           design_->phi_h, x_, design_->gamma_h, u_);
@@ -53,14 +48,14 @@ class DeadbeatObserver {
   }
 
   /// The input applied after this job.
-  constexpr void set_applied_input(const InputVec& u) { u_ = u; }
+  constexpr void set_applied_input(const typename Types::InputVec& u) { u_ = u; }
   /// x̂ at the last sample.
-  constexpr const StateVec& prediction() const { return x_; }
+  constexpr const typename Types::StateVec& prediction() const { return x_; }
 
  private:
-  const Design* design_;
-  StateVec x_{};
-  InputVec u_{};
+  const typename Types::Design* design_;
+  typename Types::StateVec x_{};
+  typename Types::InputVec u_{};
   bool first_ = true;
 };
 

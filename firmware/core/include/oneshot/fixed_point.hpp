@@ -3,8 +3,11 @@
 ///
 /// Fixed<Storage, F> holds value = raw · 2^−F in a 16- or 32-bit signed integer (F may
 /// exceed the storage width for small quantities, or be negative for large ones). Every
-/// operation rounds to nearest (ties away from zero) and saturates; a saturation sets
-/// the sticky flag saturation_flag() that the firmware can read and clear. Products of
+/// operation rounds to nearest and saturates: arithmetic (products, format conversions,
+/// Accumulator::value()) breaks ties upward, toward +∞ (round_shift: add half an LSB, shift);
+/// conversions from outside (from_double, from_ratio) and round_to_int break them away from
+/// zero, as std::lround. A saturation sets the sticky flag saturation_flag() that the
+/// firmware can read and clear. Products of
 /// two 16-bit formats are one 16×16→32 multiply; 32×16 products use two such multiplies
 /// (exact, no 64-bit multiply routine); sums go through Accumulator's 64-bit register.
 #pragma once

@@ -65,7 +65,7 @@ class GenericDiscretizer {
 
   /// Φ, Γ (and Q_d when asked) over τ_us ≥ 0 microseconds. Negative τ is clamped to 0
   /// (kClamped); kOutOfRange when the exponential cannot be scaled.
-  constexpr Status discretize(std::int32_t tau_us, Discretization<Fmt, N, M>& out,
+  [[nodiscard]] constexpr Status discretize(std::int32_t tau_us, Discretization<Fmt, N, M>& out,
                               WithQd with_qd) const {
     Status status = Status::kOk;
     if (tau_us < 0) {

@@ -15,7 +15,6 @@
 #include <cstdint>
 
 #include "oneshot/kalman_filter_base.hpp"
-#include "oneshot/time_us.hpp"
 
 namespace oneshot {
 
@@ -23,51 +22,43 @@ namespace oneshot {
 /// (at the next actuation instant).
 template <typename Fmt, typename Structure, typename Disc,
           CovarianceUpdate kForm = CovarianceUpdate::kSymmetric>
-class HalfKalman : public KalmanFilterBase<Fmt, Structure, kForm> {
- public:
-  using Base = KalmanFilterBase<Fmt, Structure, kForm>;
-  using Base::kM, Base::kN;
-  using typename Base::Core, typename Base::Cov, typename Base::Design;
-  using typename Base::InputVec, typename Base::OutputVec, typename Base::StateVec;
+class HalfKalman : public DiscretizedFilterBase<Fmt, Structure, Disc, kForm> {
+  using Base = DiscretizedFilterBase<Fmt, Structure, Disc, kForm>;
 
-  /// Filter over `design` and `disc` (both must outlive it).
-  constexpr HalfKalman(const Design& design, const Disc& disc, NoiseModel noise)
-      : Base(design, noise), disc_(&disc) {
-    reset(StateVec{}, design.p0, InputVec{});
-  }
+ public:
+  using Base::Base;  ///< HalfKalman(design, disc, noise): x̂⁻ = 0, P⁻ = P0, u = 0.
 
   /// Estimate x0 with covariance p0 at an actuation instant, input u0 applied there.
-  constexpr void reset(const StateVec& x0, const Cov& p0, const InputVec& u0) {
+  constexpr void reset(const typename Base::StateVec& x0, const typename Base::Cov& p0,
+                       const typename Base::InputVec& u0) {
     this->core_.reset(x0, p0);
     u_ = u0;
   }
 
   /// Job with sample y taken tau_us before the next actuation instant (bounded to
   /// ±kMaxTauUs first: kClamped beyond).
-  constexpr Status update(std::int32_t tau_us, const OutputVec& y) {
-    Status status = bound_tau(tau_us);
-    tau_us = disc_->quantize(tau_us);  // the discretizer's sub-grid policy
-    const Design& d = *this->design_;
-    status = worst_of(status, this->core_.predict(*disc_, d.period_us - tau_us, u_, this->noise_, d.q_constant));
+  [[nodiscard]] constexpr Status update(std::int32_t tau_us, const typename Base::OutputVec& y) {
+    Status status = this->job_tau(tau_us);
+    const auto& d = *this->design_;
+    status = worst_of(status, this->core_.predict(*this->disc_, d.period_us - tau_us, u_, this->noise_, d.q_constant));
     status = worst_of(status, this->core_.correct_all(y, d.c, d.r));
-    status = worst_of(status, this->core_.predict(*disc_, tau_us, u_, this->noise_, d.q_constant));
+    status = worst_of(status, this->core_.predict(*this->disc_, tau_us, u_, this->noise_, d.q_constant));
     return status;
   }
 
   /// A period without a job (its sample lost or refused): from the last actuation instant
   /// to the next one, x̂⁻ ← Φ(h) x̂⁻ + Γ(h) u, P⁻ ← Φ(h) P⁻ Φ(h)ᵀ + Q, u the input applied
   /// there (set_applied_input()).
-  constexpr Status skip_period() {
-    return this->core_.predict(*disc_, this->design_->period_us, u_, this->noise_, this->design_->q_constant);
+  [[nodiscard]] constexpr Status skip_period() {
+    return this->core_.predict(*this->disc_, this->design_->period_us, u_, this->noise_, this->design_->q_constant);
   }
   /// The input applied at the actuation instant the last update predicted to.
-  constexpr void set_applied_input(const InputVec& u) { u_ = u; }
+  constexpr void set_applied_input(const typename Base::InputVec& u) { u_ = u; }
   /// x̂⁻_k: the estimate at the next actuation instant.
-  constexpr const StateVec& prediction() const { return this->core_.state(); }
+  constexpr const typename Base::StateVec& prediction() const { return this->core_.state(); }
 
  private:
-  const Disc* disc_;
-  InputVec u_{};
+  typename Base::InputVec u_{};
 };
 
 }  // namespace oneshot

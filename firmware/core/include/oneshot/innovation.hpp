@@ -6,6 +6,7 @@
 
 #include "oneshot/accumulator.hpp"
 #include "oneshot/matrix.hpp"
+#include "oneshot/structured_ops.hpp"
 
 namespace oneshot {
 
@@ -18,14 +19,7 @@ constexpr Vector<typename Fmt::State, P> innovation(const Vector<typename Fmt::S
   for (std::size_t o = 0; o < P; ++o) {
     Accumulator<typename Fmt::State> acc;
     acc.add(y[o]);
-    for (std::size_t j = 0; j < N; ++j) {
-      if (CP::is_zero(o, j)) continue;
-      if (CP::is_one(o, j)) {
-        acc.sub(x[j]);
-      } else {
-        acc.sub_product(c(o, j), x[j]);
-      }
-    }
+    accumulate_row<CP, RowSign::kSubtract>(acc, c, o, x);
     e[o] = acc.value();
   }
   return e;

@@ -36,7 +36,7 @@ class InputHistory {
 
   /// Input `u` applied offset_us after the estimate instant. kOutOfRange (history
   /// unchanged) when the ring is full or offset_us precedes the last change.
-  constexpr Status push(DurationUs offset_us, const InputVec& u) {
+  [[nodiscard]] constexpr Status push(DurationUs offset_us, const InputVec& u) {
     if (size_ >= Capacity || offset_us < at(size_ - 1).offset_us) return Status::kOutOfRange;
     at(size_) = Entry{offset_us, u};
     ++size_;

@@ -26,7 +26,7 @@ enum class CovarianceUpdate : std::uint8_t { kSymmetric, kJoseph };
 /// Updates x, P with measurement y; writes the gain used to k. kSingular (x, P
 /// untouched) when the innovation variance is not positive.
 template <typename Fmt, typename Structure, CovarianceUpdate kForm, std::size_t N, std::size_t P>
-constexpr Status correct(Vector<typename Fmt::State, N>& x, Matrix<typename Fmt::Covariance, N, N>& p,
+[[nodiscard]] constexpr Status correct(Vector<typename Fmt::State, N>& x, Matrix<typename Fmt::Covariance, N, N>& p,
                          const Vector<typename Fmt::State, P>& y,
                          const Matrix<typename Fmt::Transition, P, N>& c,
                          const Matrix<typename Fmt::Covariance, P, P>& r,
@@ -52,14 +52,12 @@ constexpr Status correct(Vector<typename Fmt::State, N>& x, Matrix<typename Fmt:
   }
   add_gain_times<Fmt>(x, k, innovation<Fmt, CP>(y, c, x));
   if constexpr (kForm == CovarianceUpdate::kSymmetric) {
-    for (std::size_t i = 0; i < N; ++i)
-      for (std::size_t j = i; j < N; ++j) {
-        Accumulator<Cov> acc;
-        acc.add(p(i, j));
-        for (std::size_t o = 0; o < P; ++o) acc.sub_product(k(i, o), pct(j, o));
-        p(i, j) = acc.value();
-      }
-    mirror_upper(p);
+    fill_symmetric(p, [&](std::size_t i, std::size_t j) __attribute__((always_inline)) {  // P = P⁻ − K (P⁻Cᵀ)ᵀ
+      Accumulator<Cov> acc;
+      acc.add(p(i, j));
+      for (std::size_t o = 0; o < P; ++o) acc.sub_product(k(i, o), pct(j, o));
+      return acc.value();
+    });
   } else {
     // A = I − K C, P = A P Aᵀ + K R Kᵀ.
     Matrix<Gain, N, N> a = product<Gain, Dense<N, P>, CP>(k, c);
@@ -68,14 +66,12 @@ constexpr Status correct(Vector<typename Fmt::State, N>& x, Matrix<typename Fmt:
         a(i, j) = i == j ? ScalarTraits<Gain>::one() - a(i, j) : -a(i, j);
     const Matrix<Cov, N, N> apa = congruence<Cov, Dense<N, N>>(a, p);
     const Matrix<Cov, N, P> kr = product<Cov, Dense<N, P>, Dense<P, P>>(k, r);
-    for (std::size_t i = 0; i < N; ++i)
-      for (std::size_t j = i; j < N; ++j) {
-        Accumulator<Cov> acc;
-        acc.add(apa(i, j));
-        for (std::size_t o = 0; o < P; ++o) acc.add_product(kr(i, o), k(j, o));
-        p(i, j) = acc.value();
-      }
-    mirror_upper(p);
+    fill_symmetric(p, [&](std::size_t i, std::size_t j) __attribute__((always_inline)) {  // A P Aᵀ + (K R) Kᵀ
+      Accumulator<Cov> acc;
+      acc.add(apa(i, j));
+      for (std::size_t o = 0; o < P; ++o) acc.add_product(kr(i, o), k(j, o));
+      return acc.value();
+    });
   }
   return Status::kOk;
 }

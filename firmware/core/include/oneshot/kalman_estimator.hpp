@@ -80,7 +80,7 @@ class KalmanEstimator {
 
   /// One interval of dt_us with constant input u, discretized by `disc`.
   template <typename Disc>
-  constexpr Status predict(const Disc& disc, DurationUs dt_us, const InputVec& u, NoiseModel noise,
+  [[nodiscard]] constexpr Status predict(const Disc& disc, DurationUs dt_us, const InputVec& u, NoiseModel noise,
                            const Cov& q_constant) {
     Triple d{NoInit{}};
     const Status status = disc.discretize(dt_us, d, qd_needed(noise));
@@ -99,7 +99,7 @@ class KalmanEstimator {
   /// has it (nullptr: computed); `first_segment_noise` false: segment 0 adds no constant Q
   /// (a zero-length segment standing for a reset). history is not modified.
   template <typename Disc, std::size_t kCap>
-  constexpr Status predict_across(const Disc& disc, DurationUs dt_us,
+  [[nodiscard]] constexpr Status predict_across(const Disc& disc, DurationUs dt_us,
                                   const InputHistory<typename Fmt::Input, kM, kCap>& history, NoiseModel noise,
                                   const Cov& q_constant, const InputGain* first_gamma = nullptr,
                                   bool first_segment_noise = true) {
@@ -169,13 +169,13 @@ class KalmanEstimator {
   /// step diagonal (variances r). kSingular when an innovation variance is not positive
   /// (that output skipped, its gain column kept, the others still applied). Gain column
   /// o: the gain used for output o, zero when absent.
-  constexpr Status correct(const OutputVec& y, OutputMask present, const OutputVariances& r, const OutputMatrix& c) {
+  [[nodiscard]] constexpr Status correct(const OutputVec& y, OutputMask present, const OutputVariances& r, const OutputMatrix& c) {
     return correct_rows(y, present, r, c, std::make_index_sequence<kP>{});
   }
 
   /// Every output with the full R: the scalar update for one output, the joint update
   /// (kalman_correction.hpp, any symmetric R) for several.
-  constexpr Status correct_all(const OutputVec& y, const OutputMatrix& c,
+  [[nodiscard]] constexpr Status correct_all(const OutputVec& y, const OutputMatrix& c,
                                const Matrix<typename Fmt::Covariance, kP, kP>& r) {
     if constexpr (kP == 1) {
       OutputVariances rv;
@@ -195,7 +195,7 @@ class KalmanEstimator {
 
  private:
   template <std::size_t... O>
-  constexpr Status correct_rows(const OutputVec& y, OutputMask present, const OutputVariances& r,
+  [[nodiscard]] constexpr Status correct_rows(const OutputVec& y, OutputMask present, const OutputVariances& r,
                                 const OutputMatrix& c, std::index_sequence<O...>) {
     Status status = Status::kOk;
     ((status = worst_of(status, correct_row<O>(y, present, r, c))), ...);
@@ -203,7 +203,7 @@ class KalmanEstimator {
   }
 
   template <std::size_t O>
-  constexpr Status correct_row(const OutputVec& y, OutputMask present, const OutputVariances& r,
+  [[nodiscard]] constexpr Status correct_row(const OutputVec& y, OutputMask present, const OutputVariances& r,
                                const OutputMatrix& c) {
     Matrix<typename Fmt::KalmanGain, kN, 1> k{};  // absent output: zero gain
     Status status = Status::kOk;

@@ -12,7 +12,7 @@ namespace oneshot {
 /// Solves A·X = B in place of X (X = A⁻¹B). Returns kSingular when a pivot is zero or
 /// below N·ε·‖A‖∞ (numerically singular); X is then unspecified.
 template <typename S, std::size_t N, std::size_t K>
-constexpr Status solve(Matrix<S, N, N> a, const Matrix<S, N, K>& b, Matrix<S, N, K>& x) {
+[[nodiscard]] constexpr Status solve(Matrix<S, N, N> a, const Matrix<S, N, K>& b, Matrix<S, N, K>& x) {
   using T = ScalarTraits<S>;
   static_assert(T::kIsFloating, "solve() is for floating formats (design and host checks)");
   S norm = T::zero();
@@ -58,7 +58,7 @@ constexpr Status solve(Matrix<S, N, N> a, const Matrix<S, N, K>& b, Matrix<S, N,
 
 /// A⁻¹ (kSingular when A is numerically singular).
 template <typename S, std::size_t N>
-constexpr Status invert(const Matrix<S, N, N>& a, Matrix<S, N, N>& inverse) {
+[[nodiscard]] constexpr Status invert(const Matrix<S, N, N>& a, Matrix<S, N, N>& inverse) {
   return solve(a, Matrix<S, N, N>::identity(), inverse);
 }
 

@@ -146,4 +146,13 @@ constexpr void mirror_upper(Matrix<S, N, N>& m) {
     for (std::size_t j = i + 1; j < N; ++j) m(j, i) = m(i, j);
 }
 
+/// A symmetric result: m(i, j) = entry(i, j) for j ≥ i (row by row), then mirror_upper(m).
+/// entry may read m(i, j) itself (in-place updates of the upper triangle).
+template <typename S, std::size_t N, typename Entry>
+[[gnu::always_inline]] constexpr void fill_symmetric(Matrix<S, N, N>& m, Entry entry) {
+  for (std::size_t i = 0; i < N; ++i)
+    for (std::size_t j = i; j < N; ++j) m(i, j) = entry(i, j);
+  mirror_upper(m);
+}
+
 }  // namespace oneshot

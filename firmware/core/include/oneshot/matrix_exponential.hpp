@@ -50,7 +50,7 @@ constexpr S one_norm(const Matrix<S, N, N>& m) {
 /// result = e^M. Returns kOutOfRange (result unspecified) when ‖M‖₁ needs more than
 /// kMaxSquarings halvings.
 template <typename S, std::size_t N>
-constexpr Status matrix_exponential(const Matrix<S, N, N>& m, Matrix<S, N, N>& result) {
+[[nodiscard]] constexpr Status matrix_exponential(const Matrix<S, N, N>& m, Matrix<S, N, N>& result) {
   using T = ScalarTraits<S>;
   constexpr S half = T::from_ratio(1, 2);
   Matrix<S, N, N> x = m;

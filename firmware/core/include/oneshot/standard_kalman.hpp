@@ -20,44 +20,40 @@ namespace oneshot {
 /// after the last correction.
 template <typename Fmt, typename Structure, CovarianceUpdate kForm = CovarianceUpdate::kSymmetric>
 class StandardKalman : public KalmanFilterBase<Fmt, Structure, kForm> {
- public:
   using Base = KalmanFilterBase<Fmt, Structure, kForm>;
-  using Base::kM, Base::kN;
-  using typename Base::Core, typename Base::Cov, typename Base::Design;
-  using typename Base::InputVec, typename Base::OutputVec, typename Base::StateVec;
 
-  /// Filter over `design` (must outlive it).
-  constexpr StandardKalman(const Design& design, NoiseModel noise) : Base(design, noise) {
-    reset(StateVec{}, design.p0, InputVec{});
-  }
+ public:
+  using Base::Base;  ///< StandardKalman(design, noise): x̂ = 0, P = P0, u = 0, first sample next.
 
   /// Estimate x0 with covariance p0 at the first sampling instant.
-  constexpr void reset(const StateVec& x0, const Cov& p0, const InputVec& u0) {
+  constexpr void reset(const typename Base::StateVec& x0, const typename Base::Cov& p0,
+                       const typename Base::InputVec& u0) {
     this->core_.reset(x0, p0);
     u_ = u0;
     first_ = true;
   }
 
   /// Job with sample y; the sampling delay argument is ignored (assumed zero).
-  constexpr Status update(std::int32_t /*tau_us*/, const OutputVec& y) {
+  [[nodiscard]] constexpr Status update(std::int32_t /*tau_us*/, const typename Base::OutputVec& y) {
+    const auto& d = *this->design_;
     if (!first_) {
-      Discretization<Fmt, kN, kM> d;
-      d.phi = this->design_->phi_h;
-      d.gamma = this->design_->gamma_h;
-      d.qd = this->design_->qd_h;
-      this->core_.predict(d, u_, this->noise_, this->design_->q_constant);
+      Discretization<Fmt, Base::kN, Base::kM> step;
+      step.phi = d.phi_h;
+      step.gamma = d.gamma_h;
+      step.qd = d.qd_h;
+      this->core_.predict(step, u_, this->noise_, d.q_constant);
     }
     first_ = false;
-    return this->core_.correct_all(y, this->design_->c, this->design_->r);
+    return this->core_.correct_all(y, d.c, d.r);
   }
 
   /// The input applied after this job.
-  constexpr void set_applied_input(const InputVec& u) { u_ = u; }
+  constexpr void set_applied_input(const typename Base::InputVec& u) { u_ = u; }
   /// x̂ at the last sample (used as if it were the actuation instant).
-  constexpr const StateVec& prediction() const { return this->core_.state(); }
+  constexpr const typename Base::StateVec& prediction() const { return this->core_.state(); }
 
  private:
-  InputVec u_{};
+  typename Base::InputVec u_{};
   bool first_ = true;
 };
 

@@ -44,14 +44,14 @@ constexpr std::uint8_t severity(Status s) {
 }
 
 /// The more severe of a and b (a on ties): the status of a and b done in sequence.
-constexpr Status worst_of(Status a, Status b) { return severity(b) > severity(a) ? b : a; }
+[[nodiscard]] constexpr Status worst_of(Status a, Status b) { return severity(b) > severity(a) ? b : a; }
 
 /// True when the result can be used as is (exact or exactly extended).
 constexpr bool is_exact(Status s) { return s == Status::kOk || s == Status::kExtended; }
 
 /// Status of a sequence so far combined with the next operation's: the worst of both
 /// (kept under its historical name; it no longer returns a milder earlier status).
-constexpr Status first_failure(Status current, Status next) { return worst_of(current, next); }
+[[nodiscard]] constexpr Status first_failure(Status current, Status next) { return worst_of(current, next); }
 
 /// Short name for logs and error messages (host side).
 constexpr const char* to_string(Status s) {

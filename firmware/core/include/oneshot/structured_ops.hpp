@@ -33,12 +33,46 @@ constexpr void accumulate_term(Accumulator<Out>& acc, bool a_zero, bool a_one, c
   }
 }
 
+/// acc += Q(i, j), Q with pattern PQ (a structural one adds 1, a structural zero nothing).
+template <typename PQ, typename Out, typename SQ, std::size_t N>
+[[gnu::always_inline]] constexpr void add_patterned(Accumulator<Out>& acc, const Matrix<SQ, N, N>& q, std::size_t i, std::size_t j) {
+  if (PQ::is_one(i, j)) {
+    acc.add(ScalarTraits<Out>::one());
+  } else if (!PQ::is_zero(i, j)) {
+    acc.add(q(i, j));
+  }
+}
+
 template <typename P, std::size_t R, std::size_t C>
 constexpr void check_pattern_shape() {
   static_assert(P::kRows == R && P::kCols == C, "pattern shape does not match the matrix");
 }
 
 }  // namespace detail
+
+/// Sign of a row term in accumulate_row().
+enum class RowSign : bool { kAdd, kSubtract };
+
+/// acc ± Σ_k A(r, k)·v_k, A with pattern PA: a structural zero is skipped, a structural one
+/// adds (subtracts) v_k itself.
+template <typename PA, RowSign kSign, typename Out, typename SA, typename SV, std::size_t R, std::size_t K>
+[[gnu::always_inline]] constexpr void accumulate_row(Accumulator<Out>& acc, const Matrix<SA, R, K>& a, std::size_t r,
+                              const Vector<SV, K>& v) {
+  for (std::size_t k = 0; k < K; ++k) {
+    if (PA::is_zero(r, k)) continue;
+    if constexpr (kSign == RowSign::kAdd) {
+      if (PA::is_one(r, k)) {
+        acc.add(v[k]);
+      } else {
+        acc.add_product(a(r, k), v[k]);
+      }
+    } else if (PA::is_one(r, k)) {
+      acc.sub(v[k]);
+    } else {
+      acc.sub_product(a(r, k), v[k]);
+    }
+  }
+}
 
 /// A·B in format Out, A and B with patterns PA, PB.
 template <typename Out, typename PA, typename PB, typename SA, typename SB, std::size_t R,
@@ -102,22 +136,13 @@ constexpr Matrix<Out, N, N> congruence_impl(const Matrix<SA, N, N>& a, const Mat
       t(i, j) = acc.value();
     }
   Matrix<Out, N, N> out{NoInit{}};  // upper triangle written, lower mirrored
-  for (std::size_t i = 0; i < N; ++i)
-    for (std::size_t j = i; j < N; ++j) {
-      Accumulator<Out> acc;
-      for (std::size_t k = 0; k < N; ++k)
-        detail::accumulate_term(acc, false, false, t(i, k), PA::is_zero(j, k), PA::is_one(j, k),
-                                a(j, k));
-      if constexpr (kAddQ) {
-        if (PQ::is_one(i, j)) {
-          acc.add(ScalarTraits<Out>::one());
-        } else if (!PQ::is_zero(i, j)) {
-          acc.add(q(i, j));
-        }
-      }
-      out(i, j) = acc.value();
-    }
-  mirror_upper(out);
+  fill_symmetric(out, [&](std::size_t i, std::size_t j) __attribute__((always_inline)) {
+    Accumulator<Out> acc;
+    for (std::size_t k = 0; k < N; ++k)
+      detail::accumulate_term(acc, false, false, t(i, k), PA::is_zero(j, k), PA::is_one(j, k), a(j, k));
+    if constexpr (kAddQ) detail::add_patterned<PQ>(acc, q, i, j);
+    return acc.value();
+  });
   return out;
 }
 
@@ -140,18 +165,12 @@ template <typename Out, typename PQ, typename SP, typename SQ, std::size_t N>
 constexpr Matrix<Out, N, N> symmetric_add(const Matrix<SP, N, N>& p, const Matrix<SQ, N, N>& q) {
   detail::check_pattern_shape<PQ, N, N>();
   Matrix<Out, N, N> out{NoInit{}};  // upper triangle written, lower mirrored
-  for (std::size_t i = 0; i < N; ++i)
-    for (std::size_t j = i; j < N; ++j) {
-      Accumulator<Out> acc;
-      acc.add(p(i, j));
-      if (PQ::is_one(i, j)) {
-        acc.add(ScalarTraits<Out>::one());
-      } else if (!PQ::is_zero(i, j)) {
-        acc.add(q(i, j));
-      }
-      out(i, j) = acc.value();
-    }
-  mirror_upper(out);
+  fill_symmetric(out, [&](std::size_t i, std::size_t j) __attribute__((always_inline)) {
+    Accumulator<Out> acc;
+    acc.add(p(i, j));
+    detail::add_patterned<PQ>(acc, q, i, j);
+    return acc.value();
+  });
   return out;
 }
 

@@ -89,7 +89,7 @@ class TableDiscretizer {
   }
 
   /// Φ, Γ (and Q_d when asked) over τ_us, with the out-of-range policy above.
-  constexpr Status discretize(std::int32_t tau_us, Triple& out, WithQd with_qd) const {
+  [[nodiscard]] constexpr Status discretize(std::int32_t tau_us, Triple& out, WithQd with_qd) const {
     Status status = Status::kOk;
     if (tau_us < 0) {
       tau_us = 0;

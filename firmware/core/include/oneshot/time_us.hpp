@@ -74,7 +74,7 @@ using HostInstant = InstantUs<std::uint64_t>;
 /// fit DurationUs or lies outside [min_us, max_us]: the single point where a time span
 /// from a clock or a message enters the maths, so garbage never reaches a signed overflow.
 template <typename Rep>
-constexpr Status checked_duration(InstantUs<Rep> from, InstantUs<Rep> to, DurationUs min_us, DurationUs max_us,
+[[nodiscard]] constexpr Status checked_duration(InstantUs<Rep> from, InstantUs<Rep> to, DurationUs min_us, DurationUs max_us,
                                   DurationUs& out) {
   const auto d = to - from;
   if (d < static_cast<decltype(d)>(min_us) || d > static_cast<decltype(d)>(max_us)) return Status::kOutOfRange;
@@ -88,7 +88,7 @@ constexpr Status checked_duration(InstantUs<Rep> from, InstantUs<Rep> to, Durati
 inline constexpr DurationUs kMaxTauUs = DurationUs{1} << 29;
 
 /// Bounds τ to ±kMaxTauUs where it enters the core: kClamped (τ moved) beyond, else kOk.
-constexpr Status bound_tau(DurationUs& tau_us) {
+[[nodiscard]] constexpr Status bound_tau(DurationUs& tau_us) {
   if (tau_us > kMaxTauUs) {
     tau_us = kMaxTauUs;
     return Status::kClamped;

@@ -12,9 +12,6 @@
 ///   Board::Setpoint   static std::int32_t setpoint_code(std::size_t ch, InstantUs<Rep> at);
 ///                     the reference valid at instant `at`, in ADC codes (a reference
 ///                     generator: the trajectory is known ahead of time)
-/// The older separate Clock (now_us()) and Timer (next_actuation_us()) contracts, 32-bit,
-/// remain detectable (kHasClock, kHasTimer, kHasSetpoint) for code that still uses them;
-/// the control task needs Time and the instant-taking Setpoint.
 /// Each is checked with a static_assert in the task that uses it; there is no virtual
 /// dispatch on the control path. Ports: hal/host_sim (emulated board), hal/mcu.
 #pragma once
@@ -36,17 +33,6 @@ struct TimeSnapshot {
 
 namespace detail {
 template <typename T, typename = void>
-struct has_clock : std::false_type {};
-template <typename T>
-struct has_clock<T, std::enable_if_t<std::is_same_v<decltype(T::now_us()), std::uint32_t>>> : std::true_type {};
-
-template <typename T, typename = void>
-struct has_timer : std::false_type {};
-template <typename T>
-struct has_timer<T, std::enable_if_t<std::is_same_v<decltype(T::next_actuation_us()), std::uint32_t>>>
-    : std::true_type {};
-
-template <typename T, typename = void>
 struct has_pwm : std::false_type {};
 template <typename T>
 struct has_pwm<T, std::void_t<decltype(T::write_duty(std::size_t{}, std::int32_t{}))>> : std::true_type {};
@@ -57,12 +43,6 @@ template <typename T>
 struct has_adc<T, std::enable_if_t<std::is_same_v<decltype(T::sample(std::size_t{})), std::int32_t>>>
     : std::true_type {};
 
-template <typename T, typename = void>
-struct has_setpoint : std::false_type {};
-template <typename T>
-struct has_setpoint<
-    T, std::enable_if_t<std::is_same_v<decltype(T::setpoint_code(std::size_t{}, std::uint32_t{})), std::int32_t>>>
-    : std::true_type {};
 template <typename T>
 struct is_time_snapshot : std::false_type {};
 template <typename Rep>
@@ -91,20 +71,11 @@ using InstantOf = decltype(Board::Time::snapshot().now);
 template <typename Board>
 inline constexpr bool kHasSetpointAt = detail::has_setpoint_at<typename Board::Setpoint, InstantOf<Board>>::value;
 
-/// Board::Clock fulfils the clock contract.
-template <typename Board>
-inline constexpr bool kHasClock = detail::has_clock<typename Board::Clock>::value;
-/// Board::Timer fulfils the actuation-timer contract.
-template <typename Board>
-inline constexpr bool kHasTimer = detail::has_timer<typename Board::Timer>::value;
 /// Board::Pwm fulfils the PWM contract.
 template <typename Board>
 inline constexpr bool kHasPwm = detail::has_pwm<typename Board::Pwm>::value;
 /// Board::Adc fulfils the ADC contract.
 template <typename Board>
 inline constexpr bool kHasAdc = detail::has_adc<typename Board::Adc>::value;
-/// Board::Setpoint fulfils the set-point contract.
-template <typename Board>
-inline constexpr bool kHasSetpoint = detail::has_setpoint<typename Board::Setpoint>::value;
 
 }  // namespace oneshot::hal

@@ -71,7 +71,7 @@ class ControlTask {
   /// The control job: sample, τ, estimator, control law, actuation codes. Status: the
   /// worst of the estimator's, kOutOfRange when τ lies beyond ±kMaxTauUs (garbage timer
   /// values: τ bounded), and kOverflow when a fixed-point operation of the job saturated.
-  Status run_job() {
+  [[nodiscard]] Status run_job() {
     const auto time = Board::Time::snapshot();  // clock and timer of the same instant
     const auto t_sample = time.now;
     // One-shot: the output is applied at the next actuation instant t_k; standard: now.

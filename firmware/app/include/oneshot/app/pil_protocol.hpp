@@ -83,7 +83,7 @@ constexpr std::size_t encode(const Frame& f, std::uint8_t* out) {
 class Decoder {
  public:
   /// Consumes one byte.
-  constexpr bool feed(std::uint8_t b) {
+  [[nodiscard]] constexpr bool feed(std::uint8_t b) {
     if (b == kFlag) {
       const bool ok = !overflow_ && !escape_ && finish();
       reset();
@@ -112,7 +112,7 @@ class Decoder {
   constexpr std::uint32_t dropped() const { return dropped_; }
 
  private:
-  constexpr bool finish() {
+  [[nodiscard]] constexpr bool finish() {
     if (used_ == 0) return false;          // back-to-back flags: nothing to do
     if (used_ < 5) {
       ++dropped_;
@@ -204,9 +204,9 @@ inline constexpr std::uint32_t kFaultMalformedRequest = 0xFFFFFFFDU;  ///< Wrong
 inline constexpr std::uint8_t kCJobApproach = 5;
 /// Approach id of the generated C99 job's own-arithmetic twin: q15 in fixed-point images,
 /// float_poly in float table images (others refuse it).
-inline constexpr std::uint8_t kCJobQ15Approach = 6;
+inline constexpr std::uint8_t kCJobOwnArithApproach = 6;
 /// Largest approach id of kConfig: 0–4 are A–E, 5 and 6 the generated C99 jobs.
-inline constexpr std::uint8_t kMaxApproach = kCJobQ15Approach;
+inline constexpr std::uint8_t kMaxApproach = kCJobOwnArithApproach;
 
 /// kConfig: approach (0–6), noise model (0 constant, 1 exact), initial PWM code per input.
 template <std::size_t M>
@@ -239,7 +239,7 @@ struct TickRequest {
 /// Decodes a kConfig payload; false (out untouched) unless the length is exact and the
 /// approach and noise model are known: a truncated request must not run on zeros.
 template <std::size_t M>
-constexpr bool decode(const Frame& f, ConfigRequest<M>& out) {
+[[nodiscard]] constexpr bool decode(const Frame& f, ConfigRequest<M>& out) {
   if (f.length != ConfigRequest<M>::kLength) return false;
   Reader in(f);
   ConfigRequest<M> r;
@@ -256,7 +256,7 @@ constexpr bool decode(const Frame& f, ConfigRequest<M>& out) {
 
 /// Decodes a kSample payload; false (out untouched) unless the length is exact.
 template <std::size_t P>
-constexpr bool decode(const Frame& f, SampleRequest<P>& out) {
+[[nodiscard]] constexpr bool decode(const Frame& f, SampleRequest<P>& out) {
   if (f.length != SampleRequest<P>::kLength) return false;
   Reader in(f);
   SampleRequest<P> r;
@@ -270,7 +270,7 @@ constexpr bool decode(const Frame& f, SampleRequest<P>& out) {
 }
 
 /// Decodes a kTick payload; false (out untouched) unless the length is exact.
-constexpr bool decode(const Frame& f, TickRequest& out) {
+[[nodiscard]] constexpr bool decode(const Frame& f, TickRequest& out) {
   if (f.length != TickRequest::kLength) return false;
   Reader in(f);
   const std::uint32_t now = in.u(4);

@@ -173,7 +173,8 @@ class PilRuntime {
   /// request except those every image answers alike: kHello, kCalibrate, kEcho.
   class Session {
    public:
-    /// Feeds one received byte; a complete request is answered (returns true).
+    /// Feeds one received byte; a complete request is answered (returns true: progress, not a
+    /// status, so the main loop may ignore it).
     template <typename Handle>
     bool feed(std::uint8_t byte, const ImageInfo& info, Handle&& handle) {
       if (!decoder_.feed(byte)) return false;

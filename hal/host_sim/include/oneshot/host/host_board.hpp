@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "oneshot/hal/board_contract.hpp"
+#include "oneshot/hal/thread_current.hpp"
 
 namespace oneshot::host {
 
@@ -34,19 +35,10 @@ struct HostBoardState {
 };
 
 /// Makes `state` the current board of this thread for its lifetime.
-class ScopedHostBoard {
- public:
-  explicit ScopedHostBoard(HostBoardState& state);
-  ~ScopedHostBoard();
-  ScopedHostBoard(const ScopedHostBoard&) = delete;
-  ScopedHostBoard& operator=(const ScopedHostBoard&) = delete;
-
- private:
-  HostBoardState* previous_;
-};
+using ScopedHostBoard = hal::ScopedCurrent<HostBoardState>;
 
 /// The current board state of this thread (asserts that one is set).
-HostBoardState& current_board();
+inline HostBoardState& current_board() { return ScopedHostBoard::current(); }
 
 /// The board contract on the host.
 struct HostBoard {

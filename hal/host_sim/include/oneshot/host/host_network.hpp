@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "oneshot/hal/network_contract.hpp"
+#include "oneshot/hal/thread_current.hpp"
 
 namespace oneshot::host {
 
@@ -46,26 +47,17 @@ struct HostNetworkState {
 };
 
 /// Makes `state` the current network interface of this thread for its lifetime.
-class ScopedHostNetwork {
- public:
-  explicit ScopedHostNetwork(HostNetworkState& state);
-  ~ScopedHostNetwork();
-  ScopedHostNetwork(const ScopedHostNetwork&) = delete;
-  ScopedHostNetwork& operator=(const ScopedHostNetwork&) = delete;
-
- private:
-  HostNetworkState* previous_;
-};
+using ScopedHostNetwork = hal::ScopedCurrent<HostNetworkState>;
 
 /// The current network interface of this thread (asserts that one is set).
-HostNetworkState& current_network();
+inline HostNetworkState& current_network() { return ScopedHostNetwork::current(); }
 
 /// The network contract on the host.
 struct HostNetwork {
   /// Network interface.
   struct Net {
     static std::uint8_t address() { return current_network().address; }
-    static bool send(std::uint8_t destination, const std::uint8_t* data, std::size_t size) {
+    [[nodiscard]] static bool send(std::uint8_t destination, const std::uint8_t* data, std::size_t size) {
       HostNetworkState& n = current_network();
       if (size > n.max_frame_bytes) {
         ++n.refused_sends;

@@ -18,7 +18,7 @@ class RxRing {
     head_ = next;
   }
   /// From the main loop: takes one byte if there is one.
-  bool pop(std::uint8_t& b) {
+  [[nodiscard]] bool pop(std::uint8_t& b) {
     if (tail_ == head_) return false;
     b = data_[tail_];
     tail_ = (tail_ + 1) % kSize;

@@ -19,6 +19,7 @@
 #include <string>
 
 #include "oneshot/hal/network_contract.hpp"
+#include "oneshot/hal/thread_current.hpp"
 
 namespace oneshot::posix {
 
@@ -39,22 +40,13 @@ struct UdpNetworkState {
 };
 
 /// Makes `state` the current interface of this thread for its lifetime.
-class ScopedUdpNetwork {
- public:
-  explicit ScopedUdpNetwork(UdpNetworkState& state);
-  ~ScopedUdpNetwork();
-  ScopedUdpNetwork(const ScopedUdpNetwork&) = delete;
-  ScopedUdpNetwork& operator=(const ScopedUdpNetwork&) = delete;
-
- private:
-  UdpNetworkState* previous_;
-};
+using ScopedUdpNetwork = hal::ScopedCurrent<UdpNetworkState>;
 
 /// The current interface of this thread (asserts that one is set).
-UdpNetworkState& current_udp_network();
+inline UdpNetworkState& current_udp_network() { return ScopedUdpNetwork::current(); }
 
 /// Sends one frame of the current interface; see network_contract.hpp.
-bool udp_send(std::uint8_t destination, const std::uint8_t* data, std::size_t size);
+[[nodiscard]] bool udp_send(std::uint8_t destination, const std::uint8_t* data, std::size_t size);
 /// Receives one frame of the current interface; see network_contract.hpp.
 std::size_t udp_receive(std::uint8_t& source, std::uint8_t* data, std::size_t capacity);
 
@@ -63,7 +55,7 @@ struct UdpNetwork {
   /// Network interface.
   struct Net {
     static std::uint8_t address() { return current_udp_network().address; }
-    static bool send(std::uint8_t destination, const std::uint8_t* data, std::size_t size) {
+    [[nodiscard]] static bool send(std::uint8_t destination, const std::uint8_t* data, std::size_t size) {
       return udp_send(destination, data, size);
     }
     static std::size_t receive(std::uint8_t& source, std::uint8_t* data, std::size_t capacity) {
