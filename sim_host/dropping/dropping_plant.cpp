@@ -6,6 +6,11 @@
 #include <stdexcept>
 
 #include "oneshot/design/spectrum.hpp"
+#include "oneshot/util/file_io.hpp"
+
+#ifndef ONESHOT_STUDY_PLANT_FILE
+#error "ONESHOT_STUDY_PLANT_FILE must name lut_gen/plants/sinopoli_dropping.json (oneshot_study PLANT ... FOR)"
+#endif
 
 namespace oneshot::dropping {
 namespace {
@@ -22,6 +27,11 @@ Matrix<double, R, C> fixed(const design::DenseMatrix& m, const char* what, const
 }
 
 }  // namespace
+
+const std::string& dropping_plant_json() {
+  static const std::string text = util::read_text_file(ONESHOT_STUDY_PLANT_FILE, "plant file");
+  return text;
+}
 
 DroppingPlant load_dropping_plant(const std::string& path) {
   DroppingPlant d;

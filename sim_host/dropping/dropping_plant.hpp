@@ -49,7 +49,8 @@ double poisson_pmf(int t, double mean);
 /// D such that (1 − ε) e^{−D} = λ (T_hold = 1): D = −ln(λ / (1 − ε)); invalid_argument outside (0, 1 − ε].
 double delay_for_lambda(double lambda, double loss);
 
-/// The built-in plant file's text (embedded at build time).
+/// The built-in plant file's text (lut_gen/plants/sinopoli_dropping.json, read once; its digest
+/// names the plant in sweep shards).
 const std::string& dropping_plant_json();
 
 }  // namespace oneshot::dropping

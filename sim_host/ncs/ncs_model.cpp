@@ -14,8 +14,8 @@
 #include "oneshot/design/fixed_size.hpp"
 #include "oneshot/engine/json_fields.hpp"
 
-#ifndef ONESHOT_NCS_PLANT_FILE
-#error "ONESHOT_NCS_PLANT_FILE must name lut_gen/plants/networked_board.json"
+#ifndef ONESHOT_STUDY_PLANT_FILE
+#error "ONESHOT_STUDY_PLANT_FILE must name lut_gen/plants/networked_board.json (oneshot_study PLANT ... FOR)"
 #endif
 
 namespace oneshot::ncs {
@@ -127,7 +127,7 @@ std::string describe(const Scenario& s) {
 
 std::shared_ptr<const Context> Context::load(const std::string& plant_path) {
   auto ctx = std::make_shared<Context>();
-  ctx->plant_ = design::load_plant_file(plant_path.empty() ? std::string(ONESHOT_NCS_PLANT_FILE) : plant_path);
+  ctx->plant_ = design::load_plant_file(plant_path.empty() ? std::string(ONESHOT_STUDY_PLANT_FILE) : plant_path);
   const design::PlantDescription& p = ctx->plant_;
   if (!p.continuous() || p.a.rows != kN || p.b.cols != kM || p.c.rows != kP || !p.b_w.values.empty()) {
     throw std::invalid_argument(p.source + ": study 'ncs' needs a continuous plant with n = 2, m = 1, p = 2 and no B_w");
