@@ -71,10 +71,9 @@ class Harness {
     }
     const auto chol = measurement_cholesky(design_);
     for (std::size_t i = 0; i < 3; ++i) r_chol_[i] = chol[i];
-    for (std::size_t j = 0; j < kM; ++j) {
-      u_min_[j] = ctx.design().u_min[j];
-      u_max_[j] = ctx.design().u_max[j];
-    }
+    const live::InputRange range = live::actuator_range(ctx);
+    u_min_ = range.lo;
+    u_max_ = range.hi;
     const Vector<double, kN> x0 = ref_.state(0);
     plant_.set_state(x0);
     plant_.set_reference(x0, ref_.input(0));

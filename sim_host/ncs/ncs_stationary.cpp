@@ -3,7 +3,6 @@
 #include "ncs_stationary.hpp"
 
 #include <cmath>
-#include <cstdio>
 #include <filesystem>
 #include <iostream>
 #include <map>
@@ -15,12 +14,14 @@
 
 #include "ncs_analytic.hpp"
 #include "ncs_live.hpp"
+#include "ncs_live_nodes.hpp"
 #include "ncs_loop.hpp"
 #include "oneshot/engine/stationary_cost.hpp"
 #include "oneshot/node/sampling_sync_laws.hpp"
 #include "oneshot/node/sync_estimators.hpp"
 #include "oneshot/plant_structure.hpp"
 #include "oneshot/util/file_io.hpp"
+#include "oneshot/util/number_text.hpp"
 #include "oneshot/util/output_files.hpp"
 #include "oneshot/util/parallel.hpp"
 #include "oneshot/util/statistics.hpp"
@@ -169,12 +170,9 @@ StationaryRow stationary_row(const Context& ctx, const Scenario& sc, Approach a,
   const Design d = ctx.controller_design(sc.noise_scale);
   const Disc disc(ctx.discretizer_model(sc.noise_scale));
   const Ref ref = reference(ctx, flat);
-  InputVec u_min;
-  InputVec u_max;
-  for (std::size_t j = 0; j < kM; ++j) {
-    u_min[j] = ctx.design().u_min[j];
-    u_max[j] = ctx.design().u_max[j];
-  }
+  const live::InputRange range = live::actuator_range(ctx);
+  const InputVec& u_min = range.lo;
+  const InputVec& u_max = range.hi;
   const auto tracker = make_tracker(ctx, flat, a, d, RunOptions{}, Vector<double, kN>{}, InputVec{});
   switch (a) {
     case Approach::kA:
@@ -263,7 +261,6 @@ nlohmann::json stationary_table(const Context& ctx, const StationaryOptions& o) 
     for (std::size_t k = 0; k < na; ++k) {
       const Cell& c = cells[s * na + k];
       nlohmann::json cj;
-      char buf[96];
       if (!c.refused.empty()) {
         cj["refused"] = c.refused;
         md << " — |";
@@ -272,8 +269,7 @@ nlohmann::json stationary_table(const Context& ctx, const StationaryOptions& o) 
         cj["spectral_radius"] = c.row.spectral_radius;
         cj["residual"] = c.row.residual;
         cj["cases"] = c.row.cases;
-        std::snprintf(buf, sizeof buf, " %.6f", c.row.cost_rate);
-        md << buf;
+        md << ' ' << util::format_f(c.row.cost_rate, 6);
         if (o.check_seeds > 0) {
           cj["long_run_rate_mean"] = c.check.first;
           cj["long_run_rate_ci95"] = c.check.second;
@@ -282,8 +278,7 @@ nlohmann::json stationary_table(const Context& ctx, const StationaryOptions& o) 
           const double dist = std::fabs(c.row.cost_rate - c.check.first);
           cj["stationary_inside_long_run_ci95"] = dist <= c.check.second + slack;
           if (c.check.second > slack) worst_sigma = std::fmax(worst_sigma, dist / c.check.second);
-          std::snprintf(buf, sizeof buf, " (%.6f ± %.6f)", c.check.first, c.check.second);
-          md << buf;
+          md << " (" << util::format_f(c.check.first, 6) << " ± " << util::format_f(c.check.second, 6) << ')';
         }
         md << " |";
       }
