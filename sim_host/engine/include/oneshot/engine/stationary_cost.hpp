@@ -18,8 +18,8 @@
 /// radius of 𝒜 is below 1; otherwise the cost is infinite and the call throws, naming it.
 /// A register of z that a loop never writes nor reads (a spare slot of a shared layout) keeps
 /// its covariance for ever (an eigenvalue 1 of 𝒜 that does not move the cost): the caller names
-/// the live entries, the others are held at zero, and each dead entry is probed once to check
-/// that it indeed moves neither a live entry nor the cost (std::logic_error otherwise).
+/// the live entries, the others are held at zero, and each dead entry is probed in every case to
+/// check that it indeed moves neither a live entry nor the cost (std::logic_error otherwise).
 #pragma once
 
 #include <cstddef>
@@ -103,17 +103,15 @@ StationaryCost stationary_cost(const std::vector<double>& p, const std::vector<d
     std::size_t row = 0;
     for (std::size_t r = 0; r < k; ++r)
       for (std::size_t t = r; t < k; ++t, ++row) w[row] += p[i] * base.sigma(idx[r], idx[t]);
-    if (i == 0) {
-      for (std::size_t a = 0; a < K; ++a) {
-        if (live[a]) continue;
-        Matrix<double, K, K> basis{};
-        basis(a, a) = 1;
-        const PeriodOutcome<K> o = run(i, basis);
-        bool moved = o.cost != base.cost;
-        for (std::size_t r : idx)
-          for (std::size_t t : idx) moved = moved || o.sigma(r, t) != base.sigma(r, t);
-        if (moved) throw std::logic_error("stationary_cost: entry " + std::to_string(a) + " of z is declared dead but moves the loop");
-      }
+    for (std::size_t a = 0; a < K; ++a) {  // every case: a register dead in one may be read in another
+      if (live[a]) continue;
+      Matrix<double, K, K> basis{};
+      basis(a, a) = 1;
+      const PeriodOutcome<K> o = run(i, basis);
+      bool moved = o.cost != base.cost;
+      for (std::size_t r : idx)
+        for (std::size_t t : idx) moved = moved || o.sigma(r, t) != base.sigma(r, t);
+      if (moved) throw std::logic_error("stationary_cost: entry " + std::to_string(a) + " of z is declared dead but moves the loop");
     }
   }
   if (!(total > 1 - 1e-9 && total < 1 + 1e-9)) throw std::invalid_argument("stationary_cost: probabilities sum to " + std::to_string(total) + ", not 1");
