@@ -1,6 +1,7 @@
 /// @file c_job_host.hpp
-/// @brief The generated q15 C99 job compiled into the host build, called job by job: the
-///        oracle of the MCU's q15 job (same C, host gcc vs arm-none-eabi-gcc); likewise float_poly.
+/// @brief The generated C99 jobs with their own arithmetic (q15 table / nearest, float_poly)
+///        compiled into the host build, called job by job: the oracle of the MCU's job (same
+///        C, host gcc vs arm-none-eabi-gcc).
 #pragma once
 
 #include <cstdint>
@@ -9,38 +10,22 @@
 
 namespace oneshot::sim {
 
-/// One q15 C job state (table or nearest variant) on the host.
-class HostCJobQ15 {
+/// One host-compiled C job state of a variant with its own arithmetic.
+class HostCJob {
  public:
-  /// Starts it as oneshot_job_q15_<variant>_init(pwm0); std::invalid_argument when the
-  /// generated job has no q15 variant.
-  HostCJobQ15(bool nearest, std::uint16_t pwm0);
-  ~HostCJobQ15();
-  HostCJobQ15(const HostCJobQ15&) = delete;
-  HostCJobQ15& operator=(const HostCJobQ15&) = delete;
-  /// One job; returns the raw values the firmware reports: u[0], x[0..n), k[0].
+  /// The variants: q15 with the τ table, q15 nearest-entry, float with the polynomial.
+  enum class Variant : std::uint8_t { kQ15Table, kQ15Nearest, kFloatPoly };
+  /// Starts it as oneshot_job_<variant>_init(pwm0); std::invalid_argument when the generated
+  /// job does not have that variant.
+  HostCJob(Variant variant, std::uint16_t pwm0);
+  ~HostCJob();
+  HostCJob(const HostCJob&) = delete;
+  HostCJob& operator=(const HostCJob&) = delete;
+  /// One job; returns the words the firmware reports: u[0], x[0..n), k[0] (q15: the raw
+  /// values; float: the IEEE bits).
   std::vector<std::int32_t> run(std::int32_t tau_us, std::uint16_t adc_code, std::uint16_t setpoint_code);
-  /// True when the generated C job has the q15 variants.
-  static bool available();
-
- private:
-  struct State;
-  std::unique_ptr<State> s_;
-};
-
-/// The float_poly C job state on the host (the oracle of approach 6 in the float table images).
-class HostCJobFloatPoly {
- public:
-  /// Starts it as oneshot_job_float_poly_init(pwm0); std::invalid_argument when the generated
-  /// job has no float_poly variant.
-  explicit HostCJobFloatPoly(std::uint16_t pwm0);
-  ~HostCJobFloatPoly();
-  HostCJobFloatPoly(const HostCJobFloatPoly&) = delete;
-  HostCJobFloatPoly& operator=(const HostCJobFloatPoly&) = delete;
-  /// One job; returns the IEEE bits the firmware reports: u[0], x[0..n), k[0].
-  std::vector<std::int32_t> run(std::int32_t tau_us, std::uint16_t adc_code, std::uint16_t setpoint_code);
-  /// True when the generated C job has the float_poly variant.
-  static bool available();
+  /// True when the generated C job has `variant`.
+  static bool available(Variant variant);
 
  private:
   struct State;

@@ -341,10 +341,10 @@ nlohmann::json run_exectime_target(const SimContext& ctx, const CommonOptions& o
       if (c_job) approaches.push_back(kCJobApproach);
       // Fixed-point table images also carry the q15 C job (approach 6), whose oracle is the
       // same C compiled into this program.
-      const bool q15 = c_job && std::string(format) == "fixed" && HostCJobQ15::available();
+      const bool q15 = c_job && std::string(format) == "fixed" && HostCJob::available(HostCJob::Variant::kQ15Table);
       // Float table images: approach 6 is float_poly, likewise its own oracle.
       const bool poly = c_job && std::string(format) == "float" && std::string(disc) == "table" &&
-                        HostCJobFloatPoly::available();
+                        HostCJob::available(HostCJob::Variant::kFloatPoly);
       if (q15 || poly) approaches.push_back(kCJobOwnArithApproach);
       std::vector<std::vector<std::uint8_t>> replies_b;
       std::size_t c_job_identical = 0;
@@ -357,15 +357,13 @@ nlohmann::json run_exectime_target(const SimContext& ctx, const CommonOptions& o
         // Initial PWM code: the one nearest 0 V, as in simulate().
         cw.u(static_cast<std::uint32_t>(std::lround(-ctx.design().u_min[0] * ctx.design().steps_per_volt[0])), 2);
         link.request(app::pil::Type::kConfig, cfg);
-        std::unique_ptr<HostCJobQ15> host_q15;
-        std::unique_ptr<HostCJobFloatPoly> host_poly;
-        if (a == kCJobOwnArithApproach && poly) {
-          host_poly = std::make_unique<HostCJobFloatPoly>(
-              static_cast<std::uint16_t>(std::lround(-ctx.design().u_min[0] * ctx.design().steps_per_volt[0])));
-        } else if (a == kCJobOwnArithApproach) {
-          host_q15 = std::make_unique<HostCJobQ15>(
-              std::string(disc) == "nearest",
-              static_cast<std::uint16_t>(std::lround(-ctx.design().u_min[0] * ctx.design().steps_per_volt[0])));
+        std::unique_ptr<HostCJob> host_job;
+        if (a == kCJobOwnArithApproach) {
+          const HostCJob::Variant variant = poly ? HostCJob::Variant::kFloatPoly
+                                            : std::string(disc) == "nearest" ? HostCJob::Variant::kQ15Nearest
+                                                                             : HostCJob::Variant::kQ15Table;
+          host_job = std::make_unique<HostCJob>(
+              variant, static_cast<std::uint16_t>(std::lround(-ctx.design().u_min[0] * ctx.design().steps_per_volt[0])));
         }
         for (const JobRecord& r : jobs) {
           const app::pil::Frame reply = link.request(app::pil::Type::kSample, sample_frame(r));
@@ -373,14 +371,14 @@ nlohmann::json run_exectime_target(const SimContext& ctx, const CommonOptions& o
           if (a == static_cast<std::uint32_t>(Approach::kB)) replies_b.push_back(bytes);
           // Same inputs, same job: status, τ, saturation, estimate, gain and applied input byte for byte.
           if (a == kCJobApproach && bytes == replies_b.at(static_cast<std::size_t>(&r - jobs.data()))) ++c_job_identical;
-          if (host_q15 || host_poly) {
+          if (host_job) {
             // The MCU's τ (from its timer) and the same codes through the host-compiled C.
             app::pil::Reader head(reply);
             head.u(1);
             const std::int32_t tau = head.s(4);
             const auto y = static_cast<std::uint16_t>(r.y_code);
             const auto sp = static_cast<std::uint16_t>(r.setpoint_code);
-            const std::vector<std::int32_t> host = host_poly ? host_poly->run(tau, y, sp) : host_q15->run(tau, y, sp);
+            const std::vector<std::int32_t> host = host_job->run(tau, y, sp);
             if (host == reply_values(reply, ctx.plant().n())) ++q15_identical;
           }
         }

@@ -2,6 +2,7 @@
 /// @brief Scaling and squaring against Eigen's matrix exponential.
 #include <gtest/gtest.h>
 
+#include <unsupported/Eigen/MatrixFunctions>
 #include <cmath>
 #include <random>
 

@@ -3,6 +3,7 @@
 ///        cost, plain Riccati iteration for L and K, eigenvalues, and closed forms.
 #include <gtest/gtest.h>
 
+#include <unsupported/Eigen/MatrixFunctions>
 #include <Eigen/Eigenvalues>
 #include <cmath>
 

@@ -4,6 +4,8 @@
 ///        alone, the discrete latch/step order, and the dimension check of plain-matrix models.
 #include <gtest/gtest.h>
 
+#include <unsupported/Eigen/MatrixFunctions>
+
 #include "oneshot/engine/continuous_plant.hpp"
 #include "oneshot/engine/discrete_plant.hpp"
 #include "oneshot/engine/plant_model.hpp"

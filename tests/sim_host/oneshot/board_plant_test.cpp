@@ -3,6 +3,7 @@
 ///        segment, cost by quadrature), the latched PWM mode, and the noise statistics.
 #include <gtest/gtest.h>
 
+#include <unsupported/Eigen/MatrixFunctions>
 #include <random>
 
 #include "oneshot/design/controller_synthesis.hpp"
