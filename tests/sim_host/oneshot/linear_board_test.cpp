@@ -172,7 +172,8 @@ TEST(LinearTracker, RefusesAnInputOutsideTheRangeAndAMeanOffTheSimulatedRun) {
                                 Vector<double, 1>({2.0}));
   inside.job(eval, Vector<double, 1>{}, Vector<double, 1>({1.0}));
   EXPECT_EQ(inside.refusal(), "");
-  EXPECT_DOUBLE_EQ(inside.mean()[LinearTracker<1, 1, 1>::kL], 1.0);
+  constexpr std::size_t kL = LinearTracker<1, 1, 1>::kL;
+  EXPECT_DOUBLE_EQ(inside.mean()[kL], 1.0);
   inside.apply(Vector<double, 1>({1.0}));
   inside.flow_to(engine::SimTime{1'000'000'000});
   // x(1) = 1 − e^{−1} under u = 1 from x = 0.
