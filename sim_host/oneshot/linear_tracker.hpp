@@ -15,7 +15,9 @@
 
 #include <cmath>
 #include <cstddef>
+#include <memory>
 #include <string>
+#include <vector>
 
 #include "oneshot/engine/affine_probe.hpp"
 #include "oneshot/engine/exact_segment.hpp"
@@ -29,6 +31,53 @@
 
 namespace oneshot::sim {
 
+/// Interval maps (keyed by A, B, Q1c) and process-noise terms (keyed by A, Q_c, Q1c) shared by
+/// the runs of one thread: the matrix exponentials per interval length dominate a run, and the
+/// same lengths recur from run to run. The values per length do not depend on the cache.
+template <std::size_t N, std::size_t M>
+class SharedCaches {
+ public:
+  /// The interval maps of plant `p`.
+  static engine::ExactSegmentCache<N, M>& segments(const engine::JumpLinearPlant<N, M>& p) {
+    thread_local std::vector<std::unique_ptr<SegmentsEntry>> all;
+    for (auto& e : all)
+      if (same(e->a, p.a) && same(e->b, p.b) && same(e->q1c, p.q1c)) return e->cache;
+    if (all.size() >= 4) all.erase(all.begin());
+    all.push_back(std::make_unique<SegmentsEntry>(SegmentsEntry{p.a, p.b, p.q1c, {p.a, p.b, p.q1c}}));
+    return all.back()->cache;
+  }
+  /// The process-noise terms of plant `p`.
+  static engine::ProcessNoise<N>& noise(const engine::JumpLinearPlant<N, M>& p) {
+    thread_local std::vector<std::unique_ptr<NoiseEntry>> all;
+    for (auto& e : all)
+      if (same(e->a, p.a) && same(e->qc, p.qc) && same(e->q1c, p.q1c)) return e->cache;
+    if (all.size() >= 4) all.erase(all.begin());
+    all.push_back(std::make_unique<NoiseEntry>(NoiseEntry{p.a, p.qc, p.q1c, {p.a, p.qc, p.q1c}}));
+    return all.back()->cache;
+  }
+
+ private:
+  struct SegmentsEntry {
+    Matrix<double, N, N> a;
+    Matrix<double, N, M> b;
+    Matrix<double, N, N> q1c;
+    engine::ExactSegmentCache<N, M> cache;
+  };
+  struct NoiseEntry {
+    Matrix<double, N, N> a;
+    Matrix<double, N, N> qc;
+    Matrix<double, N, N> q1c;
+    engine::ProcessNoise<N> cache;
+  };
+  template <std::size_t R, std::size_t C>
+  static bool same(const Matrix<double, R, C>& x, const Matrix<double, R, C>& y) {
+    for (std::size_t i = 0; i < R; ++i)
+      for (std::size_t j = 0; j < C; ++j)
+        if (!(x(i, j) == y(i, j))) return false;
+    return true;
+  }
+};
+
 /// The plant of the linear board: exact flow with the input held, one N(0, Q_d(Δ)) draw per
 /// interval (the board's "process" stream), the cost as the board's (expected noise path cost).
 template <std::size_t N, std::size_t M>
@@ -36,7 +85,11 @@ class LinearPlant {
  public:
   /// Plant and cost (engine units); `noise` feeds the process noise when `noisy`.
   LinearPlant(const engine::JumpLinearPlant<N, M>& p, bool noisy, engine::RandomStream noise)
-      : p_(p), noisy_(noisy), rng_(std::move(noise)), noise_(p.a, p.qc, p.q1c), segments_(p.a, p.b, p.q1c) {}
+      : p_(p),
+        noisy_(noisy),
+        rng_(std::move(noise)),
+        noise_(SharedCaches<N, M>::noise(p)),
+        segments_(SharedCaches<N, M>::segments(p)) {}
 
   /// Advances to t1 ≥ now.
   void advance_to(engine::SimTime t1) {
@@ -71,8 +124,8 @@ class LinearPlant {
   engine::JumpLinearPlant<N, M> p_;
   bool noisy_;
   engine::RandomStream rng_;
-  engine::ProcessNoise<N> noise_;
-  engine::ExactSegmentCache<N, M> segments_;
+  engine::ProcessNoise<N>& noise_;
+  engine::ExactSegmentCache<N, M>& segments_;
   engine::SimTime now_{0};
   Vector<double, N> x_{};
   Vector<double, M> u_{};
@@ -99,7 +152,7 @@ class LinearTracker {
   /// in the estimator's memory), the actuator range.
   LinearTracker(const engine::JumpLinearPlant<N, M>& plant, const Matrix<double, P, N>& c, const Matrix<double, P, P>& r,
                 const Vector<double, M>& u0, const Vector<double, M>& u_min, const Vector<double, M>& u_max)
-      : jl_(plant), c_(c), r_(r), u_min_(u_min), u_max_(u_max) {
+      : jl_(plant, SharedCaches<N, M>::segments(plant), SharedCaches<N, M>::noise(plant)), c_(c), r_(r), u_min_(u_min), u_max_(u_max) {
     Z m{};
     for (std::size_t j = 0; j < M; ++j) m[kU + j] = m[kL + j] = m[kV + j] = u0[j];
     jl_.reset(m, typename Jlc::Cov{});
