@@ -60,21 +60,23 @@ TEST(LinearBoard, SameTimingDrawsAsTheEmulatedBoard) {
 
 TEST(LinearBoard, AnalyticMeanInsideTheMonteCarloIntervalOfTheSameModel) {
   const auto ctx = SimContext::reference();
-  const Scenario sc = uniform_scenario("t", 20'000, 0.2, 0.5, 2.0);
-  const std::size_t seeds = 1000;
-  for (Approach a : kAllApproaches) {
+  // Two scenarios: noise-dominated small steps with 20 ms jitter, larger steps with 5 ms.
+  for (const auto& [sc, seeds] : {std::pair{uniform_scenario("small", 20'000, 0.2, 0.5, 2.0), std::size_t{1000}},
+                                  std::pair{uniform_scenario("large", 5'000, 0.8, 1.0, 3.0), std::size_t{300}}}) {
+    for (Approach a : kAllApproaches) {
     if (!approach_available(*ctx, a)) continue;
     std::vector<double> mc;
     std::vector<double> an;
     for (std::uint64_t seed = 1; seed <= seeds; ++seed) {
       const LinearRunResult r = run_linear_board(*ctx, sc, seed, options(a), LinearOptions{true, true});
-      ASSERT_EQ(r.refusal, "") << info(a).letter;
+      ASSERT_EQ(r.refusal, "") << sc.name << " " << info(a).letter;
       an.push_back(r.analytic.total());
       mc.push_back(run_linear_board(*ctx, sc, seed, options(a), LinearOptions{true, false}).cost);
     }
     const util::Summary m = util::summarize(mc);
     const util::Summary e = util::summarize(an);
-    EXPECT_NEAR(e.mean, m.mean, m.ci95) << info(a).letter;
+    EXPECT_NEAR(e.mean, m.mean, m.ci95) << sc.name << " " << info(a).letter;
+    }
   }
 }
 
