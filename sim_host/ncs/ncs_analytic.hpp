@@ -29,6 +29,7 @@
 
 #include "ncs_loop.hpp"
 #include "ncs_model.hpp"
+#include "oneshot/engine/affine_probe.hpp"
 #include "oneshot/engine/jump_linear_cost.hpp"
 #include "oneshot/engine/sweep.hpp"
 #include "oneshot/engine/sweep_statistics.hpp"
@@ -219,25 +220,19 @@ class AnalyticTracker {
   double mismatch() const { return mismatch_; }                       ///< Largest |mean − simulated| / scale.
 
  private:
-  /// Columns of the affine map out = f(w) at the mean of the inputs (rows `out` of E, g).
+  /// Columns of the affine map out = f(w) at the mean of the inputs (rows `out` of E, g):
+  /// engine::probe_affine on the inputs at their indices in z.
   template <std::size_t W, std::size_t O, typename F>
   void probe(const F& f, const std::size_t (&idx)[W], const std::size_t (&out)[O], double delta, Map& e, Z& g) const {
     Vector<double, W> w0;
     for (std::size_t j = 0; j < W; ++j) w0[j] = jl_.mean()[idx[j]];
-    const auto y0 = f(w0);
+    Matrix<double, O, W> jac;
+    Vector<double, O> b;
+    engine::probe_affine<W, O>(f, w0, delta, jac, b);
     for (std::size_t i = 0; i < O; ++i) {
       for (std::size_t j = 0; j < kZ; ++j) e(out[i], j) = 0;
-      g[out[i]] = y0[i];
-    }
-    for (std::size_t j = 0; j < W; ++j) {
-      Vector<double, W> w = w0;
-      w[j] += delta;
-      const auto y = f(w);
-      for (std::size_t i = 0; i < O; ++i) {
-        const double col = (y[i] - y0[i]) / delta;
-        e(out[i], idx[j]) += col;
-        g[out[i]] -= col * w0[j];
-      }
+      for (std::size_t j = 0; j < W; ++j) e(out[i], idx[j]) += jac(i, j);
+      g[out[i]] = b[i];
     }
   }
   double row_dot(const Map& e, std::size_t row) const {

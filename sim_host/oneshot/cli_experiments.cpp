@@ -15,6 +15,7 @@
 
 #include "oneshot/sim/cli_commands.hpp"
 #include "oneshot_experiments.hpp"
+#include "table1_analytic.hpp"
 #include "oneshot/util/output_files.hpp"
 #include "oneshot/util/parallel.hpp"
 #include "oneshot/sim/pil_link.hpp"
@@ -202,11 +203,26 @@ void register_experiment_commands(CLI::App& app) {
                     "run only part i/N of the sweep (0 <= i < N) and write OUT/table1.shard-i-of-N.json; "
                     "`oneshot-sim merge` joins the shards into the same result as one run")
         ->capture_default_str();
-    cmd->callback([c, seeds, file, shard]() {
+    auto analytic = std::make_shared<bool>(false);
+    cmd->add_flag("--analytic", *analytic,
+                  "the linear board (PWM average, ADC unquantized): exact expected cost per timing draw beside its "
+                  "Monte Carlo and the emulated board's cost; OUT/table1_analytic.md");
+    cmd->callback([c, seeds, file, shard, analytic]() {
       const auto ctx = SimContext::load(c->plant);
       const engine::Shard part = engine::parse_shard(*shard);
       double wall = 0;
       const CommonOptions o = c->resolve();
+      if (*analytic) {
+        if (!part.whole()) throw std::invalid_argument("--analytic runs the whole table: no --shard");
+        const nlohmann::json j = run_table1_analytic(*ctx, o, scenarios_from(*file), *seeds, &wall);
+        write_timing(o, "table1_analytic", wall);
+        if (c->json != "-") {
+          std::cout << j["markdown"].get<std::string>();
+          std::cout << "wall time " << wall << " s on " << util::worker_count(o.threads) << " threads\n";
+        }
+        emit(*c, j);
+        return;
+      }
       const nlohmann::json j = run_table1(*ctx, o, scenarios_from(*file), *seeds, part, &wall);
       write_timing(o, "table1", wall);
       if (c->json != "-") {

@@ -1,13 +1,15 @@
 /// @file jump_linear_cost_test.cpp
 /// @brief JumpLinearCost against three oracles: the closed-form stationary LQG cost rate
 ///        (Riccati solutions, Eigen), a direct noise-free simulation (Eigen exponentials and
-///        quadrature), and a Monte Carlo of the same loop on the engine's ContinuousPlant.
+///        quadrature), and a Monte Carlo of the same loop on the engine's ContinuousPlant; the
+///        shared caches, and the affine probe of the analytic modes.
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <cstdio>
 #include <vector>
 
+#include "oneshot/engine/affine_probe.hpp"
 #include "oneshot/engine/continuous_plant.hpp"
 #include "oneshot/engine/jump_linear_cost.hpp"
 #include "oneshot/engine/random_stream.hpp"
@@ -174,6 +176,46 @@ TEST(JumpLinearCost, EventCostIsTheQuadraticMeanPlusTheTrace) {
   const double half = 1.96 * std::sqrt((sum2 - n * mean * mean) / (n - 1) / n);
   EXPECT_LT(std::fabs(jl.cost().total() - mean), half) << jl.cost().total() << " vs " << mean << " ± " << half;
   EXPECT_NEAR(jl.cost().mean, quadratic_form(w, Jlc::Z(m - c)), 1e-15);
+}
+
+TEST(JumpLinearCost, SharedCachesGiveTheSameResultsBitForBit) {
+  // Caches shared by runs (the linear board's per-thread caches) hold the same values per
+  // interval length: a run on them equals a run on its own caches, whatever ran before.
+  LqgSetup setup;
+  const JumpLinearPlant<kN, kM> ep = engine_plant(setup.p, true);
+  ExactSegmentCache<kN, kM> segments(ep.a, ep.b, ep.q1c);
+  ProcessNoise<kN> noise(ep.a, ep.qc, ep.q1c);
+  const std::vector<std::int64_t> d = jittered_intervals_us(200);
+  for (int pass = 0; pass < 2; ++pass) {
+    Jlc own(ep);
+    Jlc shared(ep, segments, noise);
+    for (std::int64_t us : d) {
+      for (Jlc* j : {&own, &shared}) {
+        j->jump(setup.m.e, setup.m.f, setup.m.g, setup.r);
+        j->flow(from_us(us));
+      }
+    }
+    EXPECT_EQ(own.cost().total(), shared.cost().total());
+    for (std::size_t i = 0; i < kK; ++i)
+      for (std::size_t k = 0; k < kK; ++k) EXPECT_EQ(own.covariance()(i, k), shared.covariance()(i, k));
+  }
+}
+
+TEST(AffineProbe, RecoversAnAffineMapFromItsValues) {
+  Matrix<double, 2, 3> a;
+  a(0, 0) = 1.5;
+  a(0, 2) = -2;
+  a(1, 1) = 0.25;
+  a(1, 2) = 3;
+  const Vector<double, 2> b({0.5, -1});
+  const auto f = [&](const Vector<double, 3>& w) { return Vector<double, 2>(a * w + b); };
+  Matrix<double, 2, 3> jac;
+  Vector<double, 2> off;
+  probe_affine<3, 2>(f, Vector<double, 3>({0.3, -7, 2}), 1.0, jac, off);
+  for (std::size_t i = 0; i < 2; ++i) {
+    for (std::size_t j = 0; j < 3; ++j) EXPECT_NEAR(jac(i, j), a(i, j), 1e-14);
+    EXPECT_NEAR(off[i], b[i], 1e-13);
+  }
 }
 
 }  // namespace

@@ -53,6 +53,36 @@ TEST(CliExperiments, Table1JsonHasTheContractedKeys) {
   EXPECT_TRUE(std::filesystem::exists(dir + "/table1_runs.csv"));
 }
 
+TEST(CliExperiments, Table1AnalyticJsonHasTheContractedKeys) {
+  const std::string dir = fresh_dir("table1_analytic");
+  const std::string scenarios = test::write_temp_file(
+      "cli_analytic_sc.json",
+      R"({"scenarios": [{"name": "s1", "duration_s": 2, "setpoint": {"amplitude_volts": 0.3, "change_period_s": 0.5},
+                         "jitter": {"model": "uniform", "release_max_us": 20000, "exec_min_us": 200, "exec_max_us": 600}},
+                        {"name": "s2", "duration_s": 2, "jitter": {"model": "none"}}]})");
+  const auto r = test::run_command(sim() + " table1 --analytic --seeds 3 --no-plots --json - --scenarios " + scenarios +
+                                   " --out " + dir);
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const auto j = nlohmann::json::parse(r.output);
+  for (const char* a : {"A", "B", "C", "D", "E"}) {
+    for (const char* k : {"analytic_mean", "analytic_ci95", "cost_mean", "cost_ci95", "board_cost_mean", "quantization_cost"})
+      EXPECT_TRUE(j["approaches"][a].contains(k)) << a << k;
+    EXPECT_GT(j["approaches"][a]["analytic_mean"].get<double>(), 0);
+  }
+  EXPECT_TRUE(j.contains("variance_reduction"));
+  ASSERT_EQ(j["per_scenario"].size(), 2U);
+  for (const auto& s : j["per_scenario"]) {
+    const std::string w = s["within_0_2_percent"].get<std::string>();
+    EXPECT_TRUE(w == "yes" || w == "no" || w == "undecided") << w;
+    EXPECT_TRUE(s.contains("analytic_B_over_A"));
+  }
+  EXPECT_TRUE(std::filesystem::exists(dir + "/table1_analytic.md"));
+  EXPECT_TRUE(std::filesystem::exists(dir + "/table1_analytic_runs.csv"));
+  const auto bad = test::run_command(sim() + " table1 --analytic --shard 0/2 --no-plots --out " + fresh_dir("bad"));
+  EXPECT_NE(bad.exit_code, 0);
+  EXPECT_NE(bad.output.find("--shard"), std::string::npos) << bad.output;
+}
+
 TEST(CliExperiments, RunAndTable1GiveTheSameCostForTheSameSeed) {
   // issue 11: `run` records a dense trace, `table1` does not; the costs must agree.
   const std::string dir = fresh_dir("run_vs_table1");

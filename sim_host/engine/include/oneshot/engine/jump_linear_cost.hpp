@@ -67,6 +67,15 @@ class JumpLinearCost {
       for (std::size_t j = 0; j < N; ++j) noisy_ = noisy_ || p.qc(i, j) != 0;
   }
 
+  /// The same, with the interval maps and noise terms taken from (and added to) caches shared
+  /// by many runs of the plant `p` (built from its A, B, Q1c and A, Q_c, Q1c; they must outlive
+  /// this object). The values per interval length do not depend on the cache: same results.
+  JumpLinearCost(const JumpLinearPlant<N, M>& p, ExactSegmentCache<N, M>& segments, ProcessNoise<N>& noise)
+      : JumpLinearCost(p) {
+    shared_segments_ = &segments;
+    shared_noise_ = &noise;
+  }
+
   /// Mean m and covariance Σ of z now.
   void reset(const Z& m, const Cov& s) {
     m_ = m;
@@ -83,7 +92,7 @@ class JumpLinearCost {
   /// Flow over `delta` (≥ 0): adds the interval's expected cost, then propagates m and Σ.
   void flow(Duration delta) {
     if (delta.count() <= 0) return;
-    const auto& seg = segments_.get(delta.count());
+    const auto& seg = (shared_segments_ != nullptr ? *shared_segments_ : segments_).get(delta.count());
     const double d = to_seconds(delta);
     // q = [x − x_ref; u − u_ref]: mean and covariance block.
     Vector<double, kQ> mq;
@@ -119,10 +128,11 @@ class JumpLinearCost {
     for (std::size_t i = 0; i < K; ++i)
       for (std::size_t j = 0; j < N; ++j) s_(i, j) = cols(i, j);
     if (noisy_) {
-      const Matrix<double, N, N>& qd = noise_.interval_covariance(delta);
+      ProcessNoise<N>& noise = shared_noise_ != nullptr ? *shared_noise_ : noise_;
+      const Matrix<double, N, N>& qd = noise.interval_covariance(delta);
       for (std::size_t i = 0; i < N; ++i)
         for (std::size_t j = 0; j < N; ++j) s_(i, j) += qd(i, j);
-      cost_.noise_path += noise_.interval_cost(delta);
+      cost_.noise_path += noise.interval_cost(delta);
     }
     mirror_upper(s_);
   }
@@ -161,6 +171,8 @@ class JumpLinearCost {
   JumpLinearPlant<N, M> plant_;
   ProcessNoise<N> noise_;
   ExactSegmentCache<N, M> segments_;
+  ExactSegmentCache<N, M>* shared_segments_ = nullptr;
+  ProcessNoise<N>* shared_noise_ = nullptr;
   bool noisy_ = false;
   Z m_{};
   Cov s_{};
