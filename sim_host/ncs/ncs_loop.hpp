@@ -62,6 +62,8 @@ struct RunResult {
   std::string analytic_refusal;    ///< Analytic runs: why the expected cost is not valid ("" when it is).
   double analytic_mismatch = 0;    ///< Analytic runs: largest |mean − simulated| (relative to max(1, |value|)).
   std::vector<double> counters;    ///< Node counters (ncs_counters.hpp, order of counter_names()).
+  /// Counters of the links the run built, by leg name (order of link_names()).
+  std::vector<std::pair<std::string, engine::LinkStatistics>> links;
   std::vector<Point> truth;      ///< True state every trace step (x1, x2).
   std::vector<Point> samples;    ///< Samples y at their instants.
   std::vector<Point> sample_truth;  ///< C x at the same instants (noise-free output).

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdio>
 #include <fstream>
+#include <optional>
 #include <set>
 #include <sstream>
 #include <stdexcept>
@@ -159,10 +160,29 @@ Disc::Model Context::discretizer_model(double s) const {
 }
 
 std::int32_t Context::worst_chain_us(const Scenario& s) const {
+  if (!s.legs.empty()) {
+    std::int64_t sum_ns = 0;
+    for (const char* leg : {"sc", "ca"}) {
+      const auto it = s.legs.find(leg);
+      if (it == s.legs.end()) continue;
+      const std::optional<engine::Duration> ub = it->second.delay.upper_bound();
+      if (!ub) throw std::invalid_argument(std::string("ncs scenario ") + s.name + ": leg " + leg + " has no upper delay bound (late sampling needs one)");
+      sum_ns += ub->count();
+    }
+    return static_cast<std::int32_t>(std::llround(static_cast<double>(sum_ns) * 1e-3) + timing_.compute_max_us);
+  }
   return static_cast<std::int32_t>(std::llround(2 * s.max_delay_ms * 1000) + timing_.compute_max_us);
 }
 
 double Context::mean_tau_io_us(const Scenario& s) const {
+  if (!s.legs.empty()) {
+    double sum_ns = 0;
+    for (const char* leg : {"sc", "ca"}) {
+      const auto it = s.legs.find(leg);
+      if (it != s.legs.end()) sum_ns += it->second.delay.mean_ns();
+    }
+    return sum_ns * 1e-3 + 0.5 * static_cast<double>(timing_.compute_min_us + timing_.compute_max_us);
+  }
   const double leg = 0.5 * (static_cast<double>(timing_.leg_min_us) + s.max_delay_ms * 1000);
   return 2 * leg + 0.5 * static_cast<double>(timing_.compute_min_us + timing_.compute_max_us);
 }

@@ -12,7 +12,8 @@
 /// positive semidefinite (checked with Eigen's eigenvalues, independently of the parser);
 /// every link of every scenario has a configuration whose delay draws are whole, finite,
 /// between the model's lower bound and its cap, whose loss rate is a probability and whose
-/// description holds no "nan" or "inf"; the CAN response-time analysis of each bus's
+/// description holds no "nan" or "inf", whose mean (study check) is not below the lower
+/// bound and whose upper bound, where the model has one, bounds every draw; the CAN response-time analysis of each bus's
 /// background traffic ends with finite figures; with the schema, approach kinds are known
 /// and parameters respect their range and integrality.
 #include <Eigen/Dense>
@@ -21,6 +22,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <optional>
 #include <set>
 #include <string>
 
@@ -89,6 +91,12 @@ void check_link(const e::LinkConfig& c, const std::string& what) {
   require(std::isfinite(rate) && rate >= 0 && rate <= 1, what + ": loss rate " + std::to_string(rate));
   const e::Duration low = c.delay.lower_bound();
   require(low.count() >= 0, what + ": negative lower bound");
+  // What `study check` prints: mean ≥ min (finite but for a Pareto tail with α ≤ 1), max ≥ min.
+  const double mean = c.delay.mean_ns();
+  require(!std::isnan(mean) && mean >= static_cast<double>(low.count()) * (1 - 1e-12) - 1, what + ": mean below the lower bound");
+  require(std::isfinite(mean) || (c.delay.kind == e::DelayModel::Kind::kPareto && c.delay.alpha <= 1), what + ": infinite mean");
+  const std::optional<e::Duration> high = c.delay.upper_bound();
+  if (high) require(*high >= low, what + ": upper bound below the lower bound");
   e::RandomStream rng(1, "fuzz");
   for (std::uint64_t k = 0; k < 16; ++k) {
     bool clamped = false;
@@ -97,6 +105,7 @@ void check_link(const e::LinkConfig& c, const std::string& what) {
     require(x.count() >= 0, what + ": negative delay drawn");
     const bool heavy = c.delay.kind == e::DelayModel::Kind::kLognormal || c.delay.kind == e::DelayModel::Kind::kPareto;
     if (heavy) require(x <= c.delay.cap, what + ": delay draw above the cap");
+    if (high) require(x <= *high, what + ": delay draw above the upper bound");
   }
 }
 
