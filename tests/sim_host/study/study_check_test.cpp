@@ -12,6 +12,8 @@
 
 #include "ncs_model.hpp"
 #include "oneshot/engine/can_bus.hpp"
+#include "oneshot/engine/delay_model.hpp"
+#include "oneshot/engine/random_stream.hpp"
 #include "oneshot/engine/study_file.hpp"
 #include "study_check.hpp"
 #include "support/run_command.hpp"
@@ -116,6 +118,50 @@ TEST(StudyCheck, UnstabilizablePlantIsRefusedNamingThePlant) {
   }
 }
 
+/// A folder holding the delay trace the fuzz harness gives its inputs ("delays.csv").
+std::string trace_dir() {
+  const std::string dir = (std::filesystem::temp_directory_path() / "oneshot_study_check_traces").string();
+  std::filesystem::create_directories(dir);
+  std::ofstream(dir + "/delays.csv") << "delay_us\n500\n# a comment\n1500\n\n250\n";
+  return dir;
+}
+
+/// What `study check` prints for a delay model, against the model's own draws: the sample
+/// mean within 5 standard errors of mean_ns(), every draw inside [lower_bound, upper_bound].
+TEST(StudyCheck, DelayMeansAndBoundsMatchTheDraws) {
+  const auto model = [](const char* text) {
+    return engine::parse_delay_model(nlohmann::json::parse(text), "delay", trace_dir());
+  };
+  const std::vector<engine::DelayModel> models = {
+      model(R"({"model": "constant", "delay_us": 1200})"),
+      model(R"({"model": "uniform", "min_us": 500, "max_us": 4000, "resolution_us": 7})"),
+      model(R"({"model": "poisson_periods", "mean_periods": 1.5, "period_us": 10000, "offset_us": 300})"),
+      model(R"({"model": "lognormal", "median_us": 3000, "sigma": 0.6, "shift_us": 500})"),
+      model(R"({"model": "pareto", "scale_us": 1000, "alpha": 4.5, "shift_us": 200})"),
+      model(R"({"model": "trace", "file": "delays.csv"})")};
+  for (const engine::DelayModel& d : models) {
+    engine::RandomStream rng(3, "delay-test");
+    const std::size_t n = 200000;
+    double sum = 0;
+    double sum2 = 0;
+    const auto ub = d.upper_bound();
+    for (std::size_t k = 0; k < n; ++k) {
+      bool clamped = false;
+      const engine::Duration x = d.draw(rng, k, clamped);
+      ASSERT_GE(x, d.lower_bound()) << d.describe();
+      if (ub) {
+        ASSERT_LE(x, *ub) << d.describe();
+      }
+      const double v = static_cast<double>(x.count());
+      sum += v;
+      sum2 += v * v;
+    }
+    const double mean = sum / static_cast<double>(n);
+    const double se = std::sqrt(std::fmax(0.0, sum2 / static_cast<double>(n) - mean * mean) / static_cast<double>(n));
+    EXPECT_NEAR(mean, d.mean_ns(), 5 * se + 1e-9 * d.mean_ns()) << d.describe();
+  }
+}
+
 /// Every number of a resolution is finite (or null: an unbounded delay or response time).
 void expect_finite(const nlohmann::json& j, const std::string& where) {
   if (j.is_number()) {
@@ -136,7 +182,7 @@ TEST(StudyCheck, FuzzCorpusFilesResolveOrAreRefusedNamingAField) {
     text << in.rdbuf();
     engine::StudyFile f;
     try {
-      f = engine::parse_study(text.str(), entry.path().string(), nullptr, ONESHOT_STUDY_FUZZ_CORPUS);
+      f = engine::parse_study(text.str(), entry.path().string(), nullptr, trace_dir());
     } catch (const engine::InputError&) {
       continue;  // the parser refuses it
     }
@@ -152,7 +198,7 @@ TEST(StudyCheck, FuzzCorpusFilesResolveOrAreRefusedNamingAField) {
       EXPECT_NE(std::string(e.what()).find("field '"), std::string::npos) << e.what();
     }
   }
-  EXPECT_GE(files, 2U);
+  EXPECT_GE(files, 4U);
 }
 
 TEST(StudyCheck, CommandLine) {
