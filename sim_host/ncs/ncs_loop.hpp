@@ -7,7 +7,8 @@
 /// link "as"; the sensor samples on arrival (AKl: at t_k − D) and reports over "sc"; the
 /// controller computes τ_c later and sends over "ca". Baseline loops (I, S, SK, S+, IK):
 /// the sensor samples at kh, the controller computes τ_c after arrival, the actuator applies
-/// on arrival. Links: uniform delays U[0.5, d] ms in whole µs; τ_c ~ U[1, 5] ms (stream
+/// on arrival. Links: uniform delays U[0.5, d] ms in whole µs, or the legs a study file gives
+/// (Scenario::legs: their delay, loss and order); τ_c ~ U[1, 5] ms (stream
 /// "compute"); I and IK have none. Streams per source (common random numbers): process,
 /// measurement, compute, link/<as|sc|ca>/delay. With a fault spec (RunOptions::faults)
 /// the links carry the engine's frame faults and the nodes "sensor", "controller",

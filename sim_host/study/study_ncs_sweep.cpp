@@ -2,7 +2,7 @@
 /// @brief The sweep and summary of `oneshot-sim study run` (see study_ncs_sweep.hpp).
 #include "study_ncs_sweep.hpp"
 
-#include <map>
+#include <array>
 
 #include "ncs_experiments.hpp"
 #include "ncs_loop.hpp"
