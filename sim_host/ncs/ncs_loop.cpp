@@ -378,15 +378,6 @@ engine::ContinuousPlantConfig<kN, kM, kP, 1> plant_config(const Context& ctx, co
   return c;
 }
 
-std::uint64_t half_wave_periods(const Context& ctx, const Scenario& sc) {
-  const double half = sc.period_s * 0.5e6 / ctx.period_us();
-  const auto n = static_cast<std::uint64_t>(std::llround(half));
-  if (n == 0 || std::fabs(half - static_cast<double>(n)) > 1e-9) {
-    throw std::invalid_argument("ncs scenario " + sc.name + ": T_r/2 must be a whole number of periods h");
-  }
-  return n;
-}
-
 node::SquareWaveReference<double, kN, kM> reference(const Context& ctx, const Scenario& sc) {
   const std::size_t out = ctx.design().tracked_outputs.empty() ? 0 : ctx.design().tracked_outputs[0];
   Vector<double, kN> nx;

@@ -74,8 +74,6 @@ struct RunResult {
 
 /// The plant of a run (process noise when `noisy`), shared by the simulation and the live plant.
 engine::ContinuousPlantConfig<kN, kM, kP, 1> plant_config(const Context& ctx, const Scenario& sc, bool noisy);
-/// Periods h in half a set-point period; std::invalid_argument unless whole.
-std::uint64_t half_wave_periods(const Context& ctx, const Scenario& sc);
 /// The set-point square wave of a scenario (x_ref, u_ref per period index).
 node::SquareWaveReference<double, kN, kM> reference(const Context& ctx, const Scenario& sc);
 /// Network leg `name` ("as", "sc", "ca"): U[0.5, d] ms in whole µs, FIFO; none for I, IK.

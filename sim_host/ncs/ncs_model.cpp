@@ -159,6 +159,15 @@ Disc::Model Context::discretizer_model(double s) const {
   return m;
 }
 
+std::uint64_t half_wave_periods(const Context& ctx, const Scenario& sc) {
+  const double half = sc.period_s * 0.5e6 / ctx.period_us();
+  const auto n = static_cast<std::uint64_t>(std::llround(half));
+  if (n == 0 || std::fabs(half - static_cast<double>(n)) > 1e-9) {
+    throw std::invalid_argument("ncs scenario " + sc.name + ": T_r/2 must be a whole number of periods h");
+  }
+  return n;
+}
+
 std::int32_t Context::worst_chain_us(const Scenario& s) const {
   if (!s.legs.empty()) {
     std::int64_t sum_ns = 0;

@@ -105,6 +105,9 @@ class Context {
   Timing timing_;
 };
 
+/// Periods h in half a set-point period; std::invalid_argument unless whole.
+std::uint64_t half_wave_periods(const Context& ctx, const Scenario& sc);
+
 /// The S+ gain: LQR on eq. 8 with a constant τ (µs) on ξ = [x_k; u_{k−1}], the continuous
 /// cost sampled exactly over the period with the input switching at τ;
 /// u_k = −[L_x, L_u] ξ. Returns the 1×3 gain.

@@ -7,7 +7,6 @@
 #include <stdexcept>
 
 #include "ncs_live.hpp"
-#include "ncs_loop.hpp"
 
 namespace oneshot::study {
 namespace {
@@ -115,6 +114,10 @@ NcsStudy map_ncs_study(const engine::StudyFile& file) {
     for (std::size_t i = 0; i < file.approaches.size(); ++i) {
       const engine::ApproachSpec& a = file.approaches[i];
       const std::string f = at("approaches", i);
+      bool known = false;
+      for (ncs::Approach k : ncs::kAllApproaches) known = known || a.kind == ncs::name(k);
+      if (!known) refuse(f + ".kind", "unknown kind '" + a.kind + "' (I, S, A, AK, AKx, AKl, SK, S+, IK)");
+      if (!a.params.empty()) refuse(f + ".params", "the ncs approaches take no parameters");
       if (a.name != a.kind) refuse(f + ".name", "must be its kind '" + a.kind + "' (the ncs table names approaches by kind)");
       const ncs::Approach ap = ncs::parse_approach(a.kind);
       if (i == 0 && ap != ncs::Approach::kI) refuse(f + ".kind", "the first approach must be I (the reference of every ratio)");
@@ -129,11 +132,26 @@ NcsStudy map_ncs_study(const engine::StudyFile& file) {
     for (std::size_t i = 0; i < file.scenarios.size(); ++i) {
       const engine::ScenarioSpec& s = file.scenarios[i];
       const std::string f = at("scenarios", i);
+      // The schema's checks again (a file parsed without it reaches here too).
+      std::map<std::string, double> params = s.params;
+      for (const engine::ParamSpec& p : ncs_schema().scenario_params) {
+        const std::string g = f + ".params." + p.name;
+        const auto it = params.find(p.name);
+        if (it == params.end()) {
+          if (p.required) refuse(g, "missing");
+          params[p.name] = p.fallback;
+        } else if (!(it->second >= p.min && it->second <= p.max)) {
+          refuse(g, "out of range");
+        }
+      }
+      if (params.size() != ncs_schema().scenario_params.size()) {
+        refuse(f + ".params", "unknown parameter (amplitude_volts, period_s, noise_scale)");
+      }
       ncs::Scenario sc;
       sc.name = s.name;
-      sc.amplitude_volts = s.params.at("amplitude_volts");
-      sc.period_s = s.params.at("period_s");
-      sc.noise_scale = s.params.at("noise_scale");
+      sc.amplitude_volts = params.at("amplitude_volts");
+      sc.period_s = params.at("period_s");
+      sc.noise_scale = params.at("noise_scale");
       sc.duration_s = s.duration_s.value_or(file.duration_s);
       for (const std::string& l : out.links) sc.legs[l] = file.link_config(l, &s);
       const std::optional<engine::Duration> ub = sc.legs.at("sc").delay.upper_bound();
