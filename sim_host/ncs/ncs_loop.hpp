@@ -76,7 +76,8 @@ struct RunResult {
 engine::ContinuousPlantConfig<kN, kM, kP, 1> plant_config(const Context& ctx, const Scenario& sc, bool noisy);
 /// The set-point square wave of a scenario (x_ref, u_ref per period index).
 node::SquareWaveReference<double, kN, kM> reference(const Context& ctx, const Scenario& sc);
-/// Network leg `name` ("as", "sc", "ca"): U[0.5, d] ms in whole µs, FIFO; none for I, IK.
+/// Network leg `name` ("as", "sc", "ca"): U[0.5, d] ms in whole µs, FIFO, or the scenario's
+/// leg from a study file (Scenario::legs); none for I, IK.
 engine::LinkConfig leg(const Context& ctx, const Scenario& sc, Approach a, const char* name);
 /// Lower Cholesky factor of R = s·R_n: y = C x + [[c0, 0], [c1, c2]] n, n ~ N(0, I).
 std::array<double, 3> measurement_cholesky(const Design& d);
