@@ -66,7 +66,7 @@ class Harness {
         h_(engine::from_us(ctx.period_us())),
         end_(engine::from_seconds(sc.duration_s, "ncs scenario duration")) {
     net_.set_faults(opt.faults);
-    if (!(sc.max_delay_ms * 1000 >= static_cast<double>(ctx.timing().leg_min_us))) {
+    if (sc.legs.empty() && !(sc.max_delay_ms * 1000 >= static_cast<double>(ctx.timing().leg_min_us))) {
       throw std::invalid_argument("ncs scenario " + sc.name + ": d must be at least 0.5 ms");
     }
     const auto chol = measurement_cholesky(design_);
@@ -103,6 +103,13 @@ class Harness {
   }
 
   engine::LinkConfig leg(const char* name) const { return ncs::leg(ctx_, sc_, approach_, name); }
+
+  /// Adds leg `name` to the network and remembers it for the run's link counters.
+  engine::Link& add_leg(const char* name) {
+    engine::Link& l = net_.add_link(leg(name));
+    legs_.emplace_back(name, &l);
+    return l;
+  }
 
   /// τ_c of the next computation (whole µs), 0 for the delay-free loops.
   Duration compute_time() {
@@ -147,6 +154,7 @@ class Harness {
     kernel_.run_until(end_);
     result_.injected = net_.fault_counters();
     result_.cost = plant_.cost().total();
+    for (const auto& [nm, l] : legs_) result_.links.emplace_back(nm, l->statistics());
     if (an_) an_->report(result_);
     for (const auto& s : plant_.trace()) {
       const double t = engine::to_seconds(s.t);
@@ -175,6 +183,7 @@ class Harness {
   InputVec u_max_;
   RunResult result_;
   std::unique_ptr<AnalyticTracker> an_;
+  std::vector<std::pair<std::string, engine::Link*>> legs_;
 };
 
 /// The actuation-synchronized loop with estimator `est` (brief §1).
@@ -230,9 +239,9 @@ RunResult run_synchronized(Harness& hs, Estimator est, std::int32_t late_us) {
   net.add_node(kController, "controller", Duration{0},
                [&]() { k.schedule_in(hs.compute_time(), EventClass::kCompute, compute_h); });
   net.add_node(kActuator, "actuator", Duration{0}, [&]() { act->on_receive(); });
-  net.route(kActuator, kSensor, net.add_link(hs.leg("as")));
-  net.route(kSensor, kController, net.add_link(hs.leg("sc")));
-  net.route(kController, kActuator, net.add_link(hs.leg("ca")));
+  net.route(kActuator, kSensor, hs.add_leg("as"));
+  net.route(kSensor, kController, hs.add_leg("sc"));
+  net.route(kController, kActuator, hs.add_leg("ca"));
   net.arm_faults({{"sensor",
                    [&]() {
                      sensor.emplace(kController, late_us);
@@ -311,8 +320,8 @@ RunResult run_sampling(Harness& hs, Law law, Saturated saturated) {
     InputVec u;
     if (act->take_output(u)) hs.apply(u);
   });
-  net.route(kSensor, kController, net.add_link(hs.leg("sc")));
-  net.route(kController, kActuator, net.add_link(hs.leg("ca")));
+  net.route(kSensor, kController, hs.add_leg("sc"));
+  net.route(kController, kActuator, hs.add_leg("ca"));
   net.arm_faults({{"sensor",
                    [&]() {
                      sensor.emplace(kController, Trigger(1));
@@ -369,15 +378,6 @@ engine::ContinuousPlantConfig<kN, kM, kP, 1> plant_config(const Context& ctx, co
   return c;
 }
 
-std::uint64_t half_wave_periods(const Context& ctx, const Scenario& sc) {
-  const double half = sc.period_s * 0.5e6 / ctx.period_us();
-  const auto n = static_cast<std::uint64_t>(std::llround(half));
-  if (n == 0 || std::fabs(half - static_cast<double>(n)) > 1e-9) {
-    throw std::invalid_argument("ncs scenario " + sc.name + ": T_r/2 must be a whole number of periods h");
-  }
-  return n;
-}
-
 node::SquareWaveReference<double, kN, kM> reference(const Context& ctx, const Scenario& sc) {
   const std::size_t out = ctx.design().tracked_outputs.empty() ? 0 : ctx.design().tracked_outputs[0];
   Vector<double, kN> nx;
@@ -396,6 +396,13 @@ engine::LinkConfig leg(const Context& ctx, const Scenario& sc, Approach a, const
   const bool report = std::string(name) == "sc" && actuation_synchronized(a);
   c.frame = engine::FrameLayout{0, 4, report ? node::kHeaderBytes + 4 : node::kHeaderBytes, 8};
   if (delay_free(a)) return c;  // constant 0
+  const auto given = sc.legs.find(name);
+  if (given != sc.legs.end()) {  // from a study file
+    c.delay = given->second.delay;
+    c.loss = given->second.loss;
+    c.fifo = given->second.fifo;
+    return c;
+  }
   c.delay.kind = engine::DelayModel::Kind::kUniform;
   c.delay.min = engine::from_us(ctx.timing().leg_min_us);
   c.delay.max = engine::from_us(std::llround(sc.max_delay_ms * 1000));

@@ -7,7 +7,8 @@
 /// link "as"; the sensor samples on arrival (AKl: at t_k − D) and reports over "sc"; the
 /// controller computes τ_c later and sends over "ca". Baseline loops (I, S, SK, S+, IK):
 /// the sensor samples at kh, the controller computes τ_c after arrival, the actuator applies
-/// on arrival. Links: uniform delays U[0.5, d] ms in whole µs; τ_c ~ U[1, 5] ms (stream
+/// on arrival. Links: uniform delays U[0.5, d] ms in whole µs, or the legs a study file gives
+/// (Scenario::legs: their delay, loss and order); τ_c ~ U[1, 5] ms (stream
 /// "compute"); I and IK have none. Streams per source (common random numbers): process,
 /// measurement, compute, link/<as|sc|ca>/delay. With a fault spec (RunOptions::faults)
 /// the links carry the engine's frame faults and the nodes "sensor", "controller",
@@ -62,6 +63,8 @@ struct RunResult {
   std::string analytic_refusal;    ///< Analytic runs: why the expected cost is not valid ("" when it is).
   double analytic_mismatch = 0;    ///< Analytic runs: largest |mean − simulated| (relative to max(1, |value|)).
   std::vector<double> counters;    ///< Node counters (ncs_counters.hpp, order of counter_names()).
+  /// Counters of the links the run built, by leg name (order of link_names()).
+  std::vector<std::pair<std::string, engine::LinkStatistics>> links;
   std::vector<Point> truth;      ///< True state every trace step (x1, x2).
   std::vector<Point> samples;    ///< Samples y at their instants.
   std::vector<Point> sample_truth;  ///< C x at the same instants (noise-free output).
@@ -71,11 +74,10 @@ struct RunResult {
 
 /// The plant of a run (process noise when `noisy`), shared by the simulation and the live plant.
 engine::ContinuousPlantConfig<kN, kM, kP, 1> plant_config(const Context& ctx, const Scenario& sc, bool noisy);
-/// Periods h in half a set-point period; std::invalid_argument unless whole.
-std::uint64_t half_wave_periods(const Context& ctx, const Scenario& sc);
 /// The set-point square wave of a scenario (x_ref, u_ref per period index).
 node::SquareWaveReference<double, kN, kM> reference(const Context& ctx, const Scenario& sc);
-/// Network leg `name` ("as", "sc", "ca"): U[0.5, d] ms in whole µs, FIFO; none for I, IK.
+/// Network leg `name` ("as", "sc", "ca"): U[0.5, d] ms in whole µs, FIFO, or the scenario's
+/// leg from a study file (Scenario::legs); none for I, IK.
 engine::LinkConfig leg(const Context& ctx, const Scenario& sc, Approach a, const char* name);
 /// Lower Cholesky factor of R = s·R_n: y = C x + [[c0, 0], [c1, c2]] n, n ~ N(0, I).
 std::array<double, 3> measurement_cholesky(const Design& d);

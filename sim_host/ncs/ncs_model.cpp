@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdio>
 #include <fstream>
+#include <optional>
 #include <set>
 #include <sstream>
 #include <stdexcept>
@@ -158,11 +159,39 @@ Disc::Model Context::discretizer_model(double s) const {
   return m;
 }
 
+std::uint64_t half_wave_periods(const Context& ctx, const Scenario& sc) {
+  const double half = sc.period_s * 0.5e6 / ctx.period_us();
+  const auto n = static_cast<std::uint64_t>(std::llround(half));
+  if (n == 0 || std::fabs(half - static_cast<double>(n)) > 1e-9) {
+    throw std::invalid_argument("ncs scenario " + sc.name + ": T_r/2 must be a whole number of periods h");
+  }
+  return n;
+}
+
 std::int32_t Context::worst_chain_us(const Scenario& s) const {
+  if (!s.legs.empty()) {
+    std::int64_t sum_ns = 0;
+    for (const char* leg : {"sc", "ca"}) {
+      const auto it = s.legs.find(leg);
+      if (it == s.legs.end()) continue;
+      const std::optional<engine::Duration> ub = it->second.delay.upper_bound();
+      if (!ub) throw std::invalid_argument(std::string("ncs scenario ") + s.name + ": leg " + leg + " has no upper delay bound (late sampling needs one)");
+      sum_ns += ub->count();
+    }
+    return static_cast<std::int32_t>(std::llround(static_cast<double>(sum_ns) * 1e-3) + timing_.compute_max_us);
+  }
   return static_cast<std::int32_t>(std::llround(2 * s.max_delay_ms * 1000) + timing_.compute_max_us);
 }
 
 double Context::mean_tau_io_us(const Scenario& s) const {
+  if (!s.legs.empty()) {
+    double sum_ns = 0;
+    for (const char* leg : {"sc", "ca"}) {
+      const auto it = s.legs.find(leg);
+      if (it != s.legs.end()) sum_ns += it->second.delay.mean_ns();
+    }
+    return sum_ns * 1e-3 + 0.5 * static_cast<double>(timing_.compute_min_us + timing_.compute_max_us);
+  }
   const double leg = 0.5 * (static_cast<double>(timing_.leg_min_us) + s.max_delay_ms * 1000);
   return 2 * leg + 0.5 * static_cast<double>(timing_.compute_min_us + timing_.compute_max_us);
 }

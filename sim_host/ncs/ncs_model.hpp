@@ -6,6 +6,7 @@
 #include <array>
 #include <cstddef>
 #include <cstdint>
+#include <map>
 #include <memory>
 #include <string>
 #include <vector>
@@ -13,6 +14,7 @@
 #include "oneshot/controller_design.hpp"
 #include "oneshot/design/controller_synthesis.hpp"
 #include "oneshot/design/plant_description.hpp"
+#include "oneshot/engine/link.hpp"
 #include "oneshot/generic_discretizer.hpp"
 #include "oneshot/number_format.hpp"
 
@@ -50,6 +52,11 @@ struct Scenario {
   double max_delay_ms = 0;       ///< d.
   double noise_scale = 1;        ///< s.
   double duration_s = 20;        ///< Run length.
+  /// Legs "as", "sc", "ca" given by a study file (delay, loss, order; the frame layout stays
+  /// the loop's). Empty: the brief's legs U[0.5, d] ms in whole µs, FIFO, lossless. When set,
+  /// d is not used by the loop: S+ designs on the legs' mean delays and AKl's D is the sum of
+  /// their upper bounds.
+  std::map<std::string, engine::LinkConfig> legs;
 };
 /// The ten scenarios of brief §3.
 std::vector<Scenario> default_scenarios();
@@ -86,7 +93,8 @@ class Context {
   Design controller_design(double noise_scale) const;
   /// The continuous model (per µs) at noise scale s (Q_c scaled), for the discretizer.
   Disc::Model discretizer_model(double noise_scale) const;
-  /// Worst τ_sc + τ_c + τ_ca of a scenario (µs): D of late sampling.
+  /// Worst τ_sc + τ_c + τ_ca of a scenario (µs): D of late sampling (std::invalid_argument
+  /// when a leg of the study file has no upper bound).
   std::int32_t worst_chain_us(const Scenario& s) const;
   /// Mean τ_io = τ_sc + τ_c + τ_ca of a scenario (µs).
   double mean_tau_io_us(const Scenario& s) const;
@@ -96,6 +104,9 @@ class Context {
   design::DesignResult design_;
   Timing timing_;
 };
+
+/// Periods h in half a set-point period; std::invalid_argument unless whole.
+std::uint64_t half_wave_periods(const Context& ctx, const Scenario& sc);
 
 /// The S+ gain: LQR on eq. 8 with a constant τ (µs) on ξ = [x_k; u_{k−1}], the continuous
 /// cost sampled exactly over the period with the input switching at τ;

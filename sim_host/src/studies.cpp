@@ -15,7 +15,8 @@ namespace oneshot::sim {
 
 const std::vector<StudyDescriptor>& studies() {
   static const std::vector<StudyDescriptor> all = {oneshot_study(), ncs_study(),  dropping_study(),
-                                                   sod_study(),     petc_study(), kernel_study()};
+                                                   sod_study(),     petc_study(), kernel_study(),
+                                                   study_files_study()};
   return all;
 }
 

@@ -12,15 +12,24 @@
 /// positive semidefinite (checked with Eigen's eigenvalues, independently of the parser);
 /// every link of every scenario has a configuration whose delay draws are whole, finite,
 /// between the model's lower bound and its cap, whose loss rate is a probability and whose
-/// description holds no "nan" or "inf"; the CAN response-time analysis of each bus's
+/// description holds no "nan" or "inf", whose mean (study check) is not below the lower
+/// bound and whose upper bound, where the model has one, bounds every draw; the CAN response-time analysis of each bus's
 /// background traffic ends with finite figures; with the schema, approach kinds are known
 /// and parameters respect their range and integrality.
+///
+/// Then `oneshot-sim study check` on it (sim_host/study/): the resolution either refuses
+/// naming a field (engine::InputError "field '…'") or gives only finite numbers (null for an
+/// unbounded delay or response time); the ncs mapping (also on a third parse with the ncs
+/// schema) refuses naming a field or yields one scenario per file scenario with the file's
+/// legs. A plant file "networked_board.json" (study ncs's) sits in the harness's folder, and
+/// inputs are parsed as if they were a file there.
 #include <Eigen/Dense>
 #include <cmath>
 #include <cstdint>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <optional>
 #include <set>
 #include <string>
 
@@ -28,6 +37,8 @@
 #include "oneshot/engine/can_analysis.hpp"
 #include "oneshot/engine/random_stream.hpp"
 #include "oneshot/engine/study_file.hpp"
+#include "study_check.hpp"
+#include "study_ncs_runner.hpp"
 
 namespace e = oneshot::engine;
 using oneshot::fuzz::require;
@@ -89,6 +100,12 @@ void check_link(const e::LinkConfig& c, const std::string& what) {
   require(std::isfinite(rate) && rate >= 0 && rate <= 1, what + ": loss rate " + std::to_string(rate));
   const e::Duration low = c.delay.lower_bound();
   require(low.count() >= 0, what + ": negative lower bound");
+  // What `study check` prints: mean ≥ min (finite but for a Pareto tail with α ≤ 1), max ≥ min.
+  const double mean = c.delay.mean_ns();
+  require(!std::isnan(mean) && mean >= static_cast<double>(low.count()) * (1 - 1e-12) - 1, what + ": mean below the lower bound");
+  require(std::isfinite(mean) || (c.delay.kind == e::DelayModel::Kind::kPareto && c.delay.alpha <= 1), what + ": infinite mean");
+  const std::optional<e::Duration> high = c.delay.upper_bound();
+  if (high) require(*high >= low, what + ": upper bound below the lower bound");
   e::RandomStream rng(1, "fuzz");
   for (std::uint64_t k = 0; k < 16; ++k) {
     bool clamped = false;
@@ -97,6 +114,7 @@ void check_link(const e::LinkConfig& c, const std::string& what) {
     require(x.count() >= 0, what + ": negative delay drawn");
     const bool heavy = c.delay.kind == e::DelayModel::Kind::kLognormal || c.delay.kind == e::DelayModel::Kind::kPareto;
     if (heavy) require(x <= c.delay.cap, what + ": delay draw above the cap");
+    if (high) require(x <= *high, what + ": delay draw above the upper bound");
   }
 }
 
@@ -173,6 +191,34 @@ void check_study(const e::StudyFile& s, const e::StudySchema* schema) {
   }
 }
 
+/// Every number finite (null allowed: unbounded figures).
+void require_finite_json(const nlohmann::json& j, const std::string& where) {
+  if (j.is_number()) require(std::isfinite(j.get<double>()), "study check: non-finite figure at " + where);
+  if (j.is_structured()) {
+    for (const auto& [k, v] : j.items()) require_finite_json(v, where + "." + k);
+  }
+}
+
+/// A refusal of study check names the field.
+void require_named(const oneshot::engine::InputError& e, const char* what) {
+  require(std::string(e.what()).find("field '") != std::string::npos, std::string(what) + " refused without naming a field: " + e.what());
+}
+
+void check_study_check(const e::StudyFile& s) {
+  try {
+    require_finite_json(oneshot::study::resolve_study(s), "resolution");
+  } catch (const e::InputError& x) {
+    require_named(x, "study check");
+  }
+  try {
+    const oneshot::study::NcsStudy n = oneshot::study::map_ncs_study(s);
+    require(n.scenarios.size() == s.scenarios.size() && n.approaches.size() == s.approaches.size(), "ncs mapping: sizes");
+    for (const auto& sc : n.scenarios) require(sc.legs.size() == n.links.size(), "ncs mapping: legs");
+  } catch (const e::InputError& x) {
+    require_named(x, "ncs mapping");
+  }
+}
+
 void remove_base_dir() {
   std::error_code ec;
   std::filesystem::remove_all(g_base_dir, ec);
@@ -185,6 +231,7 @@ extern "C" int LLVMFuzzerInitialize(int*, char***) {
   if (::mkdtemp(dir) == nullptr) std::abort();
   g_base_dir = dir;
   std::ofstream(g_base_dir + "/delays.csv") << "delay_us\n500\n# a comment\n1500\n\n250\n";
+  std::filesystem::copy_file(ONESHOT_NCS_PLANT_FILE, g_base_dir + "/networked_board.json");
   std::atexit(remove_base_dir);
   return 0;
 }
@@ -196,14 +243,16 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
       {"ideal", "kalman"},
       {{"gain", 0, 10, false, false, 1}, {"horizon", 1, 100, true, false, 10}},
       {{"amplitude", 0, 5, false, true, 0}, {"steps", 0, 1000, true, false, 0}}};
-  for (const e::StudySchema* sc : {static_cast<const e::StudySchema*>(nullptr), &schema}) {
+  const std::string source = g_base_dir + "/fuzz.json";  // plant files resolve in the harness's folder
+  for (const e::StudySchema* sc : {static_cast<const e::StudySchema*>(nullptr), &schema, &oneshot::study::ncs_schema()}) {
     e::StudyFile s;
     try {
-      s = e::parse_study(text, "fuzz", sc, g_base_dir);
+      s = e::parse_study(text, source, sc, g_base_dir);
     } catch (const e::InputError&) {
       continue;  // refused with a message: fine
     }
     check_study(s, sc);
+    if (sc != &schema) check_study_check(s);
   }
   return 0;
 }

@@ -24,7 +24,7 @@ TEST(StudyDescriptors, EveryStudyOnceInOrderWithItsCommands) {
     s.add_commands(&group);
     EXPECT_FALSE(group.get_subcommands({}).empty()) << s.name << " adds no experiment";
   }
-  EXPECT_EQ(names, (std::vector<std::string>{"oneshot", "ncs", "dropping", "sod", "petc", "kernel"}));
+  EXPECT_EQ(names, (std::vector<std::string>{"oneshot", "ncs", "dropping", "sod", "petc", "kernel", "study"}));
 }
 
 TEST(StudyDescriptors, TheCliHasOneGroupPerStudy) {
@@ -60,7 +60,7 @@ TEST(StudyDescriptors, MergeFindsEverySummarizerAndNamesTheKnownOnes) {
   } catch (const std::invalid_argument& e) {
     EXPECT_STREQ(e.what(),
                  "no study experiment 'oneshot noise' can merge sweeps (known: dropping arrival, dropping closed-loop, "
-                 "dropping hold, ncs table, oneshot kernel, oneshot table1, petc gpi, petc table, sod table)");
+                 "dropping hold, ncs table, oneshot kernel, oneshot table1, petc gpi, petc table, sod table, study run)");
   }
 }
 

@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <filesystem>
+#include <limits>
 #include <sstream>
 
 #include "oneshot/engine/json_fields.hpp"
@@ -71,6 +72,49 @@ Duration DelayModel::lower_bound() const {
     }
   }
   return Duration{0};
+}
+
+std::optional<Duration> DelayModel::upper_bound() const {
+  switch (kind) {
+    case Kind::kConstant:
+      return constant;
+    case Kind::kUniform:
+      return min + resolution * ((max - min) / resolution);
+    case Kind::kTrace: {
+      Duration m = trace.front();
+      for (Duration d : trace) m = std::max(m, d);
+      return m;
+    }
+    case Kind::kPoissonPeriods:
+    case Kind::kLognormal:
+    case Kind::kPareto:
+      break;
+  }
+  return std::nullopt;
+}
+
+double DelayModel::mean_ns() const {
+  switch (kind) {
+    case Kind::kConstant:
+      return static_cast<double>(constant.count());
+    case Kind::kUniform: {
+      const std::int64_t steps = (max - min) / resolution;
+      return static_cast<double>(min.count()) + 0.5 * static_cast<double>(resolution.count()) * static_cast<double>(steps);
+    }
+    case Kind::kPoissonPeriods:
+      return static_cast<double>(shift.count()) + mean_periods * static_cast<double>(period.count());
+    case Kind::kLognormal:
+      return static_cast<double>(shift.count()) + median_ns * std::exp(0.5 * sigma * sigma);
+    case Kind::kPareto:
+      if (alpha <= 1) return std::numeric_limits<double>::infinity();
+      return static_cast<double>(shift.count()) + scale_ns * alpha / (alpha - 1);
+    case Kind::kTrace: {
+      double sum = 0;
+      for (Duration d : trace) sum += static_cast<double>(d.count());
+      return sum / static_cast<double>(trace.size());
+    }
+  }
+  return 0;
 }
 
 std::string DelayModel::describe() const {

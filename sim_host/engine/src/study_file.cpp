@@ -288,7 +288,14 @@ StudyFile parse_study(const std::string& text, const std::string& source, const 
         if (!over.is_object()) throw InputError("field '" + f + ".links': must be an object of link overrides");
         for (const auto& item : over.items()) {
           const std::string g = f + ".links." + item.key();
-          s.link_config(item.key());  // must name a point-to-point link
+          const LinkSpec* target = nullptr;  // must name a point-to-point link
+          for (const LinkSpec& l : s.links)
+            if (l.name == item.key()) target = &l;
+          if (target == nullptr) throw InputError("field '" + g + "': no link '" + item.key() + "'");
+          if (!target->bus.empty()) {
+            throw InputError("field '" + g + "': link '" + item.key() + "' runs on CAN bus '" + target->bus +
+                             "' (no delay or loss to override)");
+          }
           require_keys(item.value(), g, {"delay", "loss"});
           if (item.value().contains("delay")) x.delays[item.key()] = parse_delay_model(item.value()["delay"], g + ".delay", base_dir);
           if (item.value().contains("loss")) x.losses[item.key()] = parse_loss_model(item.value()["loss"], g + ".loss");

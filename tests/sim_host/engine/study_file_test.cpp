@@ -99,7 +99,8 @@ TEST(StudyFile, MalformedFilesNameTheField) {
       {edited("{\"amplitude\": 0.2}", "{\"amplitude\": 0.2, \"gain\": 3}"), "scenarios[0].params.gain"},
       {edited("{\"amplitude\": 0.2}", "{}"), "scenarios[0].params.amplitude"},
       {edited("\"name\": \"d4\"", "\"name\": \"d14-heavy\""), "scenarios[1].name"},
-      {edited("\"links\": {\"sc\"", "\"links\": {\"ca\""), "link 'ca' runs on CAN bus"},
+      {edited("\"links\": {\"sc\"", "\"links\": {\"ca\""), "scenarios[1].links.ca': link 'ca' runs on CAN bus"},
+      {edited("\"links\": {\"sc\"", "\"links\": {\"xy\""), "scenarios[1].links.xy': no link 'xy'"},
       {edited("\"sigma\": 0.6", "\"sigma\": \"wide\""), "scenarios[1].links.sc.delay.sigma"},
       {"{\"schema\": ", "not valid JSON"},
       // Found by fuzz_study: a number beyond double escaped as nlohmann's out_of_range.

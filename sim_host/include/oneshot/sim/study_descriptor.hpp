@@ -48,5 +48,7 @@ StudyDescriptor sod_study();
 StudyDescriptor petc_study();
 /// CPUs, schedulers and response-time analysis of task files (sim_host/kernel/).
 StudyDescriptor kernel_study();
+/// Study files from the command line: `oneshot-sim study check|run FILE` (sim_host/study/).
+StudyDescriptor study_files_study();
 
 }  // namespace oneshot::sim

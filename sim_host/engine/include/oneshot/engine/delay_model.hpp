@@ -18,6 +18,7 @@
 
 #include <cstdint>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -50,6 +51,12 @@ struct DelayModel {
   Duration draw(RandomStream& rng, std::uint64_t index, bool& clamped) const;
   /// Smallest delay the model can produce.
   Duration lower_bound() const;
+  /// Largest delay the model can produce below its cap (constant, uniform, trace); nullopt
+  /// for the unbounded models (Poisson, lognormal, Pareto: only the cap bounds them).
+  std::optional<Duration> upper_bound() const;
+  /// Mean delay in ns of the model without its cap (exact for every model; +inf for a
+  /// Pareto tail with α ≤ 1).
+  double mean_ns() const;
   /// One-line description.
   std::string describe() const;
 };

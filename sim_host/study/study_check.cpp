@@ -1,0 +1,283 @@
+/// @file study_check.cpp
+/// @brief A study file resolved into its designs, link summaries and CAN bounds (see
+///        study_check.hpp).
+#include "study_check.hpp"
+
+#include <cmath>
+#include <cstdio>
+#include <sstream>
+
+#include "ncs_model.hpp"
+#include "oneshot/design/controller_synthesis.hpp"
+#include "oneshot/design/plant_description.hpp"
+#include "oneshot/engine/can_analysis.hpp"
+#include "study_ncs_runner.hpp"
+
+namespace oneshot::study {
+namespace {
+
+using engine::InputError;
+using nlohmann::json;
+
+json rows(const design::DenseMatrix& m) {
+  json out = json::array();
+  for (std::size_t i = 0; i < m.rows; ++i) {
+    json r = json::array();
+    for (std::size_t j = 0; j < m.cols; ++j) r.push_back(m(i, j));
+    out.push_back(r);
+  }
+  return out;
+}
+
+double us(engine::Duration d) { return static_cast<double>(d.count()) * 1e-3; }
+
+json delay_summary(const engine::DelayModel& d) {
+  json j = {{"model", d.describe()}, {"min_us", us(d.lower_bound())}, {"mean_us", d.mean_ns() * 1e-3}};
+  const auto ub = d.upper_bound();
+  if (ub) {
+    j["max_us"] = us(*ub);
+  } else {
+    j["max_us"] = nullptr;
+    j["cap_us"] = us(d.cap);
+  }
+  return j;
+}
+
+json link_summary(const engine::LinkConfig& c) {
+  return {{"delay", delay_summary(c.delay)},
+          {"loss", c.loss.describe()},
+          {"loss_probability", c.loss.loss_rate()},
+          {"order", c.fifo ? "fifo" : "any"}};
+}
+
+bool has_estimator(const std::string& kind) {
+  return kind == "AK" || kind == "AKx" || kind == "AKl" || kind == "SK" || kind == "IK";
+}
+
+bool ncs_kind(const std::string& kind) {
+  for (ncs::Approach a : ncs::kAllApproaches)
+    if (kind == ncs::name(a)) return true;
+  return false;
+}
+
+/// The smallest timer period of the file (0 when no node runs a timer).
+engine::Duration loop_period(const engine::StudyFile& f) {
+  engine::Duration p{0};
+  for (const engine::NodeSpec& n : f.nodes)
+    if (n.mode == "timer" && (p.count() == 0 || n.period < p)) p = n.period;
+  return p;
+}
+
+json plant_section(const engine::StudyFile& f, json& designs) {
+  json j;
+  switch (f.plant.kind) {
+    case engine::PlantSpec::Kind::kContinuous:
+      j = {{"kind", "continuous"}, {"n", f.plant.continuous.a.rows}, {"m", f.plant.continuous.b.cols},
+           {"p", f.plant.continuous.c.rows}, {"designed", false},
+           {"why_not_designed", "an inline plant carries no measurement covariance: give a plant file"}};
+      return j;
+    case engine::PlantSpec::Kind::kDiscrete:
+      j = {{"kind", "discrete"}, {"n", f.plant.discrete.phi.rows}, {"m", f.plant.discrete.gamma.cols},
+           {"p", f.plant.discrete.c.rows}, {"period_us", us(f.plant.discrete.period)}, {"designed", false},
+           {"why_not_designed", "an inline plant carries no measurement covariance: give a plant file"}};
+      return j;
+    case engine::PlantSpec::Kind::kFile:
+      break;
+  }
+  const std::string path = plant_file_path(f);
+  design::PlantDescription p;
+  try {
+    p = design::load_plant_file(path);
+  } catch (const std::exception& e) {
+    throw InputError("field 'plant.file': " + std::string(e.what()));
+  }
+  design::DesignResult d;
+  try {
+    d = design::synthesize(p);
+  } catch (const std::exception& e) {
+    throw InputError("field 'plant': " + std::string(e.what()));
+  }
+  if (!d.lqr_available) throw InputError("field 'plant': no LQR gain: " + d.lqr_unavailable_reason);
+  j = {{"kind", "file"}, {"file", path}, {"name", p.name}, {"form", design::to_string(p.form)},
+       {"n", p.n()}, {"m", p.m()}, {"p", p.p()}, {"period_us", p.period_us}, {"designed", true}};
+  designs["lqr_gain"] = rows(d.l);
+  designs["closed_loop_spectral_radius"] = d.closed_loop_radius;
+  designs["kalman_gain"] = rows(d.kalman_gain);
+  designs["estimator_spectral_radius"] = d.estimator_radius;
+  return j;
+}
+
+}  // namespace
+
+json resolve_study(const engine::StudyFile& f) {
+  try {
+    json r;
+    r["source"] = f.source;
+    r["study"] = f.study;
+    r["duration_s"] = f.duration_s;
+    r["seeds"] = {{"first", f.first_seed}, {"count", f.seeds}};
+    json design = json::object();
+    r["plant"] = plant_section(f, design);
+    const bool designed = r["plant"].at("designed").get<bool>();
+    // Per approach: the design its kind implies.
+    std::shared_ptr<const ncs::Context> ctx;
+    for (const engine::ApproachSpec& a : f.approaches) {
+      json e = {{"name", a.name}, {"kind", a.kind}, {"params", a.params}};
+      if (!designed) {
+        e["design"] = "none (plant not designed)";
+      } else if (f.study != "ncs" || !ncs_kind(a.kind)) {
+        e["design"] = "LQR (the kind is not an ncs approach: no estimator assumed)";
+        e["lqr_gain"] = design["lqr_gain"];
+        e["closed_loop_spectral_radius"] = design["closed_loop_spectral_radius"];
+      } else {
+        e["lqr_gain"] = design["lqr_gain"];
+        e["closed_loop_spectral_radius"] = design["closed_loop_spectral_radius"];
+        e["design"] = has_estimator(a.kind) ? "LQR + Kalman" : "LQR";
+        if (has_estimator(a.kind)) {
+          e["kalman_gain"] = design["kalman_gain"];
+          e["estimator_spectral_radius"] = design["estimator_spectral_radius"];
+        }
+        if (a.kind == "S+") {  // its own gain per scenario (add_ncs_designs)
+          e["design"] = "LQR on eq. 8 at the mean delay tau_io of each scenario";
+          e.erase("lqr_gain");
+          e.erase("closed_loop_spectral_radius");
+        }
+      }
+      r["approaches"].push_back(e);
+    }
+    // Links: point to point per scenario; bus messages by the CAN analysis.
+    const engine::Duration period = loop_period(f);
+    for (const engine::LinkSpec& l : f.links) {
+      json e = {{"name", l.name}, {"from", l.from}, {"to", l.to}};
+      if (l.bus.empty()) {
+        e["base"] = link_summary(f.link_config(l.name));
+        for (const engine::ScenarioSpec& s : f.scenarios) {
+          if (s.delays.count(l.name) != 0 || s.losses.count(l.name) != 0) {
+            e["scenarios"][s.name] = link_summary(f.link_config(l.name, &s));
+          }
+        }
+      } else {
+        e["bus"] = l.bus;
+        e["id"] = l.id;
+      }
+      r["links"].push_back(e);
+    }
+    for (std::size_t b = 0; b < f.buses.size(); ++b) {
+      const engine::BusSpec& bus = f.buses[b];
+      const std::string field = "buses[" + std::to_string(b) + "]";
+      std::vector<engine::CanStream> streams = bus.background;
+      std::vector<std::string> kinds(streams.size(), "background");
+      for (const engine::LinkSpec& l : f.links) {
+        if (l.bus != bus.config.name) continue;
+        const engine::NodeSpec& from = f.node(l.from);
+        const engine::Duration t = from.mode == "timer" ? from.period : period;
+        if (t.count() <= 0) throw InputError("field '" + field + "': link " + l.name + " has no period (no timer node)");
+        engine::CanStream st;
+        st.name = l.name;
+        st.id = l.id;
+        st.payload_bytes = kLoopFramePayloadBytes;
+        st.period = t;
+        st.deadline = t;
+        streams.push_back(st);
+        kinds.emplace_back("link");
+      }
+      double load = 0;
+      const engine::Duration bit{1'000'000'000 / bus.config.bit_rate};
+      for (const engine::CanStream& st : streams) {
+        load += static_cast<double>((bit * engine::can_frame_bits(st.payload_bytes, bus.config.extended_ids)).count()) /
+                static_cast<double>(st.period.count());
+      }
+      json e = {{"name", bus.config.name}, {"bit_rate", bus.config.bit_rate}, {"load", load}};
+      if (load > 1) {
+        char buf[64];
+        std::snprintf(buf, sizeof buf, "%.1f", 100 * load);
+        throw InputError("field '" + field + "': bus " + bus.config.name + " is loaded " + buf + " % (over 100 %)");
+      }
+      const std::vector<engine::CanStreamBound> bounds = engine::can_response_times(streams, bus.config);
+      for (std::size_t k = 0; k < streams.size(); ++k) {
+        json m = {{"name", streams[k].name}, {"kind", kinds[k]}, {"id", streams[k].id},
+                  {"payload_bytes", streams[k].payload_bytes}, {"period_us", us(streams[k].period)},
+                  {"jitter_us", us(streams[k].jitter)}, {"deadline_us", us(streams[k].deadline)},
+                  {"transmission_us", us(bounds[k].transmission)}, {"bounded", bounds[k].bounded},
+                  {"schedulable", bounds[k].schedulable}};
+        m["worst_response_us"] = bounds[k].bounded ? json(us(bounds[k].response)) : json(nullptr);
+        e["messages"].push_back(m);
+      }
+      r["buses"].push_back(e);
+    }
+    // The grid.
+    for (const engine::ScenarioSpec& s : f.scenarios) {
+      r["scenarios"].push_back({{"name", s.name}, {"duration_s", s.duration_s.value_or(f.duration_s)}, {"params", s.params}});
+    }
+    r["grid"] = {{"approaches", f.approaches.size()}, {"scenarios", f.scenarios.size()},
+                 {"runs_per_seed", f.approaches.size() * f.scenarios.size()},
+                 {"runs", f.approaches.size() * f.scenarios.size() * f.seeds}};
+    return r;
+  } catch (const InputError& e) {
+    throw InputError(f.source + ": " + e.what());
+  }
+}
+
+void add_ncs_designs(json& r, const NcsStudy& s) {
+  for (auto& a : r["approaches"]) {
+    if (a.at("kind") != "S+") continue;
+    for (const ncs::Scenario& sc : s.scenarios) {
+      const double tau = s.ctx->mean_tau_io_us(sc);
+      const auto g = ncs::delay_compensated_gain(*s.ctx, tau);
+      a["per_scenario"][sc.name] = {{"tau_io_us", tau}, {"gain_x_u", {g[0], g[1], g[2]}}};
+    }
+  }
+}
+
+std::string describe_resolution(const json& r) {
+  std::ostringstream o;
+  const json& p = r.at("plant");
+  o << "study file " << r.at("source").get<std::string>() << " (study " << r.at("study").get<std::string>() << ")\n";
+  o << "plant: " << p.at("kind").get<std::string>() << ", n = " << p.at("n") << ", m = " << p.at("m") << ", p = " << p.at("p");
+  if (p.contains("name")) o << " (" << p.at("name").get<std::string>() << ", h = " << p.at("period_us") << " us)";
+  o << "\n";
+  for (const json& a : r.at("approaches")) {
+    o << "approach " << a.at("name").get<std::string>() << " (" << a.at("kind").get<std::string>()
+      << "): " << a.at("design").get<std::string>();
+    if (a.contains("lqr_gain")) o << "; L = " << a.at("lqr_gain").dump() << ", closed-loop radius " << a.at("closed_loop_spectral_radius");
+    if (a.contains("kalman_gain")) o << "; K = " << a.at("kalman_gain").dump() << ", estimator radius " << a.at("estimator_spectral_radius");
+    o << "\n";
+    if (a.contains("per_scenario"))
+      for (const auto& [sc, g] : a.at("per_scenario").items()) o << "  " << sc << ": " << g.dump() << "\n";
+  }
+  for (const json& l : r.at("links")) {
+    o << "link " << l.at("name").get<std::string>() << " " << l.at("from").get<std::string>() << " -> "
+      << l.at("to").get<std::string>();
+    if (l.contains("bus")) {
+      o << ": CAN bus " << l.at("bus").get<std::string>() << ", id " << l.at("id") << "\n";
+      continue;
+    }
+    const json& b = l.at("base");
+    const auto line = [&](const json& x) {
+      char buf[160];
+      const json& d = x.at("delay");
+      std::snprintf(buf, sizeof buf, "delay min %.1f / mean %.1f / max %s us, loss %.4g, %s", d.at("min_us").get<double>(),
+                    d.at("mean_us").get<double>(), d.at("max_us").is_null() ? "unbounded" : d.at("max_us").dump().c_str(),
+                    x.at("loss_probability").get<double>(), x.at("order").get<std::string>().c_str());
+      return std::string(buf);
+    };
+    o << ": " << line(b) << "\n";
+    if (l.contains("scenarios"))
+      for (const auto& [sc, x] : l.at("scenarios").items()) o << "  scenario " << sc << ": " << line(x) << "\n";
+  }
+  if (r.contains("buses")) {
+    for (const json& b : r.at("buses")) {
+      o << "bus " << b.at("name").get<std::string>() << ": load " << 100 * b.at("load").get<double>() << " %\n";
+      for (const json& m : b.at("messages")) {
+        o << "  " << m.at("kind").get<std::string>() << " " << m.at("name").get<std::string>() << " id " << m.at("id")
+          << ": C " << m.at("transmission_us") << " us, worst response "
+          << (m.at("worst_response_us").is_null() ? std::string("unbounded") : m.at("worst_response_us").dump()) << " us\n";
+      }
+    }
+  }
+  o << "grid: " << r.at("grid").at("approaches") << " approaches x " << r.at("grid").at("scenarios") << " scenarios x "
+    << r.at("seeds").at("count") << " seeds = " << r.at("grid").at("runs") << " runs\n";
+  return o.str();
+}
+
+}  // namespace oneshot::study

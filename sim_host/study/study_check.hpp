@@ -1,0 +1,35 @@
+/// @file study_check.hpp
+/// @brief `oneshot-sim study check`: a study file resolved into what it implies — the plant
+///        (kind, n, m, p), per approach the design (LQR gain, Kalman gain where an estimator
+///        runs, spectral radii), per link the delay and loss summary, per CAN bus its load
+///        and the worst-case response time of every message, the approaches × scenarios grid.
+#pragma once
+
+#include <string>
+
+#include <nlohmann/json.hpp>
+
+#include "oneshot/engine/study_file.hpp"
+#include "study_ncs_runner.hpp"
+
+namespace oneshot::study {
+
+/// Frame payload the check assumes for a loop message on a CAN bus (bytes; worst case).
+inline constexpr std::size_t kLoopFramePayloadBytes = 8;
+
+/// Everything `file` implies, as JSON. engine::InputError naming the field for an
+/// undetectable or unstabilizable design ("plant"), a plant file that does not load
+/// ("plant.file"), a bus loaded over 100 % ("buses[i]") or a bus message without a period.
+/// Approach kinds of study ncs get their design (I, S, A: LQR; AK, AKx, AKl, SK, IK: LQR and
+/// Kalman; S+: the gain on eq. 8 per scenario); inline plants are summarized but not designed
+/// (they carry no measurement covariance).
+nlohmann::json resolve_study(const engine::StudyFile& file);
+
+/// Adds to the resolution `r` of an ncs file what needs its scenarios: the S+ gain
+/// [L_x, L_u] and the mean delay τ_io it is designed on, per scenario.
+void add_ncs_designs(nlohmann::json& r, const NcsStudy& s);
+
+/// The resolution as text, one fact per line.
+std::string describe_resolution(const nlohmann::json& r);
+
+}  // namespace oneshot::study

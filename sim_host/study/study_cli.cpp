@@ -1,0 +1,102 @@
+/// @file study_cli.cpp
+/// @brief `oneshot-sim study check FILE` and `oneshot-sim study run FILE`: study files
+///        (`oneshot-study/1`, docs/study-files.md) from the command line; `merge` finishes
+///        the shards of `study run`.
+#include <chrono>
+#include <filesystem>
+#include <iostream>
+#include <memory>
+
+#include "oneshot/engine/study_file.hpp"
+#include "oneshot/sim/study_descriptor.hpp"
+#include "oneshot/util/output_files.hpp"
+#include "study_check.hpp"
+#include "study_ncs_runner.hpp"
+#include "study_ncs_sweep.hpp"
+
+namespace oneshot::sim {
+namespace {
+
+/// Loads, resolves and maps a study file: every refusal before anything is written.
+struct Checked {
+  nlohmann::json resolution;
+  study::NcsStudy ncs;
+};
+
+Checked check_file(const std::string& path) {
+  const engine::StudyFile generic = engine::load_study(path, nullptr);
+  Checked c;
+  c.resolution = study::resolve_study(generic);
+  if (generic.study != "ncs") static_cast<void>(study::map_ncs_study(generic));  // refuses naming 'study'
+  c.ncs = study::map_ncs_study(engine::load_study(path, &study::ncs_schema()));
+  study::add_ncs_designs(c.resolution, c.ncs);
+  c.resolution["runs_with"] = "ncs";
+  return c;
+}
+
+struct CheckCli {
+  std::string file;
+  std::string json;
+};
+
+struct RunCli {
+  std::string file;
+  std::size_t seeds = 0;
+  unsigned threads = 0;
+  std::string shard = "0/1";
+  std::string out = "out/study";
+  std::string json;
+  bool no_plots = false;
+};
+
+void add_study_commands(CLI::App* group) {
+  {
+    auto c = std::make_shared<CheckCli>();
+    CLI::App* cmd = group->add_subcommand(
+        "check", "Validate a study file and print what it resolves to: designs, link delay/loss summaries, CAN bounds, the grid");
+    cmd->add_option("file", c->file, "study file (oneshot-study/1)")->required();
+    cmd->add_option("--json", c->json, "write the resolution as JSON to PATH, or '-' for standard output");
+    cmd->callback([c]() {
+      const Checked k = check_file(c->file);
+      if (!c->json.empty()) util::write_json(c->json, k.resolution);
+      if (c->json != "-") std::cout << study::describe_resolution(k.resolution) << "runs with: oneshot-sim study run " << c->file << "\n";
+    });
+  }
+  {
+    auto c = std::make_shared<RunCli>();
+    CLI::App* cmd = group->add_subcommand("run", "Run a study file's approaches x scenarios x seeds (today: files with \"study\": \"ncs\")");
+    cmd->add_option("file", c->file, "study file (oneshot-study/1)")->required();
+    cmd->add_option("--seeds", c->seeds, "seeds per scenario (default: the file's seeds.count)")->check(CLI::Range(2, 10000000));
+    cmd->add_option("--threads", c->threads, "worker threads (0: every core)")->capture_default_str();
+    cmd->add_option("--shard", c->shard, "run part i/N and write OUT/run.shard-i-of-N.json (`oneshot-sim merge`)")->capture_default_str();
+    cmd->add_option("--out", c->out, "output directory")->capture_default_str();
+    cmd->add_option("--json", c->json, "write the result as JSON to PATH, or '-' for standard output");
+    cmd->add_flag("--no-plots", c->no_plots, "write CSV files only (no gnuplot)");
+    cmd->callback([c]() {
+      const Checked k = check_file(c->file);
+      const engine::Shard part = engine::parse_shard(c->shard);
+      util::make_directory(c->out);
+      const auto start = std::chrono::steady_clock::now();
+      const engine::SweepResults r = study::run_ncs_sweep(k.ncs, c->seeds, c->threads, part);
+      const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+      nlohmann::json j;
+      if (!part.whole()) {
+        j = engine::write_shard_file(r, c->out, "run", part);
+      } else {
+        j = study::run_outputs(r, c->out, !c->no_plots);
+        if (c->json != "-") std::cout << j.at("markdown").get<std::string>() << "order: " << j.at("order_text").get<std::string>() << "\n";
+      }
+      if (!c->json.empty()) util::write_json(c->json, j);
+      if (c->json != "-") std::cout << "study run: " << r.spec.runs() << " runs, wall time " << wall << " s, written to " << c->out << "\n";
+    });
+  }
+}
+
+}  // namespace
+
+StudyDescriptor study_files_study() {
+  return {"study", "Study files (oneshot-study/1): check what a file resolves to, run it (docs/study-files.md)",
+          add_study_commands, {{"run", study::run_outputs}}, std::nullopt};
+}
+
+}  // namespace oneshot::sim

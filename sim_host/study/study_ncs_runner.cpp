@@ -1,0 +1,198 @@
+/// @file study_ncs_runner.cpp
+/// @brief A study file mapped onto study ncs's loop (see study_ncs_runner.hpp).
+#include "study_ncs_runner.hpp"
+
+#include <filesystem>
+#include <map>
+#include <stdexcept>
+
+#include "ncs_live.hpp"
+
+namespace oneshot::study {
+namespace {
+
+using engine::InputError;
+
+std::string at(const char* list, std::size_t i) { return std::string(list) + "[" + std::to_string(i) + "]"; }
+
+[[noreturn]] void refuse(const std::string& field, const std::string& why) {
+  throw InputError("field '" + field + "': " + why);
+}
+
+/// The leg a link is: its name must be the loop's, its ends the nodes of those roles.
+struct Leg {
+  const char* name;
+  const char* from;
+  const char* to;
+};
+constexpr Leg kLegs[] = {{"as", "actuator", "sensor"}, {"sc", "sensor", "controller"}, {"ca", "controller", "actuator"}};
+
+}  // namespace
+
+const engine::StudySchema& ncs_schema() {
+  static const engine::StudySchema schema = [] {
+    engine::StudySchema s;
+    s.study = "ncs";
+    for (ncs::Approach a : ncs::kAllApproaches) s.approach_kinds.emplace_back(ncs::name(a));
+    s.scenario_params = {{"amplitude_volts", 0, 100, false, true, 0},
+                         {"period_s", 1e-3, 1e6, false, true, 0},
+                         {"noise_scale", 0, 1e6, false, false, 1}};
+    return s;
+  }();
+  return schema;
+}
+
+std::string plant_file_path(const engine::StudyFile& file) {
+  const std::filesystem::path p(file.plant.file);
+  if (p.is_absolute()) return p.string();
+  return (std::filesystem::path(file.source).parent_path() / p).lexically_normal().string();
+}
+
+NcsStudy map_ncs_study(const engine::StudyFile& file) {
+  try {
+    NcsStudy out;
+    out.source = file.source;
+    if (file.study != "ncs") refuse("study", "'" + file.study + "' has no runner yet (study run runs 'ncs')");
+    if (file.plant.kind != engine::PlantSpec::Kind::kFile) {
+      refuse("plant", "study ncs needs a plant file (its design needs the measurement covariance, the actuator range and "
+                      "the tracked output, which the inline forms do not carry)");
+    }
+    out.plant_path = plant_file_path(file);
+    try {
+      out.ctx = ncs::Context::load(out.plant_path);
+    } catch (const std::exception& e) {
+      refuse("plant.file", e.what());
+    }
+    const std::int64_t h_us = out.ctx->period_us();
+    // Nodes: one per role, the loop's addresses, timers at h for sensor and actuator.
+    if (file.nodes.size() != 3) refuse("nodes", "study ncs runs exactly three nodes (sensor, controller, actuator)");
+    const std::map<std::string, std::uint8_t> address = {
+        {"sensor", ncs::kLiveSensor}, {"controller", ncs::kLiveController}, {"actuator", ncs::kLiveActuator}};
+    std::map<std::string, std::string> by_role;  // role → node name
+    for (std::size_t i = 0; i < file.nodes.size(); ++i) {
+      const engine::NodeSpec& n = file.nodes[i];
+      const std::string f = at("nodes", i);
+      if (!by_role.emplace(n.role, n.name).second) refuse(f + ".role", "a second " + n.role + " (study ncs runs one of each)");
+      if (n.address != address.at(n.role)) {
+        refuse(f + ".address", "the ncs loop's " + n.role + " has address " + std::to_string(address.at(n.role)));
+      }
+      if (n.clock_offset.count() != 0) refuse(f + ".clock_offset_us", "study ncs runs its nodes on one clock (0 only)");
+      if (n.trigger && !(n.trigger->rule == engine::TriggerSpec::Rule::kPeriodic && n.trigger->every == 1)) {
+        refuse(f + ".trigger", "study ncs samples every period (periodic, every 1, only)");
+      }
+      if (n.role == "controller") {
+        if (n.mode != "arrival") refuse(f + ".mode", "the ncs controller computes on arrival");
+      } else {
+        if (n.mode != "timer") {
+          refuse(f + ".mode", "the ncs " + n.role + " runs a timer at h (its sampling- or actuation-synchronized approaches)");
+        }
+        if (n.period.count() != h_us * 1000) {
+          refuse(f + ".period_us", "must be the plant's period h = " + std::to_string(h_us) + " us");
+        }
+      }
+    }
+    // Links: the loop's legs, point to point.
+    if (!file.buses.empty()) refuse("buses", "study ncs runs point-to-point links only (CAN buses are not run yet)");
+    for (std::size_t i = 0; i < file.links.size(); ++i) {
+      const engine::LinkSpec& l = file.links[i];
+      const std::string f = at("links", i);
+      const Leg* leg = nullptr;
+      for (const Leg& g : kLegs)
+        if (l.name == g.name) leg = &g;
+      if (leg == nullptr) refuse(f + ".name", "study ncs has legs as, sc, ca only (the names of their random streams)");
+      if (l.from != by_role.at(leg->from)) refuse(f + ".from", std::string("leg ") + leg->name + " leaves the " + leg->from);
+      if (l.to != by_role.at(leg->to)) refuse(f + ".to", std::string("leg ") + leg->name + " reaches the " + leg->to);
+      out.links.push_back(l.name);
+    }
+    const auto has = [&](const char* nm) {
+      for (const std::string& l : out.links)
+        if (l == nm) return true;
+      return false;
+    };
+    if (!has("sc") || !has("ca")) refuse("links", "study ncs needs the legs sc (sensor to controller) and ca (controller to actuator)");
+    // Approaches: ncs names, I first.
+    for (std::size_t i = 0; i < file.approaches.size(); ++i) {
+      const engine::ApproachSpec& a = file.approaches[i];
+      const std::string f = at("approaches", i);
+      bool known = false;
+      for (ncs::Approach k : ncs::kAllApproaches) known = known || a.kind == ncs::name(k);
+      if (!known) refuse(f + ".kind", "unknown kind '" + a.kind + "' (I, S, A, AK, AKx, AKl, SK, S+, IK)");
+      if (!a.params.empty()) refuse(f + ".params", "the ncs approaches take no parameters");
+      if (a.name != a.kind) refuse(f + ".name", "must be its kind '" + a.kind + "' (the ncs table names approaches by kind)");
+      const ncs::Approach ap = ncs::parse_approach(a.kind);
+      if (i == 0 && ap != ncs::Approach::kI) refuse(f + ".kind", "the first approach must be I (the reference of every ratio)");
+      if (ncs::actuation_synchronized(ap) && !has("as")) {
+        refuse(f + ".kind", a.kind + " is actuation-synchronized: it needs the leg as (actuator to sensor)");
+      }
+      for (ncs::Approach b : out.approaches)
+        if (b == ap) refuse(f + ".kind", "'" + a.kind + "' twice");
+      out.approaches.push_back(ap);
+    }
+    // Scenarios: ncs Scenario fields, legs from the file with the scenario's overrides.
+    for (std::size_t i = 0; i < file.scenarios.size(); ++i) {
+      const engine::ScenarioSpec& s = file.scenarios[i];
+      const std::string f = at("scenarios", i);
+      // The schema's checks again (a file parsed without it reaches here too).
+      std::map<std::string, double> params = s.params;
+      for (const engine::ParamSpec& p : ncs_schema().scenario_params) {
+        const std::string g = f + ".params." + p.name;
+        const auto it = params.find(p.name);
+        if (it == params.end()) {
+          if (p.required) refuse(g, "missing");
+          params[p.name] = p.fallback;
+        } else if (!(it->second >= p.min && it->second <= p.max)) {
+          refuse(g, "out of range");
+        }
+      }
+      if (params.size() != ncs_schema().scenario_params.size()) {
+        refuse(f + ".params", "unknown parameter (amplitude_volts, period_s, noise_scale)");
+      }
+      ncs::Scenario sc;
+      sc.name = s.name;
+      sc.amplitude_volts = params.at("amplitude_volts");
+      sc.period_s = params.at("period_s");
+      sc.noise_scale = params.at("noise_scale");
+      sc.duration_s = s.duration_s.value_or(file.duration_s);
+      for (const std::string& l : out.links) sc.legs[l] = file.link_config(l, &s);
+      const std::optional<engine::Duration> ub = sc.legs.at("sc").delay.upper_bound();
+      sc.max_delay_ms = ub ? static_cast<double>(ub->count()) * 1e-6 : 0;  // d, as the ncs table reports it
+      try {
+        static_cast<void>(ncs::half_wave_periods(*out.ctx, sc));
+      } catch (const std::exception&) {
+        refuse(f + ".params.period_s", "T_r/2 must be a whole number of periods h = " + std::to_string(h_us) + " us");
+      }
+      if (!(sc.duration_s * 1e6 >= static_cast<double>(h_us))) refuse(f + ".duration_s", "shorter than one period h");
+      for (ncs::Approach a : out.approaches) {
+        const std::string g = f + " with approach " + ncs::name(a);
+        if (a == ncs::Approach::kSPlus) {
+          const double tau = out.ctx->mean_tau_io_us(sc);
+          if (!(tau < static_cast<double>(h_us))) {
+            refuse(g, "S+ designs on the mean delay tau_io = " + std::to_string(tau) + " us, which must be below h");
+          }
+          try {
+            static_cast<void>(ncs::delay_compensated_split(*out.ctx, tau));
+          } catch (const std::exception& e) {
+            refuse(g, e.what());
+          }
+        }
+        if (a == ncs::Approach::kAKl) {
+          try {
+            static_cast<void>(out.ctx->worst_chain_us(sc));
+          } catch (const std::exception& e) {
+            refuse(g, e.what());
+          }
+        }
+      }
+      out.scenarios.push_back(sc);
+    }
+    out.first_seed = file.first_seed;
+    out.seeds = file.seeds;
+    return out;
+  } catch (const InputError& e) {
+    const std::string what = e.what();
+    if (what.rfind(file.source + ":", 0) == 0) throw;
+    throw InputError(file.source + ": " + what);
+  }
+}
+
+}  // namespace oneshot::study

@@ -1,0 +1,48 @@
+/// @file study_ncs_runner.hpp
+/// @brief A study file with "study": "ncs" mapped onto study ncs's loop (sim_host/ncs/): the
+///        schema it accepts, what it refuses at check time (naming the field), and the
+///        approaches and scenarios of its sweep.
+///
+/// The ncs loop has three firmware nodes (sensor, controller, actuator), three point-to-point
+/// legs "as" (actuator → sensor), "sc", "ca" and the plant of a plant file. A file maps onto
+/// it when it declares exactly that: the legs' delay, loss and order come from the file (and
+/// the scenarios' link overrides), the scenario parameters are ncs Scenario fields, the
+/// approach kinds are ncs approach names. Everything else the schema accepts (CAN buses,
+/// clock offsets, trigger rules other than periodic every sample, other addresses, inline
+/// plants) is refused with the field and the reason.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "ncs_model.hpp"
+#include "oneshot/engine/study_file.hpp"
+
+namespace oneshot::study {
+
+/// What `study run` accepts from a file with "study": "ncs" (approach kinds: the ncs
+/// approaches; scenario params amplitude_volts, period_s required, noise_scale default 1).
+const engine::StudySchema& ncs_schema();
+
+/// A study file resolved onto the ncs loop.
+struct NcsStudy {
+  std::string source;                         ///< The study file.
+  std::string plant_path;                     ///< The plant file (resolved against the study file's folder).
+  std::shared_ptr<const ncs::Context> ctx;    ///< Plant and design.
+  std::vector<ncs::Approach> approaches;      ///< In file order (I first).
+  std::vector<ncs::Scenario> scenarios;       ///< In file order, legs from the file.
+  std::vector<std::string> links;             ///< Leg names the file declares ("as", "sc", "ca" in file order).
+  std::uint64_t first_seed = 1;               ///< Seed of the first replication.
+  std::size_t seeds = 0;                      ///< Replications.
+};
+
+/// The plant file a study file names, relative paths taken from the study file's folder.
+std::string plant_file_path(const engine::StudyFile& file);
+
+/// Maps a file parsed with ncs_schema() onto the ncs loop; engine::InputError naming the
+/// file and the field for anything the loop cannot run.
+NcsStudy map_ncs_study(const engine::StudyFile& file);
+
+}  // namespace oneshot::study

@@ -1,0 +1,32 @@
+/// @file study_ncs_sweep.hpp
+/// @brief `oneshot-sim study run` of an ncs study file: the engine's sweep (shards, merge)
+///        over the file's approaches × scenarios × seeds, summarized with the keys of
+///        `ncs table --json` plus per-link counters.
+#pragma once
+
+#include <cstddef>
+#include <string>
+
+#include <nlohmann/json.hpp>
+
+#include "oneshot/engine/sweep.hpp"
+#include "study_ncs_runner.hpp"
+
+namespace oneshot::study {
+
+/// Names of the per-link counters, each a metric "<link>.<counter>" of the sweep.
+inline constexpr const char* kLinkCounters[] = {"sent", "delivered", "lost", "late", "refused"};
+
+/// Runs the sweep (or one shard) of `s` with `seeds` replications (0: the file's count) on
+/// `threads` threads (0: every core). The runs are ncs::run() on the file's scenarios: same
+/// seeds, same random stream names, so the same costs as `ncs table` on the same settings.
+engine::SweepResults run_ncs_sweep(const NcsStudy& s, std::size_t seeds, unsigned threads, const engine::Shard& shard);
+
+/// The summary of a complete sweep: ncs::table_outputs() (cost_mean, cost_ci95, ratio_to_I,
+/// ratio_scenario_weighted, paired differences, per scenario; files in `out_dir`) plus
+/// "links": per approach and link the totals of sent, delivered (not lost: arrived or in
+/// flight at the end), lost, late (dropped by the receiver as stale or late) and refused
+/// (refused by the receiver's frame checks) over every run.
+nlohmann::json run_outputs(const engine::SweepResults& results, const std::string& out_dir, bool plots);
+
+}  // namespace oneshot::study

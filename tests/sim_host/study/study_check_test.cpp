@@ -1,0 +1,230 @@
+/// @file study_check_test.cpp
+/// @brief `study check`: the resolution of a file (designs, link summaries, CAN load and
+///        bounds, the grid) against closed forms, its refusals naming the field, and the
+///        command line (one line, non-zero exit, nothing written on bad input).
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "ncs_model.hpp"
+#include "oneshot/engine/can_bus.hpp"
+#include "oneshot/engine/delay_model.hpp"
+#include "oneshot/engine/random_stream.hpp"
+#include "oneshot/engine/study_file.hpp"
+#include "study_check.hpp"
+#include "support/run_command.hpp"
+
+namespace oneshot::study {
+namespace {
+
+nlohmann::json read_json(const std::string& path) {
+  std::ifstream in(path);
+  std::stringstream s;
+  s << in.rdbuf();
+  return nlohmann::json::parse(s.str());
+}
+
+engine::StudyFile parse(const nlohmann::json& j, const std::string& like) {
+  return engine::parse_study(j.dump(), like, nullptr, std::filesystem::path(like).parent_path().string());
+}
+
+const std::string kNcsExample = std::string(ONESHOT_STUDY_EXAMPLES_DIR) + "/ncs.json";
+
+TEST(StudyCheck, NcsFileResolvesToTheDesignOfItsPlantFile) {
+  const nlohmann::json r = resolve_study(engine::load_study(kNcsExample, nullptr));
+  EXPECT_EQ(r.at("plant").at("n"), 2);
+  EXPECT_EQ(r.at("plant").at("m"), 1);
+  EXPECT_EQ(r.at("plant").at("p"), 2);
+  const auto ctx = ncs::Context::load("");
+  for (const nlohmann::json& a : r.at("approaches")) {
+    if (a.at("kind") == "S+") {  // its own gain per scenario (study check adds it)
+      EXPECT_FALSE(a.contains("lqr_gain"));
+      continue;
+    }
+    for (std::size_t j = 0; j < 2; ++j) EXPECT_EQ(a.at("lqr_gain")[0][j].get<double>(), ctx->design().l(0, j));
+    const double rho = a.at("closed_loop_spectral_radius").get<double>();
+    EXPECT_GT(rho, 0);
+    EXPECT_LT(rho, 1);
+    const std::string kind = a.at("kind");
+    EXPECT_EQ(a.contains("kalman_gain"), kind == "AK" || kind == "AKx" || kind == "AKl" || kind == "SK" || kind == "IK") << kind;
+  }
+  // Uniform whole-µs legs: mean (min + max)/2, no loss; d = 14 overrides of scenario 1.
+  const nlohmann::json& sc = r.at("links")[1];
+  EXPECT_EQ(sc.at("base").at("delay").at("mean_us").get<double>(), 2250);
+  EXPECT_EQ(sc.at("base").at("delay").at("max_us").get<double>(), 4000);
+  EXPECT_EQ(sc.at("base").at("loss_probability").get<double>(), 0);
+  EXPECT_EQ(sc.at("scenarios").at("a0.2-T2-d14-s1").at("delay").at("mean_us").get<double>(), 7250);
+  EXPECT_EQ(r.at("grid").at("runs"), 9 * 10 * 50);
+}
+
+TEST(StudyCheck, ExampleFileGivesLinkSummariesAndCanBounds) {
+  const engine::StudyFile f = engine::load_study(ONESHOT_ENGINE_EXAMPLE_STUDY, nullptr);
+  const nlohmann::json r = resolve_study(f);
+  EXPECT_FALSE(r.at("plant").at("designed").get<bool>());
+  // Gilbert–Elliott p = 0.01, r = 0.3, k = 0, h = 1: π_B = p/(p + r).
+  const nlohmann::json& sc = r.at("links")[0];
+  EXPECT_NEAR(sc.at("base").at("loss_probability").get<double>(), 0.01 / 0.31, 1e-15);
+  // Scenario d14-heavy: lognormal median 3 ms, σ 0.6, shift 0.5 ms: mean shift + m e^{σ²/2}.
+  EXPECT_NEAR(sc.at("scenarios").at("d14-heavy").at("delay").at("mean_us").get<double>(), 500 + 3000 * std::exp(0.18), 1e-9);
+  EXPECT_TRUE(sc.at("scenarios").at("d14-heavy").at("delay").at("max_us").is_null());
+  // Bus can0 at 500 kbit/s: 8-byte standard frames of 135 bits = 270 µs; background every
+  // 5 ms, the loop's ca message every 50 ms (the sensor's period).
+  const nlohmann::json& bus = r.at("buses")[0];
+  EXPECT_EQ(engine::can_frame_bits(8, false), 135);
+  EXPECT_NEAR(bus.at("load").get<double>(), 270.0 / 5000 + 270.0 / 50000, 1e-15);
+  ASSERT_EQ(bus.at("messages").size(), 2U);
+  const nlohmann::json& ca = bus.at("messages")[1];
+  EXPECT_EQ(ca.at("name"), "ca");
+  // ca (id 16) outranks the background (id 256): blocked by one background frame at most,
+  // no higher-priority interference: R = B + C = 270 + 270 µs.
+  EXPECT_EQ(ca.at("worst_response_us").get<double>(), 540);
+  // The background: one ca frame of interference and its own jitter 500 µs: R = J + C + C.
+  EXPECT_EQ(bus.at("messages")[0].at("worst_response_us").get<double>(), 500 + 270 + 270);
+}
+
+TEST(StudyCheck, BusOverloadIsRefusedNamingTheBus) {
+  nlohmann::json j = read_json(ONESHOT_ENGINE_EXAMPLE_STUDY);
+  for (int k = 0; k < 3; ++k) {  // 4 streams of 270 µs every 1 ms: 108 %
+    j["buses"][0]["background"].push_back({{"name", "x" + std::to_string(k)}, {"id", 300 + k}, {"payload_bytes", 8}, {"period_us", 1000}});
+  }
+  j["buses"][0]["background"][0]["period_us"] = 1000;
+  try {
+    static_cast<void>(resolve_study(parse(j, ONESHOT_ENGINE_EXAMPLE_STUDY)));
+    ADD_FAILURE() << "accepted";
+  } catch (const engine::InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("field 'buses[0]'"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("over 100 %"), std::string::npos) << e.what();
+  }
+}
+
+TEST(StudyCheck, UnstabilizablePlantIsRefusedNamingThePlant) {
+  // The ncs plant with B = 0: no input reaches the double integrator.
+  nlohmann::json p = read_json(std::string(ONESHOT_STUDY_EXAMPLES_DIR) + "/../../../lut_gen/plants/networked_board.json");
+  p["B"] = {{0.0}, {0.0}};
+  const std::string dir = (std::filesystem::temp_directory_path() / "oneshot_study_check_test").string();
+  std::filesystem::create_directories(dir);
+  std::ofstream(dir + "/plant.json") << p.dump();
+  nlohmann::json j = read_json(kNcsExample);
+  j["plant"] = {{"file", "plant.json"}};
+  try {
+    static_cast<void>(resolve_study(parse(j, dir + "/study.json")));
+    ADD_FAILURE() << "accepted";
+  } catch (const engine::InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("field 'plant'"), std::string::npos) << e.what();
+  }
+}
+
+/// A folder holding the delay trace the fuzz harness gives its inputs ("delays.csv").
+std::string trace_dir() {
+  const std::string dir = (std::filesystem::temp_directory_path() / "oneshot_study_check_traces").string();
+  std::filesystem::create_directories(dir);
+  std::ofstream(dir + "/delays.csv") << "delay_us\n500\n# a comment\n1500\n\n250\n";
+  std::filesystem::copy_file(std::string(ONESHOT_STUDY_EXAMPLES_DIR) + "/../../../lut_gen/plants/networked_board.json",
+                             dir + "/networked_board.json", std::filesystem::copy_options::overwrite_existing);
+  return dir;
+}
+
+/// What `study check` prints for a delay model, against the model's own draws: the sample
+/// mean within 5 standard errors of mean_ns(), every draw inside [lower_bound, upper_bound].
+TEST(StudyCheck, DelayMeansAndBoundsMatchTheDraws) {
+  const auto model = [](const char* text) {
+    return engine::parse_delay_model(nlohmann::json::parse(text), "delay", trace_dir());
+  };
+  const std::vector<engine::DelayModel> models = {
+      model(R"({"model": "constant", "delay_us": 1200})"),
+      model(R"({"model": "uniform", "min_us": 500, "max_us": 4000, "resolution_us": 7})"),
+      model(R"({"model": "poisson_periods", "mean_periods": 1.5, "period_us": 10000, "offset_us": 300})"),
+      model(R"({"model": "lognormal", "median_us": 3000, "sigma": 0.6, "shift_us": 500})"),
+      model(R"({"model": "pareto", "scale_us": 1000, "alpha": 4.5, "shift_us": 200})"),
+      model(R"({"model": "trace", "file": "delays.csv"})")};
+  for (const engine::DelayModel& d : models) {
+    engine::RandomStream rng(3, "delay-test");
+    const std::size_t n = 200000;
+    double sum = 0;
+    double sum2 = 0;
+    const auto ub = d.upper_bound();
+    for (std::size_t k = 0; k < n; ++k) {
+      bool clamped = false;
+      const engine::Duration x = d.draw(rng, k, clamped);
+      ASSERT_GE(x, d.lower_bound()) << d.describe();
+      if (ub) {
+        ASSERT_LE(x, *ub) << d.describe();
+      }
+      const double v = static_cast<double>(x.count());
+      sum += v;
+      sum2 += v * v;
+    }
+    const double mean = sum / static_cast<double>(n);
+    const double se = std::sqrt(std::fmax(0.0, sum2 / static_cast<double>(n) - mean * mean) / static_cast<double>(n));
+    EXPECT_NEAR(mean, d.mean_ns(), 5 * se + 1e-9 * d.mean_ns()) << d.describe();
+  }
+}
+
+/// Every number of a resolution is finite (or null: an unbounded delay or response time).
+void expect_finite(const nlohmann::json& j, const std::string& where) {
+  if (j.is_number()) {
+    EXPECT_TRUE(std::isfinite(j.get<double>())) << where;
+  }
+  if (j.is_structured()) {
+    for (const auto& [k, v] : j.items()) expect_finite(v, where + "." + k);
+  }
+}
+
+/// The fuzz harness's seed files (and any study file a fuzzer accepts): study check either
+/// refuses naming a field or resolves to finite figures; the ncs mapping likewise.
+TEST(StudyCheck, FuzzCorpusFilesResolveOrAreRefusedNamingAField) {
+  std::size_t files = 0;
+  std::size_t mapped = 0;
+  for (const auto& entry : std::filesystem::directory_iterator(ONESHOT_STUDY_FUZZ_CORPUS)) {
+    std::ifstream in(entry.path());
+    std::stringstream text;
+    text << in.rdbuf();
+    engine::StudyFile f;
+    try {
+      f = engine::parse_study(text.str(), trace_dir() + "/" + entry.path().filename().string(), nullptr, trace_dir());
+    } catch (const engine::InputError&) {
+      continue;  // the parser refuses it
+    }
+    ++files;
+    try {
+      expect_finite(resolve_study(f), entry.path().filename().string());
+    } catch (const engine::InputError& e) {
+      EXPECT_NE(std::string(e.what()).find("field '"), std::string::npos) << e.what();
+    }
+    try {
+      static_cast<void>(map_ncs_study(f));
+      ++mapped;
+    } catch (const engine::InputError& e) {
+      EXPECT_NE(std::string(e.what()).find("field '"), std::string::npos) << e.what();
+    }
+  }
+  EXPECT_GE(files, 4U);
+  EXPECT_GE(mapped, 1U);  // the ncs seed maps onto the loop
+}
+
+TEST(StudyCheck, CommandLine) {
+  const std::string tmp = (std::filesystem::temp_directory_path() / "oneshot_study_cli_check.json").string();
+  test::CommandOptions to_file;
+  to_file.stdout_path = tmp;
+  const test::CommandResult ok = test::run_command({ONESHOT_SIM_PATH, "study", "check", kNcsExample, "--json", "-"}, to_file);
+  ASSERT_EQ(ok.exit_code, 0) << ok.output;
+  const nlohmann::json r = read_json(tmp);
+  EXPECT_EQ(r.at("runs_with"), "ncs");
+  ASSERT_EQ(r.at("approaches")[7].at("kind"), "S+");
+  EXPECT_EQ(r.at("approaches")[7].at("per_scenario").size(), 10U);
+  // Refused: one line naming the field, non-zero exit, nothing written.
+  const std::string out = (std::filesystem::temp_directory_path() / "oneshot_study_cli_refused").string();
+  std::filesystem::remove_all(out);
+  const test::CommandResult bad = test::run_command({ONESHOT_SIM_PATH, "study", "run", ONESHOT_ENGINE_EXAMPLE_STUDY, "--out", out});
+  EXPECT_NE(bad.exit_code, 0);
+  EXPECT_NE(bad.output.find("field 'study'"), std::string::npos) << bad.output;
+  EXPECT_EQ(std::count(bad.output.begin(), bad.output.end(), '\n'), 1) << bad.output;
+  EXPECT_FALSE(std::filesystem::exists(out));
+}
+
+}  // namespace
+}  // namespace oneshot::study

@@ -1,0 +1,175 @@
+/// @file study_files_test.cpp
+/// @brief `study run` of an ncs study file: the same costs as `ncs table` on the same seeds
+///        (the file's legs against the table's built-in ones), per-link counters, shards
+///        merged to the same bytes as one run, and the refusals of what the loop cannot run.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <functional>
+#include <sstream>
+
+#include "ncs_experiments.hpp"
+#include "oneshot/engine/study_file.hpp"
+#include "study_ncs_runner.hpp"
+#include "study_ncs_sweep.hpp"
+
+namespace oneshot::study {
+namespace {
+
+std::string example_path() { return std::string(ONESHOT_STUDY_EXAMPLES_DIR) + "/ncs.json"; }
+
+nlohmann::json example_json() {
+  std::ifstream in(example_path());
+  std::stringstream s;
+  s << in.rdbuf();
+  return nlohmann::json::parse(s.str());
+}
+
+/// The file's text after `edit`, parsed with the ncs schema as if it sat beside the example.
+engine::StudyFile parse_edited(const std::function<void(nlohmann::json&)>& edit) {
+  nlohmann::json j = example_json();
+  edit(j);
+  return engine::parse_study(j.dump(), example_path(), &ncs_schema(), ONESHOT_STUDY_EXAMPLES_DIR);
+}
+
+std::string temp_dir(const char* name) {
+  return (std::filesystem::temp_directory_path() / ("oneshot_study_test_" + std::string(name))).string();
+}
+
+/// Scenarios 0 (d = 4), 1 (d = 14), 2 (d = 8) of the file, `duration_s` long.
+NcsStudy small_study(double duration_s) {
+  NcsStudy s = map_ncs_study(engine::load_study(example_path(), &ncs_schema()));
+  s.scenarios.resize(3);
+  for (ncs::Scenario& x : s.scenarios) x.duration_s = duration_s;
+  return s;
+}
+
+TEST(StudyFiles, NcsFileGivesTheCostsOfNcsTable) {
+  const NcsStudy s = small_study(4);
+  ASSERT_EQ(s.approaches.size(), 9U);
+  const engine::SweepResults mine = run_ncs_sweep(s, 3, 2, engine::Shard{});
+  const nlohmann::json jm = run_outputs(mine, temp_dir("costs_study"), false);
+  ncs::TableOptions t;  // the table's own scenarios: legs built from d, no file involved
+  t.seeds = 3;
+  t.threads = 2;
+  t.scenarios = ncs::default_scenarios();
+  t.scenarios.resize(3);
+  for (ncs::Scenario& x : t.scenarios) x.duration_s = 4;
+  const nlohmann::json jt = ncs::table_outputs(ncs::table_sweep(*s.ctx, t, engine::Shard{}), temp_dir("costs_table"), false);
+  for (const auto& [name, a] : jt.at("approaches").items()) {
+    const double want = a.at("cost_mean").get<double>();
+    const double got = jm.at("approaches").at(name).at("cost_mean").get<double>();
+    EXPECT_LE(std::fabs(got - want), 1e-12 * std::fabs(want)) << name;
+    EXPECT_LE(std::fabs(jm.at("approaches").at(name).at("cost_ci95").get<double>() - a.at("cost_ci95").get<double>()),
+              1e-12 * std::fabs(a.at("cost_ci95").get<double>()))
+        << name;
+  }
+  for (const auto& [pair, d] : jt.at("paired_differences").items()) {
+    EXPECT_LE(std::fabs(jm.at("paired_differences").at(pair).at("mean").get<double>() - d.at("mean").get<double>()),
+              1e-12 * std::fmax(1e-12, std::fabs(d.at("mean").get<double>())))
+        << pair;
+  }
+  EXPECT_TRUE(jm.at("approaches").at("AK").contains("ratio_to_I"));
+  // Lossless legs: every frame sent is delivered; A uses all three legs, S only sc and ca.
+  for (const char* leg : {"as", "sc", "ca"}) {
+    const nlohmann::json& c = jm.at("links").at("A").at(leg);
+    EXPECT_GT(c.at("sent").get<double>(), 0) << leg;
+    EXPECT_EQ(c.at("lost").get<double>(), 0) << leg;
+    EXPECT_EQ(c.at("delivered").get<double>(), c.at("sent").get<double>()) << leg;
+  }
+  EXPECT_EQ(jm.at("links").at("S").at("as").at("sent").get<double>(), 0);
+}
+
+TEST(StudyFiles, LossFromTheFileReachesTheLeg) {
+  const engine::StudyFile f = parse_edited([](nlohmann::json& j) {
+    j["links"][1]["loss"] = {{"model", "bernoulli"}, {"p", 0.2}};
+    j["approaches"] = nlohmann::json::parse(R"([{"name": "I"}, {"name": "AK"}])");
+  });
+  NcsStudy s = map_ncs_study(f);
+  s.scenarios.resize(1);
+  s.scenarios[0].duration_s = 10;
+  const nlohmann::json j = run_outputs(run_ncs_sweep(s, 3, 2, engine::Shard{}), temp_dir("loss"), false);
+  const nlohmann::json& sc = j.at("links").at("AK").at("sc");
+  const double sent = sc.at("sent").get<double>();
+  ASSERT_GT(sent, 500);
+  // Binomial: σ of the rate ≈ sqrt(0.2·0.8/600) ≈ 0.016; allow 4σ.
+  EXPECT_NEAR(sc.at("lost").get<double>() / sent, 0.2, 0.065);
+  EXPECT_EQ(sc.at("delivered").get<double>() + sc.at("lost").get<double>(), sent);
+  EXPECT_EQ(j.at("links").at("AK").at("ca").at("lost").get<double>(), 0);
+}
+
+TEST(StudyFiles, MergedShardsGiveTheSameBytesAsOneRun) {
+  NcsStudy s = small_study(2);
+  s.approaches = {ncs::Approach::kI, ncs::Approach::kS, ncs::Approach::kAK};
+  const std::string whole = run_outputs(run_ncs_sweep(s, 4, 2, engine::Shard{}), temp_dir("whole"), false).dump();
+  std::vector<engine::SweepResults> parts;
+  for (std::size_t i = 0; i < 3; ++i) {
+    const engine::SweepResults p = run_ncs_sweep(s, 4, 1, engine::Shard{i, 3});
+    parts.push_back(engine::shard_from_json(nlohmann::json::parse(engine::shard_to_json(p).dump())));
+  }
+  const std::string merged = run_outputs(engine::merge_shards(parts), temp_dir("merged"), false).dump();
+  EXPECT_EQ(merged, whole);
+}
+
+/// A refusal names the field; `expect` is a fragment of the message.
+void expect_refused(const std::function<void(nlohmann::json&)>& edit, const std::string& expect) {
+  try {
+    static_cast<void>(map_ncs_study(parse_edited(edit)));
+    ADD_FAILURE() << "accepted, expected " << expect;
+  } catch (const engine::InputError& e) {
+    EXPECT_NE(std::string(e.what()).find(expect), std::string::npos) << e.what();
+  }
+}
+
+TEST(StudyFiles, WhatTheLoopCannotRunIsRefusedNamingTheField) {
+  expect_refused([](nlohmann::json& j) { j["nodes"][1]["clock_offset_us"] = 100; }, "field 'nodes[1].clock_offset_us'");
+  expect_refused([](nlohmann::json& j) { j["nodes"][0]["address"] = 7; }, "field 'nodes[0].address'");
+  expect_refused([](nlohmann::json& j) { j["nodes"][0]["period_us"] = 40000; }, "field 'nodes[0].period_us'");
+  expect_refused([](nlohmann::json& j) { j["nodes"][1]["mode"] = "timer"; j["nodes"][1]["period_us"] = 50000; },
+                 "field 'nodes[1].mode'");
+  expect_refused([](nlohmann::json& j) { j["nodes"][0]["trigger"] = {{"rule", "periodic"}, {"every", 2}}; },
+                 "field 'nodes[0].trigger'");
+  expect_refused(
+      [](nlohmann::json& j) {
+        j["buses"] = nlohmann::json::parse(R"([{"name": "can0", "bit_rate": 500000}])");
+      },
+      "field 'buses'");
+  const auto drop_as_overrides = [](nlohmann::json& j) {
+    for (auto& sc : j["scenarios"])
+      if (sc.contains("links")) sc["links"].erase("as");
+  };
+  expect_refused([&](nlohmann::json& j) { drop_as_overrides(j); j["links"][0]["name"] = "back"; }, "field 'links[0].name'");
+  expect_refused([&](nlohmann::json& j) { drop_as_overrides(j); j["links"].erase(0); }, "field 'approaches[2].kind'");  // A needs as
+  expect_refused([](nlohmann::json& j) { j["approaches"][0]["name"] = "ideal"; }, "field 'approaches[0].name'");
+  expect_refused([](nlohmann::json& j) { std::swap(j["approaches"][0], j["approaches"][1]); }, "field 'approaches[0].kind'");
+  expect_refused([](nlohmann::json& j) { j["scenarios"][0]["params"]["period_s"] = 0.125; }, "field 'scenarios[0].params.period_s'");
+  expect_refused([](nlohmann::json& j) { j["plant"] = {{"continuous", {{"A", {{0}}}, {"B", {{1}}}, {"C", {{1}}}, {"Q_c", {{0}}}}}}; },
+                 "field 'plant'");
+  // S+ needs a mean delay below h: 45 + 2.25 + 3 ms is not.
+  expect_refused([](nlohmann::json& j) { j["links"][1]["delay"] = {{"model", "constant"}, {"delay_us", 45000}}; },
+                 "with approach S+");
+  // AKl needs bounded legs.
+  expect_refused(
+      [](nlohmann::json& j) {
+        j["links"][2]["delay"] = {{"model", "lognormal"}, {"median_us", 1000}, {"sigma", 0.5}};
+      },
+      "with approach AKl");
+  // The schema refuses unknown kinds and parameters (parse_study).
+  EXPECT_THROW(parse_edited([](nlohmann::json& j) { j["approaches"][1]["kind"] = "Z"; }), engine::InputError);
+  EXPECT_THROW(parse_edited([](nlohmann::json& j) { j["scenarios"][0]["params"]["d"] = 3; }), engine::InputError);
+}
+
+TEST(StudyFiles, OtherStudiesAreRefusedNamingTheStudyField) {
+  const engine::StudyFile f = engine::load_study(ONESHOT_ENGINE_EXAMPLE_STUDY, nullptr);
+  try {
+    static_cast<void>(map_ncs_study(f));
+    ADD_FAILURE() << "accepted";
+  } catch (const engine::InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("field 'study'"), std::string::npos) << e.what();
+  }
+}
+
+}  // namespace
+}  // namespace oneshot::study
