@@ -17,6 +17,7 @@
 #include "oneshot/engine/study_file.hpp"
 #include "study_check.hpp"
 #include "support/run_command.hpp"
+#include "support/temp_files.hpp"
 
 namespace oneshot::study {
 namespace {
@@ -105,8 +106,7 @@ TEST(StudyCheck, UnstabilizablePlantIsRefusedNamingThePlant) {
   // The ncs plant with B = 0: no input reaches the double integrator.
   nlohmann::json p = read_json(std::string(ONESHOT_STUDY_EXAMPLES_DIR) + "/../../../lut_gen/plants/networked_board.json");
   p["B"] = {{0.0}, {0.0}};
-  const std::string dir = (std::filesystem::temp_directory_path() / "oneshot_study_check_test").string();
-  std::filesystem::create_directories(dir);
+  const std::string dir = test::made_dir("oneshot_study_check", "unstabilizable");
   std::ofstream(dir + "/plant.json") << p.dump();
   nlohmann::json j = read_json(kNcsExample);
   j["plant"] = {{"file", "plant.json"}};
@@ -120,11 +120,14 @@ TEST(StudyCheck, UnstabilizablePlantIsRefusedNamingThePlant) {
 
 /// A folder holding the delay trace the fuzz harness gives its inputs ("delays.csv").
 std::string trace_dir() {
-  const std::string dir = (std::filesystem::temp_directory_path() / "oneshot_study_check_traces").string();
-  std::filesystem::create_directories(dir);
-  std::ofstream(dir + "/delays.csv") << "delay_us\n500\n# a comment\n1500\n\n250\n";
-  std::filesystem::copy_file(std::string(ONESHOT_STUDY_EXAMPLES_DIR) + "/../../../lut_gen/plants/networked_board.json",
-                             dir + "/networked_board.json", std::filesystem::copy_options::overwrite_existing);
+  // One folder per process, written once: ctest runs the tests of this file in parallel processes.
+  static const std::string dir = [] {
+    const std::string d = test::made_dir("oneshot_study_check", "traces");
+    std::ofstream(d + "/delays.csv") << "delay_us\n500\n# a comment\n1500\n\n250\n";
+    std::filesystem::copy_file(std::string(ONESHOT_STUDY_EXAMPLES_DIR) + "/../../../lut_gen/plants/networked_board.json",
+                               d + "/networked_board.json", std::filesystem::copy_options::overwrite_existing);
+    return d;
+  }();
   return dir;
 }
 
@@ -207,7 +210,7 @@ TEST(StudyCheck, FuzzCorpusFilesResolveOrAreRefusedNamingAField) {
 }
 
 TEST(StudyCheck, CommandLine) {
-  const std::string tmp = (std::filesystem::temp_directory_path() / "oneshot_study_cli_check.json").string();
+  const std::string tmp = test::made_dir("oneshot_study_check", "cli") + "/check.json";
   test::CommandOptions to_file;
   to_file.stdout_path = tmp;
   const test::CommandResult ok = test::run_command({ONESHOT_SIM_PATH, "study", "check", kNcsExample, "--json", "-"}, to_file);
@@ -217,8 +220,7 @@ TEST(StudyCheck, CommandLine) {
   ASSERT_EQ(r.at("approaches")[7].at("kind"), "S+");
   EXPECT_EQ(r.at("approaches")[7].at("per_scenario").size(), 10U);
   // Refused: one line naming the field, non-zero exit, nothing written.
-  const std::string out = (std::filesystem::temp_directory_path() / "oneshot_study_cli_refused").string();
-  std::filesystem::remove_all(out);
+  const std::string out = test::fresh_dir("oneshot_study_check", "cli_refused");
   const test::CommandResult bad = test::run_command({ONESHOT_SIM_PATH, "study", "run", ONESHOT_ENGINE_EXAMPLE_STUDY, "--out", out});
   EXPECT_NE(bad.exit_code, 0);
   EXPECT_NE(bad.output.find("field 'study'"), std::string::npos) << bad.output;

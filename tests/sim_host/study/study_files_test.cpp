@@ -14,6 +14,7 @@
 #include "oneshot/engine/study_file.hpp"
 #include "study_ncs_runner.hpp"
 #include "study_ncs_sweep.hpp"
+#include "support/temp_files.hpp"
 
 namespace oneshot::study {
 namespace {
@@ -34,9 +35,8 @@ engine::StudyFile parse_edited(const std::function<void(nlohmann::json&)>& edit)
   return engine::parse_study(j.dump(), example_path(), &ncs_schema(), ONESHOT_STUDY_EXAMPLES_DIR);
 }
 
-std::string temp_dir(const char* name) {
-  return (std::filesystem::temp_directory_path() / ("oneshot_study_test_" + std::string(name))).string();
-}
+/// A path under the temporary folder, unique to this process (removed first).
+std::string temp_dir(const char* name) { return test::fresh_dir("oneshot_study_test", name); }
 
 /// Scenarios 0 (d = 4), 1 (d = 14), 2 (d = 8) of the file, `duration_s` long.
 NcsStudy small_study(double duration_s) {
