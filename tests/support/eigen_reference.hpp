@@ -38,9 +38,9 @@ double relative_error(const MatX& a, const MatX& b);
 
 /// Φ(t), Γ(t), Q_d(t).
 struct Triple {
-  MatX phi;
-  MatX gamma;
-  MatX qd;
+  MatX phi;    ///< Φ(t) = e^{At}.
+  MatX gamma;  ///< Γ(t) = ∫₀ᵗ e^{As} ds B.
+  MatX qd;     ///< Q_d(t) = ∫₀ᵗ e^{As} Q_c e^{Aᵀs} ds.
 };
 
 /// Eigen's matrix exponential of the block matrix (Φ, Γ) and of Van Loan's (Q_d); t in s.
