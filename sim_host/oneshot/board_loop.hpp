@@ -23,6 +23,7 @@
 #include "control_drivers.hpp"
 #include "oneshot/engine/kernel.hpp"
 #include "board_config.hpp"
+#include "setpoint_volts.hpp"
 #include "simulation.hpp"
 
 namespace oneshot::sim {
@@ -42,12 +43,7 @@ RunResult run_board_loop(const SimContext& ctx, const Scenario& sc, std::uint64_
   RandomStream jitter_rng = kernel.stream("jitter");
   RandomStream measurement_rng = kernel.stream("measurement");
   const SetpointSchedule schedule = make_schedule(sc, plant, seed);
-  const auto code_volts = [&](std::int32_t code) { return d.y_offset[0] + code * d.volts_per_code[0]; };
-  const auto setpoint_at = [&](SimTime t) {
-    Vector<double, P> r;
-    for (std::size_t o = 0; o < P; ++o) r[o] = code_volts(schedule.code_at(t.count()));
-    return r;
-  };
+  const auto setpoint_at = [&](SimTime t) { return setpoint_volts_at<P>(d, schedule, t); };
 
   // Initial conditions: circuit at rest, the PWM at the code nearest 0 V in force from
   // power-on (whatever the register mode), the estimator agreeing.
@@ -102,7 +98,7 @@ RunResult run_board_loop(const SimContext& ctx, const Scenario& sc, std::uint64_
       JobRecord r;
       r.t_sample_s = engine::to_seconds(t_s);
       r.tau_us = report.tau_us;
-      r.y_volts = code_volts(hb.adc_codes[0]);
+      r.y_volts = code_volts(d, 0, hb.adc_codes[0]);
       for (std::size_t i = 0; i < N; ++i) {
         r.x_true.push_back(board.state()[i]);
         r.estimate.push_back(report.estimate[i]);
@@ -110,7 +106,7 @@ RunResult run_board_loop(const SimContext& ctx, const Scenario& sc, std::uint64_
       r.gain0 = report.gain0;
       const SimTime t_apply = kModel == app::TaskModel::kOneShot ? t_k + h : t_s;
       r.setpoint_code = schedule.code_at(t_apply.count());
-      r.setpoint_volts = code_volts(r.setpoint_code);
+      r.setpoint_volts = code_volts(d, 0, r.setpoint_code);
       r.y_code = hb.adc_codes[0];
       r.t_apply_s = engine::to_seconds(kModel == app::TaskModel::kOneShot ? t_apply : t_s + engine::from_us(jt.exec_us));
       r.u_volts = report.u_applied;

@@ -15,7 +15,22 @@
 #include "oneshot/standard_kalman.hpp"
 #include "oneshot/structured_ops.hpp"
 
+#include <type_traits>
+
 namespace oneshot::sim {
+
+/// True for the standard Kalman filter.
+template <typename T>
+struct is_standard_kalman : std::false_type {};
+/// True for the standard Kalman filter.
+template <typename Fmt, typename S, CovarianceUpdate kF>
+struct is_standard_kalman<StandardKalman<Fmt, S, kF>> : std::true_type {};
+/// True for the half Kalman filter.
+template <typename T>
+struct is_half_kalman : std::false_type {};
+/// True for the half Kalman filter.
+template <typename Fmt, typename S, typename D, CovarianceUpdate kF>
+struct is_half_kalman<HalfKalman<Fmt, S, D, kF>> : std::true_type {};
 
 /// The filter core's estimate of a Kalman estimator copy set to x (P kept): through the
 /// protected core, on a probe derived from it and sliced back.
@@ -51,19 +66,11 @@ typename DeadbeatObserver<Fmt, S>::StateVec memory_estimate(const DeadbeatObserv
   return e.prediction();
 }
 
-/// Standard Kalman: x̂ and u_last (u_prev unused).
-template <typename Fmt, typename S, CovarianceUpdate kF, typename Design>
-void set_memory(StandardKalman<Fmt, S, kF>& e, const Design&,
-                const Vector<typename Fmt::State, S::kStates>& x, const Vector<typename Fmt::Input, S::kInputs>& u_last,
-                const Vector<typename Fmt::Input, S::kInputs>&, bool) {
-  set_core_estimate(e, x);
-  e.set_applied_input(u_last);
-}
-/// Half Kalman: x̂ and u_last (u_prev unused).
-template <typename Fmt, typename S, typename D, CovarianceUpdate kF, typename Design>
-void set_memory(HalfKalman<Fmt, S, D, kF>& e, const Design&,
-                const Vector<typename Fmt::State, S::kStates>& x, const Vector<typename Fmt::Input, S::kInputs>& u_last,
-                const Vector<typename Fmt::Input, S::kInputs>&, bool) {
+/// Standard and half Kalman: x̂ and u_last (u_prev unused).
+template <typename Est, typename Design>
+auto set_memory(Est& e, const Design&, const typename Est::StateVec& x, const typename Est::InputVec& u_last,
+                const typename Est::InputVec&, bool)
+    -> std::enable_if_t<is_standard_kalman<Est>::value || is_half_kalman<Est>::value> {
   set_core_estimate(e, x);
   e.set_applied_input(u_last);
 }

@@ -12,6 +12,7 @@
 #include "controller_parts.hpp"
 #include "estimator_memory.hpp"
 #include "linear_tracker.hpp"
+#include "setpoint_volts.hpp"
 #include "oneshot/control_law.hpp"
 #include "oneshot/design/fixed_size.hpp"
 #include "oneshot/engine/kernel.hpp"
@@ -49,15 +50,13 @@ LinearRunResult run_linear(const SimContext& ctx, const Scenario& sc, std::uint6
   const auto c = design::to_fixed<double, P, N>(plant.c);
   const auto nx = design::to_fixed<double, N, P>(d.nx);
   const auto nu = design::to_fixed<double, M, P>(d.nu);
+  // The measurement noise is drawn and tracked as one scalar per job, R = R(0, 0): a plant with
+  // several outputs would need R's Cholesky factor (draws) and its off-diagonal terms (tracker).
+  static_assert(P == 1, "the linear board supports one output: its measurement noise is the scalar R(0, 0)");
   const double r_sigma = std::sqrt(plant.measurement_covariance(0, 0));
   const bool measurement_noise = lin.noise && !lin.analytic;
-  const auto setpoint_at = [&](SimTime t) {
-    Vector<double, P> r;
-    for (std::size_t o = 0; o < P; ++o) r[o] = d.y_offset[0] + schedule.code_at(t.count()) * d.volts_per_code[0];
-    return r;
-  };
   const auto set_reference = [&](SimTime t, auto& target) {
-    const Vector<double, P> r = setpoint_at(t);
+    const Vector<double, P> r = setpoint_volts_at<P>(d, schedule, t);
     target.set_reference(nx * r, nu * r);
   };
 
@@ -134,6 +133,7 @@ LinearRunResult run_linear(const SimContext& ctx, const Scenario& sc, std::uint6
     const Vector<double, M> u = control_law<Fmt, Structure>(design, est.prediction(), r);
     est.set_applied_input(u);
     ++result.jobs;
+    if (lin.record_jobs) result.job_records.push_back(LinearJobRecord{engine::to_seconds(t_s), tau_us});
     if (!is_exact(status)) {
       ++result.faults;
       if (tracker) tracker->refuse(kLinearRefusalInexact);

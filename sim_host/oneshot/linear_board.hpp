@@ -16,6 +16,7 @@
 
 #include <cstdint>
 #include <string>
+#include <vector>
 
 #include "oneshot/engine/jump_linear_cost.hpp"
 #include "scenario.hpp"
@@ -34,6 +35,13 @@ inline constexpr const char* kLinearRefusalMismatch = "the analytic mean left th
 struct LinearOptions {
   bool noise = true;      ///< Process and measurement noise (the board's) in the model.
   bool analytic = false;  ///< Track E[J]: the simulated trajectory is then noise-free.
+  bool record_jobs = false;  ///< Keep one LinearJobRecord per job.
+};
+
+/// Timing of one job of a linear-board run (as the emulated board's JobRecord has it).
+struct LinearJobRecord {
+  double t_sample_s = 0;    ///< Sampling instant.
+  std::int32_t tau_us = 0;  ///< τ the job used.
 };
 
 /// Outcome of a linear-board run.
@@ -45,6 +53,7 @@ struct LinearRunResult {
   std::uint32_t jobs = 0;           ///< Jobs run.
   std::uint32_t out_of_range = 0;   ///< Jobs whose input lay outside the actuator range (applied as is).
   std::uint32_t faults = 0;         ///< Estimator runs that were not exact.
+  std::vector<LinearJobRecord> job_records;  ///< When requested (LinearOptions::record_jobs).
 };
 
 /// Runs `sc` with `seed` on the linear board: approach, discretizer, noise model, P0 scale and

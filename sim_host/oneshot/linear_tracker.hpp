@@ -34,6 +34,8 @@ namespace oneshot::sim {
 /// Interval maps (keyed by A, B, Q1c) and process-noise terms (keyed by A, Q_c, Q1c) shared by
 /// the runs of one thread: the matrix exponentials per interval length dominate a run, and the
 /// same lengths recur from run to run. The values per length do not depend on the cache.
+/// Entries are never evicted (the keys are the few plants of a study: the run's plant, with
+/// and without process noise), so a reference handed out stays valid for the thread's life.
 template <std::size_t N, std::size_t M>
 class SharedCaches {
  public:
@@ -42,7 +44,6 @@ class SharedCaches {
     thread_local std::vector<std::unique_ptr<SegmentsEntry>> all;
     for (auto& e : all)
       if (same(e->a, p.a) && same(e->b, p.b) && same(e->q1c, p.q1c)) return e->cache;
-    if (all.size() >= 4) all.erase(all.begin());
     all.push_back(std::make_unique<SegmentsEntry>(SegmentsEntry{p.a, p.b, p.q1c, {p.a, p.b, p.q1c}}));
     return all.back()->cache;
   }
@@ -51,7 +52,6 @@ class SharedCaches {
     thread_local std::vector<std::unique_ptr<NoiseEntry>> all;
     for (auto& e : all)
       if (same(e->a, p.a) && same(e->qc, p.qc) && same(e->q1c, p.q1c)) return e->cache;
-    if (all.size() >= 4) all.erase(all.begin());
     all.push_back(std::make_unique<NoiseEntry>(NoiseEntry{p.a, p.qc, p.q1c, {p.a, p.qc, p.q1c}}));
     return all.back()->cache;
   }

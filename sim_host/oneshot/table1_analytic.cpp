@@ -36,6 +36,9 @@ const char* refusal_text(double code) {
   return c >= 1 && c <= std::size(kReasons) ? kReasons[c - 1] : "unknown";
 }
 
+/// Written instead of a ratio to A when A's analytic value is refused.
+constexpr const char* kReferenceRefused = "reference A refused";
+
 std::string path_in(const std::string& dir, const std::string& name) { return (std::filesystem::path(dir) / name).string(); }
 
 /// Mean and interval of x_k (over seeds) as {"mean", "ci95"}.
@@ -161,11 +164,21 @@ nlohmann::json table1_analytic_outputs(const engine::SweepResults& results, cons
     const double vr = spread ? std::pow(mc.value[a].ci95 / ci_an, 2) : std::numeric_limits<double>::quiet_NaN();
     ja["analytic_mean"] = an.value[a].mean;
     ja["analytic_ci95"] = ci_an;
-    ja["analytic_ratio_to_A"] = {{"mean", an.ratio[a].mean}, {"ci95", an.ratio[a].ci95}};
-    ja["analytic_ratio_to_A_scenario_weighted"] = {{"mean", an.ratio_weighted[a].mean}, {"ci95", an.ratio_weighted[a].ci95}};
     ja["mc_minus_analytic"] = summary(diff);
+    // Ratios to A (approach 0) only when A's analytic values all hold.
+    const bool reference_ok = refused[0] == 0;
+    if (reference_ok) {
+      ja["analytic_ratio_to_A"] = {{"mean", an.ratio[a].mean}, {"ci95", an.ratio[a].ci95}};
+      ja["analytic_ratio_to_A_scenario_weighted"] = {{"mean", an.ratio_weighted[a].mean},
+                                                     {"ci95", an.ratio_weighted[a].ci95}};
+    } else {
+      ja["analytic_ratio_to_A"] = kReferenceRefused;
+      ja["analytic_ratio_to_A_scenario_weighted"] = kReferenceRefused;
+      ja["ratio_variance_reduction"] = kReferenceRefused;
+    }
     // The ratio to A, paired per seed: the set-point draws cancel, the noise remains in the MC.
-    if (an.ratio[a].ci95 > 0) {
+    const bool ratio_spread = reference_ok && an.ratio[a].ci95 > 0;
+    if (ratio_spread) {
       const double rvr = std::pow(mc.ratio[a].ci95 / an.ratio[a].ci95, 2);
       ja["ratio_variance_reduction"] = rvr;
       table_rvr = std::fmin(table_rvr, rvr);
@@ -178,12 +191,18 @@ nlohmann::json table1_analytic_outputs(const engine::SweepResults& results, cons
       ja["variance_reduction"] = nullptr;
     }
     const util::Summary q = util::summarize(quant);
-    std::snprintf(line, sizeof line,
-                  "| %s | %.6f | ± %.6f | %.6f | ± %.6f | %.6f | %.6f ± %.6f | %.6f ± %.6f | %.5f ± %.5f | %s (%s) |\n",
+    char ratio[96];
+    if (reference_ok) {
+      std::snprintf(ratio, sizeof ratio, "%.6f ± %.6f", an.ratio[a].mean, an.ratio[a].ci95);
+    } else {
+      std::snprintf(ratio, sizeof ratio, "%s", kReferenceRefused);
+    }
+    const std::string rvr_text = ratio_spread ? std::to_string(std::pow(mc.ratio[a].ci95 / an.ratio[a].ci95, 2))
+                                              : std::string(reference_ok ? "—" : kReferenceRefused);
+    std::snprintf(line, sizeof line, "| %s | %.6f | ± %.6f | %.6f | ± %.6f | %.6f | %.6f ± %.6f | %s | %.5f ± %.5f | %s (%s) |\n",
                   nm.c_str(), an.value[a].mean, ci_an, mc.value[a].mean, mc.value[a].ci95, bd.value[a].mean, q.mean,
-                  q.ci95, an.ratio[a].mean, an.ratio[a].ci95, mc.ratio[a].mean, mc.ratio[a].ci95,
-                  std::isfinite(vr) ? std::to_string(vr).c_str() : "— (no spread)",
-                  an.ratio[a].ci95 > 0 ? std::to_string(std::pow(mc.ratio[a].ci95 / an.ratio[a].ci95, 2)).c_str() : "—");
+                  q.ci95, ratio, mc.ratio[a].mean, mc.ratio[a].ci95,
+                  std::isfinite(vr) ? std::to_string(vr).c_str() : "— (no spread)", rvr_text.c_str());
     md << line;
   }
   if (std::isfinite(table_vr)) {
@@ -237,10 +256,28 @@ nlohmann::json table1_analytic_outputs(const engine::SweepResults& results, cons
       js.push_back(e);
     }
     if (refused[ia] == 0 && refused[ib] == 0) {
-      const util::Summary& r = an.ratio[ib];
-      j["B_over_A"] = {{"analytic_mean", r.mean}, {"analytic_ci95", r.ci95},
-                       {"mc_mean", mc.ratio[ib].mean}, {"mc_ci95", mc.ratio[ib].ci95},
-                       {"within_0_2_percent", decide_within(r.mean - 1, r.ci95, kWithinTolerance)}};
+      // Two aggregates over the scenarios, both paired per seed: cost-weighted = the ratio of the
+      // scenario-summed costs (the scenarios with large costs dominate), scenario-weighted = the
+      // mean over the scenarios of the per-scenario ratio (each scenario counts the same).
+      const auto aggregate = [&](const util::Summary& r, const util::Summary& m) {
+        return nlohmann::json{{"analytic_mean", r.mean}, {"analytic_ci95", r.ci95}, {"mc_mean", m.mean}, {"mc_ci95", m.ci95},
+                              {"within_0_2_percent", decide_within(r.mean - 1, r.ci95, kWithinTolerance)}};
+      };
+      const nlohmann::json cw = aggregate(an.ratio[ib], mc.ratio[ib]);
+      const nlohmann::json sw = aggregate(an.ratio_weighted[ib], mc.ratio_weighted[ib]);
+      std::size_t within = 0;
+      for (const nlohmann::json& e : js)
+        if (e["within_0_2_percent"] == "yes") ++within;
+      j["B_over_A"] = {{"cost_weighted", cw}, {"scenario_weighted", sw}, {"scenarios_within", within}, {"scenarios", ns}};
+      char line[512];
+      std::snprintf(line, sizeof line,
+                    "\nB/A over the scenarios (analytic, paired per seed): cost-weighted (ratio of the scenario-summed "
+                    "costs) %.6f ± %.6f, within 0.2 %%: %s; scenario-weighted (mean of the per-scenario ratios) "
+                    "%.6f ± %.6f, within 0.2 %%: %s; within 0.2 %% in %zu of %zu scenarios.\n",
+                    an.ratio[ib].mean, an.ratio[ib].ci95, cw["within_0_2_percent"].get<std::string>().c_str(),
+                    an.ratio_weighted[ib].mean, an.ratio_weighted[ib].ci95,
+                    sw["within_0_2_percent"].get<std::string>().c_str(), within, ns);
+      per << line;
     }
   }
   j["per_scenario"] = js;
