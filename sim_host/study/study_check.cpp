@@ -38,7 +38,8 @@ json delay_summary(const engine::DelayModel& d) {
     j["max_us"] = us(*ub);
   } else {
     j["max_us"] = nullptr;
-    j["cap_us"] = us(d.cap);
+    // Only the heavy tails are capped (draws above the cap are clamped); Poisson is not.
+    if (d.kind == engine::DelayModel::Kind::kLognormal || d.kind == engine::DelayModel::Kind::kPareto) j["cap_us"] = us(d.cap);
   }
   return j;
 }
