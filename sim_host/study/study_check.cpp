@@ -4,7 +4,9 @@
 #include "study_check.hpp"
 
 #include <cmath>
+#include <algorithm>
 #include <cstdio>
+#include <optional>
 #include <sstream>
 
 #include "ncs_model.hpp"
@@ -38,7 +40,8 @@ json delay_summary(const engine::DelayModel& d) {
     j["max_us"] = us(*ub);
   } else {
     j["max_us"] = nullptr;
-    j["cap_us"] = us(d.cap);
+    // Only the heavy tails are capped (draws above the cap are clamped); Poisson is not.
+    if (d.kind == engine::DelayModel::Kind::kLognormal || d.kind == engine::DelayModel::Kind::kPareto) j["cap_us"] = us(d.cap);
   }
   return j;
 }
@@ -66,6 +69,78 @@ engine::Duration loop_period(const engine::StudyFile& f) {
   for (const engine::NodeSpec& n : f.nodes)
     if (n.mode == "timer" && (p.count() == 0 || n.period < p)) p = n.period;
   return p;
+}
+
+/// When a node sends, after the release of the timer that starts its chain: [lo, hi].
+struct SendWindow {
+  engine::Duration lo{0};  ///< Earliest.
+  engine::Duration hi{0};  ///< Latest.
+};
+
+/// The send window of `node` under scenario `s` (nullptr: the file's links): a timer node
+/// [0, 0]; an arrival node the union over its incoming links of the sender's window plus the
+/// link's delay bounds, plus the computation on arrival τ_c of study ncs (U[1, 5] ms, the only
+/// computation time study files model); with no incoming link [0, 0]. nullopt when unbounded:
+/// a delay model with no upper bound, an incoming link on a CAN bus (chained bus analysis is
+/// not done), a cycle of arrival nodes.
+std::optional<SendWindow> send_window(const engine::StudyFile& f, const std::string& node, const engine::ScenarioSpec* s,
+                                      std::size_t depth = 0) {
+  if (f.node(node).mode != "arrival") return SendWindow{};
+  if (depth > f.nodes.size()) return std::nullopt;
+  std::optional<SendWindow> w;
+  for (const engine::LinkSpec& l : f.links) {
+    if (l.to != node) continue;
+    if (!l.bus.empty()) return std::nullopt;
+    const std::optional<SendWindow> up = send_window(f, l.from, s, depth + 1);
+    const engine::DelayModel d = f.link_config(l.name, s).delay;
+    const std::optional<engine::Duration> ub = d.upper_bound();
+    if (!up || !ub) return std::nullopt;
+    const SendWindow x{up->lo + d.lower_bound(), up->hi + *ub};
+    w = w ? SendWindow{std::min(w->lo, x.lo), std::max(w->hi, x.hi)} : x;
+  }
+  if (!w) return SendWindow{};
+  const ncs::Timing t;
+  return SendWindow{w->lo + engine::from_us(t.compute_min_us), w->hi + engine::from_us(t.compute_max_us)};
+}
+
+/// Release jitter of the loop messages among `links` (the bus's streams from index
+/// `first_link`) under scenario `s`: its sender's send window hi − lo; nullopt when unbounded.
+std::vector<std::optional<engine::Duration>> loop_jitters(const engine::StudyFile& f, const std::vector<const engine::LinkSpec*>& links,
+                                                          const engine::ScenarioSpec* s) {
+  std::vector<std::optional<engine::Duration>> out;
+  for (const engine::LinkSpec* l : links) {
+    const std::optional<SendWindow> w = send_window(f, l->from, s);
+    out.push_back(w ? std::optional<engine::Duration>(w->hi - w->lo) : std::nullopt);
+  }
+  return out;
+}
+
+/// The response-time analysis of a bus's streams, the loop messages (from index `first_link`)
+/// with the release jitters `jitters`: one with an unbounded jitter is analyzed with 0 and
+/// reported unbounded, with every stream of lower priority (its interference on them has no
+/// bound).
+json bus_messages(std::vector<engine::CanStream> streams, const std::vector<std::string>& kinds, std::size_t first_link,
+                  const std::vector<std::optional<engine::Duration>>& jitters, const engine::CanBusConfig& config) {
+  std::vector<bool> unbounded_jitter(streams.size(), false);
+  for (std::size_t k = 0; k < jitters.size(); ++k) {
+    streams[first_link + k].jitter = jitters[k].value_or(engine::Duration{0});
+    unbounded_jitter[first_link + k] = !jitters[k];
+  }
+  const std::vector<engine::CanStreamBound> bounds = engine::can_response_times(streams, config);
+  json out = json::array();
+  for (std::size_t k = 0; k < streams.size(); ++k) {
+    bool bounded = bounds[k].bounded;
+    for (std::size_t i = 0; i < streams.size(); ++i)
+      if (unbounded_jitter[i] && streams[i].id <= streams[k].id) bounded = false;
+    json m = {{"name", streams[k].name}, {"kind", kinds[k]}, {"id", streams[k].id},
+              {"payload_bytes", streams[k].payload_bytes}, {"period_us", us(streams[k].period)},
+              {"jitter_us", unbounded_jitter[k] ? json(nullptr) : json(us(streams[k].jitter))},
+              {"deadline_us", us(streams[k].deadline)}, {"transmission_us", us(bounds[k].transmission)},
+              {"bounded", bounded}, {"schedulable", bounded && bounds[k].schedulable}};
+    m["worst_response_us"] = bounded ? json(us(bounds[k].response)) : json(nullptr);
+    out.push_back(m);
+  }
+  return out;
 }
 
 json plant_section(const engine::StudyFile& f, json& designs) {
@@ -167,6 +242,8 @@ json resolve_study(const engine::StudyFile& f) {
       const std::string field = "buses[" + std::to_string(b) + "]";
       std::vector<engine::CanStream> streams = bus.background;
       std::vector<std::string> kinds(streams.size(), "background");
+      const std::size_t first_link = streams.size();
+      std::vector<const engine::LinkSpec*> on_bus;
       for (const engine::LinkSpec& l : f.links) {
         if (l.bus != bus.config.name) continue;
         const engine::NodeSpec& from = f.node(l.from);
@@ -180,6 +257,7 @@ json resolve_study(const engine::StudyFile& f) {
         st.deadline = t;
         streams.push_back(st);
         kinds.emplace_back("link");
+        on_bus.push_back(&l);
       }
       double load = 0;
       const engine::Duration bit{1'000'000'000 / bus.config.bit_rate};
@@ -193,15 +271,12 @@ json resolve_study(const engine::StudyFile& f) {
         std::snprintf(buf, sizeof buf, "%.1f", 100 * load);
         throw InputError("field '" + field + "': bus " + bus.config.name + " is loaded " + buf + " % (over 100 %)");
       }
-      const std::vector<engine::CanStreamBound> bounds = engine::can_response_times(streams, bus.config);
-      for (std::size_t k = 0; k < streams.size(); ++k) {
-        json m = {{"name", streams[k].name}, {"kind", kinds[k]}, {"id", streams[k].id},
-                  {"payload_bytes", streams[k].payload_bytes}, {"period_us", us(streams[k].period)},
-                  {"jitter_us", us(streams[k].jitter)}, {"deadline_us", us(streams[k].deadline)},
-                  {"transmission_us", us(bounds[k].transmission)}, {"bounded", bounds[k].bounded},
-                  {"schedulable", bounds[k].schedulable}};
-        m["worst_response_us"] = bounds[k].bounded ? json(us(bounds[k].response)) : json(nullptr);
-        e["messages"].push_back(m);
+      const auto base = loop_jitters(f, on_bus, nullptr);
+      e["messages"] = bus_messages(streams, kinds, first_link, base, bus.config);
+      // A scenario whose link overrides change a loop message's jitter: its own analysis.
+      for (const engine::ScenarioSpec& s : f.scenarios) {
+        const auto jit = loop_jitters(f, on_bus, &s);
+        if (jit != base) e["scenarios"][s.name] = bus_messages(streams, kinds, first_link, jit, bus.config);
       }
       r["buses"].push_back(e);
     }
@@ -268,10 +343,20 @@ std::string describe_resolution(const json& r) {
   if (r.contains("buses")) {
     for (const json& b : r.at("buses")) {
       o << "bus " << b.at("name").get<std::string>() << ": load " << 100 * b.at("load").get<double>() << " %\n";
-      for (const json& m : b.at("messages")) {
-        o << "  " << m.at("kind").get<std::string>() << " " << m.at("name").get<std::string>() << " id " << m.at("id")
-          << ": C " << m.at("transmission_us") << " us, worst response "
-          << (m.at("worst_response_us").is_null() ? std::string("unbounded") : m.at("worst_response_us").dump()) << " us\n";
+      const auto messages = [&o](const json& list, const std::string& indent) {
+        for (const json& m : list) {
+          o << indent << m.at("kind").get<std::string>() << " " << m.at("name").get<std::string>() << " id " << m.at("id")
+            << ": C " << m.at("transmission_us") << " us, jitter "
+            << (m.at("jitter_us").is_null() ? std::string("unbounded") : m.at("jitter_us").dump() + " us") << ", worst response "
+            << (m.at("worst_response_us").is_null() ? std::string("unbounded") : m.at("worst_response_us").dump() + " us") << "\n";
+        }
+      };
+      messages(b.at("messages"), "  ");
+      if (b.contains("scenarios")) {
+        for (const auto& [sc, list] : b.at("scenarios").items()) {
+          o << "  scenario " << sc << ":\n";
+          messages(list, "    ");
+        }
       }
     }
   }

@@ -6,6 +6,7 @@
 #include <filesystem>
 #include <iostream>
 #include <memory>
+#include <optional>
 
 #include "oneshot/engine/study_file.hpp"
 #include "oneshot/sim/study_descriptor.hpp"
@@ -17,20 +18,36 @@
 namespace oneshot::sim {
 namespace {
 
-/// Loads, resolves and maps a study file: every refusal before anything is written.
+/// A study file resolved into everything `study check` can compute and, when the ncs loop
+/// can run it, mapped onto that loop.
 struct Checked {
-  nlohmann::json resolution;
-  study::NcsStudy ncs;
+  nlohmann::json resolution;             ///< resolve_study(), plus "runnable" (and "refusal").
+  std::optional<study::NcsStudy> ncs;    ///< Set when the file runs.
+  std::string refusal;                   ///< "field '<f>': <reason>" when it does not run.
 };
 
+/// Loads and resolves a study file; bad input (a parse error, a bus over 100 %, a plant that
+/// cannot be designed) throws engine::InputError before anything is written. What `study run`
+/// cannot run is not bad input: it is kept in `refusal`, naming the field.
 Checked check_file(const std::string& path) {
   const engine::StudyFile generic = engine::load_study(path, nullptr);
   Checked c;
   c.resolution = study::resolve_study(generic);
-  if (generic.study != "ncs") static_cast<void>(study::map_ncs_study(generic));  // refuses naming 'study'
-  c.ncs = study::map_ncs_study(engine::load_study(path, &study::ncs_schema()));
-  study::add_ncs_designs(c.resolution, c.ncs);
-  c.resolution["runs_with"] = "ncs";
+  try {
+    c.ncs = generic.study != "ncs" ? study::map_ncs_study(generic)  // refuses naming 'study'
+                                   : study::map_ncs_study(engine::load_study(path, &study::ncs_schema()));
+  } catch (const engine::InputError& e) {
+    c.refusal = e.what();
+    const std::string prefix = generic.source + ": ";
+    if (c.refusal.rfind(prefix, 0) == 0) c.refusal.erase(0, prefix.size());
+  }
+  c.resolution["runnable"] = c.ncs.has_value();
+  if (c.ncs) {
+    study::add_ncs_designs(c.resolution, *c.ncs);
+    c.resolution["runs_with"] = "ncs";
+  } else {
+    c.resolution["refusal"] = c.refusal;
+  }
   return c;
 }
 
@@ -53,13 +70,22 @@ void add_study_commands(CLI::App* group) {
   {
     auto c = std::make_shared<CheckCli>();
     CLI::App* cmd = group->add_subcommand(
-        "check", "Validate a study file and print what it resolves to: designs, link delay/loss summaries, CAN bounds, the grid");
+        "check", "Validate a study file and print what it resolves to: designs, link delay/loss summaries, CAN bounds, the grid; "
+        "then, if study run cannot run it, the field and the reason (non-zero exit)");
     cmd->add_option("file", c->file, "study file (oneshot-study/1)")->required();
     cmd->add_option("--json", c->json, "write the resolution as JSON to PATH, or '-' for standard output");
     cmd->callback([c]() {
       const Checked k = check_file(c->file);
       if (!c->json.empty()) util::write_json(c->json, k.resolution);
-      if (c->json != "-") std::cout << study::describe_resolution(k.resolution) << "runs with: oneshot-sim study run " << c->file << "\n";
+      if (c->json != "-") {
+        std::cout << study::describe_resolution(k.resolution);
+        if (k.ncs) std::cout << "runs with: oneshot-sim study run " << c->file << "\n";
+      }
+      if (!k.ncs) {  // the resolution is out; the refusal is the last line, and the exit is non-zero
+        std::cout.flush();
+        std::cerr << "cannot run: " << k.refusal << "\n";
+        throw CLI::RuntimeError(1);
+      }
     });
   }
   {
@@ -74,10 +100,11 @@ void add_study_commands(CLI::App* group) {
     cmd->add_flag("--no-plots", c->no_plots, "write CSV files only (no gnuplot)");
     cmd->callback([c]() {
       const Checked k = check_file(c->file);
+      if (!k.ncs) throw engine::InputError(k.resolution.at("source").get<std::string>() + ": " + k.refusal);  // one line, nothing written
       const engine::Shard part = engine::parse_shard(c->shard);
       util::make_directory(c->out);
       const auto start = std::chrono::steady_clock::now();
-      const engine::SweepResults r = study::run_ncs_sweep(k.ncs, c->seeds, c->threads, part);
+      const engine::SweepResults r = study::run_ncs_sweep(*k.ncs, c->seeds, c->threads, part);
       const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
       nlohmann::json j;
       if (!part.whole()) {

@@ -19,15 +19,13 @@ std::string at(const char* list, std::size_t i) { return std::string(list) + "["
   throw InputError("field '" + field + "': " + why);
 }
 
-/// The leg a link is: its name must be the loop's, its ends the nodes of those roles.
-struct Leg {
-  const char* name;
-  const char* from;
-  const char* to;
-};
-constexpr Leg kLegs[] = {{"as", "actuator", "sensor"}, {"sc", "sensor", "controller"}, {"ca", "controller", "actuator"}};
-
 }  // namespace
+
+const NcsLeg* find_ncs_leg(const std::string& name) {
+  for (const NcsLeg& g : kNcsLegs)
+    if (name == g.name) return &g;
+  return nullptr;
+}
 
 const engine::StudySchema& ncs_schema() {
   static const engine::StudySchema schema = [] {
@@ -96,9 +94,8 @@ NcsStudy map_ncs_study(const engine::StudyFile& file) {
     for (std::size_t i = 0; i < file.links.size(); ++i) {
       const engine::LinkSpec& l = file.links[i];
       const std::string f = at("links", i);
-      const Leg* leg = nullptr;
-      for (const Leg& g : kLegs)
-        if (l.name == g.name) leg = &g;
+      // The leg a link is: its name must be the loop's, its ends the nodes of those roles.
+      const NcsLeg* leg = find_ncs_leg(l.name);
       if (leg == nullptr) refuse(f + ".name", "study ncs has legs as, sc, ca only (the names of their random streams)");
       if (l.from != by_role.at(leg->from)) refuse(f + ".from", std::string("leg ") + leg->name + " leaves the " + leg->from);
       if (l.to != by_role.at(leg->to)) refuse(f + ".to", std::string("leg ") + leg->name + " reaches the " + leg->to);
@@ -154,8 +151,10 @@ NcsStudy map_ncs_study(const engine::StudyFile& file) {
       sc.noise_scale = params.at("noise_scale");
       sc.duration_s = s.duration_s.value_or(file.duration_s);
       for (const std::string& l : out.links) sc.legs[l] = file.link_config(l, &s);
-      const std::optional<engine::Duration> ub = sc.legs.at("sc").delay.upper_bound();
-      sc.max_delay_ms = ub ? static_cast<double>(ub->count()) * 1e-6 : 0;  // d, as the ncs table reports it
+      // d of study ncs (every leg U[0.5, d] ms) has no meaning for the file's legs, and ncs::run
+      // takes the legs instead: 0. study run leaves ncs table's by-d keys out and reports each
+      // scenario's sc + ca delay bound (study_ncs_sweep.hpp).
+      sc.max_delay_ms = 0;
       try {
         static_cast<void>(ncs::half_wave_periods(*out.ctx, sc));
       } catch (const std::exception&) {

@@ -22,6 +22,21 @@
 
 namespace oneshot::study {
 
+/// A leg of the ncs loop: its name (the link's in the file, and its random streams'
+/// `link/<name>/…`) and the roles of the nodes it leaves and reaches.
+struct NcsLeg {
+  const char* name;  ///< "as", "sc" or "ca".
+  const char* from;  ///< Role of the sending node.
+  const char* to;    ///< Role of the receiving node.
+};
+
+/// The legs of the ncs loop, the one table of their roles.
+inline constexpr NcsLeg kNcsLegs[] = {
+    {"as", "actuator", "sensor"}, {"sc", "sensor", "controller"}, {"ca", "controller", "actuator"}};
+
+/// The leg named `name`; nullptr when the loop has none of that name.
+const NcsLeg* find_ncs_leg(const std::string& name);
+
 /// What `study run` accepts from a file with "study": "ncs" (approach kinds: the ncs
 /// approaches; scenario params amplitude_volts, period_s required, noise_scale default 1).
 const engine::StudySchema& ncs_schema();

@@ -3,6 +3,7 @@
 #include "study_ncs_sweep.hpp"
 
 #include <array>
+#include <optional>
 
 #include "ncs_experiments.hpp"
 #include "ncs_loop.hpp"
@@ -10,32 +11,52 @@
 namespace oneshot::study {
 namespace {
 
-/// The node that receives on leg `link`.
-const char* receiver(const std::string& link) {
-  if (link == "as") return "sensor";
-  if (link == "sc") return "controller";
-  return "actuator";
-}
+/// Positions of the counters in kLinkCounters (and in the metrics of each link).
+constexpr std::size_t kSent = link_counter_index("sent");
+constexpr std::size_t kDelivered = link_counter_index("delivered");
+constexpr std::size_t kLost = link_counter_index("lost");
+constexpr std::size_t kLate = link_counter_index("late");
+constexpr std::size_t kRefused = link_counter_index("refused");
+static_assert(kSent < std::size(kLinkCounters) && kDelivered < std::size(kLinkCounters) &&
+                  kLost < std::size(kLinkCounters) && kLate < std::size(kLinkCounters) &&
+                  kRefused < std::size(kLinkCounters),
+              "every counter link_counts() fills is named in kLinkCounters");
 
-/// sent, delivered, lost, late, refused of `link` in run `r` of approach `a`.
-std::array<double, 5> link_counts(const ncs::RunResult& r, ncs::Approach a, const std::string& link) {
-  std::array<double, 5> v{};
+/// The counters of `link` in run `r` of approach `a`, in the order of kLinkCounters.
+std::array<double, std::size(kLinkCounters)> link_counts(const ncs::RunResult& r, ncs::Approach a, const std::string& link) {
+  std::array<double, std::size(kLinkCounters)> v{};
   for (const auto& [nm, st] : r.links) {
     if (nm != link) continue;
-    v[0] = static_cast<double>(st.sent);
-    v[1] = static_cast<double>(st.sent - st.lost);
-    v[2] = static_cast<double>(st.lost);
+    v[kSent] = static_cast<double>(st.sent);
+    v[kDelivered] = static_cast<double>(st.sent - st.lost);
+    v[kLost] = static_cast<double>(st.lost);
   }
   const std::vector<std::string> names = ncs::counter_names(a);
-  const std::string node = receiver(link);
+  const NcsLeg* leg = find_ncs_leg(link);
+  if (leg == nullptr) return v;  // map_ncs_study admits the loop's legs only
+  const std::string node = leg->to;  // the receiving node's counters
   for (std::size_t i = 0; i < names.size() && i < r.counters.size(); ++i) {
     const std::string& c = names[i];
     if (c.rfind(node + ".", 0) != 0) continue;
     const std::string what = c.substr(node.size() + 1);
-    if (what == "stale" || what == "late") v[3] += r.counters[i];
-    if (what == "malformed" || what.rfind("refused_", 0) == 0) v[4] += r.counters[i];
+    if (what == "stale" || what == "late") v[kLate] += r.counters[i];
+    if (what == "malformed" || what.rfind("refused_", 0) == 0) v[kRefused] += r.counters[i];
   }
   return v;
+}
+
+/// Upper bound of the sc + ca delays of scenario `x` in ms; null when a leg's delay model has
+/// no upper bound (Poisson, lognormal, Pareto).
+nlohmann::json sc_ca_delay_bound_ms(const ncs::Scenario& x) {
+  double ns = 0;
+  for (const char* leg : {"sc", "ca"}) {
+    const auto it = x.legs.find(leg);
+    if (it == x.legs.end()) continue;
+    const std::optional<engine::Duration> ub = it->second.delay.upper_bound();
+    if (!ub) return nullptr;
+    ns += static_cast<double>(ub->count());
+  }
+  return ns * 1e-6;
 }
 
 }  // namespace
@@ -53,7 +74,8 @@ engine::SweepResults run_ncs_sweep(const NcsStudy& s, std::size_t seeds, unsigne
       legs[nm] = {{"delay", l.delay.describe()}, {"loss", l.loss.describe()}, {"order", l.fifo ? "fifo" : "any"}};
     }
     sc.push_back({{"name", x.name}, {"amplitude_volts", x.amplitude_volts}, {"period_s", x.period_s},
-                  {"max_delay_ms", x.max_delay_ms}, {"noise_scale", x.noise_scale}, {"duration_s", x.duration_s},
+                  {"max_delay_ms", x.max_delay_ms}, {"delay_bound_sc_ca_ms", sc_ca_delay_bound_ms(x)},
+                  {"noise_scale", x.noise_scale}, {"duration_s", x.duration_s},
                   {"s_plus_mean_tau_io_us", s.ctx->mean_tau_io_us(x)}, {"legs", legs}});
   }
   spec.first_seed = s.first_seed;
@@ -90,6 +112,10 @@ nlohmann::json run_outputs(const engine::SweepResults& results, const std::strin
   const engine::SweepSpec& spec = results.spec;
   j["experiment"] = "study run";
   j["study_file"] = spec.config.at("study_file");
+  // ncs table keys S's ratio by study ncs's d, which the file's legs do not have: left out.
+  j.erase("S_ratio_to_I_by_delay_ms");
+  j.erase("S_ratio_increases_with_delay");
+  for (const auto& x : spec.config.at("scenarios")) j["delay_bound_sc_ca_ms"][x.at("name").get<std::string>()] = x.at("delay_bound_sc_ca_ms");
   for (std::size_t a = 0; a < spec.approaches.size(); ++a) {
     for (const auto& l : spec.config.at("links")) {
       const std::string link = l.get<std::string>();

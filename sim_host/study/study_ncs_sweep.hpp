@@ -5,7 +5,9 @@
 #pragma once
 
 #include <cstddef>
+#include <iterator>
 #include <string>
+#include <string_view>
 
 #include <nlohmann/json.hpp>
 
@@ -17,6 +19,13 @@ namespace oneshot::study {
 /// Names of the per-link counters, each a metric "<link>.<counter>" of the sweep.
 inline constexpr const char* kLinkCounters[] = {"sent", "delivered", "lost", "late", "refused"};
 
+/// Position of the counter `name` in kLinkCounters (its size when there is none).
+constexpr std::size_t link_counter_index(std::string_view name) {
+  std::size_t i = 0;
+  while (i < std::size(kLinkCounters) && name != kLinkCounters[i]) ++i;
+  return i;
+}
+
 /// Runs the sweep (or one shard) of `s` with `seeds` replications (0: the file's count) on
 /// `threads` threads (0: every core). The runs are ncs::run() on the file's scenarios: same
 /// seeds, same random stream names, so the same costs as `ncs table` on the same settings.
@@ -26,7 +35,10 @@ engine::SweepResults run_ncs_sweep(const NcsStudy& s, std::size_t seeds, unsigne
 /// ratio_scenario_weighted, paired differences, per scenario; files in `out_dir`) plus
 /// "links": per approach and link the totals of sent, delivered (not lost: arrived or in
 /// flight at the end), lost, late (dropped by the receiver as stale or late) and refused
-/// (refused by the receiver's frame checks) over every run.
+/// (refused by the receiver's frame checks) over every run; "delay_bound_sc_ca_ms": per
+/// scenario the upper bound of the sc + ca delays (null when a leg is unbounded). ncs table's
+/// S_ratio_to_I_by_delay_ms and S_ratio_increases_with_delay are left out: they are keyed by
+/// study ncs's d (every leg U[0.5, d] ms), which a file's legs do not have.
 nlohmann::json run_outputs(const engine::SweepResults& results, const std::string& out_dir, bool plots);
 
 }  // namespace oneshot::study

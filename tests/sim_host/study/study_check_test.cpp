@@ -80,11 +80,52 @@ TEST(StudyCheck, ExampleFileGivesLinkSummariesAndCanBounds) {
   ASSERT_EQ(bus.at("messages").size(), 2U);
   const nlohmann::json& ca = bus.at("messages")[1];
   EXPECT_EQ(ca.at("name"), "ca");
-  // ca (id 16) outranks the background (id 256): blocked by one background frame at most,
-  // no higher-priority interference: R = B + C = 270 + 270 µs.
-  EXPECT_EQ(ca.at("worst_response_us").get<double>(), 540);
-  // The background: one ca frame of interference and its own jitter 500 µs: R = J + C + C.
+  // ca is sent by the controller on arrival: released sc delay + τ_c after the sensor's timer,
+  // sc U[500, 4000] µs, τ_c U[1, 5] ms: jitter (4000 + 5000) − (500 + 1000) µs. It outranks the
+  // background (id 256): blocked by one background frame at most, no higher-priority
+  // interference: R = J + B + C = J + 270 + 270 µs.
+  const ncs::Timing t;
+  const double j_ca = static_cast<double>(4000 + t.compute_max_us - (500 + t.compute_min_us));
+  EXPECT_EQ(ca.at("jitter_us").get<double>(), j_ca);
+  EXPECT_EQ(ca.at("worst_response_us").get<double>(), j_ca + 270 + 270);
+  // The background: one ca frame of interference (J_ca + w < T_ca) and its own jitter 500 µs:
+  // R = J + C + C.
   EXPECT_EQ(bus.at("messages")[0].at("worst_response_us").get<double>(), 500 + 270 + 270);
+  // Scenario d14-heavy: sc lognormal, no upper bound: ca's jitter and response unbounded, and
+  // so is the background's (lower priority: ca's interference on it has no bound).
+  const nlohmann::json& heavy = bus.at("scenarios").at("d14-heavy");
+  EXPECT_TRUE(heavy[1].at("jitter_us").is_null());
+  EXPECT_TRUE(heavy[1].at("worst_response_us").is_null());
+  EXPECT_TRUE(heavy[0].at("worst_response_us").is_null());
+  EXPECT_FALSE(heavy[0].at("schedulable").get<bool>());
+  EXPECT_EQ(bus.at("scenarios").size(), 1U);  // d4 keeps the file's sc
+}
+
+TEST(StudyCheck, ArrivalSendersJitterAddsUpAlongTheirChain) {
+  // The actuator on arrival sends "as" on the bus: sensor timer → sc → controller (τ_c) → ca
+  // → actuator (τ_c) → as. Jitter = (max sc + max ca + 2 max τ_c) − (min sc + min ca + 2 min τ_c).
+  nlohmann::json j = read_json(ONESHOT_ENGINE_EXAMPLE_STUDY);
+  j["links"][1] = {{"name", "ca"}, {"from", "controller"}, {"to", "actuator"},
+                   {"delay", {{"model", "uniform"}, {"min_us", 200}, {"max_us", 700}}}};
+  j["links"].push_back({{"name", "as"}, {"from", "actuator"}, {"to", "sensor"}, {"bus", "can0"}, {"id", 17}});
+  j["scenarios"].erase(1);
+  const nlohmann::json r = resolve_study(parse(j, ONESHOT_ENGINE_EXAMPLE_STUDY));
+  const nlohmann::json& as = r.at("buses")[0].at("messages")[1];
+  ASSERT_EQ(as.at("name"), "as");
+  const ncs::Timing t;
+  const double expect = static_cast<double>((4000 + 700 + 2 * t.compute_max_us) - (500 + 200 + 2 * t.compute_min_us));
+  EXPECT_EQ(as.at("jitter_us").get<double>(), expect);
+  // A Poisson leg has no bound (draw() applies no cap): no cap reported, unbounded jitter.
+  j["links"][1]["delay"] = {{"model", "poisson_periods"}, {"mean_periods", 1.5}, {"period_us", 10000}};
+  const nlohmann::json p = resolve_study(parse(j, ONESHOT_ENGINE_EXAMPLE_STUDY));
+  const nlohmann::json& ca = p.at("links")[1].at("base").at("delay");
+  EXPECT_TRUE(ca.at("max_us").is_null());
+  EXPECT_FALSE(ca.contains("cap_us"));
+  EXPECT_TRUE(p.at("buses")[0].at("messages")[1].at("jitter_us").is_null());
+  // A lognormal leg: bounded by its cap only, which is reported.
+  j["links"][1]["delay"] = {{"model", "lognormal"}, {"median_us", 300}, {"sigma", 0.5}, {"cap_us", 90000}};
+  const nlohmann::json l = resolve_study(parse(j, ONESHOT_ENGINE_EXAMPLE_STUDY));
+  EXPECT_EQ(l.at("links")[1].at("base").at("delay").at("cap_us").get<double>(), 90000);
 }
 
 TEST(StudyCheck, BusOverloadIsRefusedNamingTheBus) {
@@ -219,6 +260,40 @@ TEST(StudyCheck, CommandLine) {
   EXPECT_EQ(r.at("runs_with"), "ncs");
   ASSERT_EQ(r.at("approaches")[7].at("kind"), "S+");
   EXPECT_EQ(r.at("approaches")[7].at("per_scenario").size(), 10U);
+  EXPECT_TRUE(r.at("runnable").get<bool>());
+  // A file study run cannot run: the whole resolution (CAN bounds included), then one line
+  // naming the field, and a non-zero exit.
+  const test::CommandResult ex = test::run_command({ONESHOT_SIM_PATH, "study", "check", ONESHOT_ENGINE_EXAMPLE_STUDY});
+  EXPECT_NE(ex.exit_code, 0);
+  const nlohmann::json er = resolve_study(engine::load_study(ONESHOT_ENGINE_EXAMPLE_STUDY, nullptr));
+  for (const nlohmann::json& m : er.at("buses")[0].at("messages")) {
+    const std::string bound = "worst response " + m.at("worst_response_us").dump() + " us";
+    EXPECT_NE(ex.output.find(bound), std::string::npos) << bound << "\n" << ex.output;
+  }
+  EXPECT_NE(ex.output.find("grid: "), std::string::npos) << ex.output;
+  EXPECT_NE(ex.output.find("\ncannot run: field 'study': "), std::string::npos) << ex.output;
+  EXPECT_EQ(ex.output.find("runs with"), std::string::npos) << ex.output;
+  test::CommandOptions ex_file;
+  ex_file.stdout_path = tmp;
+  const test::CommandResult exj =
+      test::run_command({ONESHOT_SIM_PATH, "study", "check", ONESHOT_ENGINE_EXAMPLE_STUDY, "--json", "-"}, ex_file);
+  EXPECT_NE(exj.exit_code, 0);
+  const nlohmann::json xr = read_json(tmp);
+  EXPECT_FALSE(xr.at("runnable").get<bool>());
+  EXPECT_EQ(xr.at("refusal").get<std::string>().rfind("field 'study': ", 0), 0U) << xr.at("refusal");
+  EXPECT_EQ(xr.at("buses"), er.at("buses"));
+  // Bad input: one line, non-zero exit, nothing written.
+  nlohmann::json over = read_json(ONESHOT_ENGINE_EXAMPLE_STUDY);
+  over["buses"][0]["background"][0]["period_us"] = 200;  // 270 µs every 200 µs
+  const std::string dir = test::made_dir("oneshot_study_check", "cli_overload");
+  std::ofstream(dir + "/study.json") << over.dump();
+  const std::string over_json = dir + "/check.json";
+  std::filesystem::remove(over_json);
+  const test::CommandResult ov = test::run_command({ONESHOT_SIM_PATH, "study", "check", dir + "/study.json", "--json", over_json});
+  EXPECT_NE(ov.exit_code, 0);
+  EXPECT_NE(ov.output.find("field 'buses[0]'"), std::string::npos) << ov.output;
+  EXPECT_EQ(std::count(ov.output.begin(), ov.output.end(), '\n'), 1) << ov.output;
+  EXPECT_FALSE(std::filesystem::exists(over_json));
   // Refused: one line naming the field, non-zero exit, nothing written.
   const std::string out = test::fresh_dir("oneshot_study_check", "cli_refused");
   const test::CommandResult bad = test::run_command({ONESHOT_SIM_PATH, "study", "run", ONESHOT_ENGINE_EXAMPLE_STUDY, "--out", out});

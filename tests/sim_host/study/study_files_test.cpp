@@ -80,6 +80,15 @@ TEST(StudyFiles, NcsFileGivesTheCostsOfNcsTable) {
     EXPECT_EQ(c.at("delivered").get<double>(), c.at("sent").get<double>()) << leg;
   }
   EXPECT_EQ(jm.at("links").at("S").at("as").at("sent").get<double>(), 0);
+  // ncs table keys S's ratio by d; a file's legs have no d: left out, the sc + ca delay bound
+  // reported per scenario instead (legs U[0.5, d] ms: 2 d).
+  EXPECT_TRUE(jt.contains("S_ratio_to_I_by_delay_ms"));
+  EXPECT_FALSE(jm.contains("S_ratio_to_I_by_delay_ms"));
+  EXPECT_FALSE(jm.contains("S_ratio_increases_with_delay"));
+  ASSERT_EQ(jm.at("delay_bound_sc_ca_ms").size(), t.scenarios.size());
+  for (const ncs::Scenario& x : t.scenarios) {
+    EXPECT_NEAR(jm.at("delay_bound_sc_ca_ms").at(x.name).get<double>(), 2 * x.max_delay_ms, 1e-12) << x.name;
+  }
 }
 
 TEST(StudyFiles, LossFromTheFileReachesTheLeg) {

@@ -12,8 +12,9 @@
 ///     trace             trace[n mod size] for the n-th message  (recorded delays, cycled)
 ///     lognormal         shift + median·exp(σ Z),  Z ~ N(0, 1)
 ///     pareto            shift + scale·U^(−1/α),  U ~ U(0, 1]    (P[X > x] = (scale/x)^α)
-/// Heavy-tailed draws above `cap` (default one hour) are clamped to it and counted by the
-/// link; with sane parameters that never happens, and the count says so.
+/// Heavy-tailed draws (lognormal, Pareto) above `cap` (default one hour) are clamped to it and
+/// counted by the link; with sane parameters that never happens, and the count says so.
+/// Poisson draws are not capped.
 #pragma once
 
 #include <cstdint>
@@ -43,7 +44,7 @@ struct DelayModel {
   double sigma = 0;              ///< Lognormal: σ of its logarithm.
   double scale_ns = 0;           ///< Pareto: scale x_m.
   double alpha = 0;              ///< Pareto: shape α.
-  Duration cap{3'600'000'000'000};  ///< Heavy tails: largest delay (draws above are clamped).
+  Duration cap{3'600'000'000'000};  ///< Lognormal, Pareto: largest delay (draws above are clamped; Poisson is not capped).
   std::vector<Duration> trace;   ///< Trace: recorded delays, used in order and cycled.
   std::string trace_path;        ///< Trace: the file they came from.
 
@@ -51,8 +52,9 @@ struct DelayModel {
   Duration draw(RandomStream& rng, std::uint64_t index, bool& clamped) const;
   /// Smallest delay the model can produce.
   Duration lower_bound() const;
-  /// Largest delay the model can produce below its cap (constant, uniform, trace); nullopt
-  /// for the unbounded models (Poisson, lognormal, Pareto: only the cap bounds them).
+  /// Largest delay the model can produce (constant, uniform, trace); nullopt for the
+  /// unbounded models: Poisson (no bound at all: draw() applies no cap to it), lognormal and
+  /// Pareto (only their `cap` bounds the draws).
   std::optional<Duration> upper_bound() const;
   /// Mean delay in ns of the model without its cap (exact for every model; +inf for a
   /// Pareto tail with α ≤ 1).
