@@ -23,6 +23,7 @@
 #include "control_drivers.hpp"
 #include "oneshot/engine/kernel.hpp"
 #include "board_config.hpp"
+#include "board_events.hpp"
 #include "setpoint_volts.hpp"
 #include "simulation.hpp"
 
@@ -129,12 +130,7 @@ RunResult run_board_loop(const SimContext& ctx, const Scenario& sc, std::uint64_
   });
   const engine::HandlerId on_end = kernel.add_handler("end", [&](std::uint64_t) { board.advance_to(kernel.now()); });
 
-  for (std::size_t i = 1; i < schedule.at_ns.size(); ++i) {
-    if (schedule.at_ns[i] <= end.count()) kernel.schedule(SimTime{schedule.at_ns[i]}, EventClass::kEnvironment, on_setpoint, i);
-  }
-  if (periods > 0) kernel.schedule(SimTime{0}, EventClass::kActuation, *on_period_id, 0);
-  kernel.schedule(end, EventClass::kEnd, on_end);
-  kernel.run_until(end);
+  run_board_events(kernel, schedule, end, periods, *on_period_id, on_setpoint, on_end);
 
   result.cost = board.cost();
   result.duration_s = engine::to_seconds(end);

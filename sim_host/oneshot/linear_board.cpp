@@ -12,6 +12,7 @@
 #include "controller_parts.hpp"
 #include "estimator_memory.hpp"
 #include "linear_tracker.hpp"
+#include "board_events.hpp"
 #include "setpoint_volts.hpp"
 #include "oneshot/control_law.hpp"
 #include "oneshot/design/fixed_size.hpp"
@@ -182,12 +183,7 @@ LinearRunResult run_linear(const SimContext& ctx, const Scenario& sc, std::uint6
     if (static_cast<std::int64_t>(k) + 1 < periods) kernel.schedule(t_k + h, EventClass::kActuation, *on_period_id, k + 1);
   });
   const engine::HandlerId on_end = kernel.add_handler("end", [&](std::uint64_t) { advance(kernel.now()); });
-  for (std::size_t i = 1; i < schedule.at_ns.size(); ++i) {
-    if (schedule.at_ns[i] <= end.count()) kernel.schedule(SimTime{schedule.at_ns[i]}, EventClass::kEnvironment, on_setpoint, i);
-  }
-  if (periods > 0) kernel.schedule(SimTime{0}, EventClass::kActuation, *on_period_id, 0);
-  kernel.schedule(end, EventClass::kEnd, on_end);
-  kernel.run_until(end);
+  run_board_events(kernel, schedule, end, periods, *on_period_id, on_setpoint, on_end);
 
   result.cost = board.cost();
   if (tracker) {
