@@ -61,8 +61,8 @@ std::array<double, std::size(kAnalyticMetrics)> analytic_metrics(const Context& 
 /// the wall time of an analytic AK run beside the noise-free run (a benchmark, not a test).
 nlohmann::json analytic_benchmark(const Context& ctx, std::uint64_t seed);
 /// `ncs table --analytic` (and `study run --analytic`): per approach analytic_mean,
-/// analytic_ci95 (over the timing draws), the analytic ratio to I (left out when I is
-/// refused), the paired MC − analytic, variance_reduction (or analytic_refused with the reason
+/// analytic_ci95 (over the timing draws), the analytic ratio to I ("reference I refused"
+/// when I is), the paired MC − analytic, variance_reduction (or analytic_refused with the reason
 /// and analytic_refused_runs), the table's variance_reduction (the smallest; and the median,
 /// variance_reduction_median), analytic_paired_differences (per seed, as paired_differences;
 /// pairs with a refused approach left out), and a markdown table appended to `md`; `mc` is

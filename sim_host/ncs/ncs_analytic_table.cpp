@@ -66,7 +66,9 @@ void analytic_outputs(const engine::SweepResults& results, const engine::SweepSu
     if (std::isfinite(vr)) vrs.push_back(vr);
     ja["analytic_mean"] = an.value[a].mean;
     ja["analytic_ci95"] = ci_an;
-    if (!reference_refused) {  // a ratio to a refused I would divide by its zeros
+    if (reference_refused) {  // a ratio to a refused I would divide by its zeros (as table1 --analytic)
+      ja["analytic_ratio_to_I"] = "reference I refused";
+    } else {
       ja["analytic_ratio_to_I"] = an.ratio[a].mean;
       ja["analytic_ratio_to_I_ci95"] = an.ratio[a].ci95;
     }
