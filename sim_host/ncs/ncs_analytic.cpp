@@ -35,6 +35,14 @@ const char* analytic_refusal_text(int code) {
   return "unknown";
 }
 
+std::array<double, std::size(kAnalyticMetrics)> analytic_metrics(const Context& ctx, Approach a, const Scenario& sc,
+                                                                  std::uint64_t seed, RunOptions options) {
+  options.analytic = true;
+  const RunResult x = run(ctx, a, sc, seed, options);
+  const int code = analytic_refusal_code(x.analytic_refusal);
+  return {code == 0 ? x.analytic.total() : 0.0, static_cast<double>(code), x.analytic_mismatch};
+}
+
 AnalyticTracker::AnalyticTracker(const engine::JumpLinearPlant<kN, kM>& plant, const Matrix<double, kP, kN>& c,
                                  const Matrix<double, kP, kP>& r, const Matrix<double, kM, kN>& l,
                                  const Vector<double, kN>& x0, const Vector<double, kN>& mem0)

@@ -18,9 +18,11 @@
 /// or faults injected.
 #pragma once
 
+#include <array>
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <iterator>
 #include <memory>
 #include <sstream>
 #include <string>
@@ -48,15 +50,23 @@ enum ZIndex : std::size_t { kZx = 0, kZu = 2, kZy = 3, kZmem = 5, kZcmd = 8, kZe
 int analytic_refusal_code(const std::string& reason);
 /// The reason of a refusal code.
 const char* analytic_refusal_text(int code);
+/// Names of the metrics an analytic sweep adds (`ncs table --analytic`, `study run --analytic`).
+inline constexpr const char* kAnalyticMetrics[] = {"analytic", "analytic_refused", "analytic_mismatch"};
+/// The values of kAnalyticMetrics for one run: `a` on `sc` with `seed` and `options` in
+/// RunOptions::analytic mode — E[J] over the noise (0 when refused), the refusal's code
+/// (analytic_refusal_code), the largest mean mismatch.
+std::array<double, std::size(kAnalyticMetrics)> analytic_metrics(const Context& ctx, Approach a, const Scenario& sc,
+                                                                  std::uint64_t seed, RunOptions options);
 /// `ncs analytic-benchmark`: ns per flow and per jump of the engine's propagation on z, and
 /// the wall time of an analytic AK run beside the noise-free run (a benchmark, not a test).
 nlohmann::json analytic_benchmark(const Context& ctx, std::uint64_t seed);
-/// `ncs table --analytic`: per approach analytic_mean, analytic_ci95 (over the timing
-/// draws), the analytic ratio to I, the paired MC − analytic, variance_reduction (or
-/// analytic_refused with the reason), the table's variance_reduction (the smallest; and the
-/// median, variance_reduction_median), analytic_paired_differences (per seed, as
-/// paired_differences), and a
-/// markdown table appended to `md`; `mc` is the summary of the Monte Carlo cost.
+/// `ncs table --analytic` (and `study run --analytic`): per approach analytic_mean,
+/// analytic_ci95 (over the timing draws), the analytic ratio to I ("reference I refused"
+/// when I is), the paired MC − analytic, variance_reduction (or analytic_refused with the reason
+/// and analytic_refused_runs), the table's variance_reduction (the smallest; and the median,
+/// variance_reduction_median), analytic_paired_differences (per seed, as paired_differences;
+/// pairs with a refused approach left out), and a markdown table appended to `md`; `mc` is
+/// the summary of the Monte Carlo cost.
 void analytic_outputs(const engine::SweepResults& results, const engine::SweepSummary& mc, nlohmann::json& j,
                       std::ostringstream& md);
 

@@ -27,21 +27,27 @@ void analytic_outputs(const engine::SweepResults& results, const engine::SweepSu
         "|---|---|---|---|---|---|\n";
   double table_vr = std::numeric_limits<double>::infinity();
   std::vector<double> vrs;
-  for (std::size_t a = 0; a < spec.approaches.size(); ++a) {
-    const std::string& nm = spec.approaches[a];
-    nlohmann::json& ja = j["approaches"][nm];
-    std::size_t refused = 0;
-    int code = 0;
-    double mismatch = 0;
+  // Runs refused per approach: their analytic column is 0, so no figure is taken from them
+  // (the approach is reported refused with the reason, its pairs and ratios left out).
+  std::vector<std::size_t> refused_runs(spec.approaches.size(), 0);
+  std::vector<int> first_code(spec.approaches.size(), 0);
+  for (std::size_t a = 0; a < spec.approaches.size(); ++a)
     for (std::size_t s = 0; s < spec.scenarios.size(); ++s)
       for (std::size_t k = 0; k < spec.seeds; ++k) {
         const int c = static_cast<int>(results.at(a, s, k, ir));
-        if (c != 0) {
-          ++refused;
-          if (code == 0) code = c;
-        }
-        mismatch = std::fmax(mismatch, results.at(a, s, k, im));
+        if (c == 0) continue;
+        ++refused_runs[a];
+        if (first_code[a] == 0) first_code[a] = c;
       }
+  const bool reference_refused = refused_runs[0] > 0;
+  for (std::size_t a = 0; a < spec.approaches.size(); ++a) {
+    const std::string& nm = spec.approaches[a];
+    nlohmann::json& ja = j["approaches"][nm];
+    const std::size_t refused = refused_runs[a];
+    const int code = first_code[a];
+    double mismatch = 0;
+    for (std::size_t s = 0; s < spec.scenarios.size(); ++s)
+      for (std::size_t k = 0; k < spec.seeds; ++k) mismatch = std::fmax(mismatch, results.at(a, s, k, im));
     char line[400];
     if (refused > 0) {
       ja["analytic_refused"] = analytic_refusal_text(code);
@@ -60,8 +66,12 @@ void analytic_outputs(const engine::SweepResults& results, const engine::SweepSu
     if (std::isfinite(vr)) vrs.push_back(vr);
     ja["analytic_mean"] = an.value[a].mean;
     ja["analytic_ci95"] = ci_an;
-    ja["analytic_ratio_to_I"] = an.ratio[a].mean;
-    ja["analytic_ratio_to_I_ci95"] = an.ratio[a].ci95;
+    if (reference_refused) {  // a ratio to a refused I would divide by its zeros (as table1 --analytic)
+      ja["analytic_ratio_to_I"] = "reference I refused";
+    } else {
+      ja["analytic_ratio_to_I"] = an.ratio[a].mean;
+      ja["analytic_ratio_to_I_ci95"] = an.ratio[a].ci95;
+    }
     ja["mc_minus_analytic_mean"] = d.mean;
     ja["mc_minus_analytic_ci95"] = d.ci95;
     ja["analytic_max_mean_mismatch"] = mismatch;
@@ -72,12 +82,14 @@ void analytic_outputs(const engine::SweepResults& results, const engine::SweepSu
       ja["variance_reduction"] = nullptr;
       ja["variance_reduction_note"] = "the expected cost does not depend on the timing draws (interval at rounding level)";
     }
-    std::snprintf(line, sizeof line, "| %s | %.6f | ± %.6f | %.5f ± %.5f | %.6f ± %.6f | %s |\n", nm.c_str(),
-                  an.value[a].mean, ci_an, an.ratio[a].mean, an.ratio[a].ci95, d.mean, d.ci95,
-                  std::isfinite(vr) ? std::to_string(vr).c_str() : "∞ (no timing spread)");
+    char ratio[64] = "— (I refused)";
+    if (!reference_refused) std::snprintf(ratio, sizeof ratio, "%.5f ± %.5f", an.ratio[a].mean, an.ratio[a].ci95);
+    std::snprintf(line, sizeof line, "| %s | %.6f | ± %.6f | %s | %.6f ± %.6f | %s |\n", nm.c_str(), an.value[a].mean,
+                  ci_an, ratio, d.mean, d.ci95, std::isfinite(vr) ? std::to_string(vr).c_str() : "∞ (no timing spread)");
     md << line;
   }
   for (const auto& p : an.paired) {
+    if (refused_runs[p.a] > 0 || refused_runs[p.b] > 0) continue;
     j["analytic_paired_differences"][spec.approaches[p.a] + "-" + spec.approaches[p.b]] = {{"mean", p.diff.mean},
                                                                                           {"ci95", p.diff.ci95}};
   }

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdio>
 #include <fstream>
+#include <iterator>
 #include <map>
 #include <sstream>
 #include <stdexcept>
@@ -69,14 +70,12 @@ engine::SweepResults table_sweep(const Context& ctx, const TableOptions& opt, co
   }
   if (opt.analytic) {  // only then: the table's spec stays as it was without
     spec.config["analytic"] = true;
-    spec.metrics.insert(spec.metrics.end(), {"analytic", "analytic_refused", "analytic_mismatch"});
+    spec.metrics.insert(spec.metrics.end(), std::begin(kAnalyticMetrics), std::end(kAnalyticMetrics));
   }
   const std::vector<Approach> approaches = opt.approaches;
   RunOptions ro;
   ro.noise_free = opt.noise_free;
   ro.faults = opt.faults;
-  RunOptions ra = ro;
-  ra.analytic = true;
   const bool analytic = opt.analytic;
   return engine::run_sweep(
       spec, shard, opt.threads,
@@ -85,9 +84,8 @@ engine::SweepResults table_sweep(const Context& ctx, const TableOptions& opt, co
         std::vector<double> v{r.cost, static_cast<double>(r.late), static_cast<double>(r.saturated),
                               static_cast<double>(r.faults)};
         if (analytic) {
-          const RunResult x = run(ctx, approaches[a], scenarios[s], seed, ra);
-          const int code = analytic_refusal_code(x.analytic_refusal);
-          v.insert(v.end(), {code == 0 ? x.analytic.total() : 0.0, static_cast<double>(code), x.analytic_mismatch});
+          const auto x = analytic_metrics(ctx, approaches[a], scenarios[s], seed, ro);
+          v.insert(v.end(), x.begin(), x.end());
         }
         return v;
       },

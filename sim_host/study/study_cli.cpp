@@ -64,6 +64,7 @@ struct RunCli {
   std::string out = "out/study";
   std::string json;
   bool no_plots = false;
+  bool analytic = false;
 };
 
 void add_study_commands(CLI::App* group) {
@@ -98,13 +99,17 @@ void add_study_commands(CLI::App* group) {
     cmd->add_option("--out", c->out, "output directory")->capture_default_str();
     cmd->add_option("--json", c->json, "write the result as JSON to PATH, or '-' for standard output");
     cmd->add_flag("--no-plots", c->no_plots, "write CSV files only (no gnuplot)");
+    cmd->add_flag("--analytic", c->analytic,
+                  "also the exact expected cost over the noise for each run's timing, as `ncs table --analytic` "
+                  "(analytic_mean, analytic_ci95, variance_reduction, ...; approaches whose runs leave the linear "
+                  "loop: analytic_refused with the reason)");
     cmd->callback([c]() {
       const Checked k = check_file(c->file);
       if (!k.ncs) throw engine::InputError(k.resolution.at("source").get<std::string>() + ": " + k.refusal);  // one line, nothing written
       const engine::Shard part = engine::parse_shard(c->shard);
       util::make_directory(c->out);
       const auto start = std::chrono::steady_clock::now();
-      const engine::SweepResults r = study::run_ncs_sweep(*k.ncs, c->seeds, c->threads, part);
+      const engine::SweepResults r = study::run_ncs_sweep(*k.ncs, c->seeds, c->threads, part, c->analytic);
       const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
       nlohmann::json j;
       if (!part.whole()) {

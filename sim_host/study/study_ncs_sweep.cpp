@@ -5,6 +5,7 @@
 #include <array>
 #include <optional>
 
+#include "ncs_analytic.hpp"
 #include "ncs_experiments.hpp"
 #include "ncs_loop.hpp"
 
@@ -61,7 +62,8 @@ nlohmann::json sc_ca_delay_bound_ms(const ncs::Scenario& x) {
 
 }  // namespace
 
-engine::SweepResults run_ncs_sweep(const NcsStudy& s, std::size_t seeds, unsigned threads, const engine::Shard& shard) {
+engine::SweepResults run_ncs_sweep(const NcsStudy& s, std::size_t seeds, unsigned threads, const engine::Shard& shard,
+                                   bool analytic) {
   engine::SweepSpec spec;
   spec.study = "study";
   spec.experiment = "run";
@@ -90,10 +92,14 @@ engine::SweepResults run_ncs_sweep(const NcsStudy& s, std::size_t seeds, unsigne
                  {"links", s.links},
                  {"compute_us", {s.ctx->timing().compute_min_us, s.ctx->timing().compute_max_us}},
                  {"scenarios", sc}};
+  if (analytic) {  // only then, as ncs table: the spec stays as it was without
+    spec.config["analytic"] = true;
+    spec.metrics.insert(spec.metrics.end(), std::begin(ncs::kAnalyticMetrics), std::end(ncs::kAnalyticMetrics));
+  }
   const NcsStudy* study = &s;
   return engine::run_sweep(
       spec, shard, threads,
-      [study](std::size_t a, std::size_t k, std::uint64_t seed) {
+      [study, analytic](std::size_t a, std::size_t k, std::uint64_t seed) {
         const ncs::Approach ap = study->approaches[a];
         const ncs::RunResult r = ncs::run(*study->ctx, ap, study->scenarios[k], seed, ncs::RunOptions{});
         std::vector<double> v{r.cost, static_cast<double>(r.late), static_cast<double>(r.saturated),
@@ -101,6 +107,10 @@ engine::SweepResults run_ncs_sweep(const NcsStudy& s, std::size_t seeds, unsigne
         for (const std::string& l : study->links) {
           const auto c = link_counts(r, ap, l);
           v.insert(v.end(), c.begin(), c.end());
+        }
+        if (analytic) {  // ncs table --analytic's columns: the same run in analytic mode
+          const auto x = ncs::analytic_metrics(*study->ctx, ap, study->scenarios[k], seed, ncs::RunOptions{});
+          v.insert(v.end(), x.begin(), x.end());
         }
         return v;
       },

@@ -29,10 +29,17 @@ constexpr std::size_t link_counter_index(std::string_view name) {
 /// Runs the sweep (or one shard) of `s` with `seeds` replications (0: the file's count) on
 /// `threads` threads (0: every core). The runs are ncs::run() on the file's scenarios: same
 /// seeds, same random stream names, so the same costs as `ncs table` on the same settings.
-engine::SweepResults run_ncs_sweep(const NcsStudy& s, std::size_t seeds, unsigned threads, const engine::Shard& shard);
+/// With `analytic` (`study run --analytic`), as `ncs table --analytic`: beside each run the
+/// same run in ncs::RunOptions::analytic mode, its exact E[J] over the noise for the run's
+/// timing in the metrics "analytic", "analytic_refused" (the refusal's code, 0 when valid) and
+/// "analytic_mismatch", and "analytic": true in the configuration (only then: the sweep's
+/// spec, and its shards, stay as they are without).
+engine::SweepResults run_ncs_sweep(const NcsStudy& s, std::size_t seeds, unsigned threads, const engine::Shard& shard,
+                                   bool analytic = false);
 
 /// The summary of a complete sweep: ncs::table_outputs() (cost_mean, cost_ci95, ratio_to_I,
-/// ratio_scenario_weighted, paired differences, per scenario; files in `out_dir`) plus
+/// ratio_scenario_weighted, paired differences, per scenario; with an analytic sweep the
+/// keys of ncs::analytic_outputs(), refused approaches with their reason; files in `out_dir`) plus
 /// "links": per approach and link the totals of sent, delivered (not lost: arrived or in
 /// flight at the end), lost, late (dropped by the receiver as stale or late) and refused
 /// (refused by the receiver's frame checks) over every run; "delay_bound_sc_ca_ms": per

@@ -1,7 +1,9 @@
 /// @file study_files_test.cpp
 /// @brief `study run` of an ncs study file: the same costs as `ncs table` on the same seeds
-///        (the file's legs against the table's built-in ones), per-link counters, shards
-///        merged to the same bytes as one run, and the refusals of what the loop cannot run.
+///        (the file's legs against the table's built-in ones), with --analytic the same
+///        figures as `ncs table --analytic` and refused approaches reported with the reason,
+///        per-link counters, shards merged to the same bytes as one run (with and without
+///        --analytic), and the refusals of what the loop cannot run.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -109,17 +111,100 @@ TEST(StudyFiles, LossFromTheFileReachesTheLeg) {
   EXPECT_EQ(j.at("links").at("AK").at("ca").at("lost").get<double>(), 0);
 }
 
+/// `want` and `got` equal within 1e-12 relative (both null, or both numbers).
+void expect_same_figure(const nlohmann::json& got, const nlohmann::json& want, const std::string& what) {
+  if (want.is_null()) {
+    EXPECT_TRUE(got.is_null()) << what;
+    return;
+  }
+  ASSERT_TRUE(got.is_number()) << what;
+  const double w = want.get<double>();
+  EXPECT_LE(std::fabs(got.get<double>() - w), 1e-12 * std::fabs(w)) << what << ": " << got << " vs " << w;
+}
+
+TEST(StudyFiles, AnalyticRunGivesTheFiguresOfNcsTableAnalytic) {
+  const NcsStudy s = small_study(4);
+  ASSERT_EQ(s.approaches.size(), 9U);
+  const nlohmann::json jm = run_outputs(run_ncs_sweep(s, 3, 2, engine::Shard{}, true), temp_dir("analytic_study"), false);
+  ncs::TableOptions t;  // the table's own scenarios: legs built from d, no file involved
+  t.seeds = 3;
+  t.threads = 2;
+  t.analytic = true;
+  t.scenarios = ncs::default_scenarios();
+  t.scenarios.resize(3);
+  for (ncs::Scenario& x : t.scenarios) x.duration_s = 4;
+  const nlohmann::json jt =
+      ncs::table_outputs(ncs::table_sweep(*s.ctx, t, engine::Shard{}), temp_dir("analytic_table"), false);
+  std::size_t compared = 0;
+  for (const auto& [name, a] : jt.at("approaches").items()) {
+    const nlohmann::json& m = jm.at("approaches").at(name);
+    EXPECT_EQ(a.contains("analytic_refused"), m.contains("analytic_refused")) << name;
+    for (const auto& [key, want] : a.items()) {
+      if (key.rfind("analytic_", 0) != 0 && key.rfind("mc_minus_analytic", 0) != 0 && key != "variance_reduction") continue;
+      ASSERT_TRUE(m.contains(key)) << name << " " << key;
+      if (want.is_string()) {
+        EXPECT_EQ(m.at(key), want) << name << " " << key;
+      } else {
+        expect_same_figure(m.at(key), want, name + " " + key);
+        ++compared;
+      }
+    }
+  }
+  EXPECT_GE(compared, 9U * 6U);  // every approach has its analytic figures (none refused here)
+  ASSERT_TRUE(jt.contains("analytic_paired_differences"));
+  for (const auto& [pair, d] : jt.at("analytic_paired_differences").items()) {
+    const nlohmann::json& m = jm.at("analytic_paired_differences").at(pair);
+    expect_same_figure(m.at("mean"), d.at("mean"), pair);
+    expect_same_figure(m.at("ci95"), d.at("ci95"), pair + " ci95");
+  }
+  expect_same_figure(jm.at("variance_reduction"), jt.at("variance_reduction"), "variance_reduction");
+  expect_same_figure(jm.at("variance_reduction_median"), jt.at("variance_reduction_median"), "variance_reduction_median");
+  EXPECT_NE(jm.at("markdown").get<std::string>().find("analytic mean"), std::string::npos);
+}
+
+TEST(StudyFiles, AnalyticRunReportsRefusedApproachesWithTheReason) {
+  // A lossy sc leg: a lost sample or request leaves the loop the analytic tracker follows, so
+  // S and AK are refused (reported with the reason, never dropped); I has no legs and is exact.
+  const engine::StudyFile f = parse_edited([](nlohmann::json& j) {
+    j["links"][1]["loss"] = {{"model", "bernoulli"}, {"p", 0.2}};
+    j["approaches"] = nlohmann::json::parse(R"([{"name": "I"}, {"name": "S"}, {"name": "AK"}])");
+  });
+  NcsStudy s = map_ncs_study(f);
+  s.scenarios.resize(1);
+  s.scenarios[0].duration_s = 4;
+  const nlohmann::json j = run_outputs(run_ncs_sweep(s, 3, 2, engine::Shard{}, true), temp_dir("analytic_loss"), false);
+  const nlohmann::json& ji = j.at("approaches").at("I");
+  EXPECT_FALSE(ji.contains("analytic_refused"));
+  EXPECT_TRUE(std::isfinite(ji.at("analytic_mean").get<double>()));
+  for (const char* name : {"S", "AK"}) {
+    const nlohmann::json& a = j.at("approaches").at(name);
+    ASSERT_TRUE(a.contains("analytic_refused")) << name;
+    const std::string reason = a.at("analytic_refused").get<std::string>();
+    EXPECT_FALSE(reason.empty()) << name;
+    EXPECT_NE(reason, "unknown") << name;
+    EXPECT_GT(a.at("analytic_refused_runs").get<std::size_t>(), 0U) << name;
+    EXPECT_FALSE(a.contains("analytic_mean")) << name;
+    EXPECT_NE(j.at("markdown").get<std::string>().find(std::string("| ") + name + " | refused ("), std::string::npos) << name;
+  }
+  // No figure is taken from the refused runs' zeros: no pair with S or AK.
+  EXPECT_FALSE(j.contains("analytic_paired_differences"));
+}
+
 TEST(StudyFiles, MergedShardsGiveTheSameBytesAsOneRun) {
   NcsStudy s = small_study(2);
   s.approaches = {ncs::Approach::kI, ncs::Approach::kS, ncs::Approach::kAK};
-  const std::string whole = run_outputs(run_ncs_sweep(s, 4, 2, engine::Shard{}), temp_dir("whole"), false).dump();
-  std::vector<engine::SweepResults> parts;
-  for (std::size_t i = 0; i < 3; ++i) {
-    const engine::SweepResults p = run_ncs_sweep(s, 4, 1, engine::Shard{i, 3});
-    parts.push_back(engine::shard_from_json(nlohmann::json::parse(engine::shard_to_json(p).dump())));
+  for (const bool analytic : {false, true}) {
+    const std::string whole =
+        run_outputs(run_ncs_sweep(s, 4, 2, engine::Shard{}, analytic), temp_dir("whole"), false).dump();
+    std::vector<engine::SweepResults> parts;
+    for (std::size_t i = 0; i < 3; ++i) {
+      const engine::SweepResults p = run_ncs_sweep(s, 4, 1, engine::Shard{i, 3}, analytic);
+      parts.push_back(engine::shard_from_json(nlohmann::json::parse(engine::shard_to_json(p).dump())));
+    }
+    const std::string merged = run_outputs(engine::merge_shards(parts), temp_dir("merged"), false).dump();
+    EXPECT_EQ(merged, whole) << "analytic " << analytic;
+    EXPECT_EQ(nlohmann::json::parse(whole).contains("variance_reduction"), analytic);
   }
-  const std::string merged = run_outputs(engine::merge_shards(parts), temp_dir("merged"), false).dump();
-  EXPECT_EQ(merged, whole);
 }
 
 /// A refusal names the field; `expect` is a fragment of the message.
