@@ -4,8 +4,8 @@
 
 #include "board_loop.hpp"
 #include "c_job_driver.hpp"
-#include "controller_parts.hpp"
 #include "control_drivers.hpp"
+#include "core_board_run.hpp"
 #include "oneshot_job.h"  // the generated C99 job, compiled into this build (oneshot_c_job)
 
 #include <cmath>
@@ -15,21 +15,13 @@
 #include <type_traits>
 
 #include "oneshot/app/control_task.hpp"
-#include "oneshot/complete_kalman.hpp"
 #include "oneshot/controller.hpp"
-#include "oneshot/deadbeat_observer.hpp"
 #include "oneshot/fixed_point.hpp"
-#include "oneshot/design/dimension_dispatch.hpp"
-#include "oneshot/design/fixed_size.hpp"
 #include "oneshot/design/structure_analysis.hpp"
 #include "oneshot/generated/plant_tables.hpp"
-#include "oneshot/generic_discretizer.hpp"
-#include "oneshot/half_kalman.hpp"
 #include "oneshot/host/host_board.hpp"
 #include "oneshot/plant_structure.hpp"
 #include "oneshot/sim/pil_link.hpp"
-#include "oneshot/standard_kalman.hpp"
-#include "oneshot/table_discretizer.hpp"
 
 namespace oneshot::sim {
 
@@ -92,50 +84,6 @@ std::shared_ptr<const SimContext> SimContext::load(const std::string& path) {
 }
 
 namespace {
-
-/// Dispatches on the context (generated header or run-time plant) and the number format.
-template <typename F>
-decltype(auto) with_controller_parts(const SimContext& ctx, const RunOptions& opt, F&& f) {
-  if (opt.format == NumberFormat::kQ15 || opt.format == NumberFormat::kFloatPoly) {
-    throw std::invalid_argument(std::string("--number-format ") + to_string(opt.format) +
-                                " is the generated C job: closed-loop runs only (not the C++ core)");
-  }
-  if (ctx.generated()) {
-    if (opt.format == NumberFormat::kFloat) {
-      using K = generated::PlantConstants<float>;
-      return with_estimator<generated::PlantStructure>(opt, K::kDesign, K::kTable, K::kModel, f);
-    }
-    if (opt.format == NumberFormat::kFixed) {
-#if ONESHOT_GENERATED_FIXED_POINT
-      using K = generated::PlantConstants<generated::FixedTag>;
-      return with_estimator<generated::PlantStructure>(opt, K::kDesign, K::kTable, K::kModel, f);
-#else
-      throw std::invalid_argument(std::string("no fixed-point build for this plant: ") + generated::kFixedPointUnavailable);
-#endif
-    }
-    using K = generated::PlantConstants<double>;
-    return with_estimator<generated::PlantStructure>(opt, K::kDesign, K::kTable, K::kModel, f);
-  }
-  if (opt.format == NumberFormat::kFixed) {
-    throw std::invalid_argument(
-        "--number-format fixed needs the plant's Q formats at build time: configure with -DONESHOT_PLANT=" +
-        ctx.plant().source + " and run without --plant");
-  }
-  const auto& plant = ctx.plant();
-  return design::with_dimensions(plant.n(), plant.m(), plant.p(), [&](auto n, auto m, auto p) {
-    constexpr std::size_t kN = decltype(n)::value;
-    constexpr std::size_t kM = decltype(m)::value;
-    constexpr std::size_t kP = decltype(p)::value;
-    if (opt.format == NumberFormat::kFloat) {
-      const auto design = design::controller_design<float, kN, kM, kP>(plant, ctx.design());
-      const auto model = design::continuous_model_per_us<float, kN, kM>(plant, ctx.design());
-      return with_estimator<DenseStructure<kN, kM, kP>>(opt, design, ctx.table_float().view(), model, f);
-    }
-    const auto design = design::controller_design<double, kN, kM, kP>(plant, ctx.design());
-    const auto model = design::continuous_model_per_us<double, kN, kM>(plant, ctx.design());
-    return with_estimator<DenseStructure<kN, kM, kP>>(opt, design, ctx.table_double().view(), model, f);
-  });
-}
 
 /// simulate() with the job in the emulated MCU.
 RunResult simulate_pil(const SimContext& ctx, const Scenario& scenario, std::uint64_t seed, const RunOptions& opt) {
@@ -270,43 +218,11 @@ RunResult simulate(const SimContext& ctx, const Scenario& scenario, std::uint64_
     d.format = NumberFormat::kDouble;
     return simulate(ctx, scenario, seed, d);
   }
-  return with_controller_parts(ctx, options, [&](auto structure, auto model, const auto& design, const auto& estimator) {
-    using Design = std::decay_t<decltype(design)>;
-    using Ctrl = Controller<typename Design::Format, typename decltype(structure)::type, std::decay_t<decltype(estimator)>>;
-    Ctrl ctrl(design, estimator);
-    LocalDriver<Ctrl, decltype(model)::value> driver(ctrl);
-    return run_board_loop<Design::kStates, Design::kInputs, Design::kOutputs, decltype(model)::value>(ctx, scenario, seed,
-                                                                                             options, driver);
-  });
-}
-
-void with_job_replay(const SimContext& ctx, const RunOptions& options, const std::vector<JobRecord>& jobs,
-                     const std::function<void(const std::function<void()>&)>& use) {
-  with_controller_parts(ctx, options, [&](auto structure, auto, const auto& design, const auto& estimator) {
-    using Design = std::decay_t<decltype(design)>;
-    using Ctrl = Controller<typename Design::Format, typename decltype(structure)::type, std::decay_t<decltype(estimator)>>;
-    using St = typename Design::Format::State;
-    constexpr std::size_t kP = Design::kOutputs;
-    Ctrl ctrl(design, estimator);
-    const auto initial = ctrl;
-    // Inputs converted once, as the ADC driver would hand them over.
-    std::vector<typename Ctrl::OutputVec> ys(jobs.size());
-    std::vector<typename Ctrl::OutputVec> rs(jobs.size());
-    for (std::size_t k = 0; k < jobs.size(); ++k)
-      for (std::size_t o = 0; o < kP; ++o) {
-        ys[k][o] = output_of_code(design.sensor, o, jobs[k].y_code);
-        rs[k][o] = output_of_code(design.sensor, o, jobs[k].setpoint_code);
-      }
-    std::int32_t codes[Design::kInputs] = {};
-    St sink{};
-    use([&]() {
-      ctrl = initial;
-      // Timing only: the statuses of these jobs are those of the simulated run, checked there.
-      for (std::size_t k = 0; k < jobs.size(); ++k) (void)ctrl.job(jobs[k].tau_us, ys[k], rs[k], codes);
-      sink = ctrl.estimator().prediction()[0];
-    });
-    static_cast<void>(sink);
-  });
+  if (ctx.generated()) return with_generated_parts(options, CoreBoardRun{ctx, scenario, seed, options});
+  require_runtime_format(ctx, options);
+  // Run-time plants: one source per format (simulation_runtime_*.cpp).
+  return options.format == NumberFormat::kFloat ? simulate_runtime<float>(ctx, scenario, seed, options)
+                                                : simulate_runtime<double>(ctx, scenario, seed, options);
 }
 
 }  // namespace oneshot::sim

@@ -1,0 +1,10 @@
+/// @file simulation_runtime_double.cpp
+/// @brief simulate() of run-time plants in double (core_board_run.hpp): one format per source, so the
+///        dimension x estimator instantiations compile in parallel.
+#include "core_board_run.hpp"
+
+namespace oneshot::sim {
+
+template RunResult simulate_runtime<double>(const SimContext&, const Scenario&, std::uint64_t, const RunOptions&);
+
+}  // namespace oneshot::sim
