@@ -239,6 +239,11 @@ TEST(StudyFiles, WhatTheLoopCannotRunIsRefusedNamingTheField) {
   expect_refused([](nlohmann::json& j) { j["approaches"][0]["name"] = "ideal"; }, "field 'approaches[0].name'");
   expect_refused([](nlohmann::json& j) { std::swap(j["approaches"][0], j["approaches"][1]); }, "field 'approaches[0].kind'");
   expect_refused([](nlohmann::json& j) { j["scenarios"][0]["params"]["period_s"] = 0.125; }, "field 'scenarios[0].params.period_s'");
+  // I, the reference of every ratio, would cost exactly 0: it starts on the set-point, without delay or noise.
+  expect_refused([](nlohmann::json& j) { j["scenarios"][0]["params"]["amplitude_volts"] = 0; },
+                 "field 'scenarios[0].params.amplitude_volts'");
+  expect_refused([](nlohmann::json& j) { j["scenarios"][2]["duration_s"] = 2; }, "field 'scenarios[2].duration_s'");  // T_r/2 = 2 s
+  expect_refused([](nlohmann::json& j) { j["duration_s"] = 0.5; }, "field 'duration_s'");
   expect_refused([](nlohmann::json& j) { j["plant"] = {{"continuous", {{"A", {{0}}}, {"B", {{1}}}, {"C", {{1}}}, {"Q_c", {{0}}}}}}; },
                  "field 'plant'");
   // S+ needs a mean delay below h: 45 + 2.25 + 3 ms is not.
