@@ -175,5 +175,23 @@ TEST(StudyReport, MaxDurationCutsEveryScenario) {
   for (const auto& x : read_json(out + ".json").at("scenarios")) EXPECT_EQ(x.at("duration_s").get<double>(), 2.5);
 }
 
+TEST(StudyReport, FuzzRunCorpusFilesRunWithinTheHarnessBound) {
+  // The seeds of tests/fuzz/fuzz_study_run.cpp run there, not refused: parsed in a folder that
+  // holds what the harness's holds, cut as the harness cuts them.
+  const std::string dir = test::made_dir("oneshot_study_report", "fuzz_corpus");
+  std::filesystem::copy_file(std::string(ONESHOT_STUDY_EXAMPLES_DIR) + "/../../../lut_gen/plants/networked_board.json",
+                             dir + "/networked_board.json");
+  std::ofstream(dir + "/delays.csv") << "delay_us\n500\n# a comment\n1500\n\n250\n";
+  std::size_t files = 0;
+  for (const auto& f : std::filesystem::directory_iterator(std::string(ONESHOT_STUDY_FUZZ_CORPUS) + "/../study_run")) {
+    ++files;
+    NcsStudy s = map_ncs_study(engine::parse_study(test::read_file(f.path().string()), dir + "/fuzz.json", &ncs_schema(), dir));
+    cap_duration(s, 0.3, "--max-duration");
+    const engine::SweepResults r = run_ncs_sweep(s, 1, 1, engine::Shard{});
+    for (double v : r.values) EXPECT_TRUE(std::isfinite(v)) << f.path();
+  }
+  EXPECT_GE(files, 3U);
+}
+
 }  // namespace
 }  // namespace oneshot::study

@@ -1,0 +1,104 @@
+/// @file fuzz_study_run.cpp
+/// @brief libFuzzer harness of `oneshot-sim study run` on what the parser and the ncs mapping
+///        accept: the file is parsed with the ncs schema (engine::parse_study), mapped onto the
+///        ncs loop (study::map_ncs_study) and RUN, bounded: its first kMaxScenarios scenarios,
+///        one seed, every scenario's simulated time capped by study::cap_duration (the
+///        runner's `--max-duration`) at min(0.3 s, 20 periods h), at least h. The node timers
+///        run once per period, so the cap bounds the events and frames of a run; an oracle
+///        checks it (frames a link carries per run ≤ periods + 2).
+///
+/// Oracles: no crash; bad input and what the loop cannot run refused with engine::InputError
+/// naming the field ("field '…'"); a run gives finite metrics (cost, counters; with
+/// --analytic, chosen by the input's length, the exact expected cost too), its link counters
+/// add up (delivered + lost = sent, late + refused ≤ delivered) and the summary of
+/// `study run` (study::run_outputs, CSV and markdown files, no plots) holds only finite
+/// numbers (null for unbounded delays). A plant file "networked_board.json" (study ncs's) and a
+/// delay trace "delays.csv" sit in the harness's folder; inputs are parsed as if they were a
+/// file there.
+#include <cmath>
+#include <cstdint>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+#include "fuzz_oracle.hpp"
+#include "oneshot/engine/study_file.hpp"
+#include "study_ncs_runner.hpp"
+#include "study_ncs_sweep.hpp"
+
+namespace e = oneshot::engine;
+namespace st = oneshot::study;
+using oneshot::fuzz::require;
+
+namespace {
+
+/// Scenarios run per input (the file's first ones).
+constexpr std::size_t kMaxScenarios = 3;
+/// Simulated seconds per run at most (and at most kMaxPeriods periods h, at least one).
+constexpr double kMaxDurationS = 0.3;
+/// Periods h per run at most.
+constexpr double kMaxPeriods = 20;
+
+std::string g_base_dir;
+
+void require_named(const e::InputError& x, const char* what) {
+  require(std::string(x.what()).find("field '") != std::string::npos, std::string(what) + " refused without naming a field: " + x.what());
+}
+
+/// Every number finite (null allowed: unbounded figures).
+void require_finite_json(const nlohmann::json& j, const std::string& where) {
+  if (j.is_number()) require(std::isfinite(j.get<double>()), "study run: non-finite figure at " + where);
+  if (j.is_structured()) {
+    for (const auto& [k, v] : j.items()) require_finite_json(v, where + "." + k);
+  }
+}
+
+void remove_base_dir() {
+  std::error_code ec;
+  std::filesystem::remove_all(g_base_dir, ec);
+}
+
+}  // namespace
+
+extern "C" int LLVMFuzzerInitialize(int*, char***) {
+  char dir[] = "/tmp/oneshot-fuzz-study-run-XXXXXX";
+  if (::mkdtemp(dir) == nullptr) std::abort();
+  g_base_dir = dir;
+  std::ofstream(g_base_dir + "/delays.csv") << "delay_us\n500\n# a comment\n1500\n\n250\n";
+  std::filesystem::copy_file(ONESHOT_NCS_PLANT_FILE, g_base_dir + "/networked_board.json");
+  std::atexit(remove_base_dir);
+  return 0;
+}
+
+extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
+  const std::string text(reinterpret_cast<const char*>(data), size);
+  st::NcsStudy s;
+  try {
+    s = st::map_ncs_study(e::parse_study(text, g_base_dir + "/fuzz.json", &st::ncs_schema(), g_base_dir));
+    if (s.scenarios.size() > kMaxScenarios) s.scenarios.resize(kMaxScenarios);
+    const double h_s = static_cast<double>(s.ctx->period_us()) * 1e-6;
+    st::cap_duration(s, std::fmax(h_s, std::fmin(kMaxDurationS, kMaxPeriods * h_s)), "--max-duration");
+  } catch (const e::InputError& x) {
+    require_named(x, "study run");
+    return 0;
+  }
+  const bool analytic = size % 2 == 1;
+  const e::SweepResults r = st::run_ncs_sweep(s, 1, 1, e::Shard{}, analytic);
+  require(r.complete(), "study run: a run missing");
+  for (double v : r.values) require(std::isfinite(v), "study run: a non-finite metric");
+  for (std::size_t a = 0; a < r.spec.approaches.size(); ++a) {
+    for (std::size_t k = 0; k < r.spec.scenarios.size(); ++k) {
+      const double periods = s.scenarios[k].duration_s * 1e6 / static_cast<double>(s.ctx->period_us());
+      for (const std::string& l : s.links) {
+        const auto at = [&](const char* c) { return r.at(a, k, 0, r.metric(l + "." + c)); };
+        const std::string where = r.spec.approaches[a] + " on " + r.spec.scenarios[k] + ", link " + l;
+        require(at("sent") <= periods + 2, where + ": more frames than periods (" + std::to_string(at("sent")) + ")");
+        require(at("delivered") + at("lost") == at("sent"), where + ": delivered + lost != sent");
+        require(at("late") + at("refused") <= at("delivered"), where + ": more late or refused frames than delivered");
+      }
+    }
+  }
+  require_finite_json(st::run_outputs(r, g_base_dir + "/out", false), "summary");
+  return 0;
+}
