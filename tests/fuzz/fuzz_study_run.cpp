@@ -7,8 +7,9 @@
 ///        run once per period, so the cap bounds the events and frames of a run; an oracle
 ///        checks it (frames a link carries per run ≤ periods + 2).
 ///
-/// Oracles: no crash; bad input and what the loop cannot run refused with engine::InputError
-/// naming the field ("field '…'"); a run gives finite metrics (cost, counters; with
+/// Oracles: no crash; bad input refused by the parser (engine::InputError), what the loop
+/// cannot run refused by the mapping or the cap with engine::InputError naming the field
+/// ("field '…'"); a run gives finite metrics (cost, counters; with
 /// --analytic, chosen by the input's length, the exact expected cost too), its link counters
 /// add up (delivered + lost = sent, late + refused ≤ delivered) and the summary of
 /// `study run` (study::run_outputs, CSV and markdown files, no plots) holds only finite
@@ -73,9 +74,15 @@ extern "C" int LLVMFuzzerInitialize(int*, char***) {
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   const std::string text(reinterpret_cast<const char*>(data), size);
+  e::StudyFile file;
+  try {
+    file = e::parse_study(text, g_base_dir + "/fuzz.json", &st::ncs_schema(), g_base_dir);
+  } catch (const e::InputError&) {
+    return 0;  // refused by the parser with a message (fuzz_study checks those): fine
+  }
   st::NcsStudy s;
   try {
-    s = st::map_ncs_study(e::parse_study(text, g_base_dir + "/fuzz.json", &st::ncs_schema(), g_base_dir));
+    s = st::map_ncs_study(file);
     if (s.scenarios.size() > kMaxScenarios) s.scenarios.resize(kMaxScenarios);
     const double h_s = static_cast<double>(s.ctx->period_us()) * 1e-6;
     st::cap_duration(s, std::fmax(h_s, std::fmin(kMaxDurationS, kMaxPeriods * h_s)), "--max-duration");
