@@ -13,19 +13,17 @@
 /// --analytic, chosen by the input's length, the exact expected cost too), its link counters
 /// add up (delivered + lost = sent, late + refused ≤ delivered) and the summary of
 /// `study run` (study::run_outputs, CSV and markdown files, no plots) holds only finite
-/// numbers (null for unbounded delays), its files written to a folder on /dev/shm where there
-/// is one (the writes are synced: on a disk they would cost more than the runs). A plant file "networked_board.json" (study ncs's) and a
-/// delay trace "delays.csv" sit in the harness's folder; inputs are parsed as if they were a
-/// file there.
+/// numbers (null for unbounded delays). Inputs are parsed as files in the harness's folder
+/// (study_fuzz_support.hpp: study ncs's plant file "networked_board.json" and a delay trace
+/// "delays.csv" beside them; on /dev/shm where there is one, the summary's files being synced
+/// writes that would cost more than the runs on a disk).
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
-#include <cstdlib>
-#include <filesystem>
-#include <fstream>
 #include <string>
 
 #include "fuzz_oracle.hpp"
+#include "study_fuzz_support.hpp"
 #include "oneshot/engine/study_file.hpp"
 #include "study_ncs_runner.hpp"
 #include "study_ncs_sweep.hpp"
@@ -33,6 +31,8 @@
 namespace e = oneshot::engine;
 namespace st = oneshot::study;
 using oneshot::fuzz::require;
+using oneshot::fuzz::require_finite_json;
+using oneshot::fuzz::require_named;
 
 namespace {
 
@@ -44,45 +44,14 @@ constexpr double kMaxDurationS = 0.3;
 /// Periods h per run at most.
 constexpr double kMaxPeriods = 20;
 
-std::string g_base_dir;
-
-void require_named(const e::InputError& x, const char* what) {
-  require(std::string(x.what()).find("field '") != std::string::npos, std::string(what) + " refused without naming a field: " + x.what());
-}
-
-/// Every number finite (null allowed: unbounded figures).
-void require_finite_json(const nlohmann::json& j, const std::string& where) {
-  if (j.is_number()) require(std::isfinite(j.get<double>()), "study run: non-finite figure at " + where);
-  if (j.is_structured()) {
-    for (const auto& [k, v] : j.items()) require_finite_json(v, where + "." + k);
-  }
-}
-
-void remove_base_dir() {
-  std::error_code ec;
-  std::filesystem::remove_all(g_base_dir, ec);
-}
-
 }  // namespace
 
-extern "C" int LLVMFuzzerInitialize(int*, char***) {
-  char shm[] = "/dev/shm/oneshot-fuzz-study-run-XXXXXX";
-  char tmp[] = "/tmp/oneshot-fuzz-study-run-XXXXXX";
-  const char* dir = ::mkdtemp(shm);
-  if (dir == nullptr) dir = ::mkdtemp(tmp);
-  if (dir == nullptr) std::abort();
-  g_base_dir = dir;
-  std::ofstream(g_base_dir + "/delays.csv") << "delay_us\n500\n# a comment\n1500\n\n250\n";
-  std::filesystem::copy_file(ONESHOT_NCS_PLANT_FILE, g_base_dir + "/networked_board.json");
-  std::atexit(remove_base_dir);
-  return 0;
-}
-
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
+  const std::string& dir = oneshot::fuzz::study_folder(ONESHOT_NCS_PLANT_FILE);
   const std::string text(reinterpret_cast<const char*>(data), size);
   e::StudyFile file;
   try {
-    file = e::parse_study(text, g_base_dir + "/fuzz.json", &st::ncs_schema(), g_base_dir);
+    file = e::parse_study(text, dir + "/fuzz.json", &st::ncs_schema(), dir);
   } catch (const e::InputError&) {
     return 0;  // refused by the parser with a message (fuzz_study checks those): fine
   }
@@ -113,6 +82,6 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
       }
     }
   }
-  require_finite_json(st::run_outputs(r, g_base_dir + "/out", false), "summary");
+  require_finite_json(st::run_outputs(r, dir + "/out", false), "summary", "study run");
   return 0;
 }
