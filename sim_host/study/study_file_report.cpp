@@ -28,7 +28,8 @@ std::string report_markdown(const std::string& file, const std::string& resoluti
      << "Per scenario (mean cost of I, ratio of each approach's mean cost to I's):\n\n"
      << outputs.at("markdown_per_scenario").get<std::string>() << "\n### Links\n\n"
      << "Totals over every run: sent (handed to the link), delivered (not lost), lost (dropped by the loss model), "
-        "late (dropped by the receiver as stale or late), refused (by the receiver's frame checks).\n\n"
+        "late (dropped by the receiver as stale: not newer than what it holds, or after its period; the periods without a "
+        "command are the late column of the cost table), refused (by the receiver's frame checks).\n\n"
      << "| approach | link |";
   for (const char* c : kLinkCounters) md << " " << c << " |";
   md << "\n|---|---|";
