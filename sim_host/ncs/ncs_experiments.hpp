@@ -36,6 +36,16 @@ engine::SweepResults table_sweep(const Context& ctx, const TableOptions& opt, co
 /// and with --noise-free the invariant checks) and files in `out_dir` (CSV, markdown, plot).
 nlohmann::json table_outputs(const engine::SweepResults& results, const std::string& out_dir, bool plots);
 
+/// Markdown of the paired differences of a table_outputs() JSON: a row (mean, 95 % CI over
+/// seeds) for each pair "X-Y" of `pairs` the table has, in that order.
+std::string paired_differences_markdown(const nlohmann::json& table, const std::vector<std::string>& pairs);
+
+/// The cost part of a report section from a table_outputs() JSON: the table (mean cost with
+/// its 95 % CI, ratios to I with theirs), the order by mean cost, the paired differences of
+/// `pairs` and, when `plot_path` is not empty, the cost bars (with intervals) it links to.
+std::string table_section_markdown(const nlohmann::json& table, const std::vector<std::string>& pairs,
+                                   const std::string& plot_path);
+
 /// E1 (Fig. 6): noisy y1, y2 beside AK's estimates on one run; files in out_dir.
 nlohmann::json run_e1(const Context& ctx, std::uint64_t seed, double duration_s, const std::string& out_dir, bool plots);
 /// E2 (Fig. 7): delays only, I, S and A on the square wave; files in out_dir.

@@ -69,17 +69,8 @@ StudyReportResult report_section(const StudyReportContext& rc) {
   md << "## Networked control synchronized at the actuation instants (study ncs)\n\n"
      << "Plant `" << ctx->plant().name << "` (C = I, h = 50 ms), ten scenarios of the brief, "
      << t.seeds << " seeds each, the same delay and noise draws for every approach (details: docs/ncs.md).\n\n"
-     << table.at("markdown").get<std::string>() << "\nOrder by mean cost (measured): "
-     << table.at("order_text").get<std::string>() << "\n\n";
-  const auto pair = [&](const char* key) {
-    const auto& p = table.at("paired_differences");
-    if (!p.contains(key)) return std::string();
-    return std::string("| ") + key + " | " + fmt("%.6f", p.at(key).at("mean").get<double>()) + " | ± " +
-           fmt("%.6f", p.at(key).at("ci95").get<double>()) + " |\n";
-  };
-  md << "Paired differences of the mean cost (per seed, 95 % CI):\n\n| pair | mean | 95 % CI |\n|---|---|---|\n"
-     << pair("S-A") << pair("S-AK") << pair("A-AK") << pair("AK-AKx") << pair("AK-AKl") << pair("S-SK") << pair("S-S+")
-     << pair("AK-SK") << pair("AK-IK") << "\n![table](" << rc.rel_dir << "/table/table.png)\n\n"
+     << ncs::table_section_markdown(table, {"S-A", "S-AK", "A-AK", "AK-AKx", "AK-AKl", "S-SK", "S-S+", "AK-SK", "AK-IK"},
+                                    rc.plots ? rc.rel_dir + "/table/table.png" : "")
      << "Noise-free invariant (" << nf.seeds << " seeds): max |J_A/J_I - 1| = "
      << fmt("%.2e", free.at("A_vs_I_max_abs_ratio_minus_1").get<double>()) << "; S/I by delay level d:";
   for (const auto& [d, r] : free.at("S_ratio_to_I_by_delay_ms").items()) md << " d = " << d << " ms: " << fmt("%.4f", r.get<double>()) << ";";

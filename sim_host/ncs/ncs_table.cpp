@@ -231,4 +231,26 @@ nlohmann::json table_outputs(const engine::SweepResults& results, const std::str
   return j;
 }
 
+std::string paired_differences_markdown(const nlohmann::json& table, const std::vector<std::string>& pairs) {
+  std::ostringstream md;
+  md << "Paired differences of the mean cost (per seed, 95 % CI):\n\n| pair | mean | 95 % CI |\n|---|---|---|\n";
+  const nlohmann::json& p = table.at("paired_differences");
+  for (const std::string& key : pairs) {
+    if (!p.contains(key)) continue;
+    char line[160];
+    std::snprintf(line, sizeof line, " | %.6f | ± %.6f |\n", p.at(key).at("mean").get<double>(), p.at(key).at("ci95").get<double>());
+    md << "| " << key << line;
+  }
+  return md.str();
+}
+
+std::string table_section_markdown(const nlohmann::json& table, const std::vector<std::string>& pairs,
+                                   const std::string& plot_path) {
+  std::ostringstream md;
+  md << table.at("markdown").get<std::string>() << "\nOrder by mean cost (measured): " << table.at("order_text").get<std::string>()
+     << "\n\n" << paired_differences_markdown(table, pairs) << "\n";
+  if (!plot_path.empty()) md << "![mean cost per approach, 95 % intervals](" << plot_path << ")\n\n";
+  return md.str();
+}
+
 }  // namespace oneshot::ncs

@@ -1,7 +1,7 @@
 /// @file study_cli.cpp
-/// @brief `oneshot-sim study check FILE` and `oneshot-sim study run FILE`: study files
-///        (`oneshot-study/1`, docs/study-files.md) from the command line; `merge` finishes
-///        the shards of `study run`.
+/// @brief `oneshot-sim study check FILE`, `oneshot-sim study run FILE` and `oneshot-sim study
+///        report FILE OUTDIR`: study files (`oneshot-study/1`, docs/study-files.md) from the
+///        command line; `merge` finishes the shards of `study run`.
 #include <chrono>
 #include <filesystem>
 #include <iostream>
@@ -12,6 +12,7 @@
 #include "oneshot/sim/study_descriptor.hpp"
 #include "oneshot/util/output_files.hpp"
 #include "study_check.hpp"
+#include "study_file_report.hpp"
 #include "study_ncs_runner.hpp"
 #include "study_ncs_sweep.hpp"
 
@@ -65,7 +66,27 @@ struct RunCli {
   std::string json;
   bool no_plots = false;
   bool analytic = false;
+  double max_duration_s = 0;  ///< > 0: every scenario's simulated time capped there.
 };
+
+struct ReportCli {
+  std::string file;
+  std::string out;
+  std::size_t seeds = 0;
+  unsigned threads = 0;
+  bool no_plots = false;
+  double max_duration_s = 0;
+};
+
+/// The file's ncs loop, its scenarios cut at `max_duration_s` (0: as the file says).
+study::NcsStudy runnable(const Checked& k, double max_duration_s) {
+  if (!k.ncs) throw engine::InputError(k.resolution.at("source").get<std::string>() + ": " + k.refusal);  // one line, nothing written
+  study::NcsStudy s = *k.ncs;
+  if (max_duration_s != 0) study::cap_duration(s, max_duration_s, "--max-duration");
+  return s;
+}
+
+constexpr const char* kMaxDurationHelp = "cap every scenario's simulated seconds (at least one period h; default: the file's)";
 
 void add_study_commands(CLI::App* group) {
   {
@@ -99,17 +120,17 @@ void add_study_commands(CLI::App* group) {
     cmd->add_option("--out", c->out, "output directory")->capture_default_str();
     cmd->add_option("--json", c->json, "write the result as JSON to PATH, or '-' for standard output");
     cmd->add_flag("--no-plots", c->no_plots, "write CSV files only (no gnuplot)");
+    cmd->add_option("--max-duration", c->max_duration_s, kMaxDurationHelp);
     cmd->add_flag("--analytic", c->analytic,
                   "also the exact expected cost over the noise for each run's timing, as `ncs table --analytic` "
                   "(analytic_mean, analytic_ci95, variance_reduction, ...; approaches whose runs leave the linear "
                   "loop: analytic_refused with the reason)");
     cmd->callback([c]() {
-      const Checked k = check_file(c->file);
-      if (!k.ncs) throw engine::InputError(k.resolution.at("source").get<std::string>() + ": " + k.refusal);  // one line, nothing written
+      const study::NcsStudy s = runnable(check_file(c->file), c->max_duration_s);
       const engine::Shard part = engine::parse_shard(c->shard);
       util::make_directory(c->out);
       const auto start = std::chrono::steady_clock::now();
-      const engine::SweepResults r = study::run_ncs_sweep(*k.ncs, c->seeds, c->threads, part, c->analytic);
+      const engine::SweepResults r = study::run_ncs_sweep(s, c->seeds, c->threads, part, c->analytic);
       const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
       nlohmann::json j;
       if (!part.whole()) {
@@ -122,12 +143,40 @@ void add_study_commands(CLI::App* group) {
       if (c->json != "-") std::cout << "study run: " << r.spec.runs() << " runs, wall time " << wall << " s, written to " << c->out << "\n";
     });
   }
+  {
+    auto c = std::make_shared<ReportCli>();
+    CLI::App* cmd = group->add_subcommand(
+        "report", "Run a study file as `study run` does and write OUTDIR/report.md: the resolved configuration, costs with "
+                  "95 % intervals, ratios to I, paired differences, per-link counters, the cost plot; OUTDIR/report.json");
+    cmd->add_option("file", c->file, "study file (oneshot-study/1)")->required();
+    cmd->add_option("outdir", c->out, "output directory")->required();
+    cmd->add_option("--seeds", c->seeds, "seeds per scenario (default: the file's seeds.count)")->check(CLI::Range(2, 10000000));
+    cmd->add_option("--threads", c->threads, "worker threads (0: every core)")->capture_default_str();
+    cmd->add_option("--max-duration", c->max_duration_s, kMaxDurationHelp);
+    cmd->add_flag("--no-plots", c->no_plots, "no plot (no gnuplot); the report links none");
+    cmd->callback([c]() {
+      const Checked k = check_file(c->file);
+      const study::NcsStudy s = runnable(k, c->max_duration_s);
+      util::make_directory(c->out);
+      const engine::SweepResults r = study::run_ncs_sweep(s, c->seeds, c->threads, engine::Shard{});
+      const nlohmann::json j = study::run_outputs(r, c->out, !c->no_plots);
+      nlohmann::json resolution = k.resolution;  // the grid that ran: --seeds overrides the file's count
+      resolution["seeds"]["count"] = r.spec.seeds;
+      resolution["grid"]["runs"] = r.spec.runs();
+      const std::string md = study::report_markdown(c->file, study::describe_resolution(resolution), r, j,
+                                                    c->no_plots ? "" : "table.png");
+      util::write_text((std::filesystem::path(c->out) / "report.md").string(), md);
+      util::write_json((std::filesystem::path(c->out) / "report.json").string(), j);
+      std::cout << "study report: " << r.spec.runs() << " runs, written to " << (std::filesystem::path(c->out) / "report.md").string()
+                << "\n";
+    });
+  }
 }
 
 }  // namespace
 
 StudyDescriptor study_files_study() {
-  return {"study", "Study files (oneshot-study/1): check what a file resolves to, run it (docs/study-files.md)",
+  return {"study", "Study files (oneshot-study/1): check what a file resolves to, run it, report it (docs/study-files.md)",
           add_study_commands, {{"run", study::run_outputs}}, std::nullopt};
 }
 

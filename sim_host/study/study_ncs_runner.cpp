@@ -2,6 +2,7 @@
 /// @brief A study file mapped onto study ncs's loop (see study_ncs_runner.hpp).
 #include "study_ncs_runner.hpp"
 
+#include <cmath>
 #include <filesystem>
 #include <map>
 #include <stdexcept>
@@ -17,6 +18,19 @@ std::string at(const char* list, std::size_t i) { return std::string(list) + "["
 
 [[noreturn]] void refuse(const std::string& field, const std::string& why) {
   throw InputError("field '" + field + "': " + why);
+}
+
+/// Why approach I, the reference of every ratio, would cost exactly 0 on `sc` ("" when it does
+/// not): it starts on the set-point without delay or noise, so it costs nothing until the first
+/// set-point switch at T_r/2, and nothing at all with amplitude 0. Ratios to it would divide by 0.
+std::string zero_reference_cost(const ncs::Context& ctx, const ncs::Scenario& sc) {
+  if (!(sc.amplitude_volts > 0)) return "amplitude 0 keeps the reference approach I at cost 0: no ratio to it";
+  const double first_switch_s = static_cast<double>(ncs::half_wave_periods(ctx, sc)) * static_cast<double>(ctx.period_us()) * 1e-6;
+  if (!(sc.duration_s > first_switch_s)) {
+    return "the run ends (" + std::to_string(sc.duration_s) + " s) before the first set-point switch at T_r/2 = " +
+           std::to_string(first_switch_s) + " s, so the reference approach I costs 0: no ratio to it";
+  }
+  return "";
 }
 
 }  // namespace
@@ -161,6 +175,9 @@ NcsStudy map_ncs_study(const engine::StudyFile& file) {
         refuse(f + ".params.period_s", "T_r/2 must be a whole number of periods h = " + std::to_string(h_us) + " us");
       }
       if (!(sc.duration_s * 1e6 >= static_cast<double>(h_us))) refuse(f + ".duration_s", "shorter than one period h");
+      if (!(sc.amplitude_volts > 0)) refuse(f + ".params.amplitude_volts", zero_reference_cost(*out.ctx, sc));
+      const std::string zero = zero_reference_cost(*out.ctx, sc);
+      if (!zero.empty()) refuse(s.duration_s ? f + ".duration_s" : std::string("duration_s"), zero);
       for (ncs::Approach a : out.approaches) {
         const std::string g = f + " with approach " + ncs::name(a);
         if (a == ncs::Approach::kSPlus) {
@@ -191,6 +208,19 @@ NcsStudy map_ncs_study(const engine::StudyFile& file) {
     const std::string what = e.what();
     if (what.rfind(file.source + ":", 0) == 0) throw;
     throw InputError(file.source + ": " + what);
+  }
+}
+
+void cap_duration(NcsStudy& s, double max_s, const std::string& field) {
+  const double h_s = static_cast<double>(s.ctx->period_us()) * 1e-6;
+  if (!(std::isfinite(max_s) && max_s >= h_s)) {
+    throw InputError("field '" + field + "': " + std::to_string(max_s) + " s is shorter than one period h = " +
+                     std::to_string(h_s) + " s");
+  }
+  for (ncs::Scenario& x : s.scenarios) {
+    x.duration_s = std::fmin(x.duration_s, max_s);
+    const std::string zero = zero_reference_cost(*s.ctx, x);
+    if (!zero.empty()) throw InputError("field '" + field + "': scenario " + x.name + ": " + zero);
   }
 }
 

@@ -57,7 +57,15 @@ struct NcsStudy {
 std::string plant_file_path(const engine::StudyFile& file);
 
 /// Maps a file parsed with ncs_schema() onto the ncs loop; engine::InputError naming the
-/// file and the field for anything the loop cannot run.
+/// file and the field for anything the loop cannot run, and for a scenario on which the
+/// reference approach I would cost 0 (amplitude 0, or a run that ends before the first
+/// set-point switch at T_r/2): every ratio to I would divide by 0.
 NcsStudy map_ncs_study(const engine::StudyFile& file);
+
+/// Caps the simulated time of every scenario of `s` at `max_s` seconds (`study run
+/// --max-duration`, the fuzz harness); longer runs are cut there, shorter ones stay.
+/// engine::InputError naming `field` when `max_s` is not finite, below one period h, or
+/// before a scenario's first set-point switch (T_r/2: the reference approach I would cost 0).
+void cap_duration(NcsStudy& s, double max_s, const std::string& field);
 
 }  // namespace oneshot::study

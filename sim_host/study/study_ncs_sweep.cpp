@@ -40,7 +40,10 @@ std::array<double, std::size(kLinkCounters)> link_counts(const ncs::RunResult& r
     const std::string& c = names[i];
     if (c.rfind(node + ".", 0) != 0) continue;
     const std::string what = c.substr(node.size() + 1);
-    if (what == "stale" || what == "late") v[kLate] += r.counters[i];
+    // Frames dropped as stale: not newer than what the node holds, or their period past (a
+    // command after its instant). The actuator's "late" counts periods without a command, not
+    // frames (the approach's late_commands): a lost frame is one of those too.
+    if (what == "stale") v[kLate] += r.counters[i];
     if (what == "malformed" || what.rfind("refused_", 0) == 0) v[kRefused] += r.counters[i];
   }
   return v;

@@ -41,7 +41,9 @@ engine::SweepResults run_ncs_sweep(const NcsStudy& s, std::size_t seeds, unsigne
 /// ratio_scenario_weighted, paired differences, per scenario; with an analytic sweep the
 /// keys of ncs::analytic_outputs(), refused approaches with their reason; files in `out_dir`) plus
 /// "links": per approach and link the totals of sent, delivered (not lost: arrived or in
-/// flight at the end), lost, late (dropped by the receiver as stale or late) and refused
+/// flight at the end), lost, late (dropped by the receiver as stale: not newer than what it
+/// holds, or after its period; the periods without a command are the approach's
+/// late_commands, not frames) and refused
 /// (refused by the receiver's frame checks) over every run; "delay_bound_sc_ca_ms": per
 /// scenario the upper bound of the sc + ca delays (null when a leg is unbounded). ncs table's
 /// S_ratio_to_I_by_delay_ms and S_ratio_increases_with_delay are left out: they are keyed by

@@ -34,6 +34,7 @@
 #include <string>
 
 #include "fuzz_oracle.hpp"
+#include "study_fuzz_support.hpp"
 #include "oneshot/engine/can_analysis.hpp"
 #include "oneshot/engine/random_stream.hpp"
 #include "oneshot/engine/study_file.hpp"
@@ -42,6 +43,8 @@
 
 namespace e = oneshot::engine;
 using oneshot::fuzz::require;
+using oneshot::fuzz::require_finite_json;
+using oneshot::fuzz::require_named;
 
 namespace {
 
@@ -191,22 +194,9 @@ void check_study(const e::StudyFile& s, const e::StudySchema* schema) {
   }
 }
 
-/// Every number finite (null allowed: unbounded figures).
-void require_finite_json(const nlohmann::json& j, const std::string& where) {
-  if (j.is_number()) require(std::isfinite(j.get<double>()), "study check: non-finite figure at " + where);
-  if (j.is_structured()) {
-    for (const auto& [k, v] : j.items()) require_finite_json(v, where + "." + k);
-  }
-}
-
-/// A refusal of study check names the field.
-void require_named(const oneshot::engine::InputError& e, const char* what) {
-  require(std::string(e.what()).find("field '") != std::string::npos, std::string(what) + " refused without naming a field: " + e.what());
-}
-
 void check_study_check(const e::StudyFile& s) {
   try {
-    require_finite_json(oneshot::study::resolve_study(s), "resolution");
+    require_finite_json(oneshot::study::resolve_study(s), "resolution", "study check");
   } catch (const e::InputError& x) {
     require_named(x, "study check");
   }
@@ -219,20 +209,10 @@ void check_study_check(const e::StudyFile& s) {
   }
 }
 
-void remove_base_dir() {
-  std::error_code ec;
-  std::filesystem::remove_all(g_base_dir, ec);
-}
-
 }  // namespace
 
 extern "C" int LLVMFuzzerInitialize(int*, char***) {
-  char dir[] = "/tmp/oneshot-fuzz-study-XXXXXX";
-  if (::mkdtemp(dir) == nullptr) std::abort();
-  g_base_dir = dir;
-  std::ofstream(g_base_dir + "/delays.csv") << "delay_us\n500\n# a comment\n1500\n\n250\n";
-  std::filesystem::copy_file(ONESHOT_NCS_PLANT_FILE, g_base_dir + "/networked_board.json");
-  std::atexit(remove_base_dir);
+  g_base_dir = oneshot::fuzz::study_folder(ONESHOT_NCS_PLANT_FILE);
   return 0;
 }
 

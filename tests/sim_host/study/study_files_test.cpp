@@ -111,6 +111,31 @@ TEST(StudyFiles, LossFromTheFileReachesTheLeg) {
   EXPECT_EQ(j.at("links").at("AK").at("ca").at("lost").get<double>(), 0);
 }
 
+TEST(StudyFiles, LinkCountersCountFrames) {
+  // Every command lost: no frame reaches the actuator, so none is dropped late there (the
+  // periods without a command are the approach's late_commands, every one of them).
+  const engine::StudyFile f = parse_edited([](nlohmann::json& j) {
+    j["links"][2]["loss"] = {{"model", "bernoulli"}, {"p", 1}};
+    j["approaches"] = nlohmann::json::parse(R"([{"name": "I"}, {"name": "S"}, {"name": "A"}, {"name": "AK"}])");
+  });
+  NcsStudy s = map_ncs_study(f);
+  s.scenarios.resize(1);
+  s.scenarios[0].duration_s = 2;
+  const nlohmann::json j = run_outputs(run_ncs_sweep(s, 2, 2, engine::Shard{}), temp_dir("frames"), false);
+  for (const char* a : {"S", "A", "AK"}) {
+    const nlohmann::json& ca = j.at("links").at(a).at("ca");
+    EXPECT_GT(ca.at("sent").get<double>(), 0) << a;
+    EXPECT_EQ(ca.at("lost").get<double>(), ca.at("sent").get<double>()) << a;
+    EXPECT_EQ(ca.at("late").get<double>(), 0) << a;
+    EXPECT_EQ(ca.at("refused").get<double>(), 0) << a;
+  }
+  for (const char* a : {"A", "AK"}) EXPECT_GT(j.at("approaches").at(a).at("late_commands").get<double>(), 0) << a;
+  // Every link and approach: frames dropped or refused by the receiver were delivered first.
+  for (const auto& [a, links] : j.at("links").items())
+    for (const auto& [l, c] : links.items())
+      EXPECT_LE(c.at("late").get<double>() + c.at("refused").get<double>(), c.at("delivered").get<double>()) << a << " " << l;
+}
+
 /// `want` and `got` equal within 1e-12 relative (both null, or both numbers).
 void expect_same_figure(const nlohmann::json& got, const nlohmann::json& want, const std::string& what) {
   if (want.is_null()) {
@@ -239,6 +264,11 @@ TEST(StudyFiles, WhatTheLoopCannotRunIsRefusedNamingTheField) {
   expect_refused([](nlohmann::json& j) { j["approaches"][0]["name"] = "ideal"; }, "field 'approaches[0].name'");
   expect_refused([](nlohmann::json& j) { std::swap(j["approaches"][0], j["approaches"][1]); }, "field 'approaches[0].kind'");
   expect_refused([](nlohmann::json& j) { j["scenarios"][0]["params"]["period_s"] = 0.125; }, "field 'scenarios[0].params.period_s'");
+  // I, the reference of every ratio, would cost exactly 0: it starts on the set-point, without delay or noise.
+  expect_refused([](nlohmann::json& j) { j["scenarios"][0]["params"]["amplitude_volts"] = 0; },
+                 "field 'scenarios[0].params.amplitude_volts'");
+  expect_refused([](nlohmann::json& j) { j["scenarios"][2]["duration_s"] = 2; }, "field 'scenarios[2].duration_s'");  // T_r/2 = 2 s
+  expect_refused([](nlohmann::json& j) { j["duration_s"] = 0.5; }, "field 'duration_s'");
   expect_refused([](nlohmann::json& j) { j["plant"] = {{"continuous", {{"A", {{0}}}, {"B", {{1}}}, {"C", {{1}}}, {"Q_c", {{0}}}}}}; },
                  "field 'plant'");
   // S+ needs a mean delay below h: 45 + 2.25 + 3 ms is not.

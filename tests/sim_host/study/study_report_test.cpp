@@ -1,0 +1,197 @@
+/// @file study_report_test.cpp
+/// @brief `oneshot-sim study report FILE OUTDIR`: on the shipped example the report names every
+///        approach with the cost, interval and link counters `study run --json` gives for the
+///        same seeds, and links a plot that exists; bad input writes nothing. `--max-duration`
+///        (study run, study report, the fuzz harness) cuts every scenario's simulated time.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "oneshot/engine/study_file.hpp"
+#include "study_ncs_runner.hpp"
+#include "study_ncs_sweep.hpp"
+#include "support/run_command.hpp"
+#include "support/temp_files.hpp"
+
+namespace oneshot::study {
+namespace {
+
+const std::string kExample = std::string(ONESHOT_STUDY_EXAMPLES_DIR) + "/ncs.json";
+
+nlohmann::json read_json(const std::string& path) { return nlohmann::json::parse(test::read_file(path)); }
+
+/// The cells of a markdown table row "| a | b | … |" (trimmed), empty when `line` is not one.
+std::vector<std::string> cells(const std::string& line) {
+  std::vector<std::string> out;
+  if (line.size() < 2 || line.front() != '|' || line.back() != '|') return out;
+  std::stringstream s(line.substr(1, line.size() - 2));
+  for (std::string c; std::getline(s, c, '|');) {
+    const auto b = c.find_first_not_of(' ');
+    const auto e = c.find_last_not_of(' ');
+    out.push_back(b == std::string::npos ? "" : c.substr(b, e - b + 1));
+  }
+  return out;
+}
+
+/// The rows of the markdown table that follows the line starting with `header` in `md`, by
+/// their first cell (joined with the second when `key_cells` is 2).
+std::map<std::string, std::vector<std::string>> table_after(const std::string& md, const std::string& header, int key_cells) {
+  std::map<std::string, std::vector<std::string>> rows;
+  std::stringstream s(md);
+  bool in = false;
+  for (std::string line; std::getline(s, line);) {
+    if (!in) {  // the rows start after the header line
+      in = line.rfind(header, 0) == 0;
+      continue;
+    }
+    const std::vector<std::string> c = cells(line);
+    if (c.empty()) {
+      if (!rows.empty()) break;
+      continue;
+    }
+    if (c[0].rfind("---", 0) == 0 || static_cast<int>(c.size()) < key_cells) continue;
+    rows[key_cells == 2 ? c[0] + "/" + c[1] : c[0]] = c;
+  }
+  return rows;
+}
+
+/// "± 0.0123" → 0.0123.
+double number(const std::string& cell) {
+  const auto p = cell.find_first_of("-0123456789");
+  return p == std::string::npos ? std::nan("") : std::strtod(cell.c_str() + p, nullptr);
+}
+
+TEST(StudyReport, NamesEveryApproachWithTheCostsOfStudyRun) {
+  const std::string run_dir = test::fresh_dir("oneshot_study_report", "run");
+  const std::string run_json = run_dir + ".json";
+  const test::CommandResult run = test::run_command({ONESHOT_SIM_PATH, "study", "run", kExample, "--seeds", "2", "--threads",
+                                                     "2", "--no-plots", "--out", run_dir, "--json", run_json});
+  ASSERT_EQ(run.exit_code, 0) << run.output;
+  const std::string out = test::fresh_dir("oneshot_study_report", "report");
+  const test::CommandResult rep =
+      test::run_command({ONESHOT_SIM_PATH, "study", "report", kExample, out, "--seeds", "2", "--threads", "2"});
+  ASSERT_EQ(rep.exit_code, 0) << rep.output;
+  const nlohmann::json j = read_json(run_json);
+  const std::string md = test::read_file(out + "/report.md");
+  ASSERT_FALSE(md.empty());
+  EXPECT_NE(md.find("`ncs.json`"), std::string::npos) << md;
+  EXPECT_NE(md.find("grid: 9 approaches x 10 scenarios x 2 seeds = 180 runs"), std::string::npos) << md;  // what ran
+  // The cost table: every approach, mean and interval as study run's to the 6 decimals printed.
+  const auto costs = table_after(md, "| approach | description | mean cost J", 1);
+  const auto links = table_after(md, "| approach | link |", 2);
+  ASSERT_EQ(j.at("approaches").size(), 9U);
+  for (const auto& [name, a] : j.at("approaches").items()) {
+    ASSERT_EQ(costs.count(name), 1U) << name << "\n" << md;
+    const std::vector<std::string>& row = costs.at(name);
+    ASSERT_GE(row.size(), 5U);
+    EXPECT_NEAR(number(row[2]), a.at("cost_mean").get<double>(), 5.1e-7) << name;
+    EXPECT_NEAR(number(row[3]), a.at("cost_ci95").get<double>(), 5.1e-7) << name;
+    EXPECT_NEAR(number(row[4]), a.at("ratio_to_I").get<double>(), 5.1e-5) << name;
+    for (const auto& [link, counters] : j.at("links").at(name).items()) {
+      ASSERT_EQ(links.count(name + "/" + link), 1U) << name << " " << link << "\n" << md;
+      const std::vector<std::string>& l = links.at(name + "/" + link);
+      ASSERT_EQ(l.size(), 2 + std::size(kLinkCounters));
+      for (std::size_t c = 0; c < std::size(kLinkCounters); ++c)
+        EXPECT_EQ(number(l[2 + c]), counters.at(kLinkCounters[c]).get<double>()) << name << " " << link << " " << kLinkCounters[c];
+    }
+  }
+  // Every paired difference, with the run's figures.
+  const auto pairs = table_after(md, "| pair | mean |", 1);
+  EXPECT_EQ(pairs.size(), j.at("paired_differences").size());
+  for (const auto& [pair, d] : j.at("paired_differences").items()) {
+    ASSERT_EQ(pairs.count(pair), 1U) << pair;
+    EXPECT_NEAR(number(pairs.at(pair)[1]), d.at("mean").get<double>(), 5.1e-7) << pair;
+    EXPECT_NEAR(number(pairs.at(pair)[2]), d.at("ci95").get<double>(), 5.1e-7) << pair;
+  }
+  // report.json holds the run's figures, bit for bit (same seeds, same runs).
+  const nlohmann::json rj = read_json(out + "/report.json");
+  for (const auto& [name, a] : j.at("approaches").items())
+    EXPECT_EQ(rj.at("approaches").at(name).at("cost_mean").get<double>(), a.at("cost_mean").get<double>()) << name;
+  // The plot the report links is there.
+  const std::string link = "](table.png)";
+  ASSERT_NE(md.find(link), std::string::npos) << md;
+  EXPECT_GT(std::filesystem::file_size(out + "/table.png"), 0U);
+}
+
+TEST(StudyReport, BadInputWritesNothing) {
+  nlohmann::json bad = read_json(kExample);
+  bad["scenarios"][0]["params"]["amplitude_volts"] = 1000;  // range [0, 100]
+  bad["plant"]["file"] = std::string(ONESHOT_STUDY_EXAMPLES_DIR) + "/" + bad["plant"]["file"].get<std::string>();
+  const std::string dir = test::made_dir("oneshot_study_report", "bad");
+  std::ofstream(dir + "/study.json") << bad.dump();
+  const std::vector<std::pair<std::vector<std::string>, std::string>> cases = {
+      {{dir + "/study.json"}, "field 'scenarios[0].params.amplitude_volts'"},
+      {{ONESHOT_ENGINE_EXAMPLE_STUDY}, "field 'study'"},                     // a file the loop cannot run
+      {{kExample, "--max-duration", "0.01"}, "field '--max-duration'"}};  // below h = 50 ms
+  for (const auto& [args, field] : cases) {
+    const std::string out = test::fresh_dir("oneshot_study_report", "bad_out");
+    std::vector<std::string> argv = {ONESHOT_SIM_PATH, "study", "report", args[0], out};
+    argv.insert(argv.end(), args.begin() + 1, args.end());
+    const test::CommandResult r = test::run_command(argv);
+    EXPECT_NE(r.exit_code, 0) << args[0];
+    EXPECT_NE(r.output.find(field), std::string::npos) << r.output;
+    EXPECT_EQ(std::count(r.output.begin(), r.output.end(), '\n'), 1) << r.output;
+    EXPECT_FALSE(std::filesystem::exists(out)) << args[0];
+  }
+}
+
+TEST(StudyReport, MaxDurationCutsEveryScenario) {
+  const NcsStudy file = map_ncs_study(engine::load_study(kExample, &ncs_schema()));
+  NcsStudy capped = file;
+  cap_duration(capped, 2.5, "--max-duration");  // past every scenario's first set-point switch (T_r/2 <= 2 s)
+  NcsStudy cut = file;  // the same scenarios, shortened by hand
+  for (ncs::Scenario& x : cut.scenarios) x.duration_s = 2.5;
+  capped.scenarios.resize(2);
+  cut.scenarios.resize(2);
+  const engine::SweepResults a = run_ncs_sweep(capped, 2, 2, engine::Shard{});
+  const engine::SweepResults b = run_ncs_sweep(cut, 2, 2, engine::Shard{});
+  EXPECT_EQ(a.values, b.values);
+  EXPECT_EQ(a.spec.to_json(), b.spec.to_json());
+  NcsStudy longer = file;  // a cap above a scenario's duration leaves it
+  cap_duration(longer, 1000, "--max-duration");
+  for (std::size_t i = 0; i < file.scenarios.size(); ++i) EXPECT_EQ(longer.scenarios[i].duration_s, file.scenarios[i].duration_s);
+  NcsStudy shorter = file;
+  // Below h, or before a scenario's first set-point switch (I would cost 0: no ratio to it).
+  for (double bad : {0.049, 0.0, -1.0, std::nan(""), 1.5}) {
+    try {
+      cap_duration(shorter, bad, "--max-duration");
+      ADD_FAILURE() << bad << " accepted";
+    } catch (const engine::InputError& e) {
+      EXPECT_NE(std::string(e.what()).find("field '--max-duration'"), std::string::npos) << e.what();
+    }
+  }
+  // From the command line: the run's scenarios say the simulated time they ran.
+  const std::string out = test::fresh_dir("oneshot_study_report", "capped");
+  const test::CommandResult r = test::run_command(
+      {ONESHOT_SIM_PATH, "study", "run", kExample, "--seeds", "2", "--max-duration", "2.5", "--no-plots", "--out", out, "--json", out + ".json"});
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  for (const auto& x : read_json(out + ".json").at("scenarios")) EXPECT_EQ(x.at("duration_s").get<double>(), 2.5);
+}
+
+TEST(StudyReport, FuzzRunCorpusFilesRunWithinTheHarnessBound) {
+  // The seeds of tests/fuzz/fuzz_study_run.cpp run there, not refused: parsed in a folder that
+  // holds what the harness's holds, cut as the harness cuts them.
+  const std::string dir = test::made_dir("oneshot_study_report", "fuzz_corpus");
+  std::filesystem::copy_file(std::string(ONESHOT_STUDY_EXAMPLES_DIR) + "/../../../lut_gen/plants/networked_board.json",
+                             dir + "/networked_board.json");
+  std::ofstream(dir + "/delays.csv") << "delay_us\n500\n# a comment\n1500\n\n250\n";
+  std::size_t files = 0;
+  for (const auto& f : std::filesystem::directory_iterator(std::string(ONESHOT_STUDY_FUZZ_CORPUS) + "/../study_run")) {
+    ++files;
+    NcsStudy s = map_ncs_study(engine::parse_study(test::read_file(f.path().string()), dir + "/fuzz.json", &ncs_schema(), dir));
+    cap_duration(s, 0.3, "--max-duration");
+    const engine::SweepResults r = run_ncs_sweep(s, 1, 1, engine::Shard{});
+    for (double v : r.values) EXPECT_TRUE(std::isfinite(v)) << f.path();
+  }
+  EXPECT_GE(files, 3U);
+}
+
+}  // namespace
+}  // namespace oneshot::study
