@@ -49,15 +49,9 @@ std::array<double, std::size(kLinkCounters)> link_counts(const ncs::RunResult& r
 /// Upper bound of the sc + ca delays of scenario `x` in ms; null when a leg's delay model has
 /// no upper bound (Poisson, lognormal, Pareto).
 nlohmann::json sc_ca_delay_bound_ms(const ncs::Scenario& x) {
-  double ns = 0;
-  for (const char* leg : {"sc", "ca"}) {
-    const auto it = x.legs.find(leg);
-    if (it == x.legs.end()) continue;
-    const std::optional<engine::Duration> ub = it->second.delay.upper_bound();
-    if (!ub) return nullptr;
-    ns += static_cast<double>(ub->count());
-  }
-  return ns * 1e-6;
+  const std::optional<engine::Duration> ub = ncs::sc_ca_delay_bound(x);
+  if (!ub) return nullptr;
+  return static_cast<double>(ub->count()) * 1e-6;
 }
 
 }  // namespace
