@@ -92,6 +92,13 @@ class Harness {
     }
     const HandlerId end = kernel_.add_handler("end", [this](std::uint64_t) { advance(); });
     kernel_.schedule(end_, EventClass::kEnd, end);
+    if (an_ && opt.analytic_mark_s > 0) {  // observes only: the plant and tracker are not advanced
+      const SimTime mark{engine::from_seconds(opt.analytic_mark_s, "analytic mark")};
+      const HandlerId at_mark = kernel_.add_handler("analytic mark", [this](std::uint64_t) {
+        result_.analytic_at_mark = an_->cost_at(kernel_.now());
+      });
+      if (mark <= end_) kernel_.schedule(mark, EventClass::kRecord, at_mark);
+    }
   }
 
   static bool noisy(Approach a, const RunOptions& opt) { return !opt.noise_free && !opt.analytic && a != Approach::kI; }
