@@ -61,6 +61,11 @@ std::string path_in(const std::string& dir, const std::string& name) { return (s
 
 void make_directory(const std::string& dir) { util::create_directories(dir); }
 
+std::string gnuplot_png_terminal(int width_px, int height_px, int font_pt) {
+  return "set terminal pngcairo size " + std::to_string(width_px) + "," + std::to_string(height_px) + " font 'Sans," +
+         std::to_string(font_pt) + "' noenhanced\n";
+}
+
 std::string gnuplot_quote(const std::string& label) {
   std::string q = "'";
   for (const char c : label) {

@@ -227,6 +227,12 @@ class AnalyticTracker {
     r.analytic_mismatch = mismatch_;
   }
   const engine::ExpectedCost& cost() const { return jl_.cost(); }     ///< Expected cost so far.
+  /// The expected cost at `t` (no event since the last one): a copy flowed to t, the run unchanged.
+  engine::ExpectedCost cost_at(engine::SimTime t) const {
+    Jlc j = jl_;
+    j.flow(t - now_);
+    return j.cost();
+  }
   double mismatch() const { return mismatch_; }                       ///< Largest |mean − simulated| / scale.
 
  private:

@@ -92,6 +92,13 @@ class Harness {
     }
     const HandlerId end = kernel_.add_handler("end", [this](std::uint64_t) { advance(); });
     kernel_.schedule(end_, EventClass::kEnd, end);
+    if (an_ && opt.analytic_mark_s > 0) {  // observes only: the plant and tracker are not advanced
+      const SimTime mark{engine::from_seconds(opt.analytic_mark_s, "analytic mark")};
+      const HandlerId at_mark = kernel_.add_handler("analytic mark", [this](std::uint64_t) {
+        result_.analytic_at_mark = an_->cost_at(kernel_.now());
+      });
+      if (mark <= end_) kernel_.schedule(mark, EventClass::kRecord, at_mark);
+    }
   }
 
   static bool noisy(Approach a, const RunOptions& opt) { return !opt.noise_free && !opt.analytic && a != Approach::kI; }
@@ -359,79 +366,6 @@ RunResult run_sampling(Harness& hs, Law law, Saturated saturated) {
 }
 
 }  // namespace
-
-engine::ContinuousPlantConfig<kN, kM, kP, 1> plant_config(const Context& ctx, const Scenario& sc, bool noisy) {
-  engine::ContinuousPlantConfig<kN, kM, kP, 1> c;
-  const design::PlantDescription& p = ctx.plant();
-  for (std::size_t i = 0; i < kN; ++i) {
-    for (std::size_t j = 0; j < kN; ++j) {
-      c.a(i, j) = p.a(i, j);
-      c.qc(i, j) = ctx.design().qc(i, j) * sc.noise_scale;
-      c.q1c(i, j) = p.q1c(i, j);
-    }
-    for (std::size_t j = 0; j < kM; ++j) c.b(i, j) = p.b(i, j);
-  }
-  for (std::size_t i = 0; i < kP; ++i)
-    for (std::size_t j = 0; j < kN; ++j) c.c(i, j) = p.c(i, j);
-  c.q2c(0, 0) = p.q2c(0, 0);
-  c.process_noise = noisy;
-  return c;
-}
-
-node::SquareWaveReference<double, kN, kM> reference(const Context& ctx, const Scenario& sc) {
-  const std::size_t out = ctx.design().tracked_outputs.empty() ? 0 : ctx.design().tracked_outputs[0];
-  Vector<double, kN> nx;
-  Vector<double, kM> nu;
-  for (std::size_t i = 0; i < kN; ++i) nx[i] = ctx.design().nx(i, out);
-  for (std::size_t j = 0; j < kM; ++j) nu[j] = ctx.design().nu(j, out);
-  return node::SquareWaveReference<double, kN, kM>(sc.amplitude_volts,
-                                                   static_cast<std::uint32_t>(half_wave_periods(ctx, sc)), nx, nu);
-}
-
-engine::LinkConfig leg(const Context& ctx, const Scenario& sc, Approach a, const char* name) {
-  engine::LinkConfig c;
-  c.name = name;
-  c.fifo = true;
-  // Frames: k (4) | instant (4) | [τ (4)] | doubles (actuation_sync_messages.hpp, message.hpp).
-  const bool report = std::string(name) == "sc" && actuation_synchronized(a);
-  c.frame = engine::FrameLayout{0, 4, report ? node::kHeaderBytes + 4 : node::kHeaderBytes, 8};
-  if (delay_free(a)) return c;  // constant 0
-  const auto given = sc.legs.find(name);
-  if (given != sc.legs.end()) {  // from a study file
-    c.delay = given->second.delay;
-    c.loss = given->second.loss;
-    c.fifo = given->second.fifo;
-    return c;
-  }
-  c.delay.kind = engine::DelayModel::Kind::kUniform;
-  c.delay.min = engine::from_us(ctx.timing().leg_min_us);
-  c.delay.max = engine::from_us(std::llround(sc.max_delay_ms * 1000));
-  c.delay.resolution = engine::from_us(1);
-  return c;
-}
-
-std::array<double, 3> measurement_cholesky(const Design& d) {
-  std::array<double, 3> c{};
-  const double r00 = d.r(0, 0);
-  c[0] = std::sqrt(r00);
-  c[1] = r00 > 0 ? d.r(1, 0) / c[0] : 0;
-  c[2] = std::sqrt(std::fmax(0.0, d.r(1, 1) - c[1] * c[1]));
-  return c;
-}
-
-std::vector<std::string> counter_names(Approach a) {
-  if (actuation_synchronized(a)) {
-    return concat(concat(sync_sensor_counter_names(), sync_controller_counter_names()), actuator_counter_names());
-  }
-  return concat(sampling_controller_counter_names(), actuator_counter_names());
-}
-
-std::vector<std::string> link_names(Approach a) {
-  if (actuation_synchronized(a)) return {"as", "sc", "ca"};
-  return {"sc", "ca"};
-}
-
-std::vector<std::string> node_names() { return {"sensor", "controller", "actuator"}; }
 
 RunResult run(const Context& ctx, Approach a, const Scenario& sc, std::uint64_t seed, const RunOptions& options) {
   RunResult r = run_approach(ctx, a, sc, seed, options);

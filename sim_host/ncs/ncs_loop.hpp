@@ -43,6 +43,9 @@ struct RunOptions {
   /// ≠ 0: the process and measurement noise drawn from this seed, the timing still from the
   /// run's (a Monte Carlo over the noise alone for one timing draw).
   std::uint64_t noise_seed = 0;
+  /// > 0 (analytic runs): also the expected cost at this instant (s) in RunResult::analytic_at_mark,
+  /// as a run of this duration would end with it; the run itself is unchanged.
+  double analytic_mark_s = 0;
 };
 
 /// One row of a recorded sample or estimate.
@@ -60,6 +63,7 @@ struct RunResult {
   std::uint32_t commands = 0;  ///< Commands applied.
   engine::FaultCounters injected;  ///< Faults injected.
   engine::ExpectedCost analytic;   ///< Analytic runs: E[J] over the noise, split by origin.
+  engine::ExpectedCost analytic_at_mark;  ///< Analytic runs: E[J] up to RunOptions::analytic_mark_s (0 without).
   std::string analytic_refusal;    ///< Analytic runs: why the expected cost is not valid ("" when it is).
   double analytic_mismatch = 0;    ///< Analytic runs: largest |mean − simulated| (relative to max(1, |value|)).
   std::vector<double> counters;    ///< Node counters (ncs_counters.hpp, order of counter_names()).

@@ -168,17 +168,27 @@ std::uint64_t half_wave_periods(const Context& ctx, const Scenario& sc) {
   return n;
 }
 
+std::optional<engine::Duration> sc_ca_delay_bound(const Scenario& s, const char** unbounded_leg) {
+  engine::Duration sum{0};
+  for (const char* leg : {"sc", "ca"}) {
+    const auto it = s.legs.find(leg);
+    if (it == s.legs.end()) continue;
+    const std::optional<engine::Duration> ub = it->second.delay.upper_bound();
+    if (!ub) {
+      if (unbounded_leg != nullptr) *unbounded_leg = leg;
+      return std::nullopt;
+    }
+    sum += *ub;
+  }
+  return sum;
+}
+
 std::int32_t Context::worst_chain_us(const Scenario& s) const {
   if (!s.legs.empty()) {
-    std::int64_t sum_ns = 0;
-    for (const char* leg : {"sc", "ca"}) {
-      const auto it = s.legs.find(leg);
-      if (it == s.legs.end()) continue;
-      const std::optional<engine::Duration> ub = it->second.delay.upper_bound();
-      if (!ub) throw std::invalid_argument(std::string("ncs scenario ") + s.name + ": leg " + leg + " has no upper delay bound (late sampling needs one)");
-      sum_ns += ub->count();
-    }
-    return static_cast<std::int32_t>(std::llround(static_cast<double>(sum_ns) * 1e-3) + timing_.compute_max_us);
+    const char* leg = "";
+    const std::optional<engine::Duration> sum = sc_ca_delay_bound(s, &leg);
+    if (!sum) throw std::invalid_argument(std::string("ncs scenario ") + s.name + ": leg " + leg + " has no upper delay bound (late sampling needs one)");
+    return static_cast<std::int32_t>(std::llround(static_cast<double>(sum->count()) * 1e-3) + timing_.compute_max_us);
   }
   return static_cast<std::int32_t>(std::llround(2 * s.max_delay_ms * 1000) + timing_.compute_max_us);
 }

@@ -8,6 +8,7 @@
 #include <cstdint>
 #include <map>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -104,6 +105,11 @@ class Context {
   design::DesignResult design_;
   Timing timing_;
 };
+
+/// Sum of the upper delay bounds of the legs "sc" and "ca" of a study-file scenario (a leg it
+/// does not set adds 0); std::nullopt when one has no bound (Poisson, lognormal, Pareto), that
+/// leg's name then in *unbounded_leg when given.
+std::optional<engine::Duration> sc_ca_delay_bound(const Scenario& s, const char** unbounded_leg = nullptr);
 
 /// Periods h in half a set-point period; std::invalid_argument unless whole.
 std::uint64_t half_wave_periods(const Context& ctx, const Scenario& sc);

@@ -3,6 +3,7 @@
 ///        board's): the same kernel events give both the same timing draws.
 #pragma once
 
+#include <cmath>
 #include <cstddef>
 #include <cstdint>
 
@@ -10,6 +11,19 @@
 #include "scenario.hpp"
 
 namespace oneshot::sim {
+
+/// The whole periods h of a run and the instant the last one ends.
+struct BoardPeriods {
+  std::int64_t count = 0;     ///< Whole periods h in the run's duration (rounded down).
+  engine::SimTime end{0};     ///< count·h: the end of the last whole period, where the run ends.
+};
+
+/// The periods of a board run of `duration_s` seconds at period `h` (the emulated board's and
+/// the linear board's: the same count and end for both).
+inline BoardPeriods board_periods(double duration_s, engine::Duration h) {
+  const auto count = static_cast<std::int64_t>(std::floor(duration_s * 1e9 / static_cast<double>(h.count())));
+  return BoardPeriods{count, engine::SimTime{count * h.count()}};
+}
 
 /// Schedules the set-point changes of `schedule` up to `end` (handler `on_setpoint`, argument
 /// the change's index), the first period at 0 when `periods` > 0 (`on_period`, argument 0) and

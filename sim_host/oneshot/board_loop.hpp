@@ -68,8 +68,9 @@ RunResult run_board_loop(const SimContext& ctx, const Scenario& sc, std::uint64_
 
   RunResult result;
   const Duration h = engine::from_us(plant.period_us);
-  const auto periods = static_cast<std::int64_t>(std::floor(sc.duration_s * 1e9 / static_cast<double>(h.count())));
-  const SimTime end{periods * h.count()};
+  const BoardPeriods run_periods = board_periods(sc.duration_s, h);
+  const std::int64_t periods = run_periods.count;
+  const SimTime end = run_periods.end;
   const auto us_of = [](SimTime t) { return static_cast<std::uint64_t>(t.count() / 1000); };  // 64-bit: no wrap
   const auto apply_writes = [&]() {
     for (const host::PwmWrite& w : hb.pwm_writes) board.set_duty(w.channel, w.code);

@@ -55,8 +55,6 @@ const TracePoint& trace_at(const RunResult& r, double t_s, std::int32_t step_us)
   return r.trace.at(std::min(index, r.trace.size() - 1));
 }
 
-const char* png_terminal() { return "set terminal pngcairo size 1100,700 font 'Sans,11' noenhanced\n"; }
-
 /// One curve of a gnuplot `plot`: columns of `file` ('' repeats the previous file), style, title.
 struct PlotSeries {
   const char* file;
@@ -128,7 +126,7 @@ nlohmann::json run_noise_experiment(const SimContext& ctx, const CommonOptions& 
   const double rms_est = std::sqrt(se_est / static_cast<double>(r.job_records.size()));
   if (opt.plots) {
     std::ostringstream g;
-    g << png_terminal() << "set output 'noise.png'\nset datafile separator ','\nset key outside right top\n"
+    g << util::gnuplot_png_terminal(1100, 700) << "set output 'noise.png'\nset datafile separator ','\nset key outside right top\n"
       << "set multiplot layout " << std::min<std::size_t>(n, 2) << ",1 title 'Noise removal: one-shot controller with half Kalman filter (jitter 0-20 ms)'\n"
       << "set grid\nset ylabel " << util::gnuplot_quote(state_label(ctx, 0) + " (V)") << "\n"
       << "plot 'noise_jobs.csv' using 1:2 skip 1 with points pt 7 ps 0.5 lc rgb '#999999' title 'measured (ADC)', "
@@ -174,7 +172,7 @@ nlohmann::json run_jitter_experiment(const SimContext& ctx, const CommonOptions&
   util::write_csv(path_in(opt, "jitter.csv"), {"t_s", "setpoint_volts", v + "_A", v + "_B", v + "_D", v + "_E"}, rows);
   if (opt.plots) {
     std::ostringstream g;
-    g << png_terminal() << "set output 'jitter.png'\nset datafile separator ','\nset key top left box opaque\nset grid\n"
+    g << util::gnuplot_png_terminal(1100, 700) << "set output 'jitter.png'\nset datafile separator ','\nset key top left box opaque\nset grid\n"
       << "set title 'Response under jitter (release 0-" << jitter_us / 1000.0 << " ms): one-shot + half Kalman vs standard controllers'\n"
       << "set xlabel 'time (s)'\nset ylabel " << util::gnuplot_quote(v + " (V)") << "\n"
       << plot_command({{"jitter.csv", "1:2", "lines dt 2 lw 1.5 lc rgb 'black'", "set-point"},
@@ -227,7 +225,7 @@ nlohmann::json run_gain_experiment(const SimContext& ctx, const CommonOptions& o
             rows);
   if (opt.plots) {
     std::ostringstream g;
-    g << png_terminal() << "set output 'gain.png'\nset datafile separator ','\nset key top right box opaque\nset grid\n"
+    g << util::gnuplot_png_terminal(1100, 700) << "set output 'gain.png'\nset datafile separator ','\nset key top right box opaque\nset grid\n"
       << "set title 'First Kalman gain element over time (P0 = " << p0_scale << " x steady state)'\n"
       << "set xlabel 'time (s)'\nset ylabel 'K(1)'\n"
       << plot_command({{"gain.csv", "2:3", "linespoints pt 7 ps 0.6 lw 1.5 lc rgb '#d62728'", "half Kalman (one-shot, jitter)"},
@@ -388,7 +386,7 @@ nlohmann::json run_exectime(const SimContext& ctx, const CommonOptions& opt, con
             rows);
   if (opt.plots) {
     std::ostringstream g;
-    g << png_terminal() << "set output 'exectime.png'\nset datafile separator ','\nset grid ytics\nset style fill solid 0.7\n"
+    g << util::gnuplot_png_terminal(1100, 700) << "set output 'exectime.png'\nset datafile separator ','\nset grid ytics\nset style fill solid 0.7\n"
       << "set boxwidth 0.35\nset xtics (\"half\\ntable\" 0, \"half\\ngeneric\" 1, \"complete\\ntable\" 2, \"complete\\ngeneric\" 3, "
          "\"half\\nnearest\" 4, \"complete\\nnearest\" 5)\n"
       << "set xrange [-0.6:5.6]\nset yrange [0:*]\nset offsets 0,0,graph 0.08,0\nset bmargin 4\nset key top left\n"
@@ -444,7 +442,7 @@ nlohmann::json run_single(const SimContext& ctx, const CommonOptions& opt, const
     util::write_csv(path_in(opt, "run_trace.csv"), th, trace);
     if (opt.plots) {
       std::ostringstream g;
-      g << png_terminal() << "set output 'run.png'\nset datafile separator ','\nset key outside right top\nset grid\n"
+      g << util::gnuplot_png_terminal(1100, 700) << "set output 'run.png'\nset datafile separator ','\nset key outside right top\nset grid\n"
         << "set multiplot layout 2,1 title "
         << util::gnuplot_quote("Run: approach " + std::string(1, info(approach).letter) + " (" + info(approach).description +
                          "), scenario " + scenario.name + ", seed " + std::to_string(opt.seed))

@@ -314,7 +314,7 @@ nlohmann::json kernel_outputs(const engine::SweepResults& r, const std::string& 
   j["files"] = {"kernel.md", "kernel.csv", "kernel_tasks_example.json"};
   if (plots && ns > 0) {
     std::ostringstream g;
-    g << "set terminal pngcairo size 1500,520 font 'Sans,10' noenhanced\nset output 'kernel.png'\n"
+    g << util::gnuplot_png_terminal(1500, 520, 10) << "set output 'kernel.png'\n"
       << "set datafile separator ','\nset grid\nset xlabel 'CPU utilization'\nset ylabel 'cost / cost of A'\n"
       << "set key top left\nset multiplot layout 1,3\n";
     for (std::size_t p = 0; p < 3; ++p) {

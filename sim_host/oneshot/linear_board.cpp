@@ -95,8 +95,9 @@ LinearRunResult run_linear(const SimContext& ctx, const Scenario& sc, std::uint6
 
   LinearRunResult result;
   const Duration h = engine::from_us(plant.period_us);
-  const auto periods = static_cast<std::int64_t>(std::floor(sc.duration_s * 1e9 / static_cast<double>(h.count())));
-  const SimTime end{periods * h.count()};
+  const BoardPeriods run_periods = board_periods(sc.duration_s, h);
+  const std::int64_t periods = run_periods.count;
+  const SimTime end = run_periods.end;
   Vector<double, M> prepared = u0;
   JobTiming current{};
   const auto advance = [&](SimTime t) {

@@ -201,8 +201,7 @@ nlohmann::json table1_outputs(const engine::SweepResults& results, const std::st
     std::ostringstream xtics;
     for (std::size_t a = 0; a < na; ++a) xtics << (a == 0 ? "" : ", ") << util::gnuplot_quote(spec.approaches[a]) << " " << a;
     std::ostringstream g;
-    g << "set terminal pngcairo size 1100,700 font 'Sans,11' noenhanced\n"
-      << "set output 'table1.png'\nset datafile separator ','\nset grid ytics\nset style fill solid 0.6\n"
+    g << util::gnuplot_png_terminal(1100, 700) << "set output 'table1.png'\nset datafile separator ','\nset grid ytics\nset style fill solid 0.6\n"
       << "set boxwidth 0.6\nset xtics (" << xtics.str() << ")\nset xrange [-0.6:" << na - 1 << ".6]\nset yrange [0:*]\n"
       << "set title 'Table I: mean control cost over " << ns << " scenarios x " << seeds << " seeds (95 % CI)'\n"
       << "set ylabel 'cost J'\nset key off\n"

@@ -4,6 +4,8 @@
 
 #include <array>
 #include <optional>
+#include <utility>
+#include <vector>
 
 #include "ncs_analytic.hpp"
 #include "ncs_experiments.hpp"
@@ -23,8 +25,34 @@ static_assert(kSent < std::size(kLinkCounters) && kDelivered < std::size(kLinkCo
                   kRefused < std::size(kLinkCounters),
               "every counter link_counts() fills is named in kLinkCounters");
 
-/// The counters of `link` in run `r` of approach `a`, in the order of kLinkCounters.
-std::array<double, std::size(kLinkCounters)> link_counts(const ncs::RunResult& r, ncs::Approach a, const std::string& link) {
+/// Where the receiving node's counters of one link add up: (position in ncs::RunResult::counters,
+/// position in kLinkCounters), in the order of ncs::counter_names().
+using LinkCounterMap = std::vector<std::pair<std::size_t, std::size_t>>;
+
+/// The map of `link` under approach `a`: the receiving node's stale counter to kLate (frames
+/// dropped as stale: not newer than what the node holds, or their period past; the actuator's
+/// "late" counts periods without a command, not frames: the approach's late_commands), its
+/// malformed and refused_* counters to kRefused (empty when `link` is not a leg of the loop).
+LinkCounterMap link_counter_map(ncs::Approach a, const std::string& link) {
+  LinkCounterMap m;
+  const NcsLeg* leg = find_ncs_leg(link);
+  if (leg == nullptr) return m;  // map_ncs_study admits the loop's legs only
+  const std::string node = leg->to;  // the receiving node's counters
+  const std::vector<std::string> names = ncs::counter_names(a);
+  for (std::size_t i = 0; i < names.size(); ++i) {
+    const std::string& c = names[i];
+    if (c.rfind(node + ".", 0) != 0) continue;
+    const std::string what = c.substr(node.size() + 1);
+    if (what == "stale") m.emplace_back(i, kLate);
+    if (what == "malformed" || what.rfind("refused_", 0) == 0) m.emplace_back(i, kRefused);
+  }
+  return m;
+}
+
+/// The counters of `link` in run `r`, in the order of kLinkCounters; `map` is
+/// link_counter_map() of the run's approach and `link`.
+std::array<double, std::size(kLinkCounters)> link_counts(const ncs::RunResult& r, const LinkCounterMap& map,
+                                                         const std::string& link) {
   std::array<double, std::size(kLinkCounters)> v{};
   for (const auto& [nm, st] : r.links) {
     if (nm != link) continue;
@@ -32,35 +60,17 @@ std::array<double, std::size(kLinkCounters)> link_counts(const ncs::RunResult& r
     v[kDelivered] = static_cast<double>(st.sent - st.lost);
     v[kLost] = static_cast<double>(st.lost);
   }
-  const std::vector<std::string> names = ncs::counter_names(a);
-  const NcsLeg* leg = find_ncs_leg(link);
-  if (leg == nullptr) return v;  // map_ncs_study admits the loop's legs only
-  const std::string node = leg->to;  // the receiving node's counters
-  for (std::size_t i = 0; i < names.size() && i < r.counters.size(); ++i) {
-    const std::string& c = names[i];
-    if (c.rfind(node + ".", 0) != 0) continue;
-    const std::string what = c.substr(node.size() + 1);
-    // Frames dropped as stale: not newer than what the node holds, or their period past (a
-    // command after its instant). The actuator's "late" counts periods without a command, not
-    // frames (the approach's late_commands): a lost frame is one of those too.
-    if (what == "stale") v[kLate] += r.counters[i];
-    if (what == "malformed" || what.rfind("refused_", 0) == 0) v[kRefused] += r.counters[i];
-  }
+  for (const auto& [i, slot] : map)
+    if (i < r.counters.size()) v[slot] += r.counters[i];
   return v;
 }
 
 /// Upper bound of the sc + ca delays of scenario `x` in ms; null when a leg's delay model has
 /// no upper bound (Poisson, lognormal, Pareto).
 nlohmann::json sc_ca_delay_bound_ms(const ncs::Scenario& x) {
-  double ns = 0;
-  for (const char* leg : {"sc", "ca"}) {
-    const auto it = x.legs.find(leg);
-    if (it == x.legs.end()) continue;
-    const std::optional<engine::Duration> ub = it->second.delay.upper_bound();
-    if (!ub) return nullptr;
-    ns += static_cast<double>(ub->count());
-  }
-  return ns * 1e-6;
+  const std::optional<engine::Duration> ub = ncs::sc_ca_delay_bound(x);
+  if (!ub) return nullptr;
+  return static_cast<double>(ub->count()) * 1e-6;
 }
 
 }  // namespace
@@ -99,16 +109,23 @@ engine::SweepResults run_ncs_sweep(const NcsStudy& s, std::size_t seeds, unsigne
     spec.config["analytic"] = true;
     spec.metrics.insert(spec.metrics.end(), std::begin(ncs::kAnalyticMetrics), std::end(ncs::kAnalyticMetrics));
   }
+  // Per approach, per link of the file: where the receiving node's counters go (built once).
+  std::vector<std::vector<LinkCounterMap>> maps;
+  for (ncs::Approach ap : s.approaches) {
+    std::vector<LinkCounterMap>& per_link = maps.emplace_back();
+    for (const std::string& l : s.links) per_link.push_back(link_counter_map(ap, l));
+  }
   const NcsStudy* study = &s;
+  const std::vector<std::vector<LinkCounterMap>>* counter_maps = &maps;
   return engine::run_sweep(
       spec, shard, threads,
-      [study, analytic](std::size_t a, std::size_t k, std::uint64_t seed) {
+      [study, counter_maps, analytic](std::size_t a, std::size_t k, std::uint64_t seed) {
         const ncs::Approach ap = study->approaches[a];
         const ncs::RunResult r = ncs::run(*study->ctx, ap, study->scenarios[k], seed, ncs::RunOptions{});
         std::vector<double> v{r.cost, static_cast<double>(r.late), static_cast<double>(r.saturated),
                               static_cast<double>(r.faults)};
-        for (const std::string& l : study->links) {
-          const auto c = link_counts(r, ap, l);
+        for (std::size_t l = 0; l < study->links.size(); ++l) {
+          const auto c = link_counts(r, (*counter_maps)[a][l], study->links[l]);
           v.insert(v.end(), c.begin(), c.end());
         }
         if (analytic) {  // ncs table --analytic's columns: the same run in analytic mode

@@ -7,11 +7,13 @@
 #include <filesystem>
 #include <fstream>
 #include <limits>
+#include <utility>
 #include <sys/resource.h>
 #include <unistd.h>
 
 #include "oneshot/util/child_process.hpp"
 #include "oneshot/util/file_io.hpp"
+#include "oneshot/util/output_files.hpp"
 #include "oneshot/util/strict_json.hpp"
 #include "support/temp_files.hpp"
 #include "support/expect_error.hpp"
@@ -25,6 +27,26 @@ namespace fs = std::filesystem;
 std::string fresh_dir(const std::string& name) { return test::made_dir("oneshot_host_util", name); }
 
 using test::message_of;
+
+TEST(TempDir, RemovesItsFolderWithEverythingInItWhenItEnds) {
+  const std::string dir = fresh_dir("scratch") + "/owned";
+  fs::create_directories(dir + "/sub");
+  std::ofstream(dir + "/sub/f.txt") << "x";
+  {
+    test::TempDir owner(dir);
+    test::TempDir moved(std::move(owner));  // the moved-from one owns nothing
+    EXPECT_EQ(owner.path(), "");
+    EXPECT_EQ(moved.path(), dir);
+    EXPECT_TRUE(fs::exists(dir + "/sub/f.txt"));
+  }
+  EXPECT_FALSE(fs::exists(dir));
+  EXPECT_TRUE(fs::exists(fs::path(dir).parent_path()));  // fresh_dir's own folder waits for the process end
+}
+
+TEST(PlotFiles, PngTerminalLineNamesSizeAndFont) {
+  EXPECT_EQ(gnuplot_png_terminal(1100, 700), "set terminal pngcairo size 1100,700 font 'Sans,11' noenhanced\n");
+  EXPECT_EQ(gnuplot_png_terminal(1500, 520, 10), "set terminal pngcairo size 1500,520 font 'Sans,10' noenhanced\n");
+}
 
 TEST(BoundedRead, DevZeroIsRefusedAtTheLimitInsteadOfFillingMemory) {
   const std::string m = message_of([] { read_text_file("/dev/zero", "scenario file", std::size_t{1} << 20); });

@@ -87,11 +87,14 @@ std::string reference_with(const std::string& pointer, const std::string& value_
 #include <fstream>
 
 #include "support/run_command.hpp"
+#include "support/temp_files.hpp"
 
 namespace oneshot::test {
 
 std::string write_temp_file(const std::string& name, const std::string& text) {
-  const auto dir = std::filesystem::temp_directory_path() / ("oneshot_test_" + std::to_string(::getpid()));
+  static const std::string dir_name =  // removed when the process ends
+      remove_at_exit((std::filesystem::temp_directory_path() / ("oneshot_test_" + std::to_string(::getpid()))).string());
+  const std::filesystem::path dir = dir_name;
   std::filesystem::create_directories(dir);
   const auto path = dir / name;
   std::ofstream(path, std::ios::binary) << text;

@@ -14,6 +14,7 @@
 #include "oneshot/util/child_process.hpp"
 #include "oneshot/engine/sweep.hpp"
 #include "oneshot/engine/sweep_statistics.hpp"
+#include "support/temp_files.hpp"
 
 namespace oneshot::engine {
 namespace {
@@ -104,8 +105,7 @@ TEST(SweepStatistics, PairedFiguresMatchHandComputation) {
 TEST(SweepStatistics, SummaryFilesHoldTheRunsAndTheIntervals) {
   const SweepResults r = run_sweep(spec(), Shard{}, 1, toy, "t");
   const SweepSummary s = summarize_metric(r, 0, 0);
-  const std::string dir = (std::filesystem::temp_directory_path() / "oneshot_sweep_files").string();
-  std::filesystem::remove_all(dir);
+  const std::string dir = test::fresh_dir("oneshot_sweep", "files");
   write_summary_files(r, s, dir, "toy", false);
   std::ifstream runs(dir + "/toy_runs.csv");
   std::string header;
@@ -133,8 +133,7 @@ TEST(SweepStatistics, NamesReachGnuplotAsQuotedStringsNotCommands) {
   sp.metrics = {"cost' . " + run + "('touch ../pwned3') . '", "packets"};
   const SweepResults r = run_sweep(sp, Shard{}, 1, toy, "t");
   const SweepSummary s = summarize_metric(r, 0, 0);
-  const std::filesystem::path root = std::filesystem::temp_directory_path() / "oneshot_sweep_labels";
-  std::filesystem::remove_all(root);
+  const std::filesystem::path root = test::fresh_dir("oneshot_sweep", "labels");
   const std::string dir = (root / "out").string();
   write_summary_files(r, s, dir, "toy", true);
   EXPECT_TRUE(std::filesystem::exists(dir + "/toy.png"));

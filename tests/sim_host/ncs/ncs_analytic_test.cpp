@@ -48,6 +48,31 @@ TEST(NcsAnalytic, NoiseFreeEqualsTheSimulatedCostOnEveryApproach) {
   EXPECT_LT(worst_mismatch, 1e-13);
 }
 
+/// The expected cost at a mark is what a run ending there gives (its oracle: that shorter run,
+/// same seed), on a period boundary and between events; the mark never changes the run.
+TEST(NcsAnalytic, TheCostAtAMarkIsTheCostOfTheRunEndingThere) {
+  for (const Approach a : {Approach::kA, Approach::kSK, Approach::kSPlus})
+    for (const double mark_s : {1.0, 1.2345}) {
+      RunOptions an;
+      an.analytic = true;
+      const Scenario whole = short_scenario(0.5, 14, 4, 3);
+      Scenario until_mark = whole;
+      until_mark.duration_s = mark_s;
+      const RunResult shorter = run(context(), a, until_mark, 7, an);
+      const RunResult plain = run(context(), a, whole, 7, an);
+      an.analytic_mark_s = mark_s;
+      const RunResult marked = run(context(), a, whole, 7, an);
+      ASSERT_EQ(marked.analytic_refusal, "") << name(a);
+      EXPECT_GT(marked.analytic_at_mark.covariance, 0) << name(a);
+      EXPECT_EQ(marked.analytic_at_mark.mean, shorter.analytic.mean) << name(a) << " at " << mark_s;
+      EXPECT_EQ(marked.analytic_at_mark.covariance, shorter.analytic.covariance) << name(a) << " at " << mark_s;
+      EXPECT_EQ(marked.analytic_at_mark.noise_path, shorter.analytic.noise_path) << name(a) << " at " << mark_s;
+      EXPECT_EQ(marked.analytic.total(), plain.analytic.total()) << name(a);
+      EXPECT_EQ(marked.cost, plain.cost) << name(a);
+      EXPECT_EQ(plain.analytic_at_mark.total(), 0) << name(a);  // no mark: nothing read
+    }
+}
+
 TEST(NcsAnalytic, WithNoiseTheAnalyticMeanIsInsideTheMonteCarloInterval) {
   const Scenario sc = short_scenario(0.2, 8, 16, 2);  // noise-dominated
   RunOptions mc;

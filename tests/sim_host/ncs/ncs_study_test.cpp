@@ -5,6 +5,9 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <optional>
+#include <stdexcept>
+#include <string>
 
 #include "ncs_experiments.hpp"
 #include "ncs_loop.hpp"
@@ -50,6 +53,39 @@ TEST(NcsStudy, LateCommandsAreCountedWhenTheChainExceedsThePeriod) {
   EXPECT_TRUE(std::isfinite(ak.cost));
   const RunResult fits = run(context(), Approach::kAK, short_scenario(0.5, 14), 5, RunOptions{});
   EXPECT_EQ(fits.late, 0U);  // 3·14 + 5 = 47 ms < h
+}
+
+/// The sc + ca delay bound of study-file legs: the sum of the legs' largest delays (the oracle:
+/// the uniform maxima given), none naming the leg when one is unbounded; AKl's D adds τ_c,max.
+TEST(NcsStudy, ScCaDelayBoundIsTheSumOfTheLegsMaximaOrNoneNamingTheLeg) {
+  Scenario sc = short_scenario(0.5, 4);
+  const auto uniform = [](std::int64_t min_us, std::int64_t max_us) {
+    engine::LinkConfig c;
+    c.delay.kind = engine::DelayModel::Kind::kUniform;
+    c.delay.min = engine::from_us(min_us);
+    c.delay.max = engine::from_us(max_us);
+    return c;
+  };
+  sc.legs["as"] = uniform(500, 90'000);  // not part of the chain
+  sc.legs["sc"] = uniform(500, 7'000);
+  sc.legs["ca"] = uniform(1'000, 3'250);
+  const std::optional<engine::Duration> ub = sc_ca_delay_bound(sc);
+  ASSERT_TRUE(ub.has_value());
+  EXPECT_EQ(ub->count(), engine::from_us(7'000 + 3'250).count());
+  EXPECT_EQ(context().worst_chain_us(sc), 7'000 + 3'250 + context().timing().compute_max_us);
+  sc.legs["ca"].delay.kind = engine::DelayModel::Kind::kLognormal;
+  sc.legs["ca"].delay.median_ns = 1e6;
+  sc.legs["ca"].delay.sigma = 0.5;
+  const char* leg = nullptr;
+  EXPECT_FALSE(sc_ca_delay_bound(sc, &leg).has_value());
+  ASSERT_NE(leg, nullptr);
+  EXPECT_STREQ(leg, "ca");
+  try {
+    static_cast<void>(context().worst_chain_us(sc));
+    ADD_FAILURE() << "an unbounded leg was accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("leg ca has no upper delay bound"), std::string::npos) << e.what();
+  }
 }
 
 /// S+ at τ = 0 is the plain LQR: [L, 0].

@@ -15,6 +15,7 @@
 #include "scenario.hpp"
 #include "support/run_command.hpp"
 #include "support/expect_error.hpp"
+#include "support/temp_files.hpp"
 
 namespace oneshot::sim {
 namespace {
@@ -69,8 +70,7 @@ TEST(ScenarioFile, TooManySetpointChangesAreRefusedByName) {
 
 TEST(ScenarioFile, DevZeroAndDirectoriesAreRefusedClearly) {
   EXPECT_NE(error_of([] { load_scenarios("/dev/zero"); }).find("longer than"), std::string::npos);
-  const fs::path dir = fs::temp_directory_path() / ("oneshot_sc_dir_" + std::to_string(::getpid()));
-  fs::create_directories(dir);
+  const fs::path dir = test::made_dir("oneshot_sc_dir", "scenarios");
   const std::string m = error_of([&] { load_scenarios(dir.string()); });
   EXPECT_NE(m.find("is a directory, not a scenario file"), std::string::npos) << m;
   EXPECT_EQ(m.find("not valid JSON"), std::string::npos) << m;
@@ -93,8 +93,7 @@ TEST(JitterTrace, TrailingTextOnALineIsRefused) {
 }
 
 TEST(OutputFiles, NonFiniteNumbersAreRefusedNotWrittenAsNullOrNan) {
-  const fs::path dir = fs::temp_directory_path() / ("oneshot_out_nan_" + std::to_string(::getpid()));
-  fs::remove_all(dir);
+  const fs::path dir = test::fresh_dir("oneshot_out_nan", "out");
   const nlohmann::json j = {{"cost", {{"total", std::numeric_limits<double>::infinity()}}}};
   const std::string m = error_of([&] { util::write_json((dir / "r.json").string(), j); });
   EXPECT_NE(m.find("field 'cost.total' is not a finite number"), std::string::npos) << m;

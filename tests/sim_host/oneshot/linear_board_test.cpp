@@ -7,6 +7,7 @@
 #include <cmath>
 #include <vector>
 
+#include "board_events.hpp"
 #include "linear_board.hpp"
 #include "linear_tracker.hpp"
 #include "oneshot/design/fixed_size.hpp"
@@ -25,6 +26,20 @@ RunOptions options(Approach a) {
   o.approach = a;
   o.format = NumberFormat::kDouble;
   return o;
+}
+
+/// A board run's whole periods (rounded down) and their end, the same for both boards.
+TEST(BoardPeriods, WholePeriodsRoundedDownAndTheirEnd) {
+  const engine::Duration h = engine::from_us(50'000);
+  const BoardPeriods exact = board_periods(1.0, h);
+  EXPECT_EQ(exact.count, 20);
+  EXPECT_EQ(exact.end.count(), 20 * h.count());
+  const BoardPeriods part = board_periods(1.07, h);  // 21.4 periods
+  EXPECT_EQ(part.count, 21);
+  EXPECT_EQ(part.end.count(), 21 * h.count());
+  const BoardPeriods none = board_periods(0.01, h);
+  EXPECT_EQ(none.count, 0);
+  EXPECT_EQ(none.end.count(), 0);
 }
 
 TEST(LinearBoard, NoiseFreeAnalyticEqualsSimulatedOnEveryApproach) {

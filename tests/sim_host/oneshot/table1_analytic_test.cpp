@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "oneshot/engine/sweep.hpp"
+#include "support/temp_files.hpp"
 #include "table1_analytic.hpp"
 
 namespace oneshot::sim {
@@ -47,9 +48,7 @@ engine::SweepResults made_up_sweep(bool refuse_a) {
 }
 
 std::string out_dir(const char* name) {
-  const fs::path d = fs::temp_directory_path() / (std::string(name) + "_" + std::to_string(::getpid()));
-  fs::create_directories(d);
-  return d.string();
+  return test::made_dir(name, "out");
 }
 
 TEST(Table1Analytic, BOverAIsPublishedCostWeightedAndScenarioWeighted) {

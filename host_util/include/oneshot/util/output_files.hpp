@@ -43,6 +43,10 @@ void make_directory(const std::string& dir);
 /// substitution happens inside), quotes doubled, control characters as spaces.
 std::string gnuplot_quote(const std::string& label);
 
+/// The line that opens a PNG plot of a gnuplot script: "set terminal pngcairo size W,H font
+/// 'Sans,F' noenhanced" (labels printed as written) and a newline.
+std::string gnuplot_png_terminal(int width_px, int height_px, int font_pt = 11);
+
 /// Writes `script` to dir/script_name and runs gnuplot on it in `dir` (argument vector, no
 /// shell; the folder's name never enters the script); std::runtime_error with gnuplot's
 /// message on failure, or when gnuplot is not installed (apt-get install gnuplot-nox).
