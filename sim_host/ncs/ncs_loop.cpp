@@ -92,12 +92,14 @@ class Harness {
     }
     const HandlerId end = kernel_.add_handler("end", [this](std::uint64_t) { advance(); });
     kernel_.schedule(end_, EventClass::kEnd, end);
+    if (opt.analytic_mark_s > 0 && !an_) throw std::invalid_argument("an analytic mark needs an analytic run");
     if (an_ && opt.analytic_mark_s > 0) {  // observes only: the plant and tracker are not advanced
       const SimTime mark{engine::from_seconds(opt.analytic_mark_s, "analytic mark")};
+      if (mark > end_) throw std::invalid_argument("the analytic mark is after the end of the run");
       const HandlerId at_mark = kernel_.add_handler("analytic mark", [this](std::uint64_t) {
         result_.analytic_at_mark = an_->cost_at(kernel_.now());
       });
-      if (mark <= end_) kernel_.schedule(mark, EventClass::kRecord, at_mark);
+      kernel_.schedule(mark, EventClass::kRecord, at_mark);
     }
   }
 

@@ -43,7 +43,8 @@ struct RunOptions {
   /// ≠ 0: the process and measurement noise drawn from this seed, the timing still from the
   /// run's (a Monte Carlo over the noise alone for one timing draw).
   std::uint64_t noise_seed = 0;
-  /// > 0 (analytic runs): also the expected cost at this instant (s) in RunResult::analytic_at_mark,
+  /// > 0 (analytic runs only, at or before the end: std::invalid_argument otherwise): also the
+  /// expected cost at this instant (s) in RunResult::analytic_at_mark,
   /// as a run of this duration would end with it; the run itself is unchanged.
   double analytic_mark_s = 0;
 };

@@ -77,13 +77,23 @@ inline void require_runtime_format(const SimContext& ctx, const RunOptions& opt)
   }
 }
 
+/// The plant and format dispatch: on_generated() for the compiled-in plant, else (the formats a
+/// run-time plant cannot run refused) on_float() or on_double().
+template <typename G, typename F32, typename F64>
+decltype(auto) dispatch_plant(const SimContext& ctx, const RunOptions& opt, G&& on_generated, F32&& on_float, F64&& on_double) {
+  if (ctx.generated()) return on_generated();
+  require_runtime_format(ctx, opt);
+  if (opt.format == NumberFormat::kFloat) return on_float();
+  return on_double();
+}
+
 /// Every plant and format: the compiled-in plant's constants or the run-time plant's design.
 template <typename F>
 decltype(auto) with_controller_parts(const SimContext& ctx, const RunOptions& opt, F&& f) {
-  if (ctx.generated()) return with_generated_parts(opt, f);
-  require_runtime_format(ctx, opt);
-  if (opt.format == NumberFormat::kFloat) return with_runtime_parts<float>(ctx, opt, f);
-  return with_runtime_parts<double>(ctx, opt, f);
+  return dispatch_plant(
+      ctx, opt, [&]() -> decltype(auto) { return with_generated_parts(opt, f); },
+      [&]() -> decltype(auto) { return with_runtime_parts<float>(ctx, opt, f); },
+      [&]() -> decltype(auto) { return with_runtime_parts<double>(ctx, opt, f); });
 }
 
 }  // namespace oneshot::sim

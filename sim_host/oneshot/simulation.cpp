@@ -218,11 +218,11 @@ RunResult simulate(const SimContext& ctx, const Scenario& scenario, std::uint64_
     d.format = NumberFormat::kDouble;
     return simulate(ctx, scenario, seed, d);
   }
-  if (ctx.generated()) return with_generated_parts(options, CoreBoardRun{ctx, scenario, seed, options});
-  require_runtime_format(ctx, options);
   // Run-time plants: one source per format (simulation_runtime_*.cpp).
-  return options.format == NumberFormat::kFloat ? simulate_runtime<float>(ctx, scenario, seed, options)
-                                                : simulate_runtime<double>(ctx, scenario, seed, options);
+  return dispatch_plant(
+      ctx, options, [&] { return with_generated_parts(options, CoreBoardRun{ctx, scenario, seed, options}); },
+      [&] { return simulate_runtime<float>(ctx, scenario, seed, options); },
+      [&] { return simulate_runtime<double>(ctx, scenario, seed, options); });
 }
 
 }  // namespace oneshot::sim

@@ -7,6 +7,8 @@
 #include <iostream>
 #include <memory>
 #include <optional>
+#include <sstream>
+#include <string>
 
 #include "oneshot/engine/study_file.hpp"
 #include "oneshot/sim/study_descriptor.hpp"
@@ -66,7 +68,7 @@ struct RunCli {
   std::string json;
   bool no_plots = false;
   bool analytic = false;
-  double max_duration_s = 0;  ///< > 0: every scenario's simulated time capped there.
+  double max_duration_s = 0;  ///< Every scenario's simulated time capped there (when given).
 };
 
 struct ReportCli {
@@ -78,12 +80,23 @@ struct ReportCli {
   double max_duration_s = 0;
 };
 
-/// The file's ncs loop, its scenarios cut at `max_duration_s` (0: as the file says).
-study::NcsStudy runnable(const Checked& k, double max_duration_s) {
+/// The file's ncs loop, its scenarios cut at `max_duration_s` when the option was given.
+study::NcsStudy runnable(const Checked& k, const CLI::Option* max_duration, double max_duration_s) {
   if (!k.ncs) throw engine::InputError(k.resolution.at("source").get<std::string>() + ": " + k.refusal);  // one line, nothing written
   study::NcsStudy s = *k.ncs;
-  if (max_duration_s != 0) study::cap_duration(s, max_duration_s, "--max-duration");
+  if (max_duration->count() > 0) study::cap_duration(s, max_duration_s, "--max-duration");
   return s;
+}
+
+/// Each scenario's simulated time as it runs, and whether --max-duration cut it.
+std::string simulated_time_text(const study::NcsStudy& s, const CLI::Option* max_duration, double max_duration_s) {
+  std::ostringstream t;
+  t << "Simulated time per run:";
+  for (std::size_t i = 0; i < s.scenarios.size(); ++i)
+    t << (i == 0 ? " " : ", ") << s.scenarios[i].name << " " << s.scenarios[i].duration_s << " s";
+  if (max_duration->count() > 0) t << " (capped by --max-duration " << max_duration_s << ")";
+  t << ".";
+  return t.str();
 }
 
 constexpr const char* kMaxDurationHelp = "cap every scenario's simulated seconds (at least one period h; default: the file's)";
@@ -120,13 +133,13 @@ void add_study_commands(CLI::App* group) {
     cmd->add_option("--out", c->out, "output directory")->capture_default_str();
     cmd->add_option("--json", c->json, "write the result as JSON to PATH, or '-' for standard output");
     cmd->add_flag("--no-plots", c->no_plots, "write CSV files only (no gnuplot)");
-    cmd->add_option("--max-duration", c->max_duration_s, kMaxDurationHelp);
+    const CLI::Option* max_duration = cmd->add_option("--max-duration", c->max_duration_s, kMaxDurationHelp);
     cmd->add_flag("--analytic", c->analytic,
                   "also the exact expected cost over the noise for each run's timing, as `ncs table --analytic` "
                   "(analytic_mean, analytic_ci95, variance_reduction, ...; approaches whose runs leave the linear "
                   "loop: analytic_refused with the reason)");
-    cmd->callback([c]() {
-      const study::NcsStudy s = runnable(check_file(c->file), c->max_duration_s);
+    cmd->callback([c, max_duration]() {
+      const study::NcsStudy s = runnable(check_file(c->file), max_duration, c->max_duration_s);
       const engine::Shard part = engine::parse_shard(c->shard);
       util::make_directory(c->out);
       const auto start = std::chrono::steady_clock::now();
@@ -152,18 +165,19 @@ void add_study_commands(CLI::App* group) {
     cmd->add_option("outdir", c->out, "output directory")->required();
     cmd->add_option("--seeds", c->seeds, "seeds per scenario (default: the file's seeds.count)")->check(CLI::Range(2, 10000000));
     cmd->add_option("--threads", c->threads, "worker threads (0: every core)")->capture_default_str();
-    cmd->add_option("--max-duration", c->max_duration_s, kMaxDurationHelp);
+    const CLI::Option* max_duration = cmd->add_option("--max-duration", c->max_duration_s, kMaxDurationHelp);
     cmd->add_flag("--no-plots", c->no_plots, "no plot (no gnuplot); the report links none");
-    cmd->callback([c]() {
+    cmd->callback([c, max_duration]() {
       const Checked k = check_file(c->file);
-      const study::NcsStudy s = runnable(k, c->max_duration_s);
+      const study::NcsStudy s = runnable(k, max_duration, c->max_duration_s);
       util::make_directory(c->out);
       const engine::SweepResults r = study::run_ncs_sweep(s, c->seeds, c->threads, engine::Shard{});
       const nlohmann::json j = study::run_outputs(r, c->out, !c->no_plots);
       nlohmann::json resolution = k.resolution;  // the grid that ran: --seeds overrides the file's count
       resolution["seeds"]["count"] = r.spec.seeds;
       resolution["grid"]["runs"] = r.spec.runs();
-      const std::string md = study::report_markdown(c->file, study::describe_resolution(resolution), r, j,
+      const std::string md = study::report_markdown(c->file, study::describe_resolution(resolution),
+                                                    simulated_time_text(s, max_duration, c->max_duration_s), r, j,
                                                     c->no_plots ? "" : "table.png");
       util::write_text((std::filesystem::path(c->out) / "report.md").string(), md);
       util::write_json((std::filesystem::path(c->out) / "report.json").string(), j);

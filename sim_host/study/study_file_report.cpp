@@ -12,7 +12,8 @@
 
 namespace oneshot::study {
 
-std::string report_markdown(const std::string& file, const std::string& resolution_text, const engine::SweepResults& results,
+std::string report_markdown(const std::string& file, const std::string& resolution_text,
+                            const std::string& simulated_time_text, const engine::SweepResults& results,
                             const nlohmann::json& outputs, const std::string& plot_path) {
   const engine::SweepSpec& spec = results.spec;
   std::vector<std::string> pairs;  // every pair, in the file's order of approaches
@@ -24,6 +25,7 @@ std::string report_markdown(const std::string& file, const std::string& resoluti
      << " scenarios x " << spec.seeds << " seeds (first seed " << spec.first_seed
      << "), the same delay and noise draws for every approach (common random numbers).\n\n"
      << "### Configuration\n\nAs `oneshot-sim study check` resolves it:\n\n```text\n" << resolution_text << "```\n\n"
+     << simulated_time_text << "\n\n"
      << "### Cost\n\n" << ncs::table_section_markdown(outputs, pairs, plot_path)
      << "Per scenario (mean cost of I, ratio of each approach's mean cost to I's):\n\n"
      << outputs.at("markdown_per_scenario").get<std::string>() << "\n### Links\n\n"

@@ -15,8 +15,10 @@ namespace oneshot::study {
 /// `study check` prints), the cost table with 95 % intervals and ratios to I (the ncs report
 /// section's code, ncs::table_section_markdown), every paired difference, the per-scenario
 /// ratios and the per-link counters. `outputs` is run_outputs() of `results`; `plot_path`
-/// (empty: none) is the cost bar plot, relative to the report.
-std::string report_markdown(const std::string& file, const std::string& resolution_text, const engine::SweepResults& results,
+/// (empty: none) is the cost bar plot, relative to the report; `simulated_time_text` says each
+/// scenario's simulated time as run (after a --max-duration cap).
+std::string report_markdown(const std::string& file, const std::string& resolution_text,
+                            const std::string& simulated_time_text, const engine::SweepResults& results,
                             const nlohmann::json& outputs, const std::string& plot_path);
 
 }  // namespace oneshot::study

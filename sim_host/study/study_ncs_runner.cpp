@@ -6,6 +6,8 @@
 #include <filesystem>
 #include <map>
 #include <stdexcept>
+#include <utility>
+#include <vector>
 
 #include "ncs_live.hpp"
 
@@ -217,11 +219,13 @@ void cap_duration(NcsStudy& s, double max_s, const std::string& field) {
     throw InputError("field '" + field + "': " + std::to_string(max_s) + " s is shorter than one period h = " +
                      std::to_string(h_s) + " s");
   }
-  for (ncs::Scenario& x : s.scenarios) {
+  std::vector<ncs::Scenario> capped = s.scenarios;  // `s` unchanged when a scenario is refused
+  for (ncs::Scenario& x : capped) {
     x.duration_s = std::fmin(x.duration_s, max_s);
     const std::string zero = zero_reference_cost(*s.ctx, x);
     if (!zero.empty()) throw InputError("field '" + field + "': scenario " + x.name + ": " + zero);
   }
+  s.scenarios = std::move(capped);
 }
 
 }  // namespace oneshot::study

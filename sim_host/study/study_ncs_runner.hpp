@@ -66,6 +66,7 @@ NcsStudy map_ncs_study(const engine::StudyFile& file);
 /// --max-duration`, the fuzz harness); longer runs are cut there, shorter ones stay.
 /// engine::InputError naming `field` when `max_s` is not finite, below one period h, or
 /// before a scenario's first set-point switch (T_r/2: the reference approach I would cost 0).
+/// `s` is unchanged when refused.
 void cap_duration(NcsStudy& s, double max_s, const std::string& field);
 
 }  // namespace oneshot::study

@@ -5,6 +5,7 @@
 ///        (study run, study report, the fuzz harness) cuts every scenario's simulated time.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
@@ -70,7 +71,7 @@ double number(const std::string& cell) {
 
 TEST(StudyReport, NamesEveryApproachWithTheCostsOfStudyRun) {
   const std::string run_dir = test::fresh_dir("oneshot_study_report", "run");
-  const std::string run_json = run_dir + ".json";
+  const std::string run_json = run_dir + "/run.json";
   const test::CommandResult run = test::run_command({ONESHOT_SIM_PATH, "study", "run", kExample, "--seeds", "2", "--threads",
                                                      "2", "--no-plots", "--out", run_dir, "--json", run_json});
   ASSERT_EQ(run.exit_code, 0) << run.output;
@@ -82,7 +83,13 @@ TEST(StudyReport, NamesEveryApproachWithTheCostsOfStudyRun) {
   const std::string md = test::read_file(out + "/report.md");
   ASSERT_FALSE(md.empty());
   EXPECT_NE(md.find("`ncs.json`"), std::string::npos) << md;
-  EXPECT_NE(md.find("grid: 9 approaches x 10 scenarios x 2 seeds = 180 runs"), std::string::npos) << md;  // what ran
+  const std::size_t approaches = j.at("approaches").size();
+  const std::size_t scenarios = j.at("scenarios").size();
+  const std::string grid = "grid: " + std::to_string(approaches) + " approaches x " + std::to_string(scenarios) +
+                           " scenarios x 2 seeds = " + std::to_string(approaches * scenarios * 2) + " runs";
+  EXPECT_NE(md.find(grid), std::string::npos) << md;  // what ran
+  EXPECT_NE(md.find("Simulated time per run:"), std::string::npos) << md;
+  EXPECT_EQ(md.find("capped by --max-duration"), std::string::npos) << md;
   // The cost table: every approach, mean and interval as study run's to the 6 decimals printed.
   const auto costs = table_after(md, "| approach | description | mean cost J", 1);
   const auto links = table_after(md, "| approach | link |", 2);
@@ -170,14 +177,27 @@ TEST(StudyReport, MaxDurationCutsEveryScenario) {
   // From the command line: the run's scenarios say the simulated time they ran.
   const std::string out = test::fresh_dir("oneshot_study_report", "capped");
   const test::CommandResult r = test::run_command(
-      {ONESHOT_SIM_PATH, "study", "run", kExample, "--seeds", "2", "--max-duration", "2.5", "--no-plots", "--out", out, "--json", out + ".json"});
+      {ONESHOT_SIM_PATH, "study", "run", kExample, "--seeds", "2", "--max-duration", "2.5", "--no-plots", "--out", out, "--json", out + "/run.json"});
   ASSERT_EQ(r.exit_code, 0) << r.output;
-  for (const auto& x : read_json(out + ".json").at("scenarios")) EXPECT_EQ(x.at("duration_s").get<double>(), 2.5);
+  for (const auto& x : read_json(out + "/run.json").at("scenarios")) EXPECT_EQ(x.at("duration_s").get<double>(), 2.5);
+  // The report says its runs were cut; an explicit 0 is a cap below one period, refused.
+  const std::string rep = test::fresh_dir("oneshot_study_report", "capped_report");
+  const test::CommandResult rr = test::run_command(
+      {ONESHOT_SIM_PATH, "study", "report", kExample, rep, "--seeds", "2", "--max-duration", "2.5", "--no-plots"});
+  ASSERT_EQ(rr.exit_code, 0) << rr.output;
+  EXPECT_NE(test::read_file(rep + "/report.md").find("(capped by --max-duration 2.5)"), std::string::npos);
+  const std::string zero = test::fresh_dir("oneshot_study_report", "zero_cap");
+  const test::CommandResult z = test::run_command(
+      {ONESHOT_SIM_PATH, "study", "run", kExample, "--seeds", "2", "--max-duration", "0", "--no-plots", "--out", zero});
+  EXPECT_NE(z.exit_code, 0);
+  EXPECT_NE(z.output.find("field '--max-duration'"), std::string::npos) << z.output;
+  EXPECT_FALSE(std::filesystem::exists(zero));
 }
 
 TEST(StudyReport, FuzzRunCorpusFilesRunWithinTheHarnessBound) {
-  // The seeds of tests/fuzz/fuzz_study_run.cpp run there, not refused: parsed in a folder that
-  // holds what the harness's holds, cut as the harness cuts them.
+  // The seeds of tests/fuzz/fuzz_study_run.cpp run, not refused: parsed in a folder that holds
+  // what the harness's holds, cut at the harness's 0.3 s (its run limit and oracles are the
+  // harness's own; here: every figure finite).
   const std::string dir = test::made_dir("oneshot_study_report", "fuzz_corpus");
   std::filesystem::copy_file(std::string(ONESHOT_STUDY_EXAMPLES_DIR) + "/../../../lut_gen/plants/networked_board.json",
                              dir + "/networked_board.json");
