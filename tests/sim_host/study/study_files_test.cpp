@@ -136,6 +136,25 @@ TEST(StudyFiles, LinkCountersCountFrames) {
       EXPECT_LE(c.at("late").get<double>() + c.at("refused").get<double>(), c.at("delivered").get<double>()) << a << " " << l;
 }
 
+TEST(StudyFiles, LateCountsCommandsTheActuatorDropsAsStale) {
+  // Commands delayed up to 1.5 h, overtaking allowed: some reach the actuator after a newer one
+  // or after their actuation instant, and it drops them as stale: the link's late counter.
+  const engine::StudyFile f = parse_edited([](nlohmann::json& j) {
+    j["links"][2]["delay"] = {{"model", "uniform"}, {"min_us", 500}, {"max_us", 75000}, {"resolution_us", 1}};
+    j["links"][2]["order"] = "any";
+    j["approaches"] = nlohmann::json::parse(R"([{"name": "I"}, {"name": "S"}, {"name": "A"}, {"name": "AK"}])");
+  });
+  NcsStudy s = map_ncs_study(f);
+  s.scenarios.resize(1);
+  s.scenarios[0].duration_s = 2;
+  const nlohmann::json j = run_outputs(run_ncs_sweep(s, 2, 2, engine::Shard{}), temp_dir("stale"), false);
+  for (const char* a : {"A", "AK"}) {
+    const nlohmann::json& ca = j.at("links").at(a).at("ca");
+    EXPECT_GT(ca.at("late").get<double>(), 0) << a;
+    EXPECT_LE(ca.at("late").get<double>() + ca.at("refused").get<double>(), ca.at("delivered").get<double>()) << a;
+  }
+}
+
 /// `want` and `got` equal within 1e-12 relative (both null, or both numbers).
 void expect_same_figure(const nlohmann::json& got, const nlohmann::json& want, const std::string& what) {
   if (want.is_null()) {
