@@ -6,6 +6,8 @@
 #include <cmath>
 #include <algorithm>
 #include <cstdio>
+#include <iterator>
+#include <map>
 #include <optional>
 #include <sstream>
 
@@ -13,6 +15,7 @@
 #include "oneshot/design/controller_synthesis.hpp"
 #include "oneshot/design/plant_description.hpp"
 #include "oneshot/engine/can_analysis.hpp"
+#include "oneshot/node/message.hpp"
 #include "study_ncs_runner.hpp"
 
 namespace oneshot::study {
@@ -75,27 +78,51 @@ engine::Duration loop_period(const engine::StudyFile& f) {
 struct SendWindow {
   engine::Duration lo{0};  ///< Earliest.
   engine::Duration hi{0};  ///< Latest.
+  bool operator==(const SendWindow& o) const { return lo == o.lo && hi == o.hi; }
 };
+
+/// Bytes of the loop message a link carries on a CAN bus: for study ncs the loop's own
+/// (network.hpp sends it in frames of ≤ 8 bytes): sc the sampling loops' report (header +
+/// p doubles; the actuation-synchronized loops, whose report is longer, do not run on a
+/// bus), ca a command (header + m doubles), as a request (header + m doubles); otherwise
+/// kLoopFramePayloadBytes (one frame).
+std::size_t loop_message_bytes(const engine::StudyFile& f, const std::string& link) {
+  if (f.study != "ncs") return kLoopFramePayloadBytes;
+  if (link == "sc") return node::encoded_size<double, ncs::kP>();
+  if (link == "ca" || link == "as") return node::encoded_size<double, ncs::kM>();
+  return kLoopFramePayloadBytes;
+}
+
+/// Delay of each loop message on a CAN bus, by link name: [C, R] (its transmission, its worst
+/// response), from the bus analysis; a link on a bus without an entry is unbounded.
+using BusDelays = std::map<std::string, SendWindow>;
 
 /// The send window of `node` under scenario `s` (nullptr: the file's links): a timer node
 /// [0, 0]; an arrival node the union over its incoming links of the sender's window plus the
-/// link's delay bounds, plus the computation on arrival τ_c of study ncs (U[1, 5] ms, the only
-/// computation time study files model); with no incoming link [0, 0]. nullopt when unbounded:
-/// a delay model with no upper bound, an incoming link on a CAN bus (chained bus analysis is
-/// not done), a cycle of arrival nodes.
+/// link's delay bounds (a link on a CAN bus: [C, R] of its message from `bus`), plus the
+/// computation on arrival τ_c of study ncs (U[1, 5] ms, the only computation time study files
+/// model); with no incoming link [0, 0]. nullopt when unbounded: a delay model with no upper
+/// bound, a bus message without a bound, a cycle of arrival nodes.
 std::optional<SendWindow> send_window(const engine::StudyFile& f, const std::string& node, const engine::ScenarioSpec* s,
-                                      std::size_t depth = 0) {
+                                      const BusDelays& bus, std::size_t depth = 0) {
   if (f.node(node).mode != "arrival") return SendWindow{};
   if (depth > f.nodes.size()) return std::nullopt;
   std::optional<SendWindow> w;
   for (const engine::LinkSpec& l : f.links) {
     if (l.to != node) continue;
-    if (!l.bus.empty()) return std::nullopt;
-    const std::optional<SendWindow> up = send_window(f, l.from, s, depth + 1);
-    const engine::DelayModel d = f.link_config(l.name, s).delay;
-    const std::optional<engine::Duration> ub = d.upper_bound();
-    if (!up || !ub) return std::nullopt;
-    const SendWindow x{up->lo + d.lower_bound(), up->hi + *ub};
+    const std::optional<SendWindow> up = send_window(f, l.from, s, bus, depth + 1);
+    if (!up) return std::nullopt;
+    SendWindow x;
+    if (!l.bus.empty()) {
+      const auto it = bus.find(l.name);
+      if (it == bus.end()) return std::nullopt;
+      x = SendWindow{up->lo + it->second.lo, up->hi + it->second.hi};
+    } else {
+      const engine::DelayModel d = f.link_config(l.name, s).delay;
+      const std::optional<engine::Duration> ub = d.upper_bound();
+      if (!ub) return std::nullopt;
+      x = SendWindow{up->lo + d.lower_bound(), up->hi + *ub};
+    }
     w = w ? SendWindow{std::min(w->lo, x.lo), std::max(w->hi, x.hi)} : x;
   }
   if (!w) return SendWindow{};
@@ -106,10 +133,10 @@ std::optional<SendWindow> send_window(const engine::StudyFile& f, const std::str
 /// Release jitter of the loop messages among `links` (the bus's streams from index
 /// `first_link`) under scenario `s`: its sender's send window hi − lo; nullopt when unbounded.
 std::vector<std::optional<engine::Duration>> loop_jitters(const engine::StudyFile& f, const std::vector<const engine::LinkSpec*>& links,
-                                                          const engine::ScenarioSpec* s) {
+                                                          const engine::ScenarioSpec* s, const BusDelays& bus) {
   std::vector<std::optional<engine::Duration>> out;
   for (const engine::LinkSpec* l : links) {
-    const std::optional<SendWindow> w = send_window(f, l->from, s);
+    const std::optional<SendWindow> w = send_window(f, l->from, s, bus);
     out.push_back(w ? std::optional<engine::Duration>(w->hi - w->lo) : std::nullopt);
   }
   return out;
@@ -133,7 +160,8 @@ json bus_messages(std::vector<engine::CanStream> streams, const std::vector<std:
     for (std::size_t i = 0; i < streams.size(); ++i)
       if (unbounded_jitter[i] && streams[i].id <= streams[k].id) bounded = false;
     json m = {{"name", streams[k].name}, {"kind", kinds[k]}, {"id", streams[k].id},
-              {"payload_bytes", streams[k].payload_bytes}, {"period_us", us(streams[k].period)},
+              {"payload_bytes", streams[k].payload_bytes}, {"frames", streams[k].leading_frames + 1},
+              {"message_bytes", 8 * streams[k].leading_frames + streams[k].payload_bytes}, {"period_us", us(streams[k].period)},
               {"jitter_us", unbounded_jitter[k] ? json(nullptr) : json(us(streams[k].jitter))},
               {"deadline_us", us(streams[k].deadline)}, {"transmission_us", us(bounds[k].transmission)},
               {"bounded", bounded}, {"schedulable", bounded && bounds[k].schedulable}};
@@ -237,48 +265,95 @@ json resolve_study(const engine::StudyFile& f) {
       }
       r["links"].push_back(e);
     }
+    // Buses: the streams of each, then their analysis together (a loop message's jitter may
+    // come from a message on a bus before it in its chain: iterated to a fixed point).
+    struct Bus {
+      std::vector<engine::CanStream> streams;
+      std::vector<std::string> kinds;
+      std::size_t first_link = 0;
+      std::vector<const engine::LinkSpec*> on_bus;
+      std::vector<engine::Duration> message_time;  ///< C of each loop message (every frame).
+    };
+    std::vector<Bus> buses;
     for (std::size_t b = 0; b < f.buses.size(); ++b) {
       const engine::BusSpec& bus = f.buses[b];
       const std::string field = "buses[" + std::to_string(b) + "]";
-      std::vector<engine::CanStream> streams = bus.background;
-      std::vector<std::string> kinds(streams.size(), "background");
-      const std::size_t first_link = streams.size();
-      std::vector<const engine::LinkSpec*> on_bus;
+      Bus x;
+      x.streams = bus.background;
+      x.kinds.assign(x.streams.size(), "background");
+      x.first_link = x.streams.size();
+      const engine::Duration bit{1'000'000'000 / bus.config.bit_rate};
       for (const engine::LinkSpec& l : f.links) {
         if (l.bus != bus.config.name) continue;
         const engine::NodeSpec& from = f.node(l.from);
         const engine::Duration t = from.mode == "timer" ? from.period : period;
         if (t.count() <= 0) throw InputError("field '" + field + "': link " + l.name + " has no period (no timer node)");
+        const std::size_t bytes = loop_message_bytes(f, l.name);
         engine::CanStream st;
         st.name = l.name;
         st.id = l.id;
-        st.payload_bytes = kLoopFramePayloadBytes;
+        st.leading_frames = (bytes - 1) / 8;
+        st.payload_bytes = bytes - 8 * st.leading_frames;
         st.period = t;
         st.deadline = t;
-        streams.push_back(st);
-        kinds.emplace_back("link");
-        on_bus.push_back(&l);
+        x.streams.push_back(st);
+        x.kinds.emplace_back("link");
+        x.on_bus.push_back(&l);
+        x.message_time.push_back(bit * (static_cast<std::int64_t>(st.leading_frames) * engine::can_frame_bits(8, bus.config.extended_ids) +
+                                        engine::can_frame_bits(st.payload_bytes, bus.config.extended_ids)));
       }
       double load = 0;
-      const engine::Duration bit{1'000'000'000 / bus.config.bit_rate};
-      for (const engine::CanStream& st : streams) {
-        load += static_cast<double>((bit * engine::can_frame_bits(st.payload_bytes, bus.config.extended_ids)).count()) /
-                static_cast<double>(st.period.count());
+      for (const engine::CanStream& st : x.streams) {
+        const std::int64_t bits = static_cast<std::int64_t>(st.leading_frames) * engine::can_frame_bits(8, bus.config.extended_ids) +
+                                  engine::can_frame_bits(st.payload_bytes, bus.config.extended_ids);
+        load += static_cast<double>((bit * bits).count()) / static_cast<double>(st.period.count());
       }
-      json e = {{"name", bus.config.name}, {"bit_rate", bus.config.bit_rate}, {"load", load}};
       if (load > 1) {
         char buf[64];
         std::snprintf(buf, sizeof buf, "%.1f", 100 * load);
         throw InputError("field '" + field + "': bus " + bus.config.name + " is loaded " + buf + " % (over 100 %)");
       }
-      const auto base = loop_jitters(f, on_bus, nullptr);
-      e["messages"] = bus_messages(streams, kinds, first_link, base, bus.config);
-      // A scenario whose link overrides change a loop message's jitter: its own analysis.
-      for (const engine::ScenarioSpec& s : f.scenarios) {
-        const auto jit = loop_jitters(f, on_bus, &s);
-        if (jit != base) e["scenarios"][s.name] = bus_messages(streams, kinds, first_link, jit, bus.config);
+      r["buses"].push_back({{"name", bus.config.name}, {"bit_rate", bus.config.bit_rate}, {"load", load}});
+      buses.push_back(std::move(x));
+    }
+    // Every bus under scenario `s`: from every loop message at its transmission time, the
+    // jitters and responses until the delays [C, R] stop moving (they only grow); after 64
+    // rounds a message still moving is taken unbounded.
+    const auto analyze = [&](const engine::ScenarioSpec* s) {
+      BusDelays delays;
+      for (const Bus& x : buses)
+        for (std::size_t k = 0; k < x.on_bus.size(); ++k) delays[x.on_bus[k]->name] = SendWindow{x.message_time[k], x.message_time[k]};
+      std::vector<json> out(buses.size());
+      for (std::size_t round = 0;; ++round) {
+        BusDelays next;
+        for (std::size_t b = 0; b < buses.size(); ++b) {
+          const Bus& x = buses[b];
+          out[b] = bus_messages(x.streams, x.kinds, x.first_link, loop_jitters(f, x.on_bus, s, delays), f.buses[b].config);
+          for (std::size_t k = 0; k < x.on_bus.size(); ++k) {
+            const json& m = out[b][x.first_link + k];
+            if (m.at("worst_response_us").is_null()) continue;
+            const engine::Duration resp{std::llround(m.at("worst_response_us").get<double>() * 1e3)};
+            next[x.on_bus[k]->name] = SendWindow{x.message_time[k], resp};
+          }
+        }
+        if (next == delays) break;
+        if (round >= 64) {
+          for (auto it = next.begin(); it != next.end();) {
+            const auto old = delays.find(it->first);
+            it = old == delays.end() || !(old->second == it->second) ? next.erase(it) : std::next(it);
+          }
+        }
+        delays = next;
       }
-      r["buses"].push_back(e);
+      return out;
+    };
+    const std::vector<json> base = analyze(nullptr);
+    for (std::size_t b = 0; b < buses.size(); ++b) r["buses"][b]["messages"] = base[b];
+    // A scenario whose link overrides change a loop message's jitter: its own analysis.
+    for (const engine::ScenarioSpec& s : f.scenarios) {
+      const std::vector<json> own = analyze(&s);
+      for (std::size_t b = 0; b < buses.size(); ++b)
+        if (own[b] != base[b]) r["buses"][b]["scenarios"][s.name] = own[b];
     }
     // The grid.
     for (const engine::ScenarioSpec& s : f.scenarios) {
@@ -300,6 +375,22 @@ void add_ncs_designs(json& r, const NcsStudy& s) {
       const double tau = s.ctx->mean_tau_io_us(sc);
       const auto g = ncs::delay_compensated_gain(*s.ctx, tau);
       a["per_scenario"][sc.name] = {{"tau_io_us", tau}, {"gain_x_u", {g[0], g[1], g[2]}}};
+    }
+  }
+}
+
+void attach_bus_bounds(NcsStudy& s, const json& r) {
+  s.bus_response_us.assign(s.scenarios.size(), {});
+  if (!r.contains("buses")) return;
+  for (std::size_t k = 0; k < s.scenarios.size(); ++k) {
+    for (const json& b : r.at("buses")) {
+      const std::string& name = s.scenarios[k].name;
+      const json& list = b.contains("scenarios") && b.at("scenarios").contains(name) ? b.at("scenarios").at(name) : b.at("messages");
+      for (const json& m : list) {
+        if (m.at("kind") != "link") continue;
+        const json& w = m.at("worst_response_us");
+        s.bus_response_us[k][m.at("name").get<std::string>()] = w.is_null() ? std::nullopt : std::optional<double>(w.get<double>());
+      }
     }
   }
 }

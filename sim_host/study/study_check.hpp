@@ -14,7 +14,8 @@
 
 namespace oneshot::study {
 
-/// Frame payload the check assumes for a loop message on a CAN bus (bytes; worst case).
+/// Frame payload the check assumes for a loop message on a CAN bus (bytes; worst case) when
+/// the study is not ncs (an ncs file's messages have the loop's sizes, in frames of ≤ 8 bytes).
 inline constexpr std::size_t kLoopFramePayloadBytes = 8;
 
 /// Everything `file` implies, as JSON. engine::InputError naming the field for an
@@ -28,6 +29,10 @@ nlohmann::json resolve_study(const engine::StudyFile& file);
 /// Adds to the resolution `r` of an ncs file what needs its scenarios: the S+ gain
 /// [L_x, L_u] and the mean delay τ_io it is designed on, per scenario.
 void add_ncs_designs(nlohmann::json& r, const NcsStudy& s);
+
+/// Sets s.bus_response_us from the resolution `r` of the same file: per scenario the
+/// worst-case response time of each leg on a bus (the scenario's own analysis where it has one).
+void attach_bus_bounds(NcsStudy& s, const nlohmann::json& r);
 
 /// The resolution as text, one fact per line.
 std::string describe_resolution(const nlohmann::json& r);
