@@ -18,7 +18,10 @@ namespace oneshot::study {
 /// the study is not ncs (an ncs file's messages have the loop's sizes, in frames of ≤ 8 bytes).
 inline constexpr std::size_t kLoopFramePayloadBytes = 8;
 
-/// Everything `file` implies, as JSON. engine::InputError naming the field for an
+/// Everything `file` implies, as JSON. Per CAN bus its load and every message's worst-case
+/// response (can_analysis.hpp): a loop message of study ncs at the loop's size in frames of
+/// ≤ 8 bytes, its release jitter chained through the links before it (a link on a bus adding
+/// [C, R] of its message; the buses analysed together to a fixed point). engine::InputError naming the field for an
 /// undetectable or unstabilizable design ("plant"), a plant file that does not load
 /// ("plant.file"), a bus loaded over 100 % ("buses[i]") or a bus message without a period.
 /// Approach kinds of study ncs get their design (I, S, A: LQR; AK, AKx, AKl, SK, IK: LQR and
