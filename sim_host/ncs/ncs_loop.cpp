@@ -11,6 +11,7 @@
 #include "ncs_analytic.hpp"
 #include "ncs_counters.hpp"
 #include "ncs_live_nodes.hpp"
+#include "oneshot/engine/can_traffic.hpp"
 #include "oneshot/engine/continuous_plant.hpp"
 #include "oneshot/engine/kernel.hpp"
 #include "oneshot/engine/network.hpp"
@@ -66,7 +67,7 @@ class Harness {
         h_(engine::from_us(ctx.period_us())),
         end_(engine::from_seconds(sc.duration_s, "ncs scenario duration")) {
     net_.set_faults(opt.faults);
-    if (sc.legs.empty() && !(sc.max_delay_ms * 1000 >= static_cast<double>(ctx.timing().leg_min_us))) {
+    if (!legs_from_file(sc) && !(sc.max_delay_ms * 1000 >= static_cast<double>(ctx.timing().leg_min_us))) {
       throw std::invalid_argument("ncs scenario " + sc.name + ": d must be at least 0.5 ms");
     }
     const auto chol = measurement_cholesky(design_);
@@ -120,6 +121,30 @@ class Harness {
     return l;
   }
 
+  /// Routes leg `name` from `source` to `destination`: over its CAN bus when the scenario puts
+  /// it on one (not for the delay-free loops I, IK), else over a link.
+  void route_leg(std::uint8_t source, std::uint8_t destination, const char* name) {
+    const auto b = sc_.bus_legs.find(name);
+    if (b == sc_.bus_legs.end() || delay_free(approach_)) {
+      net_.route(source, destination, add_leg(name));
+      return;
+    }
+    net_.route(source, destination, bus(b->second), b->second.id);
+    bus_legs_.emplace_back(name, std::make_pair(source, destination));
+  }
+
+  /// The bus of `leg`, built with its background traffic on first use.
+  engine::CanBus& bus(const BusLeg& leg) {
+    for (const auto& [nm, b] : buses_)
+      if (nm == leg.bus.name) return *b;
+    engine::CanBus& b = net_.add_can_bus(leg.bus);
+    buses_.emplace_back(leg.bus.name, &b);
+    if (!leg.background.empty()) {
+      traffic_.push_back(std::make_unique<engine::CanTraffic>(kernel_, b, leg.background, leg.offsets, end_));
+    }
+    return b;
+  }
+
   /// τ_c of the next computation (whole µs), 0 for the delay-free loops.
   Duration compute_time() {
     if (delay_free(approach_)) return Duration{0};
@@ -164,6 +189,14 @@ class Harness {
     result_.injected = net_.fault_counters();
     result_.cost = plant_.cost().total();
     for (const auto& [nm, l] : legs_) result_.links.emplace_back(nm, l->statistics());
+    for (const auto& [nm, route] : bus_legs_) {
+      const engine::BusRouteStatistics& st = net_.bus_route_statistics(route.first, route.second);
+      engine::LinkStatistics ls;
+      ls.sent = st.sent;
+      ls.max_delay = st.max_delay;
+      result_.links.emplace_back(nm, ls);
+      result_.bus_legs.emplace_back(nm, st);
+    }
     if (an_) an_->report(result_);
     for (const auto& s : plant_.trace()) {
       const double t = engine::to_seconds(s.t);
@@ -193,6 +226,9 @@ class Harness {
   RunResult result_;
   std::unique_ptr<AnalyticTracker> an_;
   std::vector<std::pair<std::string, engine::Link*>> legs_;
+  std::vector<std::pair<std::string, std::pair<std::uint8_t, std::uint8_t>>> bus_legs_;  ///< Name, route.
+  std::vector<std::pair<std::string, engine::CanBus*>> buses_;
+  std::vector<std::unique_ptr<engine::CanTraffic>> traffic_;
 };
 
 /// The actuation-synchronized loop with estimator `est` (brief §1).
@@ -248,9 +284,9 @@ RunResult run_synchronized(Harness& hs, Estimator est, std::int32_t late_us) {
   net.add_node(kController, "controller", Duration{0},
                [&]() { k.schedule_in(hs.compute_time(), EventClass::kCompute, compute_h); });
   net.add_node(kActuator, "actuator", Duration{0}, [&]() { act->on_receive(); });
-  net.route(kActuator, kSensor, hs.add_leg("as"));
-  net.route(kSensor, kController, hs.add_leg("sc"));
-  net.route(kController, kActuator, hs.add_leg("ca"));
+  hs.route_leg(kActuator, kSensor, "as");
+  hs.route_leg(kSensor, kController, "sc");
+  hs.route_leg(kController, kActuator, "ca");
   net.arm_faults({{"sensor",
                    [&]() {
                      sensor.emplace(kController, late_us);
@@ -329,8 +365,8 @@ RunResult run_sampling(Harness& hs, Law law, Saturated saturated) {
     InputVec u;
     if (act->take_output(u)) hs.apply(u);
   });
-  net.route(kSensor, kController, hs.add_leg("sc"));
-  net.route(kController, kActuator, hs.add_leg("ca"));
+  hs.route_leg(kSensor, kController, "sc");
+  hs.route_leg(kController, kActuator, "ca");
   net.arm_faults({{"sensor",
                    [&]() {
                      sensor.emplace(kController, Trigger(1));

@@ -11,6 +11,9 @@
 /// (Scenario::legs: their delay, loss and order); τ_c ~ U[1, 5] ms (stream
 /// "compute"); I and IK have none. Streams per source (common random numbers): process,
 /// measurement, compute, link/<as|sc|ca>/delay. With a fault spec (RunOptions::faults)
+/// Legs a study file puts on a CAN bus (Scenario::bus_legs) go over the engine's CanBus with
+/// their identifier and the bus's background traffic (CanTraffic, stream "can/<bus>/jitter");
+/// I and IK keep their delay-free links. With a fault spec (RunOptions::faults)
 /// the links carry the engine's frame faults and the nodes "sensor", "controller",
 /// "actuator" restart at the spec's instants: a restarted node is rebuilt as at power-on
 /// (its interface emptied; the actuator's period index starts again from 0 at its next
@@ -28,6 +31,7 @@
 #include "oneshot/engine/fault_spec.hpp"
 #include "oneshot/engine/frame_faults.hpp"
 #include "oneshot/engine/link.hpp"
+#include "oneshot/engine/network.hpp"
 #include "oneshot/node/square_wave_reference.hpp"
 
 namespace oneshot::ncs {
@@ -70,6 +74,9 @@ struct RunResult {
   std::vector<double> counters;    ///< Node counters (ncs_counters.hpp, order of counter_names()).
   /// Counters of the links the run built, by leg name (order of link_names()).
   std::vector<std::pair<std::string, engine::LinkStatistics>> links;
+  /// Legs on a CAN bus (Scenario::bus_legs), by leg name: messages queued and their delays
+  /// (queueing + transmission of every frame). Their sent counts are in `links` too (lost 0).
+  std::vector<std::pair<std::string, engine::BusRouteStatistics>> bus_legs;
   std::vector<Point> truth;      ///< True state every trace step (x1, x2).
   std::vector<Point> samples;    ///< Samples y at their instants.
   std::vector<Point> sample_truth;  ///< C x at the same instants (noise-free output).

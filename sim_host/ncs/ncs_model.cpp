@@ -171,6 +171,10 @@ std::uint64_t half_wave_periods(const Context& ctx, const Scenario& sc) {
 std::optional<engine::Duration> sc_ca_delay_bound(const Scenario& s, const char** unbounded_leg) {
   engine::Duration sum{0};
   for (const char* leg : {"sc", "ca"}) {
+    if (s.bus_legs.count(leg) != 0) {
+      if (unbounded_leg != nullptr) *unbounded_leg = leg;
+      return std::nullopt;
+    }
     const auto it = s.legs.find(leg);
     if (it == s.legs.end()) continue;
     const std::optional<engine::Duration> ub = it->second.delay.upper_bound();
@@ -184,7 +188,7 @@ std::optional<engine::Duration> sc_ca_delay_bound(const Scenario& s, const char*
 }
 
 std::int32_t Context::worst_chain_us(const Scenario& s) const {
-  if (!s.legs.empty()) {
+  if (legs_from_file(s)) {
     const char* leg = "";
     const std::optional<engine::Duration> sum = sc_ca_delay_bound(s, &leg);
     if (!sum) throw std::invalid_argument(std::string("ncs scenario ") + s.name + ": leg " + leg + " has no upper delay bound (late sampling needs one)");
@@ -194,7 +198,7 @@ std::int32_t Context::worst_chain_us(const Scenario& s) const {
 }
 
 double Context::mean_tau_io_us(const Scenario& s) const {
-  if (!s.legs.empty()) {
+  if (legs_from_file(s)) {
     double sum_ns = 0;
     for (const char* leg : {"sc", "ca"}) {
       const auto it = s.legs.find(leg);

@@ -15,6 +15,8 @@
 #include "oneshot/controller_design.hpp"
 #include "oneshot/design/controller_synthesis.hpp"
 #include "oneshot/design/plant_description.hpp"
+#include "oneshot/engine/can_analysis.hpp"
+#include "oneshot/engine/can_bus.hpp"
 #include "oneshot/engine/link.hpp"
 #include "oneshot/generic_discretizer.hpp"
 #include "oneshot/number_format.hpp"
@@ -44,6 +46,16 @@ bool actuation_synchronized(Approach a);
 /// True for the ideal loops without delays (I, IK).
 bool delay_free(Approach a);
 
+/// A leg on a CAN bus (study files): the bus, the leg's identifier and the bus's other
+/// traffic (periodic streams, their first releases). Its delay is the bus's: arbitration
+/// by identifier, the message in frames of ≤ 8 bytes (network.hpp), no loss.
+struct BusLeg {
+  engine::CanBusConfig bus;                 ///< Name, bit rate, identifier length.
+  std::uint32_t id = 0;                     ///< The leg's identifier.
+  std::vector<engine::CanStream> background;  ///< Other traffic on the bus (can_traffic.hpp).
+  std::vector<engine::Duration> offsets;    ///< First release of each background stream.
+};
+
 /// One scenario (brief §3): square wave ±A_r of period T_r, network legs U[0.5, d] ms,
 /// noise scale s.
 struct Scenario {
@@ -58,7 +70,13 @@ struct Scenario {
   /// d is not used by the loop: S+ designs on the legs' mean delays and AKl's D is the sum of
   /// their upper bounds.
   std::map<std::string, engine::LinkConfig> legs;
+  /// Legs on a CAN bus (study files), by name: not in `legs`. The delay-free loops (I, IK)
+  /// keep their delay-free links.
+  std::map<std::string, BusLeg> bus_legs;
 };
+
+/// True when the legs come from a study file (point to point or on a bus), not from d.
+inline bool legs_from_file(const Scenario& s) { return !s.legs.empty() || !s.bus_legs.empty(); }
 /// The ten scenarios of brief §3.
 std::vector<Scenario> default_scenarios();
 /// Scenarios from the text of a scenario file {"description", "scenarios": [{"name",
@@ -97,7 +115,8 @@ class Context {
   /// Worst τ_sc + τ_c + τ_ca of a scenario (µs): D of late sampling (std::invalid_argument
   /// when a leg of the study file has no upper bound).
   std::int32_t worst_chain_us(const Scenario& s) const;
-  /// Mean τ_io = τ_sc + τ_c + τ_ca of a scenario (µs).
+  /// Mean τ_io = τ_sc + τ_c + τ_ca of a scenario (µs); a leg on a CAN bus adds 0 (its mean
+  /// delay is not known before the run: study files refuse S+ on bus legs).
   double mean_tau_io_us(const Scenario& s) const;
 
  private:
@@ -107,8 +126,8 @@ class Context {
 };
 
 /// Sum of the upper delay bounds of the legs "sc" and "ca" of a study-file scenario (a leg it
-/// does not set adds 0); std::nullopt when one has no bound (Poisson, lognormal, Pareto), that
-/// leg's name then in *unbounded_leg when given.
+/// does not set adds 0); std::nullopt when one has no bound (Poisson, lognormal, Pareto) or is
+/// on a CAN bus (its bound is the bus analysis's), that leg's name then in *unbounded_leg when given.
 std::optional<engine::Duration> sc_ca_delay_bound(const Scenario& s, const char** unbounded_leg = nullptr);
 
 /// Periods h in half a set-point period; std::invalid_argument unless whole.

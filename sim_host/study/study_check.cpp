@@ -12,7 +12,7 @@
 #include "ncs_model.hpp"
 #include "oneshot/design/controller_synthesis.hpp"
 #include "oneshot/design/plant_description.hpp"
-#include "oneshot/engine/can_analysis.hpp"
+#include "study_bus_analysis.hpp"
 #include "study_ncs_runner.hpp"
 
 namespace oneshot::study {
@@ -61,86 +61,6 @@ bool ncs_kind(const std::string& kind) {
   for (ncs::Approach a : ncs::kAllApproaches)
     if (kind == ncs::name(a)) return true;
   return false;
-}
-
-/// The smallest timer period of the file (0 when no node runs a timer).
-engine::Duration loop_period(const engine::StudyFile& f) {
-  engine::Duration p{0};
-  for (const engine::NodeSpec& n : f.nodes)
-    if (n.mode == "timer" && (p.count() == 0 || n.period < p)) p = n.period;
-  return p;
-}
-
-/// When a node sends, after the release of the timer that starts its chain: [lo, hi].
-struct SendWindow {
-  engine::Duration lo{0};  ///< Earliest.
-  engine::Duration hi{0};  ///< Latest.
-};
-
-/// The send window of `node` under scenario `s` (nullptr: the file's links): a timer node
-/// [0, 0]; an arrival node the union over its incoming links of the sender's window plus the
-/// link's delay bounds, plus the computation on arrival τ_c of study ncs (U[1, 5] ms, the only
-/// computation time study files model); with no incoming link [0, 0]. nullopt when unbounded:
-/// a delay model with no upper bound, an incoming link on a CAN bus (chained bus analysis is
-/// not done), a cycle of arrival nodes.
-std::optional<SendWindow> send_window(const engine::StudyFile& f, const std::string& node, const engine::ScenarioSpec* s,
-                                      std::size_t depth = 0) {
-  if (f.node(node).mode != "arrival") return SendWindow{};
-  if (depth > f.nodes.size()) return std::nullopt;
-  std::optional<SendWindow> w;
-  for (const engine::LinkSpec& l : f.links) {
-    if (l.to != node) continue;
-    if (!l.bus.empty()) return std::nullopt;
-    const std::optional<SendWindow> up = send_window(f, l.from, s, depth + 1);
-    const engine::DelayModel d = f.link_config(l.name, s).delay;
-    const std::optional<engine::Duration> ub = d.upper_bound();
-    if (!up || !ub) return std::nullopt;
-    const SendWindow x{up->lo + d.lower_bound(), up->hi + *ub};
-    w = w ? SendWindow{std::min(w->lo, x.lo), std::max(w->hi, x.hi)} : x;
-  }
-  if (!w) return SendWindow{};
-  const ncs::Timing t;
-  return SendWindow{w->lo + engine::from_us(t.compute_min_us), w->hi + engine::from_us(t.compute_max_us)};
-}
-
-/// Release jitter of the loop messages among `links` (the bus's streams from index
-/// `first_link`) under scenario `s`: its sender's send window hi − lo; nullopt when unbounded.
-std::vector<std::optional<engine::Duration>> loop_jitters(const engine::StudyFile& f, const std::vector<const engine::LinkSpec*>& links,
-                                                          const engine::ScenarioSpec* s) {
-  std::vector<std::optional<engine::Duration>> out;
-  for (const engine::LinkSpec* l : links) {
-    const std::optional<SendWindow> w = send_window(f, l->from, s);
-    out.push_back(w ? std::optional<engine::Duration>(w->hi - w->lo) : std::nullopt);
-  }
-  return out;
-}
-
-/// The response-time analysis of a bus's streams, the loop messages (from index `first_link`)
-/// with the release jitters `jitters`: one with an unbounded jitter is analyzed with 0 and
-/// reported unbounded, with every stream of lower priority (its interference on them has no
-/// bound).
-json bus_messages(std::vector<engine::CanStream> streams, const std::vector<std::string>& kinds, std::size_t first_link,
-                  const std::vector<std::optional<engine::Duration>>& jitters, const engine::CanBusConfig& config) {
-  std::vector<bool> unbounded_jitter(streams.size(), false);
-  for (std::size_t k = 0; k < jitters.size(); ++k) {
-    streams[first_link + k].jitter = jitters[k].value_or(engine::Duration{0});
-    unbounded_jitter[first_link + k] = !jitters[k];
-  }
-  const std::vector<engine::CanStreamBound> bounds = engine::can_response_times(streams, config);
-  json out = json::array();
-  for (std::size_t k = 0; k < streams.size(); ++k) {
-    bool bounded = bounds[k].bounded;
-    for (std::size_t i = 0; i < streams.size(); ++i)
-      if (unbounded_jitter[i] && streams[i].id <= streams[k].id) bounded = false;
-    json m = {{"name", streams[k].name}, {"kind", kinds[k]}, {"id", streams[k].id},
-              {"payload_bytes", streams[k].payload_bytes}, {"period_us", us(streams[k].period)},
-              {"jitter_us", unbounded_jitter[k] ? json(nullptr) : json(us(streams[k].jitter))},
-              {"deadline_us", us(streams[k].deadline)}, {"transmission_us", us(bounds[k].transmission)},
-              {"bounded", bounded}, {"schedulable", bounded && bounds[k].schedulable}};
-    m["worst_response_us"] = bounded ? json(us(bounds[k].response)) : json(nullptr);
-    out.push_back(m);
-  }
-  return out;
 }
 
 json plant_section(const engine::StudyFile& f, json& designs) {
@@ -221,7 +141,6 @@ json resolve_study(const engine::StudyFile& f) {
       r["approaches"].push_back(e);
     }
     // Links: point to point per scenario; bus messages by the CAN analysis.
-    const engine::Duration period = loop_period(f);
     for (const engine::LinkSpec& l : f.links) {
       json e = {{"name", l.name}, {"from", l.from}, {"to", l.to}};
       if (l.bus.empty()) {
@@ -237,49 +156,7 @@ json resolve_study(const engine::StudyFile& f) {
       }
       r["links"].push_back(e);
     }
-    for (std::size_t b = 0; b < f.buses.size(); ++b) {
-      const engine::BusSpec& bus = f.buses[b];
-      const std::string field = "buses[" + std::to_string(b) + "]";
-      std::vector<engine::CanStream> streams = bus.background;
-      std::vector<std::string> kinds(streams.size(), "background");
-      const std::size_t first_link = streams.size();
-      std::vector<const engine::LinkSpec*> on_bus;
-      for (const engine::LinkSpec& l : f.links) {
-        if (l.bus != bus.config.name) continue;
-        const engine::NodeSpec& from = f.node(l.from);
-        const engine::Duration t = from.mode == "timer" ? from.period : period;
-        if (t.count() <= 0) throw InputError("field '" + field + "': link " + l.name + " has no period (no timer node)");
-        engine::CanStream st;
-        st.name = l.name;
-        st.id = l.id;
-        st.payload_bytes = kLoopFramePayloadBytes;
-        st.period = t;
-        st.deadline = t;
-        streams.push_back(st);
-        kinds.emplace_back("link");
-        on_bus.push_back(&l);
-      }
-      double load = 0;
-      const engine::Duration bit{1'000'000'000 / bus.config.bit_rate};
-      for (const engine::CanStream& st : streams) {
-        load += static_cast<double>((bit * engine::can_frame_bits(st.payload_bytes, bus.config.extended_ids)).count()) /
-                static_cast<double>(st.period.count());
-      }
-      json e = {{"name", bus.config.name}, {"bit_rate", bus.config.bit_rate}, {"load", load}};
-      if (load > 1) {
-        char buf[64];
-        std::snprintf(buf, sizeof buf, "%.1f", 100 * load);
-        throw InputError("field '" + field + "': bus " + bus.config.name + " is loaded " + buf + " % (over 100 %)");
-      }
-      const auto base = loop_jitters(f, on_bus, nullptr);
-      e["messages"] = bus_messages(streams, kinds, first_link, base, bus.config);
-      // A scenario whose link overrides change a loop message's jitter: its own analysis.
-      for (const engine::ScenarioSpec& s : f.scenarios) {
-        const auto jit = loop_jitters(f, on_bus, &s);
-        if (jit != base) e["scenarios"][s.name] = bus_messages(streams, kinds, first_link, jit, bus.config);
-      }
-      r["buses"].push_back(e);
-    }
+    if (!f.buses.empty()) r["buses"] = analyze_buses(f);  // study_bus_analysis.hpp
     // The grid.
     for (const engine::ScenarioSpec& s : f.scenarios) {
       r["scenarios"].push_back({{"name", s.name}, {"duration_s", s.duration_s.value_or(f.duration_s)}, {"params", s.params}});
@@ -300,6 +177,22 @@ void add_ncs_designs(json& r, const NcsStudy& s) {
       const double tau = s.ctx->mean_tau_io_us(sc);
       const auto g = ncs::delay_compensated_gain(*s.ctx, tau);
       a["per_scenario"][sc.name] = {{"tau_io_us", tau}, {"gain_x_u", {g[0], g[1], g[2]}}};
+    }
+  }
+}
+
+void attach_bus_bounds(NcsStudy& s, const json& r) {
+  s.bus_response_us.assign(s.scenarios.size(), {});
+  if (!r.contains("buses")) return;
+  for (std::size_t k = 0; k < s.scenarios.size(); ++k) {
+    for (const json& b : r.at("buses")) {
+      const std::string& name = s.scenarios[k].name;
+      const json& list = b.contains("scenarios") && b.at("scenarios").contains(name) ? b.at("scenarios").at(name) : b.at("messages");
+      for (const json& m : list) {
+        if (m.at("kind") != "link") continue;
+        const json& w = m.at("worst_response_us");
+        s.bus_response_us[k][m.at("name").get<std::string>()] = w.is_null() ? std::nullopt : std::optional<double>(w.get<double>());
+      }
     }
   }
 }

@@ -14,10 +14,14 @@
 
 namespace oneshot::study {
 
-/// Frame payload the check assumes for a loop message on a CAN bus (bytes; worst case).
+/// Frame payload the check assumes for a loop message on a CAN bus (bytes; worst case) when
+/// the study is not ncs (an ncs file's messages have the loop's sizes, in frames of ≤ 8 bytes).
 inline constexpr std::size_t kLoopFramePayloadBytes = 8;
 
-/// Everything `file` implies, as JSON. engine::InputError naming the field for an
+/// Everything `file` implies, as JSON. Per CAN bus its load and every message's worst-case
+/// response (can_analysis.hpp): a loop message of study ncs at the loop's size in frames of
+/// ≤ 8 bytes, its release jitter chained through the links before it (a link on a bus adding
+/// [C, R] of its message; the buses analysed together to a fixed point). engine::InputError naming the field for an
 /// undetectable or unstabilizable design ("plant"), a plant file that does not load
 /// ("plant.file"), a bus loaded over 100 % ("buses[i]") or a bus message without a period.
 /// Approach kinds of study ncs get their design (I, S, A: LQR; AK, AKx, AKl, SK, IK: LQR and
@@ -28,6 +32,10 @@ nlohmann::json resolve_study(const engine::StudyFile& file);
 /// Adds to the resolution `r` of an ncs file what needs its scenarios: the S+ gain
 /// [L_x, L_u] and the mean delay τ_io it is designed on, per scenario.
 void add_ncs_designs(nlohmann::json& r, const NcsStudy& s);
+
+/// Sets s.bus_response_us from the resolution `r` of the same file: per scenario the
+/// worst-case response time of each leg on a bus (the scenario's own analysis where it has one).
+void attach_bus_bounds(NcsStudy& s, const nlohmann::json& r);
 
 /// The resolution as text, one fact per line.
 std::string describe_resolution(const nlohmann::json& r);

@@ -47,6 +47,7 @@ Checked check_file(const std::string& path) {
   c.resolution["runnable"] = c.ncs.has_value();
   if (c.ncs) {
     study::add_ncs_designs(c.resolution, *c.ncs);
+    study::attach_bus_bounds(*c.ncs, c.resolution);
     c.resolution["runs_with"] = "ncs";
   } else {
     c.resolution["refusal"] = c.refusal;

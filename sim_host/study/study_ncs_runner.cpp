@@ -105,8 +105,8 @@ NcsStudy map_ncs_study(const engine::StudyFile& file) {
         }
       }
     }
-    // Links: the loop's legs, point to point.
-    if (!file.buses.empty()) refuse("buses", "study ncs runs point-to-point links only (CAN buses are not run yet)");
+    // Links: the loop's legs, point to point or on a CAN bus.
+    std::string first_bus_link;  // field of the first leg on a bus ("" when none)
     for (std::size_t i = 0; i < file.links.size(); ++i) {
       const engine::LinkSpec& l = file.links[i];
       const std::string f = at("links", i);
@@ -115,7 +115,18 @@ NcsStudy map_ncs_study(const engine::StudyFile& file) {
       if (leg == nullptr) refuse(f + ".name", "study ncs has legs as, sc, ca only (the names of their random streams)");
       if (l.from != by_role.at(leg->from)) refuse(f + ".from", std::string("leg ") + leg->name + " leaves the " + leg->from);
       if (l.to != by_role.at(leg->to)) refuse(f + ".to", std::string("leg ") + leg->name + " reaches the " + leg->to);
+      if (!l.bus.empty()) {
+        if (l.name == "as") {
+          refuse(f + ".bus", "the leg as serves the actuation-synchronized approaches only, which do not run on a CAN bus");
+        }
+        if (first_bus_link.empty()) first_bus_link = f + ".bus";
+      }
       out.links.push_back(l.name);
+    }
+    for (std::size_t b = 0; b < file.buses.size(); ++b) {
+      bool used = false;
+      for (const engine::LinkSpec& l : file.links) used = used || l.bus == file.buses[b].config.name;
+      if (!used) refuse(at("buses", b), "no leg of the loop runs on it (its traffic would run on nothing)");
     }
     const auto has = [&](const char* nm) {
       for (const std::string& l : out.links)
@@ -139,6 +150,14 @@ NcsStudy map_ncs_study(const engine::StudyFile& file) {
       }
       for (ncs::Approach b : out.approaches)
         if (b == ap) refuse(f + ".kind", "'" + a.kind + "' twice");
+      if (!first_bus_link.empty() && ncs::actuation_synchronized(ap)) {
+        refuse(f + ".kind", a.kind + " is actuation-synchronized: its sensor reports on the request's arrival in a longer frame, "
+                            "which the bus analysis (" + first_bus_link + ": the sensor on its timer) does not cover");
+      }
+      if (!first_bus_link.empty() && ap == ncs::Approach::kSPlus) {
+        refuse(f + ".kind", "S+ designs on the legs' mean delays, which a leg on a CAN bus (" + first_bus_link +
+                                ") does not have before the run");
+      }
       out.approaches.push_back(ap);
     }
     // Scenarios: ncs Scenario fields, legs from the file with the scenario's overrides.
@@ -166,7 +185,21 @@ NcsStudy map_ncs_study(const engine::StudyFile& file) {
       sc.period_s = params.at("period_s");
       sc.noise_scale = params.at("noise_scale");
       sc.duration_s = s.duration_s.value_or(file.duration_s);
-      for (const std::string& l : out.links) sc.legs[l] = file.link_config(l, &s);
+      for (const engine::LinkSpec& l : file.links) {
+        if (l.bus.empty()) {
+          sc.legs[l.name] = file.link_config(l.name, &s);
+          continue;
+        }
+        ncs::BusLeg b;
+        for (const engine::BusSpec& bus : file.buses) {
+          if (bus.config.name != l.bus) continue;
+          b.bus = bus.config;
+          b.background = bus.background;
+          b.offsets = bus.offsets;
+        }
+        b.id = l.id;
+        sc.bus_legs[l.name] = b;
+      }
       // d of study ncs (every leg U[0.5, d] ms) has no meaning for the file's legs, and ncs::run
       // takes the legs instead: 0. study run leaves ncs table's by-d keys out and reports each
       // scenario's sc + ca delay bound (study_ncs_sweep.hpp).

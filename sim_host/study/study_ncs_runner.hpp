@@ -7,13 +7,17 @@
 /// legs "as" (actuator → sensor), "sc", "ca" and the plant of a plant file. A file maps onto
 /// it when it declares exactly that: the legs' delay, loss and order come from the file (and
 /// the scenarios' link overrides), the scenario parameters are ncs Scenario fields, the
-/// approach kinds are ncs approach names. Everything else the schema accepts (CAN buses,
-/// clock offsets, trigger rules other than periodic every sample, other addresses, inline
+/// approach kinds are ncs approach names. Legs sc and ca may run on a CAN bus (with the bus's
+/// background traffic) under the sampling loops (I, S, SK, IK): the actuation-synchronized
+/// approaches and S+ are refused then, as is the leg as on a bus. Everything else the schema
+/// accepts (clock offsets, trigger rules other than periodic every sample, other addresses, inline
 /// plants) is refused with the field and the reason.
 #pragma once
 
 #include <cstdint>
+#include <map>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -49,6 +53,9 @@ struct NcsStudy {
   std::vector<ncs::Approach> approaches;      ///< In file order (I first).
   std::vector<ncs::Scenario> scenarios;       ///< In file order, legs from the file.
   std::vector<std::string> links;             ///< Leg names the file declares ("as", "sc", "ca" in file order).
+  /// Per scenario (file order), per leg on a CAN bus: the worst-case response time of its
+  /// message from `study check`'s analysis in µs (nullopt: unbounded); attach_bus_bounds().
+  std::vector<std::map<std::string, std::optional<double>>> bus_response_us;
   std::uint64_t first_seed = 1;               ///< Seed of the first replication.
   std::size_t seeds = 0;                      ///< Replications.
 };

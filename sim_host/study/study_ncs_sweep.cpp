@@ -3,6 +3,8 @@
 #include "study_ncs_sweep.hpp"
 
 #include <array>
+#include <cmath>
+#include <cstdio>
 #include <optional>
 #include <utility>
 #include <vector>
@@ -73,6 +75,29 @@ nlohmann::json sc_ca_delay_bound_ms(const ncs::Scenario& x) {
   return static_cast<double>(ub->count()) * 1e-6;
 }
 
+/// The legs of `s` on a CAN bus (the same in every scenario: overrides cannot move a leg).
+std::vector<std::string> bus_links(const NcsStudy& s) {
+  std::vector<std::string> out;
+  if (s.scenarios.empty()) return out;
+  for (const std::string& l : s.links)
+    if (s.scenarios[0].bus_legs.count(l) != 0) out.push_back(l);
+  return out;
+}
+
+/// The delay metrics of `leg` in run `r`, in the order of kBusDelayMetrics (0 when the run
+/// sent nothing over the bus: I and IK keep their delay-free links).
+std::array<double, std::size(kBusDelayMetrics)> bus_delays(const ncs::RunResult& r, const std::string& leg) {
+  std::array<double, std::size(kBusDelayMetrics)> v{};
+  for (const auto& [nm, st] : r.bus_legs) {
+    if (nm != leg) continue;
+    v[0] = static_cast<double>(st.delivered);
+    v[1] = static_cast<double>(st.min_delay.count()) * 1e-3;
+    v[2] = static_cast<double>(st.max_delay.count()) * 1e-3;
+    v[3] = static_cast<double>(st.total_delay.count()) * 1e-3;
+  }
+  return v;
+}
+
 }  // namespace
 
 engine::SweepResults run_ncs_sweep(const NcsStudy& s, std::size_t seeds, unsigned threads, const engine::Shard& shard,
@@ -82,8 +107,20 @@ engine::SweepResults run_ncs_sweep(const NcsStudy& s, std::size_t seeds, unsigne
   spec.experiment = "run";
   for (ncs::Approach a : s.approaches) spec.approaches.emplace_back(ncs::name(a));
   nlohmann::json sc = nlohmann::json::array();
-  for (const ncs::Scenario& x : s.scenarios) {
+  const std::vector<std::string> on_bus = bus_links(s);
+  for (std::size_t i = 0; i < s.scenarios.size(); ++i) {
+    const ncs::Scenario& x = s.scenarios[i];
     spec.scenarios.push_back(x.name);
+    nlohmann::json bus_legs = nlohmann::json::object();
+    for (const auto& [nm, b] : x.bus_legs) {
+      nlohmann::json wcrt = nullptr;
+      if (i < s.bus_response_us.size()) {
+        const auto it = s.bus_response_us[i].find(nm);
+        if (it != s.bus_response_us[i].end() && it->second) wcrt = *it->second;
+      }
+      bus_legs[nm] = {{"bus", b.bus.name}, {"bit_rate", b.bus.bit_rate}, {"id", b.id},
+                      {"background_streams", b.background.size()}, {"worst_response_us", wcrt}};
+    }
     nlohmann::json legs = nlohmann::json::object();
     for (const auto& [nm, l] : x.legs) {
       legs[nm] = {{"delay", l.delay.describe()}, {"loss", l.loss.describe()}, {"order", l.fifo ? "fifo" : "any"}};
@@ -91,13 +128,17 @@ engine::SweepResults run_ncs_sweep(const NcsStudy& s, std::size_t seeds, unsigne
     sc.push_back({{"name", x.name}, {"amplitude_volts", x.amplitude_volts}, {"period_s", x.period_s},
                   {"max_delay_ms", x.max_delay_ms}, {"delay_bound_sc_ca_ms", sc_ca_delay_bound_ms(x)},
                   {"noise_scale", x.noise_scale}, {"duration_s", x.duration_s},
-                  {"s_plus_mean_tau_io_us", s.ctx->mean_tau_io_us(x)}, {"legs", legs}});
+                  {"s_plus_mean_tau_io_us", x.bus_legs.empty() ? nlohmann::json(s.ctx->mean_tau_io_us(x)) : nlohmann::json(nullptr)},
+                  {"legs", legs}});
+    if (!x.bus_legs.empty()) sc.back()["bus_legs"] = bus_legs;
   }
   spec.first_seed = s.first_seed;
   spec.seeds = seeds == 0 ? s.seeds : seeds;
   spec.metrics = {"cost", "late", "saturated", "faults"};
   for (const std::string& l : s.links)
     for (const char* c : kLinkCounters) spec.metrics.push_back(l + "." + c);
+  for (const std::string& l : on_bus)
+    for (const char* c : kBusDelayMetrics) spec.metrics.push_back(l + "." + c);
   spec.config = {{"study_file", s.source},
                  {"plant", s.ctx->plant().name},
                  {"plant_source", s.ctx->plant().source},
@@ -105,6 +146,7 @@ engine::SweepResults run_ncs_sweep(const NcsStudy& s, std::size_t seeds, unsigne
                  {"links", s.links},
                  {"compute_us", {s.ctx->timing().compute_min_us, s.ctx->timing().compute_max_us}},
                  {"scenarios", sc}};
+  if (!on_bus.empty()) spec.config["bus_links"] = on_bus;  // only then: the spec of files without stays as it was
   if (analytic) {  // only then, as ncs table: the spec stays as it was without
     spec.config["analytic"] = true;
     spec.metrics.insert(spec.metrics.end(), std::begin(ncs::kAnalyticMetrics), std::end(ncs::kAnalyticMetrics));
@@ -117,9 +159,10 @@ engine::SweepResults run_ncs_sweep(const NcsStudy& s, std::size_t seeds, unsigne
   }
   const NcsStudy* study = &s;
   const std::vector<std::vector<LinkCounterMap>>* counter_maps = &maps;
+  const std::vector<std::string>* bus = &on_bus;
   return engine::run_sweep(
       spec, shard, threads,
-      [study, counter_maps, analytic](std::size_t a, std::size_t k, std::uint64_t seed) {
+      [study, counter_maps, bus, analytic](std::size_t a, std::size_t k, std::uint64_t seed) {
         const ncs::Approach ap = study->approaches[a];
         const ncs::RunResult r = ncs::run(*study->ctx, ap, study->scenarios[k], seed, ncs::RunOptions{});
         std::vector<double> v{r.cost, static_cast<double>(r.late), static_cast<double>(r.saturated),
@@ -127,6 +170,10 @@ engine::SweepResults run_ncs_sweep(const NcsStudy& s, std::size_t seeds, unsigne
         for (std::size_t l = 0; l < study->links.size(); ++l) {
           const auto c = link_counts(r, (*counter_maps)[a][l], study->links[l]);
           v.insert(v.end(), c.begin(), c.end());
+        }
+        for (const std::string& l : *bus) {
+          const auto d = bus_delays(r, l);
+          v.insert(v.end(), d.begin(), d.end());
         }
         if (analytic) {  // ncs table --analytic's columns: the same run in analytic mode
           const auto x = ncs::analytic_metrics(*study->ctx, ap, study->scenarios[k], seed, ncs::RunOptions{});
@@ -136,6 +183,71 @@ engine::SweepResults run_ncs_sweep(const NcsStudy& s, std::size_t seeds, unsigne
       },
       "study run");
 }
+
+namespace {
+
+/// Adds "bus_delays" (per approach, per leg on a bus: observed delays over every run beside
+/// the analysis's worst-case response time) and its table to the markdown.
+void add_bus_delays(nlohmann::json& j, const engine::SweepResults& results) {
+  const engine::SweepSpec& spec = results.spec;
+  std::string md = "\n| approach | leg | messages | min delay (us) | mean delay (us) | max delay (us) | worst-case response (us) |\n"
+                   "|---|---|---:|---:|---:|---:|---:|\n";
+  for (std::size_t a = 0; a < spec.approaches.size(); ++a) {
+    for (const auto& l : spec.config.at("bus_links")) {
+      const std::string leg = l.get<std::string>();
+      const std::size_t mm = results.metric(leg + ".bus_messages");
+      const std::size_t mn = results.metric(leg + ".bus_delay_min_us");
+      const std::size_t mx = results.metric(leg + ".bus_delay_max_us");
+      const std::size_t ms = results.metric(leg + ".bus_delay_sum_us");
+      nlohmann::json e = nlohmann::json::object();
+      double n_all = 0, sum_all = 0, min_all = 0, max_all = 0;
+      nlohmann::json wcrt_all = 0.0;
+      for (std::size_t s = 0; s < spec.scenarios.size(); ++s) {
+        double n = 0, sum = 0, lo = 0, hi = 0;
+        for (std::size_t k = 0; k < spec.seeds; ++k) {
+          const double c = results.at(a, s, k, mm);
+          if (c <= 0) continue;
+          lo = n == 0 ? results.at(a, s, k, mn) : std::fmin(lo, results.at(a, s, k, mn));
+          hi = std::fmax(hi, results.at(a, s, k, mx));
+          n += c;
+          sum += results.at(a, s, k, ms);
+        }
+        const nlohmann::json& w = spec.config.at("scenarios")[s].at("bus_legs").at(leg).at("worst_response_us");
+        if (w.is_null() || wcrt_all.is_null()) {
+          wcrt_all = nullptr;
+        } else {
+          wcrt_all = std::fmax(wcrt_all.get<double>(), w.get<double>());
+        }
+        nlohmann::json x = {{"messages", n}, {"worst_response_us", w}};
+        x["min_us"] = n > 0 ? nlohmann::json(lo) : nlohmann::json(nullptr);
+        x["mean_us"] = n > 0 ? nlohmann::json(sum / n) : nlohmann::json(nullptr);
+        x["max_us"] = n > 0 ? nlohmann::json(hi) : nlohmann::json(nullptr);
+        e["per_scenario"][spec.scenarios[s]] = x;
+        if (n > 0) {
+          min_all = n_all == 0 ? lo : std::fmin(min_all, lo);
+          max_all = std::fmax(max_all, hi);
+          n_all += n;
+          sum_all += sum;
+        }
+      }
+      e["messages"] = n_all;
+      e["min_us"] = n_all > 0 ? nlohmann::json(min_all) : nlohmann::json(nullptr);
+      e["mean_us"] = n_all > 0 ? nlohmann::json(sum_all / n_all) : nlohmann::json(nullptr);
+      e["max_us"] = n_all > 0 ? nlohmann::json(max_all) : nlohmann::json(nullptr);
+      e["worst_response_us"] = wcrt_all;
+      e["within_bound"] = n_all == 0 || (!wcrt_all.is_null() && max_all <= wcrt_all.get<double>());
+      j["bus_delays"][spec.approaches[a]][leg] = e;
+      if (n_all == 0) continue;  // I and IK: delay-free links, nothing on the bus
+      char row[256];
+      std::snprintf(row, sizeof row, "| %s | %s | %.0f | %.3f | %.3f | %.3f | %s |\n", spec.approaches[a].c_str(), leg.c_str(), n_all,
+                    min_all, sum_all / n_all, max_all, wcrt_all.is_null() ? "unbounded" : wcrt_all.dump().c_str());
+      md += row;
+    }
+  }
+  j["markdown"] = j.at("markdown").get<std::string>() + md;
+}
+
+}  // namespace
 
 nlohmann::json run_outputs(const engine::SweepResults& results, const std::string& out_dir, bool plots) {
   nlohmann::json j = ncs::table_outputs(results, out_dir, plots);
@@ -160,6 +272,7 @@ nlohmann::json run_outputs(const engine::SweepResults& results, const std::strin
       j["links"][spec.approaches[a]][link] = e;
     }
   }
+  if (spec.config.contains("bus_links")) add_bus_delays(j, results);
   return j;
 }
 

@@ -19,6 +19,11 @@ namespace oneshot::study {
 /// Names of the per-link counters, each a metric "<link>.<counter>" of the sweep.
 inline constexpr const char* kLinkCounters[] = {"sent", "delivered", "lost", "late", "refused"};
 
+/// Names of the delay metrics of a leg on a CAN bus, each a metric "<link>.<name>" of the
+/// sweep: messages delivered over the bus, the smallest, largest and summed delay (µs, from
+/// queued to the end of the message's last frame: queueing + transmission).
+inline constexpr const char* kBusDelayMetrics[] = {"bus_messages", "bus_delay_min_us", "bus_delay_max_us", "bus_delay_sum_us"};
+
 /// Position of the counter `name` in kLinkCounters (its size when there is none).
 constexpr std::size_t link_counter_index(std::string_view name) {
   std::size_t i = 0;
@@ -47,7 +52,11 @@ engine::SweepResults run_ncs_sweep(const NcsStudy& s, std::size_t seeds, unsigne
 /// (refused by the receiver's frame checks) over every run; "delay_bound_sc_ca_ms": per
 /// scenario the upper bound of the sc + ca delays (null when a leg is unbounded). ncs table's
 /// S_ratio_to_I_by_delay_ms and S_ratio_increases_with_delay are left out: they are keyed by
-/// study ncs's d (every leg U[0.5, d] ms), which a file's legs do not have.
+/// study ncs's d (every leg U[0.5, d] ms), which a file's legs do not have. With legs on a
+/// CAN bus, "bus_delays": per approach and leg the messages, min_us, mean_us, max_us of the
+/// observed delays (queueing + transmission) over every run, the check's worst_response_us
+/// (the largest over the scenarios; null when unbounded), within_bound, and per_scenario the
+/// same; their table is appended to "markdown".
 nlohmann::json run_outputs(const engine::SweepResults& results, const std::string& out_dir, bool plots);
 
 }  // namespace oneshot::study

@@ -203,7 +203,7 @@ void check_study_check(const e::StudyFile& s) {
   try {
     const oneshot::study::NcsStudy n = oneshot::study::map_ncs_study(s);
     require(n.scenarios.size() == s.scenarios.size() && n.approaches.size() == s.approaches.size(), "ncs mapping: sizes");
-    for (const auto& sc : n.scenarios) require(sc.legs.size() == n.links.size(), "ncs mapping: legs");
+    for (const auto& sc : n.scenarios) require(sc.legs.size() + sc.bus_legs.size() == n.links.size(), "ncs mapping: legs");
   } catch (const e::InputError& x) {
     require_named(x, "ncs mapping");
   }

@@ -30,8 +30,17 @@ std::vector<CanStreamBound> can_response_times(const std::vector<CanStream>& str
     max_period = std::max(max_period, s.period.count());
   }
   const std::int64_t limit = 10'000 * max_period;
+  // Per stream: its whole message c, its last frame f, its longest single frame np (what it blocks for).
   std::vector<std::int64_t> c(streams.size());
-  for (std::size_t i = 0; i < streams.size(); ++i) c[i] = tau * can_frame_bits(streams[i].payload_bytes, config.extended_ids);
+  std::vector<std::int64_t> f(streams.size());
+  std::vector<std::int64_t> np(streams.size());
+  const std::int64_t full = tau * can_frame_bits(8, config.extended_ids);
+  for (std::size_t i = 0; i < streams.size(); ++i) {
+    f[i] = tau * can_frame_bits(streams[i].payload_bytes, config.extended_ids);
+    const auto lead = static_cast<std::int64_t>(streams[i].leading_frames);
+    c[i] = lead * full + f[i];
+    np[i] = lead > 0 ? std::max(full, f[i]) : f[i];
+  }
 
   std::vector<CanStreamBound> out(streams.size());
   for (std::size_t m = 0; m < streams.size(); ++m) {
@@ -40,7 +49,7 @@ std::vector<CanStreamBound> can_response_times(const std::vector<CanStream>& str
     r.transmission = Duration{c[m]};
     std::int64_t b = 0;  // B_m = max over lower-priority frames
     for (std::size_t k = 0; k < streams.size(); ++k)
-      if (streams[k].id > sm.id) b = std::max(b, c[k]);
+      if (streams[k].id > sm.id) b = std::max(b, np[k]);
     r.blocking = Duration{b};
     const auto higher = [&](std::size_t k) { return streams[k].id < sm.id; };
     // Level-m busy period: t = B + Σ_{hep} ⌈(t + J_k)/T_k⌉ C_k, from t = C_m.
@@ -65,8 +74,8 @@ std::vector<CanStreamBound> can_response_times(const std::vector<CanStream>& str
     r.instances = static_cast<std::size_t>(ceil_div(t + sm.jitter.count(), sm.period.count()));
     std::int64_t worst = 0;
     for (std::size_t q = 0; q < r.instances; ++q) {
-      // Queuing delay of instance q: w = B + q C_m + Σ_{hp} ⌈(w + J_k + τ)/T_k⌉ C_k.
-      const std::int64_t base = b + static_cast<std::int64_t>(q) * c[m];
+      // Queuing delay of instance q's last frame: w = B + q C_m + (C_m − F_m) + Σ_{hp} ⌈(w + J_k + τ)/T_k⌉ C_k.
+      const std::int64_t base = b + static_cast<std::int64_t>(q) * c[m] + (c[m] - f[m]);
       std::int64_t w = base;
       for (;;) {
         std::int64_t next = base;
@@ -78,7 +87,7 @@ std::vector<CanStreamBound> can_response_times(const std::vector<CanStream>& str
         }
         w = next;
       }
-      const std::int64_t rq = sm.jitter.count() + w - static_cast<std::int64_t>(q) * sm.period.count() + c[m];
+      const std::int64_t rq = sm.jitter.count() + w - static_cast<std::int64_t>(q) * sm.period.count() + f[m];
       if (q == 0) r.response_original = Duration{rq};
       worst = std::max(worst, rq);
     }

@@ -2,6 +2,7 @@
 /// @brief The simulated network (see network.hpp).
 #include "oneshot/engine/network.hpp"
 
+#include <algorithm>
 #include <stdexcept>
 
 namespace oneshot::engine {
@@ -9,6 +10,7 @@ namespace oneshot::engine {
 Network::Network(Kernel& kernel) : kernel_(kernel) {
   deliver_id_ = kernel_.add_handler("network delivery", [this](std::uint64_t slot) { deliver(slot); });
   fragment_id_ = kernel_.add_handler("network fragment", [](std::uint64_t) {});
+  bus_deliver_id_ = kernel_.add_handler("network bus delivery", [this](std::uint64_t slot) { deliver_from_bus(slot); });
 }
 
 NodePort& Network::add_node(std::uint8_t address, const std::string& name, Duration clock_offset,
@@ -75,7 +77,16 @@ void Network::route(std::uint8_t source, std::uint8_t destination, Link& link) {
 }
 
 void Network::route(std::uint8_t source, std::uint8_t destination, CanBus& bus, std::uint32_t id) {
-  routes_[{source, destination}] = Route{nullptr, nullptr, &bus, id};
+  bus_stats_.emplace_back();
+  routes_[{source, destination}] = Route{nullptr, nullptr, &bus, id, bus_stats_.size() - 1};
+}
+
+const BusRouteStatistics& Network::bus_route_statistics(std::uint8_t source, std::uint8_t destination) const {
+  const auto it = routes_.find({source, destination});
+  if (it == routes_.end() || it->second.bus == nullptr) {
+    throw std::invalid_argument("network: no CAN route from " + std::to_string(source) + " to " + std::to_string(destination));
+  }
+  return bus_stats_[it->second.bus_stats];
 }
 
 NodePort& Network::node(std::uint8_t address) {
@@ -93,6 +104,7 @@ McuInstant Network::node_clock(std::uint8_t address) const {
 std::uint64_t Network::park(host::Frame frame) {
   if (free_slots_.empty()) {
     in_flight_.push_back(std::move(frame));
+    slot_bus_.resize(in_flight_.size());
     return in_flight_.size() - 1;
   }
   const std::uint64_t slot = free_slots_.back();
@@ -136,9 +148,23 @@ void Network::run_node(std::uint8_t address, const std::function<void()>& f) {
         r.bus->queue(r.id, 8, fragment_id_, 0);
         left -= 8;
       }
-      r.bus->queue(r.id, left, deliver_id_, park(std::move(frame)));
+      const std::uint64_t slot = park(std::move(frame));
+      slot_bus_[slot] = {r.bus_stats, kernel_.now()};
+      ++bus_stats_[r.bus_stats].sent;
+      r.bus->queue(r.id, left, bus_deliver_id_, slot);
     }
   }
+}
+
+void Network::deliver_from_bus(std::uint64_t slot) {
+  const auto [route, queued] = slot_bus_[slot];
+  BusRouteStatistics& st = bus_stats_[route];
+  const Duration d = kernel_.now() - queued;
+  st.min_delay = st.delivered == 0 ? d : std::min(st.min_delay, d);
+  st.max_delay = std::max(st.max_delay, d);
+  st.total_delay += d;
+  ++st.delivered;
+  deliver(slot);
 }
 
 void Network::deliver(std::uint64_t slot) {

@@ -273,7 +273,7 @@ TEST(StudyFiles, WhatTheLoopCannotRunIsRefusedNamingTheField) {
       [](nlohmann::json& j) {
         j["buses"] = nlohmann::json::parse(R"([{"name": "can0", "bit_rate": 500000}])");
       },
-      "field 'buses'");
+      "field 'buses[0]'");  // a bus no leg runs on
   const auto drop_as_overrides = [](nlohmann::json& j) {
     for (auto& sc : j["scenarios"])
       if (sc.contains("links")) sc["links"].erase("as");

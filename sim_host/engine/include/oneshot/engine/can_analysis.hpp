@@ -15,7 +15,15 @@
 /// The original analysis (Tindell et al. 1994) examined q = 0 only; the paper shows that it
 /// is optimistic when an instance's own previous frame pushes into its busy period, and
 /// the busy-period check over all Q_m instances fixes it. Both are given here, the
-/// original for comparison. All arithmetic is in integer ns; a fixed-point iteration that
+/// original for comparison. A message longer than 8 bytes (network.hpp segments it into
+/// frames of ≤ 8 bytes queued back to back with its identifier) is a stream with
+/// `leading_frames` 8-byte frames before its last frame: C_m is the whole message, a higher-
+/// priority frame may win the arbitration at each frame boundary, so (fixed preemption
+/// points, the last frame F_m non-preemptive)
+///     w_m(q) = B_m + q C_m + (C_m − F_m) + Σ_{k ∈ hp(m)} ⌈(w_m(q) + J_k + τ_bit)/T_k⌉ C_k
+///     R_m(q) = J_m + w_m(q) − q T_m + F_m,
+/// and it blocks higher-priority streams for one frame only (B: the longest single frame of
+/// lp(m)). With leading_frames 0 this is the analysis above. All arithmetic is in integer ns; a fixed-point iteration that
 /// passes 10^4 · max T (hep utilization ≥ 1) reports the stream as unbounded.
 #pragma once
 
@@ -37,11 +45,12 @@ struct CanStream {
   Duration period{0};           ///< T.
   Duration jitter{0};           ///< J: queuing jitter (release to queue).
   Duration deadline{0};         ///< D (from release).
+  std::size_t leading_frames = 0;  ///< 8-byte frames of the same message queued before its last one (payload_bytes).
 };
 
 /// The analysis of one stream.
 struct CanStreamBound {
-  Duration transmission{0};     ///< C.
+  Duration transmission{0};     ///< C (the whole message: every frame).
   Duration blocking{0};         ///< B.
   Duration busy_period{0};      ///< t (revised analysis).
   std::size_t instances = 0;    ///< Q.

@@ -39,6 +39,17 @@ struct NodePort {
   std::function<void()> on_receive;     ///< Called (inside run_node) after each arrival.
 };
 
+/// What a route over a CAN bus carried: messages queued and, per delivered message, its
+/// delay from the instant it was queued to the end of its last frame (queueing +
+/// transmission of every frame).
+struct BusRouteStatistics {
+  std::uint64_t sent = 0;       ///< Messages queued.
+  std::uint64_t delivered = 0;  ///< Messages whose last frame ended.
+  Duration min_delay{0};        ///< Smallest delay of a delivered message (0 when none).
+  Duration max_delay{0};        ///< Largest.
+  Duration total_delay{0};      ///< Sum over the delivered messages.
+};
+
 /// Nodes, links, buses and routes of one run.
 class Network {
  public:
@@ -58,6 +69,10 @@ class Network {
   void route(std::uint8_t source, std::uint8_t destination, Link& link);
   /// Frames from `source` to `destination` are queued on `bus` with identifier `id`.
   void route(std::uint8_t source, std::uint8_t destination, CanBus& bus, std::uint32_t id);
+
+  /// The statistics of the CAN route from `source` to `destination` (std::invalid_argument
+  /// when there is no route over a bus between them).
+  const BusRouteStatistics& bus_route_statistics(std::uint8_t source, std::uint8_t destination) const;
 
   /// Runs `f` as node `address` (its interface current), then routes what it sent.
   void run_node(std::uint8_t address, const std::function<void()>& f);
@@ -86,8 +101,10 @@ class Network {
     LinkFaults* faults = nullptr;
     CanBus* bus = nullptr;
     std::uint32_t id = 0;
+    std::size_t bus_stats = 0;  ///< Index in bus_stats_ (bus routes).
   };
   void deliver(std::uint64_t slot);
+  void deliver_from_bus(std::uint64_t slot);
   std::uint64_t park(host::Frame frame);
 
   Kernel& kernel_;
@@ -100,7 +117,10 @@ class Network {
   std::map<std::pair<std::uint8_t, std::uint8_t>, Route> routes_;
   std::vector<host::Frame> in_flight_;
   std::vector<std::uint64_t> free_slots_;
+  std::vector<std::pair<std::size_t, SimTime>> slot_bus_;  ///< Beside in_flight_: bus route, queued at.
+  std::vector<BusRouteStatistics> bus_stats_;
   HandlerId deliver_id_ = 0;
+  HandlerId bus_deliver_id_ = 0;
   HandlerId fragment_id_ = 0;
   std::uint64_t frames_sent_ = 0;
 };

@@ -1,0 +1,193 @@
+/// @file study_can_test.cpp
+/// @brief `study run` with the loop's legs on a CAN bus (sim_host/study/examples/ncs_can.json):
+///        without background traffic every message's delay is its transmission time (closed
+///        form), with it every delay is within the check's worst-case response time and the
+///        mean grows with the background load, the same bytes on 1 and 2 threads and from
+///        merged shards, and bad bus references refused naming the field.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <functional>
+#include <sstream>
+
+#include "oneshot/engine/study_file.hpp"
+#include "study_check.hpp"
+#include "study_ncs_runner.hpp"
+#include "study_ncs_sweep.hpp"
+#include "support/temp_files.hpp"
+
+namespace oneshot::study {
+namespace {
+
+std::string can_path() { return std::string(ONESHOT_STUDY_EXAMPLES_DIR) + "/ncs_can.json"; }
+
+nlohmann::json can_json() {
+  std::ifstream in(can_path());
+  std::stringstream s;
+  s << in.rdbuf();
+  return nlohmann::json::parse(s.str());
+}
+
+engine::StudyFile parse(const nlohmann::json& j) {
+  return engine::parse_study(j.dump(), can_path(), &ncs_schema(), ONESHOT_STUDY_EXAMPLES_DIR);
+}
+
+/// The file after `edit`, mapped onto the loop with the check's bounds, every scenario
+/// `duration_s` long.
+NcsStudy can_study(const std::function<void(nlohmann::json&)>& edit, double duration_s) {
+  nlohmann::json j = can_json();
+  edit(j);
+  const engine::StudyFile f = parse(j);
+  NcsStudy s = map_ncs_study(f);
+  for (ncs::Scenario& x : s.scenarios) x.duration_s = duration_s;
+  attach_bus_bounds(s, resolve_study(f));
+  return s;
+}
+
+std::string temp_dir(const char* name) { return test::fresh_dir("oneshot_study_can_test", name); }
+
+/// Bits of a standard CAN data frame with s payload bytes under worst-case stuffing (Davis et
+/// al. 2007, eq. 1): 34 + 8s stuffable bits, ⌊(34 + 8s − 1)/4⌋ stuff bits, 13 unstuffed.
+std::int64_t stuffed_bits(std::int64_t s) { return 34 + 8 * s + 13 + (34 + 8 * s - 1) / 4; }
+
+/// Transmission of a message of `bytes` in frames of ≤ 8 bytes at `bit_rate` (µs).
+double message_us(std::int64_t bytes, std::int64_t bit_rate) {
+  std::int64_t bits = 0;
+  for (std::int64_t left = bytes; left > 0; left -= 8) bits += stuffed_bits(left > 8 ? 8 : left);
+  return static_cast<double>(bits) * 1e6 / static_cast<double>(bit_rate);
+}
+
+TEST(StudyCan, WithoutBackgroundEveryDelayIsTheTransmissionTime) {
+  const NcsStudy s = can_study([](nlohmann::json& j) { j["buses"][0].erase("background"); }, 4);
+  const nlohmann::json j = run_outputs(run_ncs_sweep(s, 3, 2, engine::Shard{}), temp_dir("quiet"), false);
+  // The loop's messages: header (sequence, stamp: 8 bytes) + p = 2 doubles (sc), + m = 1 double (ca).
+  const double sc_us = message_us(8 + 2 * 8, 125'000);
+  const double ca_us = message_us(8 + 1 * 8, 125'000);
+  EXPECT_EQ(sc_us, 3 * 135 * 8.0);  // three 8-byte frames of 135 bits, 8 us each
+  for (const char* a : {"S", "SK"}) {
+    for (const auto& [leg, c] : {std::pair<const char*, double>{"sc", sc_us}, {"ca", ca_us}}) {
+      const nlohmann::json& e = j.at("bus_delays").at(a).at(leg);
+      EXPECT_EQ(e.at("messages").get<double>(), 3 * 2 * 80) << a << " " << leg;  // 3 seeds x 2 scenarios x 4 s / 50 ms
+      EXPECT_EQ(e.at("min_us").get<double>(), c) << a << " " << leg;
+      EXPECT_EQ(e.at("max_us").get<double>(), c) << a << " " << leg;
+      EXPECT_TRUE(e.at("within_bound").get<bool>());
+    }
+  }
+  // I and IK keep their delay-free links: nothing on the bus.
+  EXPECT_EQ(j.at("bus_delays").at("I").at("sc").at("messages").get<double>(), 0);
+  EXPECT_TRUE(j.at("bus_delays").at("I").at("sc").at("max_us").is_null());
+}
+
+TEST(StudyCan, CheckAnalysesTheLoopMessagesInFramesWithTheirChainedJitter) {
+  nlohmann::json j = can_json();
+  j["buses"][0].erase("background");
+  const nlohmann::json r = resolve_study(parse(j));
+  const nlohmann::json& m = r.at("buses")[0].at("messages");
+  ASSERT_EQ(m.size(), 2U);
+  const nlohmann::json& sc = m[0];
+  const nlohmann::json& ca = m[1];
+  ASSERT_EQ(sc.at("name"), "sc");
+  // 125 kbit/s: 8 us a bit, an 8-byte frame 135 bits = 1080 us. sc: 24 bytes, 3 frames,
+  // C = 3240 us; ca: 16 bytes, 2 frames, C = 2160 us, and the higher priority (id 240 < 256).
+  EXPECT_EQ(sc.at("frames"), 3);
+  EXPECT_EQ(sc.at("transmission_us").get<double>(), 3240);
+  EXPECT_EQ(ca.at("transmission_us").get<double>(), 2160);
+  // sc (timer, J = 0, nothing below it: B = 0): its first two frames, one ca message between
+  // frames, its last frame: R = (3240 − 1080) + 2160 + 1080 = 5400 us.
+  EXPECT_EQ(sc.at("jitter_us").get<double>(), 0);
+  EXPECT_EQ(sc.at("worst_response_us").get<double>(), 5400);
+  // ca is sent τ_c ∈ [1, 5] ms after sc arrives, sc's delay in [C, R] = [3240, 5400] us:
+  // J = (5400 + 5000) − (3240 + 1000) = 6160 us. Blocked by one sc frame (1080 us), then its
+  // first frame and its last: R = J + 1080 + 1080 + 1080 = 9400 us.
+  EXPECT_EQ(ca.at("jitter_us").get<double>(), 6160);
+  EXPECT_EQ(ca.at("worst_response_us").get<double>(), 9400);
+}
+
+/// Mean delay of leg `leg` under S with the background periods multiplied by `scale`, after
+/// checking every observed delay against the analysis (`seeds` seeds, 4 s per scenario).
+double mean_delay_checked(double scale, const char* leg, std::size_t seeds) {
+  const NcsStudy s = can_study(
+      [scale](nlohmann::json& j) {
+        for (auto& b : j["buses"][0]["background"]) b["period_us"] = std::llround(b["period_us"].get<double>() * scale);
+      },
+      4);
+  const nlohmann::json j = run_outputs(run_ncs_sweep(s, seeds, 2, engine::Shard{}), temp_dir("load"), false);
+  for (const char* a : {"S", "SK"}) {
+    for (const char* l : {"sc", "ca"}) {
+      const nlohmann::json& e = j.at("bus_delays").at(a).at(l);
+      EXPECT_FALSE(e.at("worst_response_us").is_null()) << a << " " << l;
+      EXPECT_LE(e.at("max_us").get<double>(), e.at("worst_response_us").get<double>()) << a << " " << l << " scale " << scale;
+      EXPECT_TRUE(e.at("within_bound").get<bool>());
+      for (const auto& [sc, x] : e.at("per_scenario").items()) {
+        EXPECT_LE(x.at("max_us").get<double>(), x.at("worst_response_us").get<double>()) << a << " " << l << " " << sc;
+      }
+    }
+  }
+  const nlohmann::json& e = j.at("bus_delays").at("S").at(leg);
+  std::printf("background periods x%.2f: S %s delay min %.1f mean %.1f max %.1f us, worst-case response %.1f us\n", scale, leg,
+              e.at("min_us").get<double>(), e.at("mean_us").get<double>(), e.at("max_us").get<double>(),
+              e.at("worst_response_us").get<double>());
+  return e.at("mean_us").get<double>();
+}
+
+TEST(StudyCan, WithBackgroundDelaysStayWithinTheBoundAndTheMeanGrowsWithTheLoad) {
+  for (const char* leg : {"sc", "ca"}) {
+    const double light = mean_delay_checked(4, leg, 100);
+    const double file = mean_delay_checked(1, leg, 100);
+    const double heavy = mean_delay_checked(0.5, leg, 100);
+    EXPECT_LT(light, file) << leg;
+    EXPECT_LT(file, heavy) << leg;
+  }
+}
+
+TEST(StudyCan, SameBytesOnOneAndTwoThreadsAndFromMergedShards) {
+  const NcsStudy s = can_study([](nlohmann::json&) {}, 2.5);
+  const std::string one = run_outputs(run_ncs_sweep(s, 4, 1, engine::Shard{}), temp_dir("one"), false).dump();
+  const std::string two = run_outputs(run_ncs_sweep(s, 4, 2, engine::Shard{}), temp_dir("two"), false).dump();
+  EXPECT_EQ(one, two);
+  std::vector<engine::SweepResults> parts;
+  for (std::size_t i = 0; i < 3; ++i) {
+    const engine::SweepResults p = run_ncs_sweep(s, 4, 1, engine::Shard{i, 3});
+    parts.push_back(engine::shard_from_json(nlohmann::json::parse(engine::shard_to_json(p).dump())));
+  }
+  EXPECT_EQ(run_outputs(engine::merge_shards(parts), temp_dir("merged"), false).dump(), two);
+  EXPECT_TRUE(nlohmann::json::parse(two).contains("bus_delays"));
+}
+
+/// Mapping the edited file is refused, the message containing `expect`.
+void expect_refused(const std::function<void(nlohmann::json&)>& edit, const std::string& expect) {
+  nlohmann::json j = can_json();
+  edit(j);
+  try {
+    static_cast<void>(map_ncs_study(parse(j)));
+    ADD_FAILURE() << "accepted, expected " << expect;
+  } catch (const engine::InputError& e) {
+    EXPECT_NE(std::string(e.what()).find(expect), std::string::npos) << e.what();
+  }
+}
+
+TEST(StudyCan, BadBusReferencesAreRefusedNamingTheField) {
+  expect_refused([](nlohmann::json& j) { j["links"][0]["bus"] = "can1"; }, "field 'links[0].bus'");  // no such bus
+  expect_refused([](nlohmann::json& j) { j["links"][1]["id"] = 80; }, "field 'links[1].id'");  // the background's
+  expect_refused([](nlohmann::json& j) { j["links"][0]["id"] = 4096; }, "field 'links[0].id'");  // beyond 11 bits
+  // A bus leg takes its delay from the bus: delay, loss and order are not its keys (schema).
+  expect_refused([](nlohmann::json& j) { j["links"][0]["delay"] = {{"model", "constant"}, {"delay_us", 100}}; }, "links[0]");
+  expect_refused([](nlohmann::json& j) { j["links"][1]["loss"] = {{"model", "bernoulli"}, {"p", 0.1}}; }, "links[1]");
+  expect_refused([](nlohmann::json& j) { j["scenarios"][0]["links"] = {{"sc", {{"delay", {{"model", "constant"}, {"delay_us", 1}}}}}}; },
+                 "scenarios[0].links");
+  // What the run cannot do on a bus.
+  expect_refused([](nlohmann::json& j) { j["approaches"].push_back({{"name", "A"}, {"kind", "A"}}); }, "field 'approaches[4].kind'");
+  expect_refused([](nlohmann::json& j) { j["approaches"].push_back({{"name", "S+"}, {"kind", "S+"}}); }, "field 'approaches[4].kind'");
+  expect_refused(
+      [](nlohmann::json& j) {
+        j["links"].push_back({{"name", "as"}, {"from", "actuator"}, {"to", "sensor"}, {"bus", "can0"}, {"id", 300}});
+      },
+      "field 'links[2].bus'");
+  expect_refused(
+      [](nlohmann::json& j) { j["buses"].push_back({{"name", "spare"}, {"bit_rate", 250000}}); }, "field 'buses[1]'");  // unused
+}
+
+}  // namespace
+}  // namespace oneshot::study
