@@ -179,8 +179,8 @@ TEST(StudyReport, MaxDurationCutsEveryScenario) {
   const test::CommandResult r = test::run_command(
       {ONESHOT_SIM_PATH, "study", "run", kExample, "--seeds", "2", "--max-duration", "2.5", "--no-plots", "--out", out, "--json", out + "/run.json"});
   ASSERT_EQ(r.exit_code, 0) << r.output;
-  const nlohmann::json capped = read_json(out + "/run.json");  // kept alive: the loop reads inside it
-  for (const auto& x : capped.at("scenarios")) EXPECT_EQ(x.at("duration_s").get<double>(), 2.5);
+  const nlohmann::json capped_run = read_json(out + "/run.json");  // kept alive: the loop reads inside it
+  for (const auto& x : capped_run.at("scenarios")) EXPECT_EQ(x.at("duration_s").get<double>(), 2.5);
   // The report says its runs were cut; an explicit 0 is a cap below one period, refused.
   const std::string rep = test::fresh_dir("oneshot_study_report", "capped_report");
   const test::CommandResult rr = test::run_command(
