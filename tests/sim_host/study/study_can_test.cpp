@@ -8,9 +8,7 @@
 
 #include <cmath>
 #include <cstdio>
-#include <fstream>
 #include <functional>
-#include <sstream>
 
 #include "oneshot/engine/study_file.hpp"
 #include "study_check.hpp"
@@ -23,12 +21,7 @@ namespace {
 
 std::string can_path() { return std::string(ONESHOT_STUDY_EXAMPLES_DIR) + "/ncs_can.json"; }
 
-nlohmann::json can_json() {
-  std::ifstream in(can_path());
-  std::stringstream s;
-  s << in.rdbuf();
-  return nlohmann::json::parse(s.str());
-}
+nlohmann::json can_json() { return nlohmann::json::parse(test::read_file(can_path())); }
 
 engine::StudyFile parse(const nlohmann::json& j) {
   return engine::parse_study(j.dump(), can_path(), &ncs_schema(), ONESHOT_STUDY_EXAMPLES_DIR);

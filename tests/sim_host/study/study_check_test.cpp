@@ -22,12 +22,7 @@
 namespace oneshot::study {
 namespace {
 
-nlohmann::json read_json(const std::string& path) {
-  std::ifstream in(path);
-  std::stringstream s;
-  s << in.rdbuf();
-  return nlohmann::json::parse(s.str());
-}
+nlohmann::json read_json(const std::string& path) { return nlohmann::json::parse(test::read_file(path)); }
 
 engine::StudyFile parse(const nlohmann::json& j, const std::string& like) {
   return engine::parse_study(j.dump(), like, nullptr, std::filesystem::path(like).parent_path().string());

@@ -8,9 +8,7 @@
 
 #include <cmath>
 #include <filesystem>
-#include <fstream>
 #include <functional>
-#include <sstream>
 
 #include "ncs_experiments.hpp"
 #include "oneshot/engine/study_file.hpp"
@@ -23,12 +21,7 @@ namespace {
 
 std::string example_path() { return std::string(ONESHOT_STUDY_EXAMPLES_DIR) + "/ncs.json"; }
 
-nlohmann::json example_json() {
-  std::ifstream in(example_path());
-  std::stringstream s;
-  s << in.rdbuf();
-  return nlohmann::json::parse(s.str());
-}
+nlohmann::json example_json() { return nlohmann::json::parse(test::read_file(example_path())); }
 
 /// The file's text after `edit`, parsed with the ncs schema as if it sat beside the example.
 engine::StudyFile parse_edited(const std::function<void(nlohmann::json&)>& edit) {
