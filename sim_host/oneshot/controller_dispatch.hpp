@@ -1,7 +1,7 @@
 /// @file controller_dispatch.hpp
 /// @brief The controller parts of a run (design, estimator, model) for the compiled-in plant or
 ///        a run-time plant in one number format: the dispatch the core runs of study 000 share
-///        (simulation.cpp, simulation_runtime_*.cpp, job_replay.cpp). Split by plant and format
+///        (simulation.cpp, simulation_runtime_*.cpp). Split by plant and format
 ///        so each source instantiates a part of the dimension x format x estimator product.
 #pragma once
 
@@ -85,15 +85,6 @@ decltype(auto) dispatch_plant(const SimContext& ctx, const RunOptions& opt, G&& 
   require_runtime_format(ctx, opt);
   if (opt.format == NumberFormat::kFloat) return on_float();
   return on_double();
-}
-
-/// Every plant and format: the compiled-in plant's constants or the run-time plant's design.
-template <typename F>
-decltype(auto) with_controller_parts(const SimContext& ctx, const RunOptions& opt, F&& f) {
-  return dispatch_plant(
-      ctx, opt, [&]() -> decltype(auto) { return with_generated_parts(opt, f); },
-      [&]() -> decltype(auto) { return with_runtime_parts<float>(ctx, opt, f); },
-      [&]() -> decltype(auto) { return with_runtime_parts<double>(ctx, opt, f); });
 }
 
 }  // namespace oneshot::sim

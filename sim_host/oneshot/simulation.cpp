@@ -225,4 +225,12 @@ RunResult simulate(const SimContext& ctx, const Scenario& scenario, std::uint64_
       [&] { return simulate_runtime<double>(ctx, scenario, seed, options); });
 }
 
+void with_job_replay(const SimContext& ctx, const RunOptions& options, const std::vector<JobRecord>& jobs,
+                     const std::function<void(const std::function<void()>&)>& use) {
+  // Run-time plants: with their runs, one source per format (simulation_runtime_*.cpp).
+  dispatch_plant(
+      ctx, options, [&] { with_generated_parts(options, CoreJobReplay{jobs, use}); },
+      [&] { replay_runtime<float>(ctx, options, jobs, use); }, [&] { replay_runtime<double>(ctx, options, jobs, use); });
+}
+
 }  // namespace oneshot::sim
