@@ -314,8 +314,11 @@ TEST(NcsLive, NanAndForgedSequenceFramesAreRefusedAndTheLoopGoesOn) {
   EXPECT_EQ(injected.at("forge_seq").get<double>(), 2);
   EXPECT_EQ(c.at("sensor.refused_sequence").get<double>() + c.at("controller.refused_sequence").get<double>(), 2);
   EXPECT_EQ(c.at("controller.estimator_resets").get<double>(), 0);
-  // Commands go on: at most the refused frames' periods (and the timing's) held.
-  EXPECT_LT(j.at("late_commands").get<double>(), 0.25 * j.at("actuation_instants_expected").get<double>());
+  // Commands go on. A loop stopped by the forged k at 0.5 s holds every command after it:
+  // ≥ 74 % of the 2 s run late. A working one loses a period's command to a NaN on one of
+  // three links (1 − 0.95³ ≈ 14 %) plus what the live timing makes late on a loaded machine
+  // (10 of 39 measured under ASan with two builds running): asserted below half.
+  EXPECT_LT(j.at("late_commands").get<double>(), 0.5 * j.at("actuation_instants_expected").get<double>());
   EXPECT_NEAR(j.at("replay_over_live").get<double>(), 1.0, 1e-12);
   std::filesystem::remove_all(o.out_dir);
 }
