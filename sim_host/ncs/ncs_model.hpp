@@ -56,6 +56,8 @@ struct BusLeg {
   std::vector<engine::Duration> offsets;    ///< First release of each background stream.
 };
 
+struct ControllerCpu;  // ncs_cpu.hpp
+
 /// One scenario (brief §3): square wave ±A_r of period T_r, network legs U[0.5, d] ms,
 /// noise scale s.
 struct Scenario {
@@ -73,6 +75,10 @@ struct Scenario {
   /// Legs on a CAN bus (study files), by name: not in `legs`. The delay-free loops (I, IK)
   /// keep their delay-free links.
   std::map<std::string, BusLeg> bus_legs;
+  /// The controller's computation as a job on a modeled CPU (study files' `cpus`,
+  /// ncs_cpu.hpp): τ_c is its response time in the schedule instead of U[1, 5] ms; null:
+  /// the draw. The delay-free loops (I, IK) keep τ_c = 0.
+  std::shared_ptr<const ControllerCpu> controller_cpu;
 };
 
 /// True when the legs come from a study file (point to point or on a bus), not from d.
