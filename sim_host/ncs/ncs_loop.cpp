@@ -169,6 +169,7 @@ class Harness {
   /// τ_c of the next computation (whole µs), 0 for the delay-free loops.
   Duration compute_time() {
     if (delay_free(approach_)) return Duration{0};
+    if (sc_.compute_us) return engine::from_us(compute_.uniform_int(sc_.compute_us->first, sc_.compute_us->second));
     return engine::from_us(compute_.uniform_int(ctx_.timing().compute_min_us, ctx_.timing().compute_max_us));
   }
 

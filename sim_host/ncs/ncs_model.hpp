@@ -10,6 +10,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "oneshot/controller_design.hpp"
@@ -79,6 +80,9 @@ struct Scenario {
   /// ncs_cpu.hpp): τ_c is its response time in the schedule instead of U[1, 5] ms; null:
   /// the draw. The delay-free loops (I, IK) keep τ_c = 0.
   std::shared_ptr<const ControllerCpu> controller_cpu;
+  /// τ_c ~ U[first, second] in whole µs instead of Timing's U[1, 5] ms (without a CPU; study
+  /// files do not set it: a constant τ_c is the oracle of a lone constant job on a CPU).
+  std::optional<std::pair<std::int64_t, std::int64_t>> compute_us;
 };
 
 /// True when the legs come from a study file (point to point or on a bus), not from d.
