@@ -7,8 +7,11 @@
 ///        input refused naming the field.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
+#include <fstream>
 #include <functional>
 
 #include "ncs_cpu.hpp"
@@ -17,6 +20,7 @@
 #include "study_check.hpp"
 #include "study_ncs_runner.hpp"
 #include "study_ncs_sweep.hpp"
+#include "support/run_command.hpp"
 #include "support/temp_files.hpp"
 
 namespace oneshot::study {
@@ -220,6 +224,40 @@ TEST(StudyCpu, BadCpusAreRefusedNamingTheField) {
   expect_refused([](nlohmann::json& j) { j["approaches"].push_back({{"name", "S+"}, {"kind", "S+"}}); }, "field 'approaches[7].kind'");
   expect_refused([](nlohmann::json& j) { j["links"][1]["delay"] = {{"model", "poisson_periods"}, {"mean_periods", 1}, {"period_us", 1000}}; },
                  "field 'nodes[1].cpu'");  // no bound on the input's arrival
+}
+
+TEST(StudyCpu, CommandLine) {
+  // check prints every task's analysis, the node job's as the JSON gives it.
+  const test::CommandResult ok = test::run_command({ONESHOT_SIM_PATH, "study", "check", cpu_path()});
+  ASSERT_EQ(ok.exit_code, 0) << ok.output;
+  const nlohmann::json r = resolve_study(parse(cpu_json()));
+  const nlohmann::json& c = r.at("cpus")[0];
+  EXPECT_NE(ok.output.find("cpu dspic: fixed_priority"), std::string::npos) << ok.output;
+  for (const nlohmann::json& t : c.at("tasks")) {
+    const std::string line = t.at("name").get<std::string>() + " (T " + t.at("period_us").dump();
+    EXPECT_NE(ok.output.find(line), std::string::npos) << line << "\n" << ok.output;
+    const std::string bounds = "WCRT " + t.at("wcrt_us").dump() + " us, BCRT " + t.at("bcrt_us").dump() + " us";
+    EXPECT_NE(ok.output.find(bounds), std::string::npos) << bounds << "\n" << ok.output;
+  }
+  EXPECT_NE(ok.output.find("node job (on input arrival) controller"), std::string::npos) << ok.output;
+  // An unschedulable CPU: check and run refuse it in one line naming the task, nothing written.
+  nlohmann::json bad = cpu_json();
+  bad["plant"]["file"] = std::string(ONESHOT_STUDY_EXAMPLES_DIR) + "/../../../lut_gen/plants/networked_board.json";
+  bad["cpus"][0]["tasks"][2]["wcet_us"] = 12000;
+  const std::string dir = test::made_dir("oneshot_study_cpu_test", "cli_bad");
+  std::ofstream(dir + "/study.json") << bad.dump();
+  const std::string json = dir + "/check.json";
+  std::filesystem::remove(json);
+  const test::CommandResult ck = test::run_command({ONESHOT_SIM_PATH, "study", "check", dir + "/study.json", "--json", json});
+  EXPECT_NE(ck.exit_code, 0);
+  EXPECT_NE(ck.output.find("field 'cpus[0].tasks[2]': cpu 'dspic' is unschedulable"), std::string::npos) << ck.output;
+  EXPECT_EQ(std::count(ck.output.begin(), ck.output.end(), '\n'), 1) << ck.output;
+  EXPECT_FALSE(std::filesystem::exists(json));
+  const std::string out = test::fresh_dir("oneshot_study_cpu_test", "cli_bad_run");
+  const test::CommandResult rn = test::run_command({ONESHOT_SIM_PATH, "study", "run", dir + "/study.json", "--out", out});
+  EXPECT_NE(rn.exit_code, 0);
+  EXPECT_NE(rn.output.find("field 'cpus[0].tasks[2]'"), std::string::npos) << rn.output;
+  EXPECT_FALSE(std::filesystem::exists(out));
 }
 
 }  // namespace
