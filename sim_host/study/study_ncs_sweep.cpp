@@ -314,6 +314,7 @@ void add_cpu_stats(nlohmann::json& j, const engine::SweepResults& results) {
     md += row;
   }
   j["markdown"] = j.at("markdown").get<std::string>() + md;
+  j["markdown_cpu"] = md;
 }
 
 }  // namespace

@@ -66,7 +66,8 @@ engine::SweepResults run_ncs_sweep(const NcsStudy& s, std::size_t seeds, unsigne
 /// approach the controller job's jobs and observed response min_us, mean_us, max_us beside
 /// the analysis's wcrt_us and bcrt_us, within_bounds, deadline_misses, other_misses (the
 /// CPU's other tasks and ISRs) and the measured utilization (busy time / simulated time;
-/// I and IK do not use the CPU: 0 jobs); its table is appended to "markdown".
+/// I and IK do not use the CPU: 0 jobs); its table is appended to "markdown" and is
+/// "markdown_cpu".
 nlohmann::json run_outputs(const engine::SweepResults& results, const std::string& out_dir, bool plots);
 
 }  // namespace oneshot::study

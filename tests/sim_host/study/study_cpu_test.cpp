@@ -240,6 +240,19 @@ TEST(StudyCpu, CommandLine) {
     EXPECT_NE(ok.output.find(bounds), std::string::npos) << bounds << "\n" << ok.output;
   }
   EXPECT_NE(ok.output.find("node job (on input arrival) controller"), std::string::npos) << ok.output;
+  // report: the CPU section with study run's figures.
+  const std::string rep = test::fresh_dir("oneshot_study_cpu_test", "cli_report");
+  const test::CommandResult rp = test::run_command(
+      {ONESHOT_SIM_PATH, "study", "report", cpu_path(), rep, "--seeds", "2", "--max-duration", "2.5", "--no-plots", "--threads", "1"});
+  ASSERT_EQ(rp.exit_code, 0) << rp.output;
+  const std::string md = test::read_file(rep + "/report.md");
+  const nlohmann::json rj = nlohmann::json::parse(test::read_file(rep + "/report.json"));
+  EXPECT_NE(md.find("### Controller CPU"), std::string::npos);
+  char row[128];
+  const nlohmann::json& s_cpu = rj.at("cpu").at("S");
+  std::snprintf(row, sizeof row, "| S | %.0f | %.1f | %.1f | %.1f |", s_cpu.at("jobs").get<double>(), s_cpu.at("min_us").get<double>(),
+                s_cpu.at("mean_us").get<double>(), s_cpu.at("max_us").get<double>());
+  EXPECT_NE(md.find(row), std::string::npos) << row << "\n" << md;
   // An unschedulable CPU: check and run refuse it in one line naming the task, nothing written.
   nlohmann::json bad = cpu_json();
   bad["plant"]["file"] = std::string(ONESHOT_STUDY_EXAMPLES_DIR) + "/../../../lut_gen/plants/networked_board.json";
