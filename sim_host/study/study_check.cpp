@@ -181,6 +181,9 @@ json resolve_study(const engine::StudyFile& f) {
 
 void add_ncs_designs(json& r, const NcsStudy& s) {
   for (auto& a : r["approaches"]) {
+    if (a.at("kind") == "AKl") {  // D = max sc + max ca + max τ_c (the controller job's WCRT on a CPU)
+      for (const ncs::Scenario& sc : s.scenarios) a["per_scenario"][sc.name] = {{"late_sampling_d_us", s.ctx->worst_chain_us(sc)}};
+    }
     if (a.at("kind") != "S+") continue;
     for (const ncs::Scenario& sc : s.scenarios) {
       const double tau = s.ctx->mean_tau_io_us(sc);

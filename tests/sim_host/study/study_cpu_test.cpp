@@ -240,6 +240,17 @@ TEST(StudyCpu, CommandLine) {
     EXPECT_NE(ok.output.find(bounds), std::string::npos) << bounds << "\n" << ok.output;
   }
   EXPECT_NE(ok.output.find("node job (on input arrival) controller"), std::string::npos) << ok.output;
+  // Its JSON: AKl's D = max sc + max ca + the controller job's WCRT (legs U[0.5, 4] ms).
+  const std::string cj = test::made_dir("oneshot_study_cpu_test", "cli_json") + "/check.json";
+  ASSERT_EQ(test::run_command({ONESHOT_SIM_PATH, "study", "check", cpu_path(), "--json", cj}).exit_code, 0);
+  const nlohmann::json cr = nlohmann::json::parse(test::read_file(cj));
+  EXPECT_EQ(cr.at("cpus")[0], c);
+  for (const nlohmann::json& a : cr.at("approaches")) {
+    if (a.at("kind") != "AKl") continue;
+    for (const auto& [sc, d] : a.at("per_scenario").items()) {
+      EXPECT_EQ(d.at("late_sampling_d_us").get<double>(), 4000 + 4000 + std::ceil(c.at("tasks")[3].at("wcrt_us").get<double>())) << sc;
+    }
+  }
   // report: the CPU section with study run's figures.
   const std::string rep = test::fresh_dir("oneshot_study_cpu_test", "cli_report");
   const test::CommandResult rp = test::run_command(
