@@ -118,10 +118,7 @@ std::vector<CpuPlan> plan_cpus(const engine::StudyFile& f, std::int64_t h_us) {
       }
       if (t.deadline.count() == 0) t.deadline = n.mode == "timer" ? n.period : h;
       if (t.exec.wcet > t.period) {
-        refuse(nf + ".job." + (n.job->exec.kind == engine::cpu::ExecModel::Kind::kConstant ||
-                                       n.job->exec.kind == engine::cpu::ExecModel::Kind::kUniform
-                                   ? "wcet_us"
-                                   : "exec"),
+        refuse(nf + ".job." + (n.job_exec ? "exec" : "wcet_us"),
                "the worst-case execution time " + std::to_string(us(t.exec.wcet)) + " us exceeds the job's minimum inter-arrival " +
                    std::to_string(us(t.period)) + " us");
       }

@@ -193,6 +193,7 @@ StudyFile parse_study(const std::string& text, const std::string& source, const 
         if (on == nullptr) throw InputError("field '" + f + ".cpu': no cpu '" + node.cpu + "' (cpus[].name)");
         if (!n.contains("job")) throw InputError("field '" + f + ".job': missing (the node's job on cpu '" + node.cpu + "')");
         node.job = cpu::parse_node_job(n["job"], f + ".job", node.name, base_dir);
+        node.job_exec = n["job"].contains("exec");
         for (const auto* list : {&on->tasks, &on->isrs})
           for (const cpu::TaskSpec& t : *list)
             if (t.name == node.name) throw InputError("field '" + f + ".name': cpu '" + node.cpu + "' has a task or ISR '" + t.name + "'");

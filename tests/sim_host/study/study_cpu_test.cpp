@@ -218,6 +218,7 @@ TEST(StudyCpu, BadCpusAreRefusedNamingTheField) {
   expect_refused([](nlohmann::json& j) { j["nodes"][1]["job"]["period_us"] = 50000; }, "field 'nodes[1].job.period_us'");
   expect_refused([](nlohmann::json& j) { j["nodes"][1]["job"]["sample_at"] = "end"; }, "field 'nodes[1].job.sample_at'");
   expect_refused([](nlohmann::json& j) { j["nodes"][1]["job"] = {{"wcet_us", 45000}, {"priority", 3}}; }, "field 'nodes[1].job.wcet_us'");  // > h - J
+  expect_refused([](nlohmann::json& j) { j["nodes"][1]["job"]["exec"]["instructions_max"] = 2'000'000; }, "field 'nodes[1].job.exec'");
   expect_refused([](nlohmann::json& j) { j["nodes"][0]["cpu"] = "dspic"; j["nodes"][0]["job"] = {{"wcet_us", 100}, {"priority", 5}}; },
                  "field 'nodes[0].cpu'");  // the sensor runs on its timer
   expect_refused([](nlohmann::json& j) { j["cpus"].push_back({{"name", "spare"}, {"scheduler", "edf"}}); }, "field 'cpus[1]'");

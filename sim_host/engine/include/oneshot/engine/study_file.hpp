@@ -88,6 +88,7 @@ struct NodeSpec {
   /// Its job on that CPU (cpu_task_set.hpp parse_node_job(): external, period and an absent
   /// deadline 0, set by the runner); given exactly when `cpu` is.
   std::optional<cpu::TaskSpec> job;
+  bool job_exec = false;         ///< The job's execution time is an `exec` model (not wcet_us/bcet_us).
 };
 
 /// A link between two nodes: its own delay/loss models, or a CAN bus identifier.
