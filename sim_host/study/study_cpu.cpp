@@ -41,8 +41,10 @@ std::optional<Duration> link_spread(const engine::StudyFile& f, const engine::Li
 /// actuation-synchronized ones): the sender of the controller's input is woken by a link.
 bool senders_woken_by_links(const engine::StudyFile& f) {
   if (f.study != "ncs") return false;
-  for (const engine::ApproachSpec& a : f.approaches)
-    if (a.kind == "A" || a.kind == "AK" || a.kind == "AKx" || a.kind == "AKl") return true;
+  for (const engine::ApproachSpec& a : f.approaches) {
+    for (ncs::Approach k : ncs::kAllApproaches)
+      if (a.kind == ncs::name(k) && ncs::actuation_synchronized(k)) return true;
+  }
   return false;
 }
 
