@@ -10,9 +10,11 @@
 
 #include "ncs_analytic.hpp"
 #include "ncs_counters.hpp"
+#include "ncs_cpu.hpp"
 #include "ncs_live_nodes.hpp"
 #include "oneshot/engine/can_traffic.hpp"
 #include "oneshot/engine/continuous_plant.hpp"
+#include "oneshot/engine/cpu.hpp"
 #include "oneshot/engine/kernel.hpp"
 #include "oneshot/engine/network.hpp"
 #include "oneshot/host/host_network.hpp"
@@ -91,6 +93,14 @@ class Harness {
     for (std::uint64_t k = half; SimTime{h_ * static_cast<std::int64_t>(k)} < end_; k += half) {
       kernel_.schedule(SimTime{h_ * static_cast<std::int64_t>(k)}, EventClass::kEnvironment, sw, k);
     }
+    if (sc.controller_cpu && !delay_free(a)) {  // τ_c from the schedule (ncs_cpu.hpp)
+      cpu_ = std::make_unique<engine::cpu::Cpu>(kernel_, sc.controller_cpu->set);
+      cpu_task_ = sc.controller_cpu->task;
+      cpu_->on_job([this](const engine::cpu::CpuJob& j) {
+        if (j.entity == cpu_task_ && !j.aborted) kernel_.schedule(kernel_.now(), EventClass::kCompute, computed_);
+      });
+      cpu_->start(end_);
+    }
     const HandlerId end = kernel_.add_handler("end", [this](std::uint64_t) { advance(); });
     kernel_.schedule(end_, EventClass::kEnd, end);
     if (opt.analytic_mark_s > 0 && !an_) throw std::invalid_argument("an analytic mark needs an analytic run");
@@ -145,9 +155,21 @@ class Harness {
     return b;
   }
 
+  /// A frame reached the controller: `compute_h` runs τ_c later, τ_c drawn (compute_time())
+  /// or, on a CPU, the response of the job released now (the handler runs at its finish).
+  void start_computation(HandlerId compute_h) {
+    if (!cpu_) {
+      kernel_.schedule_in(compute_time(), EventClass::kCompute, compute_h);
+      return;
+    }
+    computed_ = compute_h;
+    cpu_->release(cpu_task_);
+  }
+
   /// τ_c of the next computation (whole µs), 0 for the delay-free loops.
   Duration compute_time() {
     if (delay_free(approach_)) return Duration{0};
+    if (sc_.compute_us) return engine::from_us(compute_.uniform_int(sc_.compute_us->first, sc_.compute_us->second));
     return engine::from_us(compute_.uniform_int(ctx_.timing().compute_min_us, ctx_.timing().compute_max_us));
   }
 
@@ -198,6 +220,20 @@ class Harness {
       result_.bus_legs.emplace_back(nm, st);
     }
     if (an_) an_->report(result_);
+    if (cpu_) {
+      CpuRunStats& c = result_.cpu;
+      const engine::cpu::CpuTaskStats& st = cpu_->stats()[cpu_task_];
+      c.present = true;
+      c.jobs = st.finished;
+      c.response_min = st.response_min;
+      c.response_max = st.response_max;
+      c.response_sum_us = st.response_sum_s * 1e6;
+      c.deadline_misses = st.deadline_misses;
+      for (std::size_t e = 0; e < cpu_->stats().size(); ++e) {
+        c.busy += cpu_->stats()[e].busy;
+        if (e != cpu_task_) c.other_misses += cpu_->stats()[e].deadline_misses;
+      }
+    }
     for (const auto& s : plant_.trace()) {
       const double t = engine::to_seconds(s.t);
       result_.truth.push_back(Point{t, {s.x[0], s.x[1]}});
@@ -229,6 +265,9 @@ class Harness {
   std::vector<std::pair<std::string, std::pair<std::uint8_t, std::uint8_t>>> bus_legs_;  ///< Name, route.
   std::vector<std::pair<std::string, engine::CanBus*>> buses_;
   std::vector<std::unique_ptr<engine::CanTraffic>> traffic_;
+  std::unique_ptr<engine::cpu::Cpu> cpu_;  ///< The controller's CPU (Scenario::controller_cpu).
+  std::size_t cpu_task_ = 0;               ///< The controller's job in it.
+  HandlerId computed_ = 0;                 ///< The loop's compute handler (set at each release).
 };
 
 /// The actuation-synchronized loop with estimator `est` (brief §1).
@@ -282,7 +321,7 @@ RunResult run_synchronized(Harness& hs, Estimator est, std::int32_t late_us) {
     }
   });
   net.add_node(kController, "controller", Duration{0},
-               [&]() { k.schedule_in(hs.compute_time(), EventClass::kCompute, compute_h); });
+               [&]() { hs.start_computation(compute_h); });
   net.add_node(kActuator, "actuator", Duration{0}, [&]() { act->on_receive(); });
   hs.route_leg(kActuator, kSensor, "as");
   hs.route_leg(kSensor, kController, "sc");
@@ -359,7 +398,7 @@ RunResult run_sampling(Harness& hs, Law law, Saturated saturated) {
   });
   net.add_node(kSensor, "sensor", Duration{0}, nullptr);
   net.add_node(kController, "controller", Duration{0},
-               [&]() { k.schedule_in(hs.compute_time(), EventClass::kCompute, compute_h); });
+               [&]() { hs.start_computation(compute_h); });
   net.add_node(kActuator, "actuator", Duration{0}, [&]() {
     act->on_receive();
     InputVec u;

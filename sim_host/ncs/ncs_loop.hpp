@@ -59,6 +59,19 @@ struct Point {
   double v[2] = {};  ///< Values (y1, y2 or x̂1, x̂2).
 };
 
+/// The controller's CPU over a run (Scenario::controller_cpu): its job's response times (τ_c),
+/// misses and the CPU's busy time.
+struct CpuRunStats {
+  bool present = false;           ///< The run's controller ran on a CPU.
+  std::uint64_t jobs = 0;         ///< Controller jobs finished.
+  engine::Duration response_min{0};  ///< Smallest response (finish − release).
+  engine::Duration response_max{0};  ///< Largest.
+  double response_sum_us = 0;     ///< Σ responses (µs).
+  std::uint64_t deadline_misses = 0;  ///< Controller jobs past their deadline (or aborted).
+  std::uint64_t other_misses = 0;     ///< Background tasks' and ISRs' misses.
+  engine::Duration busy{0};       ///< CPU time used by every task and ISR (context switches included).
+};
+
 /// What a run returns.
 struct RunResult {
   double cost = 0;             ///< J over the run.
@@ -77,6 +90,7 @@ struct RunResult {
   /// Legs on a CAN bus (Scenario::bus_legs), by leg name: messages queued and their delays
   /// (queueing + transmission of every frame). Their sent counts are in `links` too (lost 0).
   std::vector<std::pair<std::string, engine::BusRouteStatistics>> bus_legs;
+  CpuRunStats cpu;               ///< The controller's CPU (Scenario::controller_cpu; I, IK: none).
   std::vector<Point> truth;      ///< True state every trace step (x1, x2).
   std::vector<Point> samples;    ///< Samples y at their instants.
   std::vector<Point> sample_truth;  ///< C x at the same instants (noise-free output).

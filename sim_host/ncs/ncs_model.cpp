@@ -2,6 +2,8 @@
 /// @brief Plant, design, approaches, scenarios and the S+ design of study `ncs`.
 #include "ncs_model.hpp"
 
+#include "ncs_cpu.hpp"
+
 #include <cmath>
 #include <cstdio>
 #include <fstream>
@@ -192,7 +194,11 @@ std::int32_t Context::worst_chain_us(const Scenario& s) const {
     const char* leg = "";
     const std::optional<engine::Duration> sum = sc_ca_delay_bound(s, &leg);
     if (!sum) throw std::invalid_argument(std::string("ncs scenario ") + s.name + ": leg " + leg + " has no upper delay bound (late sampling needs one)");
-    return static_cast<std::int32_t>(std::llround(static_cast<double>(sum->count()) * 1e-3) + timing_.compute_max_us);
+    // τ_c's bound: the controller job's WCRT on its CPU (rounded up to whole µs), else the draw's maximum.
+    const std::int64_t tau_max_us = s.controller_cpu ? (s.controller_cpu->wcrt.count() + 999) / 1000
+                                    : s.compute_us   ? s.compute_us->second
+                                                     : timing_.compute_max_us;
+    return static_cast<std::int32_t>(std::llround(static_cast<double>(sum->count()) * 1e-3) + tau_max_us);
   }
   return static_cast<std::int32_t>(std::llround(2 * s.max_delay_ms * 1000) + timing_.compute_max_us);
 }
@@ -204,6 +210,7 @@ double Context::mean_tau_io_us(const Scenario& s) const {
       const auto it = s.legs.find(leg);
       if (it != s.legs.end()) sum_ns += it->second.delay.mean_ns();
     }
+    if (s.compute_us) return sum_ns * 1e-3 + 0.5 * static_cast<double>(s.compute_us->first + s.compute_us->second);
     return sum_ns * 1e-3 + 0.5 * static_cast<double>(timing_.compute_min_us + timing_.compute_max_us);
   }
   const double leg = 0.5 * (static_cast<double>(timing_.leg_min_us) + s.max_delay_ms * 1000);

@@ -10,6 +10,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "oneshot/controller_design.hpp"
@@ -56,6 +57,8 @@ struct BusLeg {
   std::vector<engine::Duration> offsets;    ///< First release of each background stream.
 };
 
+struct ControllerCpu;  // ncs_cpu.hpp
+
 /// One scenario (brief §3): square wave ±A_r of period T_r, network legs U[0.5, d] ms,
 /// noise scale s.
 struct Scenario {
@@ -73,6 +76,13 @@ struct Scenario {
   /// Legs on a CAN bus (study files), by name: not in `legs`. The delay-free loops (I, IK)
   /// keep their delay-free links.
   std::map<std::string, BusLeg> bus_legs;
+  /// The controller's computation as a job on a modeled CPU (study files' `cpus`,
+  /// ncs_cpu.hpp): τ_c is its response time in the schedule instead of U[1, 5] ms; null:
+  /// the draw. The delay-free loops (I, IK) keep τ_c = 0.
+  std::shared_ptr<const ControllerCpu> controller_cpu;
+  /// τ_c ~ U[first, second] in whole µs instead of Timing's U[1, 5] ms (without a CPU; study
+  /// files do not set it: a constant τ_c is the oracle of a lone constant job on a CPU).
+  std::optional<std::pair<std::int64_t, std::int64_t>> compute_us;
 };
 
 /// True when the legs come from a study file (point to point or on a bus), not from d.

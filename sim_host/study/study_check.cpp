@@ -13,6 +13,7 @@
 #include "oneshot/design/controller_synthesis.hpp"
 #include "oneshot/design/plant_description.hpp"
 #include "study_bus_analysis.hpp"
+#include "study_cpu.hpp"
 #include "study_ncs_runner.hpp"
 
 namespace oneshot::study {
@@ -157,6 +158,14 @@ json resolve_study(const engine::StudyFile& f) {
       r["links"].push_back(e);
     }
     if (!f.buses.empty()) r["buses"] = analyze_buses(f);  // study_bus_analysis.hpp
+    if (!f.cpus.empty()) {  // study_cpu.hpp: node jobs on input arrival need the period h
+      const json& p = r.at("plant");
+      if (p.contains("period_us")) {
+        r["cpus"] = cpus_json(f, plan_cpus(f, static_cast<std::int64_t>(std::llround(p.at("period_us").get<double>()))));
+      } else {
+        r["cpus_not_analysed"] = "the inline continuous plant has no period h (the node jobs' inter-arrival)";
+      }
+    }
     // The grid.
     for (const engine::ScenarioSpec& s : f.scenarios) {
       r["scenarios"].push_back({{"name", s.name}, {"duration_s", s.duration_s.value_or(f.duration_s)}, {"params", s.params}});
@@ -172,6 +181,9 @@ json resolve_study(const engine::StudyFile& f) {
 
 void add_ncs_designs(json& r, const NcsStudy& s) {
   for (auto& a : r["approaches"]) {
+    if (a.at("kind") == "AKl") {  // D = max sc + max ca + max τ_c (the controller job's WCRT on a CPU)
+      for (const ncs::Scenario& sc : s.scenarios) a["per_scenario"][sc.name] = {{"late_sampling_d_us", s.ctx->worst_chain_us(sc)}};
+    }
     if (a.at("kind") != "S+") continue;
     for (const ncs::Scenario& sc : s.scenarios) {
       const double tau = s.ctx->mean_tau_io_us(sc);
@@ -253,6 +265,7 @@ std::string describe_resolution(const json& r) {
       }
     }
   }
+  if (r.contains("cpus")) o << describe_cpus(r.at("cpus"));
   o << "grid: " << r.at("grid").at("approaches") << " approaches x " << r.at("grid").at("scenarios") << " scenarios x "
     << r.at("seeds").at("count") << " seeds = " << r.at("grid").at("runs") << " runs\n";
   return o.str();

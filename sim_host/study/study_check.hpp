@@ -30,7 +30,8 @@ inline constexpr std::size_t kLoopFramePayloadBytes = 8;
 nlohmann::json resolve_study(const engine::StudyFile& file);
 
 /// Adds to the resolution `r` of an ncs file what needs its scenarios: the S+ gain
-/// [L_x, L_u] and the mean delay τ_io it is designed on, per scenario.
+/// [L_x, L_u] and the mean delay τ_io it is designed on, and AKl's D (late_sampling_d_us:
+/// max sc + max ca + max τ_c, the controller job's WCRT on a CPU), per scenario.
 void add_ncs_designs(nlohmann::json& r, const NcsStudy& s);
 
 /// Sets s.bus_response_us from the resolution `r` of the same file: per scenario the

@@ -50,6 +50,14 @@ std::string report_markdown(const std::string& file, const std::string& resoluti
       md << "\n";
     }
   }
+  if (outputs.contains("markdown_cpu")) {
+    const nlohmann::json& c = spec.config.at("controller_cpu");
+    md << "\n### Controller CPU\n\nThe controller's job `" << c.at("job").get<std::string>() << "` on CPU `"
+       << c.at("cpu").get<std::string>() << "` (" << c.at("scheduler").get<std::string>()
+       << "): its response time tau_c over every run, beside the analysis's BCRT and WCRT; misses of the job and of the "
+          "CPU's other tasks and ISRs; the CPU's busy time over the simulated time. I and IK do not use the CPU.\n"
+       << outputs.at("markdown_cpu").get<std::string>();
+  }
   return md.str();
 }
 

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "ncs_live.hpp"
+#include "study_cpu.hpp"
 
 namespace oneshot::study {
 namespace {
@@ -236,6 +237,7 @@ NcsStudy map_ncs_study(const engine::StudyFile& file) {
       }
       out.scenarios.push_back(sc);
     }
+    attach_controller_cpu(file, out);  // study_cpu.hpp: τ_c from the controller's CPU, when it has one
     out.first_seed = file.first_seed;
     out.seeds = file.seeds;
     return out;

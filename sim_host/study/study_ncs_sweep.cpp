@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "ncs_analytic.hpp"
+#include "ncs_cpu.hpp"
 #include "ncs_experiments.hpp"
 #include "ncs_loop.hpp"
 
@@ -98,6 +99,14 @@ std::array<double, std::size(kBusDelayMetrics)> bus_delays(const ncs::RunResult&
   return v;
 }
 
+/// The CPU metrics of run `r`, in the order of kCpuMetrics.
+std::array<double, std::size(kCpuMetrics)> cpu_metrics(const ncs::RunResult& r) {
+  const ncs::CpuRunStats& c = r.cpu;
+  return {static_cast<double>(c.jobs), static_cast<double>(c.response_min.count()) * 1e-3,
+          static_cast<double>(c.response_max.count()) * 1e-3, c.response_sum_us, static_cast<double>(c.deadline_misses),
+          static_cast<double>(c.other_misses), static_cast<double>(c.busy.count()) * 1e-3};
+}
+
 }  // namespace
 
 engine::SweepResults run_ncs_sweep(const NcsStudy& s, std::size_t seeds, unsigned threads, const engine::Shard& shard,
@@ -139,6 +148,9 @@ engine::SweepResults run_ncs_sweep(const NcsStudy& s, std::size_t seeds, unsigne
     for (const char* c : kLinkCounters) spec.metrics.push_back(l + "." + c);
   for (const std::string& l : on_bus)
     for (const char* c : kBusDelayMetrics) spec.metrics.push_back(l + "." + c);
+  const bool on_cpu = !s.scenarios.empty() && s.scenarios[0].controller_cpu != nullptr;
+  if (on_cpu)
+    for (const char* c : kCpuMetrics) spec.metrics.push_back(std::string("cpu.") + c);
   spec.config = {{"study_file", s.source},
                  {"plant", s.ctx->plant().name},
                  {"plant_source", s.ctx->plant().source},
@@ -147,6 +159,15 @@ engine::SweepResults run_ncs_sweep(const NcsStudy& s, std::size_t seeds, unsigne
                  {"compute_us", {s.ctx->timing().compute_min_us, s.ctx->timing().compute_max_us}},
                  {"scenarios", sc}};
   if (!on_bus.empty()) spec.config["bus_links"] = on_bus;  // only then: the spec of files without stays as it was
+  if (on_cpu) {  // likewise
+    const ncs::ControllerCpu& c = *s.scenarios[0].controller_cpu;
+    spec.config["controller_cpu"] = {{"cpu", c.set.name},
+                                     {"job", c.set.tasks[c.task].name},
+                                     {"scheduler", engine::cpu::to_string(c.set.scheduler)},
+                                     {"utilization", c.set.utilization()},
+                                     {"wcrt_us", static_cast<double>(c.wcrt.count()) * 1e-3},
+                                     {"bcrt_us", static_cast<double>(c.bcrt.count()) * 1e-3}};
+  }
   if (analytic) {  // only then, as ncs table: the spec stays as it was without
     spec.config["analytic"] = true;
     spec.metrics.insert(spec.metrics.end(), std::begin(ncs::kAnalyticMetrics), std::end(ncs::kAnalyticMetrics));
@@ -162,7 +183,7 @@ engine::SweepResults run_ncs_sweep(const NcsStudy& s, std::size_t seeds, unsigne
   const std::vector<std::string>* bus = &on_bus;
   return engine::run_sweep(
       spec, shard, threads,
-      [study, counter_maps, bus, analytic](std::size_t a, std::size_t k, std::uint64_t seed) {
+      [study, counter_maps, bus, analytic, on_cpu](std::size_t a, std::size_t k, std::uint64_t seed) {
         const ncs::Approach ap = study->approaches[a];
         const ncs::RunResult r = ncs::run(*study->ctx, ap, study->scenarios[k], seed, ncs::RunOptions{});
         std::vector<double> v{r.cost, static_cast<double>(r.late), static_cast<double>(r.saturated),
@@ -174,6 +195,10 @@ engine::SweepResults run_ncs_sweep(const NcsStudy& s, std::size_t seeds, unsigne
         for (const std::string& l : *bus) {
           const auto d = bus_delays(r, l);
           v.insert(v.end(), d.begin(), d.end());
+        }
+        if (on_cpu) {
+          const auto c = cpu_metrics(r);
+          v.insert(v.end(), c.begin(), c.end());
         }
         if (analytic) {  // ncs table --analytic's columns: the same run in analytic mode
           const auto x = ncs::analytic_metrics(*study->ctx, ap, study->scenarios[k], seed, ncs::RunOptions{});
@@ -247,6 +272,51 @@ void add_bus_delays(nlohmann::json& j, const engine::SweepResults& results) {
   j["markdown"] = j.at("markdown").get<std::string>() + md;
 }
 
+/// Adds "cpu" (per approach: the controller job's observed response times over every run
+/// beside the analysis's bounds, misses, measured utilization) and its table to the markdown.
+void add_cpu_stats(nlohmann::json& j, const engine::SweepResults& results) {
+  const engine::SweepSpec& spec = results.spec;
+  const nlohmann::json& cfg = spec.config.at("controller_cpu");
+  const double wcrt = cfg.at("wcrt_us").get<double>(), bcrt = cfg.at("bcrt_us").get<double>();
+  std::size_t m[std::size(kCpuMetrics)];
+  for (std::size_t i = 0; i < std::size(kCpuMetrics); ++i) m[i] = results.metric(std::string("cpu.") + kCpuMetrics[i]);
+  std::string md = "\n| approach | controller jobs | min tau_c (us) | mean tau_c (us) | max tau_c (us) | BCRT (us) | WCRT (us) | "
+                   "within | deadline misses | other misses | utilization |\n|---|---:|---:|---:|---:|---:|---:|---|---:|---:|---:|\n";
+  for (std::size_t a = 0; a < spec.approaches.size(); ++a) {
+    double n = 0, lo = 0, hi = 0, sum = 0, miss = 0, other = 0, busy = 0, time_us = 0;
+    for (std::size_t s = 0; s < spec.scenarios.size(); ++s) {
+      const double dur_us = spec.config.at("scenarios")[s].at("duration_s").get<double>() * 1e6;
+      for (std::size_t k = 0; k < spec.seeds; ++k) {
+        const double c = results.at(a, s, k, m[0]);
+        time_us += dur_us;
+        busy += results.at(a, s, k, m[6]);
+        other += results.at(a, s, k, m[5]);
+        if (c <= 0) continue;
+        lo = n == 0 ? results.at(a, s, k, m[1]) : std::fmin(lo, results.at(a, s, k, m[1]));
+        hi = std::fmax(hi, results.at(a, s, k, m[2]));
+        n += c;
+        sum += results.at(a, s, k, m[3]);
+        miss += results.at(a, s, k, m[4]);
+      }
+    }
+    nlohmann::json e = {{"jobs", n}, {"wcrt_us", wcrt}, {"bcrt_us", bcrt}, {"deadline_misses", miss}, {"other_misses", other},
+                        {"utilization_measured", time_us > 0 ? busy / time_us : 0.0}};
+    e["min_us"] = n > 0 ? nlohmann::json(lo) : nlohmann::json(nullptr);
+    e["mean_us"] = n > 0 ? nlohmann::json(sum / n) : nlohmann::json(nullptr);
+    e["max_us"] = n > 0 ? nlohmann::json(hi) : nlohmann::json(nullptr);
+    e["within_bounds"] = n == 0 || (lo >= bcrt && hi <= wcrt);
+    j["cpu"][spec.approaches[a]] = e;
+    if (n == 0) continue;  // I and IK: delay-free, not on the CPU
+    char row[320];
+    std::snprintf(row, sizeof row, "| %s | %.0f | %.1f | %.1f | %.1f | %.1f | %.1f | %s | %.0f | %.0f | %.4f |\n", spec.approaches[a].c_str(), n,
+                  lo, sum / n, hi, bcrt, wcrt, e.at("within_bounds").get<bool>() ? "yes" : "no", miss, other,
+                  e.at("utilization_measured").get<double>());
+    md += row;
+  }
+  j["markdown"] = j.at("markdown").get<std::string>() + md;
+  j["markdown_cpu"] = md;
+}
+
 }  // namespace
 
 nlohmann::json run_outputs(const engine::SweepResults& results, const std::string& out_dir, bool plots) {
@@ -273,6 +343,7 @@ nlohmann::json run_outputs(const engine::SweepResults& results, const std::strin
     }
   }
   if (spec.config.contains("bus_links")) add_bus_delays(j, results);
+  if (spec.config.contains("controller_cpu")) add_cpu_stats(j, results);
   return j;
 }
 

@@ -24,6 +24,12 @@ inline constexpr const char* kLinkCounters[] = {"sent", "delivered", "lost", "la
 /// queued to the end of the message's last frame: queueing + transmission).
 inline constexpr const char* kBusDelayMetrics[] = {"bus_messages", "bus_delay_min_us", "bus_delay_max_us", "bus_delay_sum_us"};
 
+/// Names of the metrics of the controller's CPU (a file's `cpus`), each "cpu.<name>": its
+/// jobs finished, their smallest, largest and summed response time τ_c (µs), its deadline
+/// misses, the misses of the other tasks and ISRs, and the CPU's busy time (µs).
+inline constexpr const char* kCpuMetrics[] = {"jobs", "response_min_us", "response_max_us", "response_sum_us",
+                                              "deadline_misses", "other_misses", "busy_us"};
+
 /// Position of the counter `name` in kLinkCounters (its size when there is none).
 constexpr std::size_t link_counter_index(std::string_view name) {
   std::size_t i = 0;
@@ -56,7 +62,12 @@ engine::SweepResults run_ncs_sweep(const NcsStudy& s, std::size_t seeds, unsigne
 /// CAN bus, "bus_delays": per approach and leg the messages, min_us, mean_us, max_us of the
 /// observed delays (queueing + transmission) over every run, the check's worst_response_us
 /// (the largest over the scenarios; null when unbounded), within_bound, and per_scenario the
-/// same; their table is appended to "markdown".
+/// same; their table is appended to "markdown". With the controller on a CPU, "cpu": per
+/// approach the controller job's jobs and observed response min_us, mean_us, max_us beside
+/// the analysis's wcrt_us and bcrt_us, within_bounds, deadline_misses, other_misses (the
+/// CPU's other tasks and ISRs) and the measured utilization (busy time / simulated time;
+/// I and IK do not use the CPU: 0 jobs); its table is appended to "markdown" and is
+/// "markdown_cpu".
 nlohmann::json run_outputs(const engine::SweepResults& results, const std::string& out_dir, bool plots);
 
 }  // namespace oneshot::study

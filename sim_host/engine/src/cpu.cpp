@@ -37,7 +37,7 @@ Cpu::Cpu(Kernel& kernel, TaskSet set) : kernel_(kernel), set_(std::move(set)) {
   }
   for (const TaskSpec& t : set_.isrs) specs_.push_back(&t);
   for (std::size_t e = 0; e < specs_.size(); ++e) {
-    const std::string& n = specs_[e]->name;
+    const std::string n = set_.streams_per_cpu ? set_.name + "/" + specs_[e]->name : specs_[e]->name;
     ent_.push_back(Entity{specs_[e], e >= set_.tasks.size(), {}, 0, SimTime{0},
                           kernel_.stream(stream_name("cpu", n, "exec")), kernel_.stream(stream_name("cpu", n, "jitter")),
                           kernel_.stream(stream_name("cpu", n, "arrival"))});
@@ -55,6 +55,7 @@ const std::string& Cpu::entity_name(std::size_t e) const { return specs_.at(e)->
 void Cpu::start(SimTime end) {
   end_ = end;
   for (std::size_t e = 0; e < ent_.size(); ++e) {
+    if (ent_[e].spec->external) continue;
     ent_[e].next_arrival = ent_[e].spec->offset;
     if (ent_[e].next_arrival <= end_) kernel_.schedule(ent_[e].next_arrival, EventClass::kCompute, h_arrive_, e);
   }
@@ -97,6 +98,18 @@ void Cpu::arrive(std::size_t e) {
   }
   en.next_arrival = now + gap;
   if (en.next_arrival <= end_) kernel_.schedule(en.next_arrival, EventClass::kCompute, h_arrive_, e);
+  admit(e);
+}
+
+void Cpu::release(std::size_t task) {
+  if (task >= set_.tasks.size() || !set_.tasks[task].external) throw std::invalid_argument("cpu: release() of a task that is not external");
+  admit(task);
+}
+
+void Cpu::admit(std::size_t e) {
+  Entity& en = ent_[e];
+  const TaskSpec& s = *en.spec;
+  const SimTime now = kernel_.now();
   const std::uint64_t index = en.next_index++;
   if (!en.pending.empty()) {
     ++stats_[e].overruns;

@@ -271,41 +271,61 @@ const char* to_string(OverrunPolicy p) {
   return "?";
 }
 
+TaskSet parse_task_set_json(const nlohmann::json& root, const std::string& prefix, const std::string& base_dir,
+                            bool allow_no_tasks) {
+  require_keys(root, prefix, {"name", "scheduler", "context_switch_us", "tasks", "isrs"});
+  TaskSet s;
+  s.name = string_of(root, prefix, "name", true, "cpu");
+  if (s.name.size() > 100) fail(at(prefix, "name"), "longer than 100 characters");
+  const std::string sched = string_of(root, prefix, "scheduler");
+  if (sched == "fixed_priority") {
+    s.scheduler = SchedulerKind::kFixedPriority;
+  } else if (sched == "fixed_priority_nonpreemptive") {
+    s.scheduler = SchedulerKind::kFixedPriorityNonPreemptive;
+  } else if (sched == "edf") {
+    s.scheduler = SchedulerKind::kEdf;
+  } else {
+    fail(at(prefix, "scheduler"), "unknown scheduler '" + sched + "' (fixed_priority, fixed_priority_nonpreemptive, edf)");
+  }
+  s.context_switch = us(integer_in(root, prefix, "context_switch_us", 0, 1'000'000, true, 0));
+  std::set<std::string> names;
+  for (const char* list : {"tasks", "isrs"}) {
+    const bool isr = std::string(list) == "isrs";
+    const std::string lf = at(prefix, list);
+    if (!root.contains(list)) {
+      if (!isr && !allow_no_tasks) fail(lf, "missing");
+      continue;
+    }
+    const nlohmann::json& a = root[list];
+    if (!a.is_array() || a.size() > 1000) fail(lf, "must be an array of at most 1000 entries");
+    if (!isr && a.empty() && !allow_no_tasks) fail(lf, "must hold at least one task");
+    for (std::size_t i = 0; i < a.size(); ++i) {
+      const std::string f = lf + "[" + std::to_string(i) + "]";
+      TaskSpec t = parse_task(a[i], f, isr, base_dir);
+      if (!names.insert(t.name).second) fail(f + ".name", "duplicate name '" + t.name + "'");
+      (isr ? s.isrs : s.tasks).push_back(std::move(t));
+    }
+  }
+  return s;
+}
+
+TaskSpec parse_node_job(const nlohmann::json& j, const std::string& field, const std::string& name, const std::string& base_dir) {
+  require_keys(j, field, {"wcet_us", "bcet_us", "exec", "priority", "deadline_us", "nonpreemptive_us", "overrun"});
+  nlohmann::json task = j;  // the task parser's keys, with the name and a period the runner replaces
+  task["name"] = name;
+  task["period_us"] = kMaxUs;
+  TaskSpec t = parse_task(task, field, false, base_dir);
+  t.external = true;
+  t.sporadic = true;
+  t.period = Duration{0};
+  t.max_interarrival = Duration{0};
+  if (!j.contains("deadline_us")) t.deadline = Duration{0};
+  return t;
+}
+
 TaskSet parse_task_set(const std::string& text, const std::string& source, const std::string& base_dir) {
   try {
-    const nlohmann::json root = parse_json_strict(text, source);
-    require_keys(root, "", {"name", "scheduler", "context_switch_us", "tasks", "isrs"});
-    TaskSet s;
-    s.name = string_of(root, "", "name", true, "cpu");
-    const std::string sched = string_of(root, "", "scheduler");
-    if (sched == "fixed_priority") {
-      s.scheduler = SchedulerKind::kFixedPriority;
-    } else if (sched == "fixed_priority_nonpreemptive") {
-      s.scheduler = SchedulerKind::kFixedPriorityNonPreemptive;
-    } else if (sched == "edf") {
-      s.scheduler = SchedulerKind::kEdf;
-    } else {
-      fail("scheduler", "unknown scheduler '" + sched + "' (fixed_priority, fixed_priority_nonpreemptive, edf)");
-    }
-    s.context_switch = us(integer_in(root, "", "context_switch_us", 0, 1'000'000, true, 0));
-    std::set<std::string> names;
-    for (const char* list : {"tasks", "isrs"}) {
-      const bool isr = std::string(list) == "isrs";
-      if (!root.contains(list)) {
-        if (!isr) fail("tasks", "missing");
-        continue;
-      }
-      const nlohmann::json& a = root[list];
-      if (!a.is_array() || a.size() > 1000) fail(list, "must be an array of at most 1000 entries");
-      if (!isr && a.empty()) fail(list, "must hold at least one task");
-      for (std::size_t i = 0; i < a.size(); ++i) {
-        const std::string f = std::string(list) + "[" + std::to_string(i) + "]";
-        TaskSpec t = parse_task(a[i], f, isr, base_dir);
-        if (!names.insert(t.name).second) fail(f + ".name", "duplicate name '" + t.name + "'");
-        (isr ? s.isrs : s.tasks).push_back(std::move(t));
-      }
-    }
-    return s;
+    return parse_task_set_json(parse_json_strict(text, source), "", base_dir, false);
   } catch (const InputError& e) {
     std::string m = e.what();
     const std::string lead = "field '.";

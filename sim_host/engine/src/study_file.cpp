@@ -132,7 +132,7 @@ StudyFile parse_study(const std::string& text, const std::string& source, const 
   const json root = parse_json_strict(text, source);
   try {
     require_keys(root, "study file", {"schema", "study", "description", "plant", "duration_s", "seeds", "nodes", "links",
-                                      "buses", "approaches", "scenarios"});
+                                      "buses", "cpus", "approaches", "scenarios"});
     StudyFile s;
     s.source = source;
     if (string_of(root, "study file", "schema") != kStudySchemaVersion) {
@@ -150,12 +150,24 @@ StudyFile parse_study(const std::string& text, const std::string& source, const 
     s.first_seed = static_cast<std::uint64_t>(integer_in(seeds, "seeds", "first", 0, INT64_MAX, true, 1));
     s.seeds = static_cast<std::size_t>(integer_in(seeds, "seeds", "count", 2, 10'000'000));
 
+    // CPUs first (the nodes name them): the task-file parser, fields under cpus[i].
+    const json& cpus = array_of(root, "study file", "cpus", true);
+    for (std::size_t i = 0; i < cpus.size(); ++i) {
+      const std::string f = at("cpus", i);
+      if (!cpus[i].is_object() || !cpus[i].contains("name")) throw InputError("field '" + f + ".name': missing");
+      cpu::TaskSet c = cpu::parse_task_set_json(cpus[i], f, base_dir, true);
+      c.streams_per_cpu = true;
+      for (const cpu::TaskSet& o : s.cpus)
+        if (o.name == c.name) throw InputError("field '" + f + ".name': '" + c.name + "' used twice");
+      s.cpus.push_back(std::move(c));
+    }
+
     const json& nodes = array_of(root, "study file", "nodes", true);
     std::set<std::int64_t> addresses;
     for (std::size_t i = 0; i < nodes.size(); ++i) {
       const std::string f = at("nodes", i);
       const json& n = nodes[i];
-      require_keys(n, f, {"name", "role", "address", "mode", "period_us", "clock_offset_us", "trigger"});
+      require_keys(n, f, {"name", "role", "address", "mode", "period_us", "clock_offset_us", "trigger", "cpu", "job"});
       NodeSpec node;
       node.name = string_of(n, f, "name");
       node.role = string_of(n, f, "role");
@@ -173,6 +185,21 @@ StudyFile parse_study(const std::string& text, const std::string& source, const 
       }
       node.clock_offset = from_us(integer_in(n, f, "clock_offset_us", -3'600'000'000, 3'600'000'000, true, 0));
       if (n.contains("trigger")) node.trigger = parse_trigger(n["trigger"], f + ".trigger");
+      if (n.contains("cpu")) {
+        node.cpu = string_of(n, f, "cpu");
+        const cpu::TaskSet* on = nullptr;
+        for (const cpu::TaskSet& c : s.cpus)
+          if (c.name == node.cpu) on = &c;
+        if (on == nullptr) throw InputError("field '" + f + ".cpu': no cpu '" + node.cpu + "' (cpus[].name)");
+        if (!n.contains("job")) throw InputError("field '" + f + ".job': missing (the node's job on cpu '" + node.cpu + "')");
+        node.job = cpu::parse_node_job(n["job"], f + ".job", node.name, base_dir);
+        node.job_exec = n["job"].contains("exec");
+        for (const auto* list : {&on->tasks, &on->isrs})
+          for (const cpu::TaskSpec& t : *list)
+            if (t.name == node.name) throw InputError("field '" + f + ".name': cpu '" + node.cpu + "' has a task or ISR '" + t.name + "'");
+      } else if (n.contains("job")) {
+        throw InputError("field '" + f + ".job': a job needs a cpu (nodes[].cpu)");
+      }
       s.nodes.push_back(node);
     }
     unique_names(s.nodes, "nodes");

@@ -304,4 +304,27 @@ TEST(Cpu, LogRecordsPreemptionAndResume) {
             "preempt:lo@4 start:hi@4 sample:hi@4 actuate:hi@5 finish:hi@5 resume:lo@5 actuate:lo@7 finish:lo@7 ");
 }
 
+/// An external task (a node's job) arrives only when released: hi (T 4, C 1) above ext (C 2):
+/// released at 0 and 4 it waits for hi's job (response 1 + 2), at 9 it runs at once (2).
+TEST(Cpu, ExternalTaskArrivesOnlyWhenReleased) {
+  TaskSet s;
+  s.tasks = {task("hi", 4, 1, 1, 1), task("ext", 10, 2, 2, 2)};
+  s.tasks[1].external = true;
+  s.tasks[1].sporadic = true;
+  Kernel k(1);
+  Cpu cpu(k, s);
+  const HandlerId rel = k.add_handler("release", [&](std::uint64_t) { cpu.release(1); });
+  for (std::int64_t t : {0, 4, 9}) k.schedule(SimTime{from_us(t)}, EventClass::kEnvironment, rel);
+  std::vector<std::int64_t> responses;
+  cpu.on_job([&](const CpuJob& j) {
+    if (j.entity == 1) responses.push_back((j.finish - j.arrival).count() / 1000);
+  });
+  cpu.start(from_us(40));
+  k.run_until(from_us(50));
+  EXPECT_EQ(responses, (std::vector<std::int64_t>{3, 3, 2}));
+  EXPECT_EQ(cpu.stats()[1].released, 3U);
+  EXPECT_EQ(cpu.stats()[0].released, 11U);  // hi: 0, 4, …, 40
+  EXPECT_THROW(cpu.release(0), std::invalid_argument);  // hi is not external
+}
+
 }  // namespace

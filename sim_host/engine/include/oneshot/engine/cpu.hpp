@@ -13,7 +13,8 @@
 /// A context switch costs `context_switch` of CPU time, charged to the incoming task job
 /// whenever the CPU switches to a task job other than the last one it ran (ISRs return
 /// to the interrupted job without one). Random streams per task: "cpu/<task>/exec",
-/// "cpu/<task>/jitter", "cpu/<task>/arrival".
+/// "cpu/<task>/jitter", "cpu/<task>/arrival" ("cpu/<cpu>/<task>/…" with
+/// TaskSet::streams_per_cpu). External tasks arrive only by release().
 #pragma once
 
 #include <cstdint>
@@ -96,8 +97,11 @@ class Cpu {
   Cpu(const Cpu&) = delete;
   Cpu& operator=(const Cpu&) = delete;
 
-  /// Schedules the first arrivals; no arrival is scheduled after `end`.
+  /// Schedules the first arrivals (not of external tasks); no arrival is scheduled after `end`.
   void start(SimTime end);
+  /// A job of external task `task` (TaskSpec::external) arrives now: queued, released and
+  /// dispatched as any arrival (execution drawn from its stream, overrun policy applied).
+  void release(std::size_t task);
   /// Keeps the log (entries beyond `max_entries` are counted, not stored).
   void enable_log(std::size_t max_entries) { log_enabled_ = true; log_limit_ = max_entries; }
   /// Called for every finished or aborted job.
@@ -135,6 +139,7 @@ class Cpu {
   };
 
   void arrive(std::size_t e);
+  void admit(std::size_t e);
   void make_ready(std::uint64_t arg);
   void complete(std::uint64_t generation);
   void abort_job(std::uint64_t arg);

@@ -72,6 +72,9 @@ struct TaskSpec {
   OverrunPolicy overrun = OverrunPolicy::kContinue;  ///< Late jobs.
   JobPoint sample_at = job_start();  ///< Where the job reads its input (cpu_job_point.hpp).
   JobPoint actuate_at = job_end();   ///< Where it writes its output (not before sample_at).
+  /// Released from outside (Cpu::release(): a node's job on its input's arrival), never by
+  /// its own arrivals; the analysis takes it as sporadic with minimum inter-arrival `period`.
+  bool external = false;
 };
 
 /// A CPU and what runs on it.
@@ -81,6 +84,9 @@ struct TaskSet {
   Duration context_switch{0};      ///< Charged whenever a task job is dispatched after another (or idle).
   std::vector<TaskSpec> tasks;     ///< Tasks.
   std::vector<TaskSpec> isrs;      ///< Interrupt handlers (cost = exec; no overrun policy but continue).
+  /// Random streams "cpu/<name>/<task>/exec|jitter|arrival" (a study file's CPUs) instead of
+  /// "cpu/<task>/…" (a task file's single CPU).
+  bool streams_per_cpu = false;
 
   /// Σ wcet/T over tasks and ISRs (context switches excluded).
   double utilization() const;
@@ -98,6 +104,19 @@ const char* to_string(OverrunPolicy p);
 TaskSet parse_task_set(const std::string& text, const std::string& source, const std::string& base_dir);
 /// Parses one execution-time model object (the task file's "exec"; `field` names it in errors).
 ExecModel parse_exec_model(const nlohmann::json& j, const std::string& field, const std::string& base_dir);
+/// Parses a task file's object `root` (the keys name, scheduler, context_switch_us, tasks,
+/// isrs); fields named under `prefix` ("cpus[0]" → "cpus[0].tasks[1].wcet_us"; "" for a task
+/// file). `allow_no_tasks`: an empty or absent "tasks" accepted (a study file's CPU whose only
+/// task may be a node's job). InputError without the source.
+TaskSet parse_task_set_json(const nlohmann::json& root, const std::string& prefix, const std::string& base_dir,
+                            bool allow_no_tasks);
+/// Parses a node's job (a study file's `nodes[i].job`) with the task parser: the task keys
+/// wcet_us, bcet_us, exec, priority, deadline_us, nonpreemptive_us, overrun (no name, period,
+/// offset, jitter, sample or actuation point: the node reads its input and sends at the job's
+/// end, released by its input's arrival). Named `name`, external, sporadic; its period (the
+/// minimum inter-arrival) and, when `deadline_us` is absent, its deadline are 0: the runner
+/// sets them. InputError naming `field`.
+TaskSpec parse_node_job(const nlohmann::json& j, const std::string& field, const std::string& name, const std::string& base_dir);
 /// Reads (bounded) and parses a task file.
 TaskSet load_task_set(const std::string& path);
 

@@ -21,6 +21,7 @@
 
 #include "oneshot/engine/can_analysis.hpp"
 #include "oneshot/engine/can_bus.hpp"
+#include "oneshot/engine/cpu_task_set.hpp"
 #include "oneshot/engine/delay_model.hpp"
 #include "oneshot/engine/json_fields.hpp"
 #include "oneshot/engine/link.hpp"
@@ -83,6 +84,11 @@ struct NodeSpec {
   Duration period{0};            ///< Timer period (mode timer; 0 otherwise).
   Duration clock_offset{0};      ///< Its clock reads t + offset.
   std::optional<TriggerSpec> trigger;  ///< Sensors (and event-triggered controllers).
+  std::string cpu;               ///< The CPU its job runs on (a declared `cpus[].name`; empty: none).
+  /// Its job on that CPU (cpu_task_set.hpp parse_node_job(): external, period and an absent
+  /// deadline 0, set by the runner); given exactly when `cpu` is.
+  std::optional<cpu::TaskSpec> job;
+  bool job_exec = false;         ///< The job's execution time is an `exec` model (not wcet_us/bcet_us).
 };
 
 /// A link between two nodes: its own delay/loss models, or a CAN bus identifier.
@@ -132,6 +138,9 @@ struct StudyFile {
   std::vector<NodeSpec> nodes;          ///< Nodes.
   std::vector<LinkSpec> links;          ///< Links.
   std::vector<BusSpec> buses;           ///< CAN buses.
+  /// CPUs (the kernel task file's keys: name, scheduler, context_switch_us, background
+  /// tasks, isrs; streams per CPU), names unique; node jobs are not among their tasks.
+  std::vector<cpu::TaskSet> cpus;
   std::vector<ApproachSpec> approaches; ///< Approaches.
   std::vector<ScenarioSpec> scenarios;  ///< Scenarios.
 
