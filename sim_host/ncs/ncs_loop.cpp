@@ -504,7 +504,8 @@ RunResult run_one_shot(Harness& hs, Approach a) {
   Vector<double, kP> r_diag;
   for (std::size_t i = 0; i < kP; ++i) r_diag[i] = hs.design_.r(i, i);
   OneShotLaw::Receiver rx(delta, r_diag, n_t, a == Approach::kOS ? node::SilencePolicy::kHeld : node::SilencePolicy::kPredictOnly);
-  OneShotLaw::Estimator est(hs.design_.phi_h, hs.design_.gamma_h, hs.design_.qd_h, hs.design_.c);
+  // Q_d at the scenario's noise scale s (the plant's process noise is s·Q_c; the design's qd_h is at s = 1).
+  OneShotLaw::Estimator est(hs.design_.phi_h, hs.design_.gamma_h, hs.design_.qd_h * sc.noise_scale, hs.design_.c);
   const Vector<double, kN> x0 = hs.ref_.state(0);
   est.reset(x0, hs.design_.p0);
   Sensor sensor(kController, Trigger(delta, sensor_n_t));

@@ -2,6 +2,7 @@
 /// @brief The sweep and summary of `oneshot-sim study run` (see study_ncs_sweep.hpp).
 #include "study_ncs_sweep.hpp"
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstdio>
@@ -12,6 +13,7 @@
 #include "ncs_analytic.hpp"
 #include "ncs_experiments.hpp"
 #include "ncs_loop.hpp"
+#include "oneshot/engine/sweep_statistics.hpp"
 
 namespace oneshot::study {
 namespace {
@@ -102,6 +104,11 @@ std::array<double, std::size(kBusDelayMetrics)> bus_delays(const ncs::RunResult&
 
 engine::SweepResults run_ncs_sweep(const NcsStudy& s, std::size_t seeds, unsigned threads, const engine::Shard& shard,
                                    bool analytic) {
+  bool one_shot = false;
+  for (ncs::Approach a : s.approaches) one_shot = one_shot || ncs::one_shot(a);
+  if (analytic && one_shot) {
+    throw engine::InputError("field '--analytic': the one-shot approaches (OS, OSp, OSK) have no analytic cost");
+  }
   engine::SweepSpec spec;
   spec.study = "study";
   spec.experiment = "run";
@@ -139,6 +146,8 @@ engine::SweepResults run_ncs_sweep(const NcsStudy& s, std::size_t seeds, unsigne
     for (const char* c : kLinkCounters) spec.metrics.push_back(l + "." + c);
   for (const std::string& l : on_bus)
     for (const char* c : kBusDelayMetrics) spec.metrics.push_back(l + "." + c);
+  // Only with one-shot approaches: the spec of other files stays as it was.
+  if (one_shot) spec.metrics.insert(spec.metrics.end(), std::begin(kOneShotMetrics), std::end(kOneShotMetrics));
   spec.config = {{"study_file", s.source},
                  {"plant", s.ctx->plant().name},
                  {"plant_source", s.ctx->plant().source},
@@ -162,7 +171,7 @@ engine::SweepResults run_ncs_sweep(const NcsStudy& s, std::size_t seeds, unsigne
   const std::vector<std::string>* bus = &on_bus;
   return engine::run_sweep(
       spec, shard, threads,
-      [study, counter_maps, bus, analytic](std::size_t a, std::size_t k, std::uint64_t seed) {
+      [study, counter_maps, bus, analytic, one_shot](std::size_t a, std::size_t k, std::uint64_t seed) {
         const ncs::Approach ap = study->approaches[a];
         const ncs::RunResult r = ncs::run(*study->ctx, ap, study->scenarios[k], seed, ncs::RunOptions{});
         std::vector<double> v{r.cost, static_cast<double>(r.late), static_cast<double>(r.saturated),
@@ -175,6 +184,7 @@ engine::SweepResults run_ncs_sweep(const NcsStudy& s, std::size_t seeds, unsigne
           const auto d = bus_delays(r, l);
           v.insert(v.end(), d.begin(), d.end());
         }
+        if (one_shot) v.insert(v.end(), {r.nees, static_cast<double>(r.nees_steps), static_cast<double>(r.sampled), static_cast<double>(r.sent)});
         if (analytic) {  // ncs table --analytic's columns: the same run in analytic mode
           const auto x = ncs::analytic_metrics(*study->ctx, ap, study->scenarios[k], seed, ncs::RunOptions{});
           v.insert(v.end(), x.begin(), x.end());
@@ -249,6 +259,47 @@ void add_bus_delays(nlohmann::json& j, const engine::SweepResults& results) {
 
 }  // namespace
 
+namespace {
+
+/// Adds "one_shot" (per one-shot approach: the filter's NEES, mean and 95 % interval over
+/// seeds of the scenario mean, and the sensor's send rate, overall and per scenario) and its
+/// table to the markdown.
+void add_one_shot(nlohmann::json& j, const engine::SweepResults& results) {
+  const engine::SweepSpec& spec = results.spec;
+  const engine::SweepSummary nees = engine::summarize_metric(results, results.metric("nees"), 0);
+  const std::size_t sampled = results.metric("sensor.samples");
+  const std::size_t sent = results.metric("sensor.sent");
+  std::string md = "\n| approach | NEES (n = 2) | 95 % CI | samples sent |\n|---|---:|---:|---:|\n";
+  for (std::size_t a = 0; a < spec.approaches.size(); ++a) {
+    if (!ncs::one_shot(ncs::parse_any_approach(spec.approaches[a]))) continue;
+    nlohmann::json e = {{"nees_mean", nees.value[a].mean}, {"nees_ci95", nees.value[a].ci95}};
+    double n_all = 0, s_all = 0;
+    for (std::size_t x = 0; x < spec.scenarios.size(); ++x) {
+      double n = 0, sn = 0;
+      for (std::size_t k = 0; k < spec.seeds; ++k) {
+        n += results.at(a, x, k, sampled);
+        sn += results.at(a, x, k, sent);
+      }
+      e["per_scenario"][spec.scenarios[x]] = {{"nees_mean", nees.per_scenario[a][x].mean},
+                                              {"nees_ci95", nees.per_scenario[a][x].ci95},
+                                              {"samples", n}, {"sent", sn}, {"send_rate", n > 0 ? sn / n : 0.0}};
+      n_all += n;
+      s_all += sn;
+    }
+    e["samples"] = n_all;
+    e["sent"] = s_all;
+    e["send_rate"] = n_all > 0 ? s_all / n_all : 0.0;
+    j["one_shot"][spec.approaches[a]] = e;
+    char row[200];
+    std::snprintf(row, sizeof row, "| %s | %.4f | ± %.4f | %.4f |\n", spec.approaches[a].c_str(), nees.value[a].mean,
+                  nees.value[a].ci95, e["send_rate"].get<double>());
+    md += row;
+  }
+  j["markdown"] = j.at("markdown").get<std::string>() + md;
+}
+
+}  // namespace
+
 nlohmann::json run_outputs(const engine::SweepResults& results, const std::string& out_dir, bool plots) {
   nlohmann::json j = ncs::table_outputs(results, out_dir, plots);
   const engine::SweepSpec& spec = results.spec;
@@ -273,6 +324,7 @@ nlohmann::json run_outputs(const engine::SweepResults& results, const std::strin
     }
   }
   if (spec.config.contains("bus_links")) add_bus_delays(j, results);
+  if (std::find(spec.metrics.begin(), spec.metrics.end(), "nees") != spec.metrics.end()) add_one_shot(j, results);
   return j;
 }
 

@@ -24,6 +24,11 @@ inline constexpr const char* kLinkCounters[] = {"sent", "delivered", "lost", "la
 /// queued to the end of the message's last frame: queueing + transmission).
 inline constexpr const char* kBusDelayMetrics[] = {"bus_messages", "bus_delay_min_us", "bus_delay_max_us", "bus_delay_sum_us"};
 
+/// Metrics of the one-shot approaches (only in sweeps that run one): the filter's NEES (mean of
+/// e_kᵀ P_k⁻¹ e_k over the run's computations, 0 for the other approaches), its computations,
+/// the sensor's samples and the samples it sent.
+inline constexpr const char* kOneShotMetrics[] = {"nees", "nees_steps", "sensor.samples", "sensor.sent"};
+
 /// Position of the counter `name` in kLinkCounters (its size when there is none).
 constexpr std::size_t link_counter_index(std::string_view name) {
   std::size_t i = 0;
@@ -56,7 +61,9 @@ engine::SweepResults run_ncs_sweep(const NcsStudy& s, std::size_t seeds, unsigne
 /// CAN bus, "bus_delays": per approach and leg the messages, min_us, mean_us, max_us of the
 /// observed delays (queueing + transmission) over every run, the check's worst_response_us
 /// (the largest over the scenarios; null when unbounded), within_bound, and per_scenario the
-/// same; their table is appended to "markdown".
+/// same; their table is appended to "markdown". With one-shot approaches, "one_shot": per
+/// such approach nees_mean, nees_ci95 (over seeds), samples, sent, send_rate and per_scenario
+/// the same (table appended to "markdown").
 nlohmann::json run_outputs(const engine::SweepResults& results, const std::string& out_dir, bool plots);
 
 }  // namespace oneshot::study
