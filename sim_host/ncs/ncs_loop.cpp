@@ -535,10 +535,13 @@ RunResult run_one_shot(Harness& hs, Approach a) {
     const double e0 = truth[n][0] - xh[0];
     const double e1 = truth[n][1] - xh[1];
     const double det = p(0, 0) * p(1, 1) - p(0, 1) * p(1, 0);
-    // eᵀ P⁻¹ e with P⁻¹ = [[p11, −p01], [−p10, p00]] / det
-    nees_sum += (e0 * e0 * p(1, 1) - e0 * e1 * (p(0, 1) + p(1, 0)) + e1 * e1 * p(0, 0)) / det;
-    ++nees_n;
     hs.estimate(kk, xh);
+    if (!(det > 0)) return;  // a singular P (noise scale 0): no NEES term
+    // eᵀ P⁻¹ e with P⁻¹ = [[p11, −p01], [−p10, p00]] / det
+    const double q = (e0 * e0 * p(1, 1) - e0 * e1 * (p(0, 1) + p(1, 0)) + e1 * e1 * p(0, 0)) / det;
+    if (!std::isfinite(q)) return;
+    nees_sum += q;
+    ++nees_n;
   });
   auto ctrl_h = std::make_shared<HandlerId>(0);
   *ctrl_h = k.add_handler("controller timer", [&, ctrl_h](std::uint64_t n) {
