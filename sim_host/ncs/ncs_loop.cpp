@@ -511,6 +511,9 @@ RunResult run_one_shot(Harness& hs, Approach a) {
   Sensor sensor(kController, Trigger(delta, sensor_n_t));
   Ctrl ctrl(kActuator, node::ControllerMode::kOnTimer, OneShotLaw(rx, est, hs.design_.l, hs.u_min_, hs.u_max_, hs.ref_));
   ctrl.expect_source(kSensor);
+  // A send-on-delta sensor may stay silent for any number of periods: its next sample is not a
+  // sequence jump (the frame checks' default window is 4096 periods).
+  ctrl.set_sequence_window(1U << 30, node::kDefaultReacquireFrames);
   Act act(node::ActuatorMode::kOnTimer, InputVec{});
   live::check_commands(hs.ctx_, act);
   engine::Network& net = hs.net_;
