@@ -156,6 +156,11 @@ engine::SweepResults run_ncs_sweep(const NcsStudy& s, std::size_t seeds, unsigne
                  {"compute_us", {s.ctx->timing().compute_min_us, s.ctx->timing().compute_max_us}},
                  {"scenarios", sc}};
   if (!on_bus.empty()) spec.config["bus_links"] = on_bus;  // only then: the spec of files without stays as it was
+  if (one_shot && !s.scenarios.empty()) {  // the file's sensor rule and controller phase (the same in every scenario)
+    const ncs::Scenario& x = s.scenarios[0];
+    spec.config["one_shot"] = {{"send_on_delta", x.sod_delta}, {"time_steps", x.sod_time_steps},
+                               {"controller_phase_us", x.controller_phase_us}};
+  }
   if (analytic) {  // only then, as ncs table: the spec stays as it was without
     spec.config["analytic"] = true;
     spec.metrics.insert(spec.metrics.end(), std::begin(ncs::kAnalyticMetrics), std::end(ncs::kAnalyticMetrics));
