@@ -450,10 +450,13 @@ class OneShotLaw {
     return node::LawResult::kSend;
   }
 
-  /// x̂_{k|k} of the last computation and its covariance.
+  /// x̂_{k|k} of the last computation.
   const Vector<double, kN>& corrected() const { return corrected_; }
+  /// Its covariance P_{k|k}.
   const Matrix<double, kN, kN>& corrected_covariance() const { return corrected_p_; }
+  /// Commands clamped to the actuator's range.
   std::uint32_t saturated() const { return saturated_; }
+  /// Filter steps whose status was not kOk (singular or reset).
   std::uint32_t faults() const { return faults_; }
 
  private:
