@@ -34,6 +34,9 @@ const char* name(Approach a) {
     case Approach::kSK: return "SK";
     case Approach::kSPlus: return "S+";
     case Approach::kIK: return "IK";
+    case Approach::kOS: return "OS";
+    case Approach::kOSp: return "OSp";
+    case Approach::kOSK: return "OSK";
   }
   return "?";
 }
@@ -49,6 +52,9 @@ const char* description(Approach a) {
     case Approach::kSK: return "sampling-synchronized, periodic Kalman";
     case Approach::kSPlus: return "sampling-synchronized, LQR on eq. 8 for the mean delay";
     case Approach::kIK: return "no delay, noise, periodic Kalman";
+    case Approach::kOS: return "one-shot, send-on-delta sensor, held value with inflated R";
+    case Approach::kOSp: return "one-shot, send-on-delta sensor, predict-only when silent";
+    case Approach::kOSK: return "one-shot, sensor every sample, predict-only when missing";
   }
   return "?";
 }
@@ -57,6 +63,12 @@ Approach parse_approach(const std::string& text) {
   for (Approach a : kAllApproaches)
     if (text == name(a)) return a;
   throw std::invalid_argument("ncs: unknown approach '" + text + "' (I, S, A, AK, AKx, AKl, SK, S+, IK)");
+}
+
+Approach parse_any_approach(const std::string& text) {
+  for (Approach a : kOneShotApproaches)
+    if (text == name(a)) return a;
+  return parse_approach(text);
 }
 
 bool actuation_synchronized(Approach a) {

@@ -31,17 +31,28 @@ using Fmt = UniformFormat<double>;
 using Design = ControllerDesign<Fmt, kN, kM, kP>;
 using Disc = GenericDiscretizer<Fmt, kN, kM>;
 
-/// The approaches of brief §5, in table order (I first: the reference of every ratio).
-enum class Approach : std::uint8_t { kI, kS, kA, kAK, kAKx, kAKl, kSK, kSPlus, kIK };
+/// The approaches of brief §5, in table order (I first: the reference of every ratio), then
+/// the one-shot loops of study files (kOneShotApproaches; not in study ncs's table).
+enum class Approach : std::uint8_t { kI, kS, kA, kAK, kAKx, kAKl, kSK, kSPlus, kIK, kOS, kOSp, kOSK };
 inline constexpr std::array<Approach, 9> kAllApproaches = {Approach::kI,   Approach::kS,   Approach::kA,
                                                            Approach::kAK,  Approach::kAKx, Approach::kAKl,
                                                            Approach::kSK,  Approach::kSPlus, Approach::kIK};
-/// Short name ("I", "S", "A", "AK", "AKx", "AKl", "SK", "S+", "IK").
+/// The one-shot loops (study files): sensor on its timer at kh (send-on-delta for OS and OSp,
+/// every sample for OSK), controller on its timer at kh + φ (Scenario::controller_phase_us)
+/// correcting with what arrived (OS: a silent sensor's held value with R̄ = R + ((d+1)δy)²/3;
+/// OSp and OSK: predict only) and computing u_{k+1}, actuator on its timer applying it at (k+1)h.
+inline constexpr std::array<Approach, 3> kOneShotApproaches = {Approach::kOS, Approach::kOSp, Approach::kOSK};
+/// True for the one-shot loops (OS, OSp, OSK).
+constexpr bool one_shot(Approach a) { return a == Approach::kOS || a == Approach::kOSp || a == Approach::kOSK; }
+/// Short name ("I", "S", "A", "AK", "AKx", "AKl", "SK", "S+", "IK", "OS", "OSp", "OSK").
 const char* name(Approach a);
 /// One-line description.
 const char* description(Approach a);
-/// Approach from its name; std::invalid_argument listing the names otherwise.
+/// Approach of study ncs (kAllApproaches) from its name; std::invalid_argument listing the names otherwise.
 Approach parse_approach(const std::string& text);
+/// Any approach from its name, the one-shot loops of study files included (kOneShotApproaches);
+/// std::invalid_argument listing the names otherwise.
+Approach parse_any_approach(const std::string& text);
 /// True for the actuation-synchronized loops (A, AK, AKx, AKl).
 bool actuation_synchronized(Approach a);
 /// True for the ideal loops without delays (I, IK).
@@ -83,6 +94,13 @@ struct Scenario {
   /// τ_c ~ U[first, second] in whole µs instead of Timing's U[1, 5] ms (without a CPU; study
   /// files do not set it: a constant τ_c is the oracle of a lone constant job on a CPU).
   std::optional<std::pair<std::int64_t, std::int64_t>> compute_us;
+  /// One-shot loops (OS, OSp): the sensor's send-on-delta thresholds δy per output (empty:
+  /// every sample) and its time rule n_t in samples (0: plain send-on-delta), from a study file.
+  std::vector<double> sod_delta;
+  std::uint32_t sod_time_steps = 0;  ///< n_t of the send-on-delta rule (0: off).
+  /// One-shot loops: the controller's timer fires φ after each sampling instant, at kh + φ
+  /// (0 < φ < h; std::invalid_argument otherwise).
+  std::int64_t controller_phase_us = 0;
 };
 
 /// True when the legs come from a study file (point to point or on a bus), not from d.

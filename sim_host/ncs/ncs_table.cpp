@@ -130,7 +130,7 @@ nlohmann::json table_outputs(const engine::SweepResults& results, const std::str
       }
     }
     const std::string& nm = spec.approaches[a];
-    const Approach ap = parse_approach(nm);
+    const Approach ap = parse_any_approach(nm);
     j["approaches"][nm] = {{"description", description(ap)},
                            {"cost_mean", sm.value[a].mean},
                            {"cost_ci95", sm.value[a].ci95},

@@ -54,14 +54,16 @@ json link_summary(const engine::LinkConfig& c) {
           {"order", c.fifo ? "fifo" : "any"}};
 }
 
+bool one_shot_kind(const std::string& kind) { return kind == "OS" || kind == "OSp" || kind == "OSK"; }
+
 bool has_estimator(const std::string& kind) {
-  return kind == "AK" || kind == "AKx" || kind == "AKl" || kind == "SK" || kind == "IK";
+  return kind == "AK" || kind == "AKx" || kind == "AKl" || kind == "SK" || kind == "IK" || one_shot_kind(kind);
 }
 
 bool ncs_kind(const std::string& kind) {
   for (ncs::Approach a : ncs::kAllApproaches)
     if (kind == ncs::name(a)) return true;
-  return false;
+  return one_shot_kind(kind);
 }
 
 json plant_section(const engine::StudyFile& f, json& designs) {
@@ -129,6 +131,10 @@ json resolve_study(const engine::StudyFile& f) {
         e["lqr_gain"] = design["lqr_gain"];
         e["closed_loop_spectral_radius"] = design["closed_loop_spectral_radius"];
         e["design"] = has_estimator(a.kind) ? "LQR + Kalman" : "LQR";
+        if (one_shot_kind(a.kind)) {  // the filter runs on what arrives: its gain varies (kalman_gain: the steady state of every sample)
+          e["design"] = a.kind == "OS" ? "LQR on the prediction to (k+1)h + Kalman filter, a silent sensor's held value with inflated R"
+                                       : "LQR on the prediction to (k+1)h + Kalman filter, predict-only when no sample arrives";
+        }
         if (has_estimator(a.kind)) {
           e["kalman_gain"] = design["kalman_gain"];
           e["estimator_spectral_radius"] = design["estimator_spectral_radius"];

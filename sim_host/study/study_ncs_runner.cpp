@@ -49,6 +49,7 @@ const engine::StudySchema& ncs_schema() {
     engine::StudySchema s;
     s.study = "ncs";
     for (ncs::Approach a : ncs::kAllApproaches) s.approach_kinds.emplace_back(ncs::name(a));
+    for (ncs::Approach a : ncs::kOneShotApproaches) s.approach_kinds.emplace_back(ncs::name(a));
     s.scenario_params = {{"amplitude_volts", 0, 100, false, true, 0},
                          {"period_s", 1e-3, 1e6, false, true, 0},
                          {"noise_scale", 0, 1e6, false, false, 1}};
@@ -84,6 +85,13 @@ NcsStudy map_ncs_study(const engine::StudyFile& file) {
     const std::map<std::string, std::uint8_t> address = {
         {"sensor", ncs::kLiveSensor}, {"controller", ncs::kLiveController}, {"actuator", ncs::kLiveActuator}};
     std::map<std::string, std::string> by_role;  // role → node name
+    // One-shot loops (OS, OSp, OSK): the controller runs a timer at kh + φ, the sensor may send on delta.
+    bool one_shot = false;
+    for (const engine::ApproachSpec& a : file.approaches) one_shot = one_shot || a.kind == "OS" || a.kind == "OSp" || a.kind == "OSK";
+    std::string sod_field;  // the sensor's send-on-delta trigger ("" when it has none)
+    std::vector<double> sod_delta;
+    std::uint32_t sod_time_steps = 0;
+    std::int64_t phase_us = 0;
     for (std::size_t i = 0; i < file.nodes.size(); ++i) {
       const engine::NodeSpec& n = file.nodes[i];
       const std::string f = at("nodes", i);
@@ -91,11 +99,37 @@ NcsStudy map_ncs_study(const engine::StudyFile& file) {
       if (n.address != address.at(n.role)) {
         refuse(f + ".address", "the ncs loop's " + n.role + " has address " + std::to_string(address.at(n.role)));
       }
-      if (n.clock_offset.count() != 0) refuse(f + ".clock_offset_us", "study ncs runs its nodes on one clock (0 only)");
-      if (n.trigger && !(n.trigger->rule == engine::TriggerSpec::Rule::kPeriodic && n.trigger->every == 1)) {
-        refuse(f + ".trigger", "study ncs samples every period (periodic, every 1, only)");
+      const bool timed_controller = one_shot && n.role == "controller";
+      if (timed_controller && !n.cpu.empty()) {
+        refuse(f + ".cpu", "the one-shot controller runs on its timer: its job on a CPU is not modelled (the CPU models the "
+                           "controller of the arrival-driven approaches)");
       }
-      if (n.role == "controller") {
+      if (n.clock_offset.count() != 0 && !timed_controller) {
+        refuse(f + ".clock_offset_us", "study ncs runs its nodes on one clock (0 only; the one-shot controller's gives its phase)");
+      }
+      const bool sod = n.trigger && n.trigger->rule == engine::TriggerSpec::Rule::kSendOnDelta && n.role == "sensor";
+      if (sod) {
+        if (!one_shot) refuse(f + ".trigger", "send-on-delta runs with the one-shot approaches only (OS, OSp, OSK)");
+        if (n.trigger->delta.size() != ncs::kP) {
+          refuse(f + ".trigger.delta", "one threshold per output: " + std::to_string(ncs::kP) + " values, not " +
+                                           std::to_string(n.trigger->delta.size()));
+        }
+        sod_field = f + ".trigger";
+        sod_delta = n.trigger->delta;
+        sod_time_steps = n.trigger->time_steps;
+      } else if (n.trigger && !(n.trigger->rule == engine::TriggerSpec::Rule::kPeriodic && n.trigger->every == 1)) {
+        refuse(f + ".trigger", "study ncs samples every period (periodic, every 1, or a sensor's send-on-delta with OS, OSp)");
+      }
+      if (timed_controller) {
+        if (n.mode != "timer") refuse(f + ".mode", "the one-shot controller (OS, OSp, OSK) runs a timer at h");
+        if (n.period.count() != h_us * 1000) refuse(f + ".period_us", "must be the plant's period h = " + std::to_string(h_us) + " us");
+        const std::int64_t phi = n.clock_offset.count() / 1000;
+        if (!(phi > 0 && phi < h_us) || phi * 1000 != n.clock_offset.count()) {
+          refuse(f + ".clock_offset_us", "the one-shot controller's phase: its timer fires at kh + clock_offset_us, 0 < it < h = " +
+                                             std::to_string(h_us) + " us (whole us)");
+        }
+        phase_us = phi;
+      } else if (n.role == "controller") {
         if (n.mode != "arrival") refuse(f + ".mode", "the ncs controller computes on arrival");
       } else {
         if (n.mode != "timer") {
@@ -141,10 +175,25 @@ NcsStudy map_ncs_study(const engine::StudyFile& file) {
       const std::string f = at("approaches", i);
       bool known = false;
       for (ncs::Approach k : ncs::kAllApproaches) known = known || a.kind == ncs::name(k);
-      if (!known) refuse(f + ".kind", "unknown kind '" + a.kind + "' (I, S, A, AK, AKx, AKl, SK, S+, IK)");
+      for (ncs::Approach k : ncs::kOneShotApproaches) known = known || a.kind == ncs::name(k);
+      if (!known) refuse(f + ".kind", "unknown kind '" + a.kind + "' (I, S, A, AK, AKx, AKl, SK, S+, IK, OS, OSp, OSK)");
       if (!a.params.empty()) refuse(f + ".params", "the ncs approaches take no parameters");
       if (a.name != a.kind) refuse(f + ".name", "must be its kind '" + a.kind + "' (the ncs table names approaches by kind)");
-      const ncs::Approach ap = ncs::parse_approach(a.kind);
+      const ncs::Approach ap = ncs::parse_any_approach(a.kind);
+      if (one_shot && !ncs::one_shot(ap) && !ncs::delay_free(ap)) {
+        refuse(f + ".kind", a.kind + " runs its controller on arrival: a file with one-shot approaches (OS, OSp, OSK) has a timer "
+                            "controller; its other approaches can be I and IK only");
+      }
+      if (!sod_field.empty() && !ncs::one_shot(ap) && !ncs::delay_free(ap)) {
+        refuse(f + ".kind", a.kind + " cannot use the sensor's send-on-delta rule (" + sod_field + ")");
+      }
+      if (sod_field.empty() && (ap == ncs::Approach::kOS || ap == ncs::Approach::kOSp)) {
+        refuse(f + ".kind", a.kind + " needs a send-on-delta sensor (nodes[].trigger {\"rule\": \"send_on_delta\", ...}); "
+                            "OSK is the one-shot loop with a sensor that sends every sample");
+      }
+      if (!first_bus_link.empty() && ncs::one_shot(ap)) {
+        refuse(f + ".kind", a.kind + ": the one-shot loops do not run on a CAN bus (" + first_bus_link + ")");
+      }
       if (i == 0 && ap != ncs::Approach::kI) refuse(f + ".kind", "the first approach must be I (the reference of every ratio)");
       if (ncs::actuation_synchronized(ap) && !has("as")) {
         refuse(f + ".kind", a.kind + " is actuation-synchronized: it needs the leg as (actuator to sensor)");
@@ -186,6 +235,9 @@ NcsStudy map_ncs_study(const engine::StudyFile& file) {
       sc.period_s = params.at("period_s");
       sc.noise_scale = params.at("noise_scale");
       sc.duration_s = s.duration_s.value_or(file.duration_s);
+      sc.sod_delta = sod_delta;
+      sc.sod_time_steps = sod_time_steps;
+      sc.controller_phase_us = phase_us;
       for (const engine::LinkSpec& l : file.links) {
         if (l.bus.empty()) {
           sc.legs[l.name] = file.link_config(l.name, &s);

@@ -2,6 +2,7 @@
 /// @brief The sweep and summary of `oneshot-sim study run` (see study_ncs_sweep.hpp).
 #include "study_ncs_sweep.hpp"
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstdio>
@@ -13,6 +14,7 @@
 #include "ncs_cpu.hpp"
 #include "ncs_experiments.hpp"
 #include "ncs_loop.hpp"
+#include "oneshot/engine/sweep_statistics.hpp"
 
 namespace oneshot::study {
 namespace {
@@ -111,6 +113,11 @@ std::array<double, std::size(kCpuMetrics)> cpu_metrics(const ncs::RunResult& r) 
 
 engine::SweepResults run_ncs_sweep(const NcsStudy& s, std::size_t seeds, unsigned threads, const engine::Shard& shard,
                                    bool analytic) {
+  bool one_shot = false;
+  for (ncs::Approach a : s.approaches) one_shot = one_shot || ncs::one_shot(a);
+  if (analytic && one_shot) {
+    throw engine::InputError("field '--analytic': the one-shot approaches (OS, OSp, OSK) have no analytic cost");
+  }
   engine::SweepSpec spec;
   spec.study = "study";
   spec.experiment = "run";
@@ -151,6 +158,8 @@ engine::SweepResults run_ncs_sweep(const NcsStudy& s, std::size_t seeds, unsigne
   const bool on_cpu = !s.scenarios.empty() && s.scenarios[0].controller_cpu != nullptr;
   if (on_cpu)
     for (const char* c : kCpuMetrics) spec.metrics.push_back(std::string("cpu.") + c);
+  // Only with one-shot approaches: the spec of other files stays as it was.
+  if (one_shot) spec.metrics.insert(spec.metrics.end(), std::begin(kOneShotMetrics), std::end(kOneShotMetrics));
   spec.config = {{"study_file", s.source},
                  {"plant", s.ctx->plant().name},
                  {"plant_source", s.ctx->plant().source},
@@ -167,6 +176,10 @@ engine::SweepResults run_ncs_sweep(const NcsStudy& s, std::size_t seeds, unsigne
                                      {"utilization", c.set.utilization()},
                                      {"wcrt_us", static_cast<double>(c.wcrt.count()) * 1e-3},
                                      {"bcrt_us", static_cast<double>(c.bcrt.count()) * 1e-3}};
+  if (one_shot && !s.scenarios.empty()) {  // the file's sensor rule and controller phase (the same in every scenario)
+    const ncs::Scenario& x = s.scenarios[0];
+    spec.config["one_shot"] = {{"send_on_delta", x.sod_delta}, {"time_steps", x.sod_time_steps},
+                               {"controller_phase_us", x.controller_phase_us}};
   }
   if (analytic) {  // only then, as ncs table: the spec stays as it was without
     spec.config["analytic"] = true;
@@ -183,7 +196,7 @@ engine::SweepResults run_ncs_sweep(const NcsStudy& s, std::size_t seeds, unsigne
   const std::vector<std::string>* bus = &on_bus;
   return engine::run_sweep(
       spec, shard, threads,
-      [study, counter_maps, bus, analytic, on_cpu](std::size_t a, std::size_t k, std::uint64_t seed) {
+      [study, counter_maps, bus, analytic, on_cpu, one_shot](std::size_t a, std::size_t k, std::uint64_t seed) {
         const ncs::Approach ap = study->approaches[a];
         const ncs::RunResult r = ncs::run(*study->ctx, ap, study->scenarios[k], seed, ncs::RunOptions{});
         std::vector<double> v{r.cost, static_cast<double>(r.late), static_cast<double>(r.saturated),
@@ -200,6 +213,7 @@ engine::SweepResults run_ncs_sweep(const NcsStudy& s, std::size_t seeds, unsigne
           const auto c = cpu_metrics(r);
           v.insert(v.end(), c.begin(), c.end());
         }
+        if (one_shot) v.insert(v.end(), {r.nees, static_cast<double>(r.nees_steps), static_cast<double>(r.sampled), static_cast<double>(r.sent)});
         if (analytic) {  // ncs table --analytic's columns: the same run in analytic mode
           const auto x = ncs::analytic_metrics(*study->ctx, ap, study->scenarios[k], seed, ncs::RunOptions{});
           v.insert(v.end(), x.begin(), x.end());
@@ -319,6 +333,47 @@ void add_cpu_stats(nlohmann::json& j, const engine::SweepResults& results) {
 
 }  // namespace
 
+namespace {
+
+/// Adds "one_shot" (per one-shot approach: the filter's NEES, mean and 95 % interval over
+/// seeds of the scenario mean, and the sensor's send rate, overall and per scenario) and its
+/// table to the markdown.
+void add_one_shot(nlohmann::json& j, const engine::SweepResults& results) {
+  const engine::SweepSpec& spec = results.spec;
+  const engine::SweepSummary nees = engine::summarize_metric(results, results.metric("nees"), 0);
+  const std::size_t sampled = results.metric("sensor.samples");
+  const std::size_t sent = results.metric("sensor.sent");
+  std::string md = "\n| approach | NEES (n = 2) | 95 % CI | samples sent |\n|---|---:|---:|---:|\n";
+  for (std::size_t a = 0; a < spec.approaches.size(); ++a) {
+    if (!ncs::one_shot(ncs::parse_any_approach(spec.approaches[a]))) continue;
+    nlohmann::json e = {{"nees_mean", nees.value[a].mean}, {"nees_ci95", nees.value[a].ci95}};
+    double n_all = 0, s_all = 0;
+    for (std::size_t x = 0; x < spec.scenarios.size(); ++x) {
+      double n = 0, sn = 0;
+      for (std::size_t k = 0; k < spec.seeds; ++k) {
+        n += results.at(a, x, k, sampled);
+        sn += results.at(a, x, k, sent);
+      }
+      e["per_scenario"][spec.scenarios[x]] = {{"nees_mean", nees.per_scenario[a][x].mean},
+                                              {"nees_ci95", nees.per_scenario[a][x].ci95},
+                                              {"samples", n}, {"sent", sn}, {"send_rate", n > 0 ? sn / n : 0.0}};
+      n_all += n;
+      s_all += sn;
+    }
+    e["samples"] = n_all;
+    e["sent"] = s_all;
+    e["send_rate"] = n_all > 0 ? s_all / n_all : 0.0;
+    j["one_shot"][spec.approaches[a]] = e;
+    char row[200];
+    std::snprintf(row, sizeof row, "| %s | %.4f | ± %.4f | %.4f |\n", spec.approaches[a].c_str(), nees.value[a].mean,
+                  nees.value[a].ci95, e["send_rate"].get<double>());
+    md += row;
+  }
+  j["markdown"] = j.at("markdown").get<std::string>() + md;
+}
+
+}  // namespace
+
 nlohmann::json run_outputs(const engine::SweepResults& results, const std::string& out_dir, bool plots) {
   nlohmann::json j = ncs::table_outputs(results, out_dir, plots);
   const engine::SweepSpec& spec = results.spec;
@@ -344,6 +399,7 @@ nlohmann::json run_outputs(const engine::SweepResults& results, const std::strin
   }
   if (spec.config.contains("bus_links")) add_bus_delays(j, results);
   if (spec.config.contains("controller_cpu")) add_cpu_stats(j, results);
+  if (std::find(spec.metrics.begin(), spec.metrics.end(), "nees") != spec.metrics.end()) add_one_shot(j, results);
   return j;
 }
 

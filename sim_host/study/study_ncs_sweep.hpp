@@ -29,6 +29,10 @@ inline constexpr const char* kBusDelayMetrics[] = {"bus_messages", "bus_delay_mi
 /// misses, the misses of the other tasks and ISRs, and the CPU's busy time (µs).
 inline constexpr const char* kCpuMetrics[] = {"jobs", "response_min_us", "response_max_us", "response_sum_us",
                                               "deadline_misses", "other_misses", "busy_us"};
+/// Metrics of the one-shot approaches (only in sweeps that run one): the filter's NEES (mean of
+/// e_kᵀ P_k⁻¹ e_k over the run's computations, 0 for the other approaches), its computations,
+/// the sensor's samples and the samples it sent.
+inline constexpr const char* kOneShotMetrics[] = {"nees", "nees_steps", "sensor.samples", "sensor.sent"};
 
 /// Position of the counter `name` in kLinkCounters (its size when there is none).
 constexpr std::size_t link_counter_index(std::string_view name) {
@@ -68,6 +72,9 @@ engine::SweepResults run_ncs_sweep(const NcsStudy& s, std::size_t seeds, unsigne
 /// CPU's other tasks and ISRs) and the measured utilization (busy time / simulated time;
 /// I and IK do not use the CPU: 0 jobs); its table is appended to "markdown" and is
 /// "markdown_cpu".
+/// With one-shot approaches, "one_shot": per
+/// such approach nees_mean, nees_ci95 (over seeds), samples, sent, send_rate and per_scenario
+/// the same (table appended to "markdown").
 nlohmann::json run_outputs(const engine::SweepResults& results, const std::string& out_dir, bool plots);
 
 }  // namespace oneshot::study

@@ -68,14 +68,21 @@ class ControllerNode {
       latest_ = m;
       have_ = true;
       fresh_ = true;
-      if (mode_ == ControllerMode::kOnArrival) run(now);
+      if (mode_ == ControllerMode::kOnArrival) run(now, latest_.seq);
       return s;
     });
   }
 
   /// The controller's timer: timer mode computes with the newest measurement.
   void on_timer(McuInstant now) {
-    if (mode_ == ControllerMode::kOnTimer && have_) run(now);
+    if (mode_ == ControllerMode::kOnTimer && have_) run(now, latest_.seq);
+  }
+
+  /// The controller's timer in a loop whose commands name the period they are for (a one-shot
+  /// loop: computed in period k, applied at k + 1 by an actuator on its timer): timer mode
+  /// computes with the newest measurement and stamps the command `command_seq`.
+  void on_timer(McuInstant now, SequenceNumber command_seq) {
+    if (mode_ == ControllerMode::kOnTimer && have_) run(now, command_seq);
   }
 
   /// Accepts measurements from `sensor` only.
@@ -101,7 +108,7 @@ class ControllerNode {
   [[nodiscard]] constexpr SendResult last_send() const { return last_send_; }
 
  private:
-  void run(McuInstant now) {
+  void run(McuInstant now, SequenceNumber command_seq) {
     ++stats_.computations;
     Command c;
     const LawResult result = law_.compute(latest_, fresh_, now, c.payload.value);
@@ -111,7 +118,7 @@ class ControllerNode {
       ++stats_.withheld;
       return;
     }
-    c.seq = latest_.seq;
+    c.seq = command_seq;
     c.stamp = now;
     last_send_ = send_message<Board>(destination_, c, stats_);
   }

@@ -1,0 +1,199 @@
+/// @file study_oneshot_test.cpp
+/// @brief `study run` of the one-shot loops (sim_host/study/examples/sod_ge_oneshot.json: a
+///        send-on-delta sensor over a Gilbert–Elliott link, OS, OSp, OSK): at δy = 0 without
+///        noise the held-value loop OS is the periodic loop OSK bit for bit, the sensor sends
+///        fewer samples as δy grows, delivered + lost = sent on the lossy leg, the filter's NEES
+///        is near n = 2 when it is consistent (every sample, no loss), the same bytes on 1 and
+///        2 threads, and what the loop cannot run is refused naming the field.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <functional>
+
+#include "ncs_loop.hpp"
+#include "oneshot/engine/study_file.hpp"
+#include "study_ncs_runner.hpp"
+#include "study_ncs_sweep.hpp"
+#include "support/temp_files.hpp"
+
+namespace oneshot::study {
+namespace {
+
+std::string os_path() { return std::string(ONESHOT_STUDY_EXAMPLES_DIR) + "/sod_ge_oneshot.json"; }
+
+nlohmann::json os_json() { return nlohmann::json::parse(test::read_file(os_path())); }
+
+engine::StudyFile parse(const nlohmann::json& j) {
+  return engine::parse_study(j.dump(), os_path(), &ncs_schema(), ONESHOT_STUDY_EXAMPLES_DIR);
+}
+
+/// The example after `edit`, mapped onto the loop, every scenario `duration_s` long.
+NcsStudy os_study(const std::function<void(nlohmann::json&)>& edit, double duration_s) {
+  nlohmann::json j = os_json();
+  edit(j);
+  NcsStudy s = map_ncs_study(parse(j));
+  for (ncs::Scenario& x : s.scenarios) x.duration_s = duration_s;
+  return s;
+}
+
+std::string temp_dir(const char* name) { return test::fresh_dir("oneshot_study_os_test", name); }
+
+/// The sensor's thresholds δy (both outputs) and no loss on sc.
+std::function<void(nlohmann::json&)> lossless_delta(double delta) {
+  return [delta](nlohmann::json& j) {
+    j["nodes"][0]["trigger"]["delta"] = {delta, delta};
+    j["links"][0].erase("loss");
+  };
+}
+
+TEST(StudyOneShot, AtZeroDeltaTheHeldValueLoopIsThePeriodicLoop) {
+  const NcsStudy s = os_study(lossless_delta(0), 4);
+  ncs::RunOptions quiet;
+  quiet.noise_free = true;
+  for (std::size_t x = 0; x < s.scenarios.size(); ++x) {
+    for (std::uint64_t seed = 1; seed <= 3; ++seed) {
+      // No noise: a silent sensor's held value is its sample (the plant did not move) with
+      // R̄ = R + (δy)²/3 = R: the same correction as the sample itself.
+      const ncs::RunResult os = ncs::run(*s.ctx, ncs::Approach::kOS, s.scenarios[x], seed, quiet);
+      const ncs::RunResult osk = ncs::run(*s.ctx, ncs::Approach::kOSK, s.scenarios[x], seed, quiet);
+      EXPECT_EQ(os.cost, osk.cost) << x << " " << seed;
+      EXPECT_GT(os.cost, 0);
+      EXPECT_LE(os.sent, osk.sent);
+      EXPECT_EQ(osk.sent, osk.sampled);
+      // With noise every sample moves: δy = 0 sends every one, and the loops are the same.
+      const ncs::RunResult n_os = ncs::run(*s.ctx, ncs::Approach::kOS, s.scenarios[x], seed, ncs::RunOptions{});
+      const ncs::RunResult n_osk = ncs::run(*s.ctx, ncs::Approach::kOSK, s.scenarios[x], seed, ncs::RunOptions{});
+      EXPECT_EQ(n_os.sent, n_os.sampled);
+      EXPECT_EQ(n_os.cost, n_osk.cost);
+      EXPECT_EQ(n_os.nees, n_osk.nees);
+    }
+  }
+}
+
+TEST(StudyOneShot, SendsFallAsDeltaGrows) {
+  double last = 0;
+  bool first = true;
+  for (double delta : {0.0, 0.005, 0.01, 0.02, 0.05, 0.1}) {
+    const NcsStudy s = os_study(lossless_delta(delta), 6);
+    double sent = 0, sampled = 0;
+    for (const ncs::Approach a : {ncs::Approach::kOS, ncs::Approach::kOSp}) {
+      for (const ncs::Scenario& x : s.scenarios) {
+        for (std::uint64_t seed = 1; seed <= 4; ++seed) {
+          const ncs::RunResult r = ncs::run(*s.ctx, a, x, seed, ncs::RunOptions{});
+          sent += r.sent;
+          sampled += r.sampled;
+        }
+      }
+    }
+    if (!first) {
+      EXPECT_LT(sent, last) << "delta " << delta;
+    }
+    EXPECT_LE(sent, sampled);
+    last = sent;
+    first = false;
+  }
+}
+
+TEST(StudyOneShot, OnTheLossyLegDeliveredAndLostAddUpToSent) {
+  const NcsStudy s = os_study([](nlohmann::json&) {}, 6);
+  const engine::SweepResults r = run_ncs_sweep(s, 4, 2, engine::Shard{});
+  const std::size_t sent = r.metric("sc.sent");
+  const std::size_t delivered = r.metric("sc.delivered");
+  const std::size_t lost = r.metric("sc.lost");
+  double lost_all = 0;
+  for (std::size_t a = 0; a < r.spec.approaches.size(); ++a) {
+    for (std::size_t x = 0; x < r.spec.scenarios.size(); ++x) {
+      for (std::size_t k = 0; k < r.spec.seeds; ++k) {
+        EXPECT_EQ(r.at(a, x, k, delivered) + r.at(a, x, k, lost), r.at(a, x, k, sent));
+        if (r.spec.approaches[a] == "I" || r.spec.approaches[a] == "IK") {
+          EXPECT_EQ(r.at(a, x, k, lost), 0);  // the delay-free references ignore the legs
+        } else {
+          lost_all += r.at(a, x, k, lost);
+        }
+      }
+    }
+  }
+  EXPECT_GT(lost_all, 0);
+  const nlohmann::json j = run_outputs(r, temp_dir("lossy"), false);
+  for (const char* a : {"OS", "OSp", "OSK"}) {
+    const nlohmann::json& c = j.at("links").at(a).at("sc");
+    EXPECT_EQ(c.at("delivered").get<double>() + c.at("lost").get<double>(), c.at("sent").get<double>()) << a;
+    EXPECT_EQ(j.at("one_shot").at(a).at("sent").get<double>(), c.at("sent").get<double>()) << a;
+  }
+  EXPECT_EQ(j.at("one_shot").at("OSK").at("send_rate").get<double>(), 1.0);
+  EXPECT_LT(j.at("one_shot").at("OS").at("send_rate").get<double>(), 1.0);
+  EXPECT_FALSE(j.at("one_shot").contains("I"));
+}
+
+TEST(StudyOneShot, NeesIsNearTheStateDimensionWhenTheFilterIsConsistent) {
+  // Every sample, no loss: the filter's model is the loop's (inputs applied at kh, exact Q_d).
+  const NcsStudy s = os_study(lossless_delta(0.02), 100);
+  NcsStudy osk = s;
+  osk.approaches = {ncs::Approach::kI, ncs::Approach::kOSK};
+  const nlohmann::json j = run_outputs(run_ncs_sweep(osk, 20, 2, engine::Shard{}), temp_dir("nees"), false);
+  const double nees = j.at("one_shot").at("OSK").at("nees_mean").get<double>();
+  const double ci = j.at("one_shot").at("OSK").at("nees_ci95").get<double>();
+  // Measured 1.949 ± 0.057 (20 seeds × 2000 steps; the first ~20 steps from P0 = 10 R pull it
+  // down by ~1 %): within three intervals of n = 2.
+  EXPECT_LT(std::fabs(nees - 2.0), 3 * ci + 0.02) << nees << " ± " << ci;
+  EXPECT_LT(ci, 0.2);
+}
+
+TEST(StudyOneShot, SameBytesOnOneAndTwoThreads) {
+  const NcsStudy s = os_study([](nlohmann::json&) {}, 3);
+  const std::string one = run_outputs(run_ncs_sweep(s, 3, 1, engine::Shard{}), temp_dir("one"), false).dump();
+  const std::string two = run_outputs(run_ncs_sweep(s, 3, 2, engine::Shard{}), temp_dir("two"), false).dump();
+  EXPECT_EQ(one, two);
+  EXPECT_TRUE(nlohmann::json::parse(two).contains("one_shot"));
+}
+
+/// Mapping the edited file is refused, the message containing `expect`.
+void expect_refused(const std::function<void(nlohmann::json&)>& edit, const std::string& expect) {
+  nlohmann::json j = os_json();
+  edit(j);
+  try {
+    static_cast<void>(map_ncs_study(parse(j)));
+    ADD_FAILURE() << "accepted, expected " << expect;
+  } catch (const engine::InputError& e) {
+    EXPECT_NE(std::string(e.what()).find(expect), std::string::npos) << e.what();
+  }
+}
+
+TEST(StudyOneShot, WhatTheLoopCannotRunIsRefusedNamingTheField) {
+  expect_refused([](nlohmann::json& j) { j["nodes"][0]["trigger"]["delta"] = {0.02}; }, "field 'nodes[0].trigger.delta'");
+  expect_refused([](nlohmann::json& j) { j["nodes"][0]["trigger"]["delta"] = {0.02, 0.02, 0.02}; },
+                 "field 'nodes[0].trigger.delta'");
+  // S, SK cannot use a send-on-delta sensor (nor a timer controller).
+  expect_refused([](nlohmann::json& j) { j["approaches"].push_back({{"name", "S"}, {"kind", "S"}}); }, "field 'approaches[5].kind'");
+  expect_refused([](nlohmann::json& j) { j["approaches"].push_back({{"name", "SK"}, {"kind", "SK"}}); }, "field 'approaches[5].kind'");
+  // Send-on-delta without a one-shot approach.
+  expect_refused(
+      [](nlohmann::json& j) {
+        j["approaches"] = nlohmann::json::parse(R"([{"name": "I", "kind": "I"}, {"name": "IK", "kind": "IK"}])");
+      },
+      "field 'nodes[0].trigger'");
+  // OS and OSp need a send-on-delta sensor; OSK does not.
+  expect_refused([](nlohmann::json& j) { j["nodes"][0].erase("trigger"); }, "field 'approaches[2].kind'");
+  // The controller's phase: 0 < φ < h, a timer at h.
+  expect_refused([](nlohmann::json& j) { j["nodes"][1]["clock_offset_us"] = 0; }, "field 'nodes[1].clock_offset_us'");
+  expect_refused([](nlohmann::json& j) { j["nodes"][1]["clock_offset_us"] = 50000; }, "field 'nodes[1].clock_offset_us'");
+  expect_refused([](nlohmann::json& j) { j["nodes"][1]["period_us"] = 25000; }, "field 'nodes[1].period_us'");
+  expect_refused(
+      [](nlohmann::json& j) {
+        j["nodes"][1]["mode"] = "arrival";
+        j["nodes"][1].erase("period_us");
+      },
+      "field 'nodes[1].mode'");
+  expect_refused([](nlohmann::json& j) { j["nodes"][0]["clock_offset_us"] = 100; }, "field 'nodes[0].clock_offset_us'");
+  // No analytic cost for the one-shot loops.
+  const NcsStudy s = os_study([](nlohmann::json&) {}, 3);
+  try {
+    static_cast<void>(run_ncs_sweep(s, 2, 1, engine::Shard{}, true));
+    ADD_FAILURE() << "--analytic accepted";
+  } catch (const engine::InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("field '--analytic'"), std::string::npos) << e.what();
+  }
+}
+
+}  // namespace
+}  // namespace oneshot::study
