@@ -51,12 +51,23 @@ struct RunOptions {
   /// expected cost at this instant (s) in RunResult::analytic_at_mark,
   /// as a run of this duration would end with it; the run itself is unchanged.
   double analytic_mark_s = 0;
+  /// Log every message of the legs in RunResult::messages (observes only: the run is unchanged).
+  bool record_messages = false;
 };
 
 /// One row of a recorded sample or estimate.
 struct Point {
   double t_s = 0;    ///< Time (s).
   double v[2] = {};  ///< Values (y1, y2 or x̂1, x̂2).
+};
+
+/// One message of a leg (RunOptions::record_messages), in the order sent.
+struct MessageEvent {
+  std::string leg;         ///< "as", "sc" or "ca".
+  double sent_s = 0;       ///< Handed to the link (queued on the bus).
+  double arrival_s = 0;    ///< Arrival when delivered (may lie after the run's end: in flight then).
+  bool lost = false;       ///< Dropped by the leg's loss model.
+  bool delivered = false;  ///< Not lost (a bus leg's: its last frame ended within the run).
 };
 
 /// What a run returns.
@@ -84,6 +95,8 @@ struct RunResult {
   /// Legs on a CAN bus (Scenario::bus_legs), by leg name: messages queued and their delays
   /// (queueing + transmission of every frame). Their sent counts are in `links` too (lost 0).
   std::vector<std::pair<std::string, engine::BusRouteStatistics>> bus_legs;
+  std::vector<MessageEvent> messages;  ///< RunOptions::record_messages: every message of the legs.
+  std::uint64_t events = 0;      ///< Kernel events run (the engine's event queue pops).
   std::vector<Point> truth;      ///< True state every trace step (x1, x2).
   std::vector<Point> samples;    ///< Samples y at their instants.
   std::vector<Point> sample_truth;  ///< C x at the same instants (noise-free output).
