@@ -123,8 +123,8 @@ nlohmann::json write_traces(const NcsStudy& s, const std::vector<std::size_t>& s
   if (s.scenarios.empty()) return j;
   const ncs::Scenario& sc = s.scenarios[0];
   ncs::RunOptions ro;
-  // Every millisecond, at most 20000 rows (longer runs: a coarser step in whole ms).
-  ro.trace_step_s = std::max(1.0, std::ceil(sc.duration_s / 20.0)) * 1e-3;
+  // Every millisecond, at most 5000 rows (longer runs: a coarser step in whole ms).
+  ro.trace_step_s = std::max(1.0, std::ceil(sc.duration_s / 5.0)) * 1e-3;
   ro.record_messages = true;
   const double h_s = s.ctx->period_us() * 1e-6;
   const double window_s = std::min(sc.duration_s, 30 * h_s);
