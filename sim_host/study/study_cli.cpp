@@ -1,6 +1,7 @@
 /// @file study_cli.cpp
 /// @brief `oneshot-sim study check FILE`, `oneshot-sim study run FILE` and `oneshot-sim study
-///        report FILE OUTDIR`: study files (`oneshot-study/1`, docs/study-files.md) from the
+///        report FILE OUTDIR` (with traced runs), `oneshot-sim study bench FILE` (events and
+///        wall time of the sweep): study files (`oneshot-study/1`, docs/study-files.md) from the
 ///        command line; `merge` finishes the shards of `study run`.
 #include <algorithm>
 #include <chrono>
@@ -126,7 +127,7 @@ nlohmann::json bench(const study::NcsStudy& s, std::size_t seeds, unsigned threa
   for (const ncs::Scenario& x : s.scenarios) spec.scenarios.push_back(x.name);
   spec.first_seed = s.first_seed;
   spec.seeds = seeds == 0 ? s.seeds : seeds;
-  spec.metrics = {"cost", "events", "simulated_s"};
+  spec.metrics = {"cost", "events", "simulated_s", "run_s"};
   spec.config = {{"study_file", s.source}};
   const unsigned used = threads == 0 ? std::max(1U, std::thread::hardware_concurrency()) : threads;
   const std::clock_t cpu0 = std::clock();
@@ -134,8 +135,10 @@ nlohmann::json bench(const study::NcsStudy& s, std::size_t seeds, unsigned threa
   const engine::SweepResults r = engine::run_sweep(
       spec, engine::Shard{}, used,
       [&s](std::size_t a, std::size_t k, std::uint64_t seed) {
+        const auto t0 = std::chrono::steady_clock::now();
         const ncs::RunResult x = ncs::run(*s.ctx, s.approaches[a], s.scenarios[k], seed, ncs::RunOptions{});
-        return std::vector<double>{x.cost, static_cast<double>(x.events), s.scenarios[k].duration_s};
+        const double run_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+        return std::vector<double>{x.cost, static_cast<double>(x.events), s.scenarios[k].duration_s, run_s};
       },
       "study bench");
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
@@ -144,13 +147,21 @@ nlohmann::json bench(const study::NcsStudy& s, std::size_t seeds, unsigned threa
   double simulated = 0;
   const std::size_t ev = r.metric("events");
   const std::size_t sim = r.metric("simulated_s");
-  for (std::size_t a = 0; a < spec.approaches.size(); ++a)
+  const std::size_t rs = r.metric("run_s");
+  nlohmann::json per = nlohmann::json::object();  // per approach: its runs' events and their time on their thread
+  for (std::size_t a = 0; a < spec.approaches.size(); ++a) {
+    double ea = 0;
+    double ta = 0;
     for (std::size_t x = 0; x < spec.scenarios.size(); ++x)
       for (std::size_t k = 0; k < spec.seeds; ++k) {
-        events += r.at(a, x, k, ev);
+        ea += r.at(a, x, k, ev);
+        ta += r.at(a, x, k, rs);
         simulated += r.at(a, x, k, sim);
       }
-  return {{"study_file", s.source}, {"runs", spec.runs()}, {"seeds", spec.seeds}, {"threads", used},
+    events += ea;
+    per[spec.approaches[a]] = {{"events", ea}, {"run_s", ta}, {"events_per_run_s", ta > 0 ? ea / ta : 0.0}};
+  }
+  return {{"per_approach", per}, {"study_file", s.source}, {"runs", spec.runs()}, {"seeds", spec.seeds}, {"threads", used},
           {"events", events}, {"simulated_s", simulated}, {"wall_s", wall}, {"cpu_s", cpu},
           {"events_per_s", events / wall}, {"events_per_s_per_thread", events / wall / used},
           {"events_per_cpu_s", cpu > 0 ? events / cpu : 0.0}};

@@ -27,7 +27,7 @@ std::vector<std::size_t> trace_selection(const NcsStudy& s, const std::string& n
 /// One traced run per approach of `selected` on the first scenario and the first seed, the
 /// same run as the sweep's (same seed and streams; the trace and the message log only
 /// observe): OUT_DIR/trace_<A>_states.csv (t_s, x1, x2, r1, u: the plant's true states, the
-/// set-point and the applied input every trace step), trace_<A>_estimates.csv (t_s, xhat1,
+/// set-point and the applied input every ms; runs past 5 s a coarser step, at most 5000 rows), trace_<A>_estimates.csv (t_s, xhat1,
 /// xhat2: the controller's estimate at the instant it targets; only when the approach has
 /// one), trace_<A>_messages.csv (leg, leg_index, sent_s, arrival_s, lost, delivered: every
 /// message of the legs; arrival_s empty when there is none) and, with `plots`,
