@@ -336,5 +336,32 @@ TEST(StudyReport, NoPlotsWritesTheTracesCsvOnly) {
   EXPECT_EQ(read_json(out + "/report.json").at("traces").size(), 2U);
 }
 
+TEST(StudyReport, BenchCountsTheSweepsKernelEvents) {
+  // `study bench`'s events are the kernel events of the sweep's runs, counted here one run at a time.
+  const std::string file = std::string(ONESHOT_STUDY_EXAMPLES_DIR) + "/sod_ge_oneshot.json";
+  const std::string dir = test::made_dir("oneshot_study_report", "bench");
+  const test::CommandResult r = test::run_command({ONESHOT_SIM_PATH, "study", "bench", file, "--seeds", "2", "--threads", "2",
+                                                   "--max-duration", "2.5", "--json", dir + "/bench.json"});
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const nlohmann::json j = read_json(dir + "/bench.json");
+  NcsStudy s = map_ncs_study(engine::load_study(file, &ncs_schema()));
+  cap_duration(s, 2.5, "--max-duration");
+  double total = 0;
+  for (ncs::Approach a : s.approaches) {
+    double events = 0;
+    for (const ncs::Scenario& x : s.scenarios)
+      for (std::uint64_t seed = s.first_seed; seed < s.first_seed + 2; ++seed)
+        events += static_cast<double>(ncs::run(*s.ctx, a, x, seed, ncs::RunOptions{}).events);
+    EXPECT_EQ(j.at("per_approach").at(ncs::name(a)).at("events").get<double>(), events) << ncs::name(a);
+    EXPECT_GT(events, 0);
+    total += events;
+  }
+  EXPECT_EQ(j.at("events").get<double>(), total);
+  EXPECT_EQ(j.at("runs").get<std::size_t>(), s.approaches.size() * s.scenarios.size() * 2);
+  EXPECT_EQ(j.at("threads").get<unsigned>(), 2U);
+  EXPECT_GT(j.at("wall_s").get<double>(), 0);
+  EXPECT_NEAR(j.at("events_per_s_per_thread").get<double>(), total / j.at("wall_s").get<double>() / 2, 1e-9 * total);
+}
+
 }  // namespace
 }  // namespace oneshot::study
