@@ -195,9 +195,10 @@ std::string traces_markdown(const nlohmann::json& traces, const engine::SweepRes
   const std::size_t cost = results.metric("cost");
   md << "\n### Traces\n\nOne run per approach on the first scenario and the first seed (the sweep's run: same seed, same "
         "draws; the trace only observes). "
-     << (plots ? "Each plot: the true states x1, x2 with the set-point r1 and the controller's estimates (crosses, where the "
-                 "approach has an estimator); the applied input u; a time line of the first periods with one arrow per "
-                 "delivered message of each leg from its sending to its arrival and a red cross per lost one."
+     << (plots ? "Each plot: the true states x1, x2 with the set-point r1 and the controller's estimates (crosses: the "
+                 "actuation-synchronized and one-shot loops record them); the applied input u; a time line of the first "
+                 "30 periods with one arrow per delivered message of each leg from its sending to its arrival and a red "
+                 "cross per lost one."
                : "CSV files only (--no-plots).")
      << "\n\n";
   for (std::size_t a = 0; a < results.spec.approaches.size(); ++a) {  // in the file's order
