@@ -51,6 +51,8 @@ struct RunOptions {
   /// expected cost at this instant (s) in RunResult::analytic_at_mark,
   /// as a run of this duration would end with it; the run itself is unchanged.
   double analytic_mark_s = 0;
+  /// Log every message of the legs in RunResult::messages (observes only: the run is unchanged).
+  bool record_messages = false;
 };
 
 /// One row of a recorded sample or estimate.
@@ -70,6 +72,15 @@ struct CpuRunStats {
   std::uint64_t deadline_misses = 0;  ///< Controller jobs past their deadline (or aborted).
   std::uint64_t other_misses = 0;     ///< Background tasks' and ISRs' misses.
   engine::Duration busy{0};       ///< CPU time used by every task and ISR (context switches included).
+};
+
+/// One message of a leg (RunOptions::record_messages), in the order sent.
+struct MessageEvent {
+  std::string leg;         ///< "as", "sc" or "ca".
+  double sent_s = 0;       ///< Handed to the link (queued on the bus).
+  double arrival_s = 0;    ///< Arrival when delivered (may lie after the run's end: in flight then).
+  bool lost = false;       ///< Dropped by the leg's loss model.
+  bool delivered = false;  ///< Not lost (a bus leg's: its last frame ended within the run).
 };
 
 /// What a run returns.
@@ -98,6 +109,8 @@ struct RunResult {
   /// (queueing + transmission of every frame). Their sent counts are in `links` too (lost 0).
   std::vector<std::pair<std::string, engine::BusRouteStatistics>> bus_legs;
   CpuRunStats cpu;               ///< The controller's CPU (Scenario::controller_cpu; I, IK: none).
+  std::vector<MessageEvent> messages;  ///< RunOptions::record_messages: every message of the legs.
+  std::uint64_t events = 0;      ///< Kernel events run (the engine's event queue pops).
   std::vector<Point> truth;      ///< True state every trace step (x1, x2).
   std::vector<Point> samples;    ///< Samples y at their instants.
   std::vector<Point> sample_truth;  ///< C x at the same instants (noise-free output).
