@@ -19,7 +19,7 @@ namespace {
 
 using namespace engine::cpu;
 
-std::string path_in(const std::string& dir, const std::string& name) { return (std::filesystem::path(dir) / name).string(); }
+using util::path_in;
 
 constexpr ControlPriority kPositions[] = {ControlPriority::kHighest, ControlPriority::kRateMonotonic, ControlPriority::kLowest};
 

@@ -22,7 +22,7 @@ std::string hex64(std::uint64_t v) {
   return b;
 }
 
-std::string path_in(const std::string& dir, const std::string& name) { return (std::filesystem::path(dir) / name).string(); }
+using util::path_in;
 
 }  // namespace
 

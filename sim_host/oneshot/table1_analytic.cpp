@@ -39,7 +39,7 @@ const char* refusal_text(double code) {
 /// Written instead of a ratio to A when A's analytic value is refused.
 constexpr const char* kReferenceRefused = "reference A refused";
 
-std::string path_in(const std::string& dir, const std::string& name) { return (std::filesystem::path(dir) / name).string(); }
+using util::path_in;
 
 /// Mean and interval of x_k (over seeds) as {"mean", "ci95"}.
 nlohmann::json summary(const std::vector<double>& x) {

@@ -22,8 +22,6 @@ namespace {
 using engine::InputError;
 using nlohmann::json;
 
-double us(engine::Duration d) { return static_cast<double>(d.count()) * 1e-3; }
-
 /// The smallest timer period of the file (0 when no node runs a timer).
 engine::Duration loop_period(const engine::StudyFile& f) {
   engine::Duration p{0};
@@ -119,11 +117,11 @@ json bus_messages(std::vector<engine::CanStream> streams, const std::vector<std:
       if (unbounded_jitter[i] && streams[i].id <= streams[k].id) bounded = false;
     json m = {{"name", streams[k].name}, {"kind", kinds[k]}, {"id", streams[k].id},
               {"payload_bytes", streams[k].payload_bytes}, {"frames", streams[k].leading_frames + 1},
-              {"message_bytes", 8 * streams[k].leading_frames + streams[k].payload_bytes}, {"period_us", us(streams[k].period)},
-              {"jitter_us", unbounded_jitter[k] ? json(nullptr) : json(us(streams[k].jitter))},
-              {"deadline_us", us(streams[k].deadline)}, {"transmission_us", us(bounds[k].transmission)},
+              {"message_bytes", 8 * streams[k].leading_frames + streams[k].payload_bytes}, {"period_us", to_us(streams[k].period)},
+              {"jitter_us", unbounded_jitter[k] ? json(nullptr) : json(to_us(streams[k].jitter))},
+              {"deadline_us", to_us(streams[k].deadline)}, {"transmission_us", to_us(bounds[k].transmission)},
               {"bounded", bounded}, {"schedulable", bounded && bounds[k].schedulable}};
-    m["worst_response_us"] = bounded ? json(us(bounds[k].response)) : json(nullptr);
+    m["worst_response_us"] = bounded ? json(to_us(bounds[k].response)) : json(nullptr);
     out.push_back(m);
   }
   return out;

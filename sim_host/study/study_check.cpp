@@ -32,17 +32,15 @@ json rows(const design::DenseMatrix& m) {
   return out;
 }
 
-double us(engine::Duration d) { return static_cast<double>(d.count()) * 1e-3; }
-
 json delay_summary(const engine::DelayModel& d) {
-  json j = {{"model", d.describe()}, {"min_us", us(d.lower_bound())}, {"mean_us", d.mean_ns() * 1e-3}};
+  json j = {{"model", d.describe()}, {"min_us", to_us(d.lower_bound())}, {"mean_us", d.mean_ns() * 1e-3}};
   const auto ub = d.upper_bound();
   if (ub) {
-    j["max_us"] = us(*ub);
+    j["max_us"] = to_us(*ub);
   } else {
     j["max_us"] = nullptr;
     // Only the heavy tails are capped (draws above the cap are clamped); Poisson is not.
-    if (d.kind == engine::DelayModel::Kind::kLognormal || d.kind == engine::DelayModel::Kind::kPareto) j["cap_us"] = us(d.cap);
+    if (d.kind == engine::DelayModel::Kind::kLognormal || d.kind == engine::DelayModel::Kind::kPareto) j["cap_us"] = to_us(d.cap);
   }
   return j;
 }
@@ -80,7 +78,7 @@ json plant_section(const engine::StudyFile& f, json& designs) {
       return j;
     case engine::PlantSpec::Kind::kDiscrete:
       j = {{"kind", "discrete"}, {"n", f.plant.discrete.phi.rows}, {"m", f.plant.discrete.gamma.cols},
-           {"p", f.plant.discrete.c.rows}, {"period_us", us(f.plant.discrete.period)}, {"designed", false},
+           {"p", f.plant.discrete.c.rows}, {"period_us", to_us(f.plant.discrete.period)}, {"designed", false},
            {"why_not_designed", "an inline plant carries no measurement covariance: give a plant file"}};
       return j;
     case engine::PlantSpec::Kind::kFile:

@@ -18,6 +18,9 @@ namespace oneshot::study {
 /// the study is not ncs (an ncs file's messages have the loop's sizes, in frames of ≤ 8 bytes).
 inline constexpr std::size_t kLoopFramePayloadBytes = 8;
 
+/// A duration in µs, as the check's JSON gives durations.
+inline double to_us(engine::Duration d) { return static_cast<double>(d.count()) * 1e-3; }
+
 /// Everything `file` implies, as JSON. Per CAN bus its load and every message's worst-case
 /// response (can_analysis.hpp): a loop message of study ncs at the loop's size in frames of
 /// ≤ 8 bytes, its release jitter chained through the links before it (a link on a bus adding

@@ -1,12 +1,11 @@
 /// @file dare_test.cpp
 /// @brief The ordered-QZ DARE against Eigen oracles for n = 3, 6, 12: the residual
 ///        evaluated independently in long double, a long-double doubling solution, and the
-///        closed-loop spectral radius from Eigen's EigenSolver; failures are reported, not
+///        closed-loop spectral radius from Eigen's EigenSolver (support/eigen_reference); failures are reported, not
 ///        returned as solutions.
 #include <gtest/gtest.h>
 
 #include <Eigen/Dense>
-#include <Eigen/Eigenvalues>
 #include <random>
 
 #include "oneshot/design/dare.hpp"
@@ -19,9 +18,13 @@ namespace oneshot::design {
 namespace {
 
 using test::MatX;
-using MatL = Eigen::Matrix<long double, Eigen::Dynamic, Eigen::Dynamic>;
-
-MatL to_long(const DenseMatrix& d) { return test::to_eigen(d).cast<long double>(); }
+/// Relative residual of X = AᵀXA − AᵀXB(R + BᵀXB)⁻¹BᵀXA + Q, evaluated in long double.
+double residual_long(const DenseMatrix& a, const DenseMatrix& b, const DenseMatrix& q, const DenseMatrix& r,
+                     const DenseMatrix& x) {
+  return test::dare_residual_long(test::to_eigen(a), test::to_eigen(b), test::to_eigen(q), test::to_eigen(r),
+                                  MatX::Zero(static_cast<Eigen::Index>(b.rows), static_cast<Eigen::Index>(b.cols)),
+                                  test::to_eigen(x));
+}
 
 DenseMatrix random_matrix(std::mt19937_64& rng, std::size_t r, std::size_t c, double scale) {
   std::normal_distribution<double> nd(0.0, scale);
@@ -30,40 +33,10 @@ DenseMatrix random_matrix(std::mt19937_64& rng, std::size_t r, std::size_t c, do
   return m;
 }
 
-/// Relative residual of X = AᵀXA − AᵀXB(R + BᵀXB)⁻¹BᵀXA + Q, evaluated in long double.
-double residual_long(const DenseMatrix& a, const DenseMatrix& b, const DenseMatrix& q, const DenseMatrix& r,
-                     const DenseMatrix& x) {
-  const MatL al = to_long(a), bl = to_long(b), ql = to_long(q), rl = to_long(r), xl = to_long(x);
-  const MatL axa = al.transpose() * xl * al;
-  const MatL corr = al.transpose() * xl * bl * (rl + bl.transpose() * xl * bl).inverse() * bl.transpose() * xl * al;
-  const MatL res = axa - corr + ql - xl;
-  return static_cast<double>(res.norm() / (ql.norm() + axa.norm() + corr.norm()));
-}
-
-/// Structure-preserving doubling in long double (the oracle): X = AᵀX(I + GX)⁻¹A + Q.
-MatL doubling_long(const DenseMatrix& a, const DenseMatrix& b, const DenseMatrix& q, const DenseMatrix& r) {
-  MatL al = to_long(a);
-  MatL g = to_long(b) * to_long(r).inverse() * to_long(b).transpose();
-  MatL h = to_long(q);
-  const MatL eye = MatL::Identity(al.rows(), al.cols());
-  for (int it = 0; it < 200; ++it) {
-    const auto lu = (eye + g * h).partialPivLu();
-    const MatL wa = lu.solve(al);
-    const MatL wg = lu.solve(g);
-    const MatL h_next = h + al.transpose() * h * wa;
-    g = g + al * wg * al.transpose();
-    al = al * wa;
-    const long double change = (h_next - h).cwiseAbs().maxCoeff();
-    h = 0.5L * (h_next + h_next.transpose());
-    if (change <= 1e-30L * h.cwiseAbs().maxCoeff()) break;
-  }
-  return h;
-}
-
 double closed_loop_radius_eigen(const DenseMatrix& a, const DenseMatrix& b, const DenseMatrix& r, const DenseMatrix& x) {
   const MatX al = test::to_eigen(a), bl = test::to_eigen(b), xl = test::to_eigen(x);
   const MatX k = (test::to_eigen(r) + bl.transpose() * xl * bl).inverse() * bl.transpose() * xl * al;
-  return Eigen::EigenSolver<MatX>(al - bl * k).eigenvalues().cwiseAbs().maxCoeff();
+  return test::spectral_radius(al - bl * k);
 }
 
 /// Random plant with an unstable mode and poles spread over (0.2, 1.3); controllable.
@@ -90,9 +63,9 @@ TEST_P(DareAgainstEigen, ResidualRadiusAndSolutionMatchTheOracles) {
     // Measured ≤ 1.1e−15 for n = 3 … 12 (15 cases); asserted 1e−14.
     EXPECT_LT(residual_long(a, b, q, r, sol.x), 1e-14) << n;
     EXPECT_LT(sol.residual, 1e-14) << n;
-    const MatL oracle = doubling_long(a, b, q, r);
+    const MatX oracle = test::dare_doubling_long(test::to_eigen(a), test::to_eigen(b), test::to_eigen(q), test::to_eigen(r));
     // Measured ≤ 3.9e−15; asserted 2e−14.
-    EXPECT_LT(test::relative_error(test::to_eigen(sol.x), oracle.cast<double>()), 2e-14) << n;
+    EXPECT_LT(test::relative_error(test::to_eigen(sol.x), oracle), 2e-14) << n;
     const double rho = closed_loop_radius_eigen(a, b, r, sol.x);
     EXPECT_LT(rho, 1.0);
     EXPECT_NEAR(sol.closed_loop_radius, rho, 2e-14) << n;  // measured ≤ 2.9e−15
@@ -123,13 +96,14 @@ TEST(Dare, BadlyScaledKalmanProblemOfTheHddPlantMatchesLongDouble) {
   const DenseMatrix ct = transpose(p.c);
   const DareSolution sol = solve_dare(at, ct, s.qd, p.measurement_covariance);
   ASSERT_EQ(sol.status, DareStatus::kOk) << to_string(sol.status);
-  const MatL oracle = doubling_long(at, ct, s.qd, p.measurement_covariance);
+  const MatX oracle =
+      test::dare_doubling_long(test::to_eigen(at), test::to_eigen(ct), test::to_eigen(s.qd), test::to_eigen(p.measurement_covariance));
   // Measured 8.5e−15 (without the state balancing: 9e−6, P(x_d1) < 0 and an unstable
   // estimator); asserted 5e−14.
-  EXPECT_LT(test::relative_error(test::to_eigen(sol.x), oracle.cast<double>()), 5e-14);
+  EXPECT_LT(test::relative_error(test::to_eigen(sol.x), oracle), 5e-14);
   // The smallest diagonal entry (~4e−22, 19 decades below the largest) keeps its sign and
   // digits (measured 1.0e−10 relative).
-  EXPECT_NEAR(sol.x(10, 10), static_cast<double>(oracle(10, 10)), 1e-9 * static_cast<double>(oracle(10, 10)));
+  EXPECT_NEAR(sol.x(10, 10), oracle(10, 10), 1e-9 * oracle(10, 10));
   EXPECT_LT(sol.closed_loop_radius, 1.0);
 }
 

@@ -1,11 +1,10 @@
 /// @file plant_files_test.cpp
 /// @brief Every shipped plant file loads and designs; the reference design keeps its
 ///        numbers; equivalent plant forms give equivalent designs; designs of n = 3, 6, 12
-///        against Eigen (DARE residuals in long double, spectral radii by EigenSolver).
+///        against Eigen (DARE residuals in long double, spectral radii by EigenSolver: support/eigen_reference).
 #include <gtest/gtest.h>
 
 #include <Eigen/Dense>
-#include <Eigen/Eigenvalues>
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <random>
@@ -20,35 +19,24 @@ namespace oneshot::design {
 namespace {
 
 using test::MatX;
-using MatL = Eigen::Matrix<long double, Eigen::Dynamic, Eigen::Dynamic>;
 
 std::string plant_path(const std::string& file) { return std::string(ONESHOT_PLANTS_DIR) + "/" + file; }
 
-double eigen_radius(const MatX& m) { return Eigen::EigenSolver<MatX>(m).eigenvalues().cwiseAbs().maxCoeff(); }
-
 /// Relative residuals (long double) of the design's LQR and Kalman Riccati solutions.
 void check_riccati_residuals(const PlantDescription& p, const DesignResult& d, double tol) {
-  const MatL phi = test::to_eigen(d.phi_h).cast<long double>();
-  const MatL gam = test::to_eigen(d.gamma_h).cast<long double>();
+  const MatX phi = test::to_eigen(d.phi_h);
   if (d.lqr_available && d.exogenous_states == 0) {
-    const MatL s = test::to_eigen(d.riccati).cast<long double>();
-    const MatL q1 = test::to_eigen(d.q1).cast<long double>();
-    const MatL q12 = test::to_eigen(d.q12).cast<long double>();
-    const MatL q2 = test::to_eigen(d.q2).cast<long double>();
-    const MatL axa = phi.transpose() * s * phi;
-    const MatL cross = phi.transpose() * s * gam + q12;
-    const MatL corr = cross * (q2 + gam.transpose() * s * gam).inverse() * cross.transpose();
-    const MatL res = axa - corr + q1 - s;
-    EXPECT_LT(static_cast<double>(res.norm() / (q1.norm() + axa.norm() + corr.norm())), tol) << p.name;
+    EXPECT_LT(test::dare_residual_long(phi, test::to_eigen(d.gamma_h), test::to_eigen(d.q1), test::to_eigen(d.q2),
+                                       test::to_eigen(d.q12), test::to_eigen(d.riccati)),
+              tol)
+        << p.name;
   }
-  const MatL pp = test::to_eigen(d.kalman_prior).cast<long double>();
-  const MatL c = test::to_eigen(p.c).cast<long double>();
-  const MatL q = test::to_eigen(d.qd_h).cast<long double>();
-  const MatL r = test::to_eigen(d.r).cast<long double>();
-  const MatL apa = phi * pp * phi.transpose();
-  const MatL corr = phi * pp * c.transpose() * (c * pp * c.transpose() + r).inverse() * c * pp * phi.transpose();
-  const MatL res = apa - corr + q - pp;
-  EXPECT_LT(static_cast<double>(res.norm() / (q.norm() + apa.norm() + corr.norm())), tol) << p.name;
+  // The prior Riccati equation: A = Φᵀ, B = Cᵀ, no cross weight.
+  const MatX ct = test::to_eigen(p.c).transpose();
+  EXPECT_LT(test::dare_residual_long(phi.transpose(), ct, test::to_eigen(d.qd_h), test::to_eigen(d.r),
+                                     MatX::Zero(ct.rows(), ct.cols()), test::to_eigen(d.kalman_prior)),
+            tol)
+      << p.name;
 }
 
 void check_radii(const PlantDescription& p, const DesignResult& d) {
@@ -56,12 +44,12 @@ void check_radii(const PlantDescription& p, const DesignResult& d) {
   const MatX k = test::to_eigen(d.kalman_gain);
   const MatX c = test::to_eigen(p.c);
   const MatX est = (MatX::Identity(phi.rows(), phi.cols()) - k * c) * phi;
-  EXPECT_NEAR(d.estimator_radius, eigen_radius(est), 1e-13) << p.name;  // measured ≤ 1.2e−15
+  EXPECT_NEAR(d.estimator_radius, test::spectral_radius(est), 1e-13) << p.name;  // measured ≤ 1.2e−15
   EXPECT_LT(d.estimator_radius, 1.0) << p.name;
   if (d.lqr_available) {
     const Eigen::Index np = phi.rows() - static_cast<Eigen::Index>(d.exogenous_states);
     const MatX cl = phi.topLeftCorner(np, np) - test::to_eigen(d.gamma_h).topRows(np) * test::to_eigen(d.l).leftCols(np);
-    EXPECT_NEAR(d.closed_loop_radius, eigen_radius(cl), 1e-13) << p.name;
+    EXPECT_NEAR(d.closed_loop_radius, test::spectral_radius(cl), 1e-13) << p.name;
     EXPECT_LT(d.closed_loop_radius, 1.0) << p.name;
   }
 }

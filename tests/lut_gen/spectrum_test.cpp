@@ -4,7 +4,6 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Dense>
-#include <Eigen/Eigenvalues>
 #include <random>
 
 #include "oneshot/design/dense_ops.hpp"
@@ -39,7 +38,7 @@ DenseMatrix with_poles(const std::vector<double>& radii, double angle, std::uint
 }
 
 double eigen_radius(const DenseMatrix& a) {
-  return Eigen::EigenSolver<MatX>(test::to_eigen(a)).eigenvalues().cwiseAbs().maxCoeff();
+  return test::spectral_radius(test::to_eigen(a));
 }
 
 class SpectralRadius : public ::testing::TestWithParam<std::size_t> {};

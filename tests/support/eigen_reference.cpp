@@ -3,6 +3,7 @@
 ///        (Eigen's matrix exponential costs each including file seconds of compile time).
 #include "support/eigen_reference.hpp"
 
+#include <Eigen/Eigenvalues>
 #include <unsupported/Eigen/MatrixFunctions>
 
 namespace oneshot::test {
@@ -11,6 +12,43 @@ double relative_error(const MatX& a, const MatX& b) {
   const double scale = b.cwiseAbs().maxCoeff();
   const double err = (a - b).cwiseAbs().maxCoeff();
   return scale > 0 ? err / scale : err;
+}
+
+double spectral_radius(const MatX& a) { return Eigen::EigenSolver<MatX>(a).eigenvalues().cwiseAbs().maxCoeff(); }
+
+MatX expm(const MatX& m) { return m.exp(); }
+
+namespace {
+using MatL = Eigen::Matrix<long double, Eigen::Dynamic, Eigen::Dynamic>;
+MatL to_long(const MatX& m) { return m.cast<long double>(); }
+}  // namespace
+
+double dare_residual_long(const MatX& a, const MatX& b, const MatX& q, const MatX& r, const MatX& s, const MatX& x) {
+  const MatL al = to_long(a), bl = to_long(b), ql = to_long(q), rl = to_long(r), sl = to_long(s), xl = to_long(x);
+  const MatL axa = al.transpose() * xl * al;
+  const MatL cross = al.transpose() * xl * bl + sl;
+  const MatL corr = cross * (rl + bl.transpose() * xl * bl).inverse() * cross.transpose();
+  const MatL res = axa - corr + ql - xl;
+  return static_cast<double>(res.norm() / (ql.norm() + axa.norm() + corr.norm()));
+}
+
+MatX dare_doubling_long(const MatX& a, const MatX& b, const MatX& q, const MatX& r) {
+  MatL al = to_long(a);
+  MatL g = to_long(b) * to_long(r).inverse() * to_long(b).transpose();
+  MatL h = to_long(q);
+  const MatL eye = MatL::Identity(al.rows(), al.cols());
+  for (int it = 0; it < 200; ++it) {
+    const auto lu = (eye + g * h).partialPivLu();
+    const MatL wa = lu.solve(al);
+    const MatL wg = lu.solve(g);
+    const MatL h_next = h + al.transpose() * h * wa;
+    g = g + al * wg * al.transpose();
+    al = al * wa;
+    const long double change = (h_next - h).cwiseAbs().maxCoeff();
+    h = 0.5L * (h_next + h_next.transpose());
+    if (change <= 1e-30L * h.cwiseAbs().maxCoeff()) break;
+  }
+  return h.cast<double>();
 }
 
 Triple reference_triple(const MatX& a, const MatX& b, const MatX& qc, double t) {

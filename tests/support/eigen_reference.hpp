@@ -1,6 +1,9 @@
 /// @file eigen_reference.hpp
 /// @brief Oracles written directly from the brief with Eigen (double): the matrix
-///        exponential, Van Loan, quadrature of Q_d, and the half / complete filters.
+///        exponential, Van Loan, quadrature of Q_d, the half / complete filters, spectral
+///        radii and the Riccati equation in long double. Compiled once (eigen_reference.cpp):
+///        Eigen's eigenvalue, exponential and long-double code cost each including test
+///        source seconds of compile time.
 #pragma once
 
 #include <Eigen/Dense>
@@ -35,6 +38,22 @@ MatX to_eigen(const Matrix<S, R, C>& a) {
 
 /// Largest |a − b| / max(|b|) (0 when b is zero and a equals it).
 double relative_error(const MatX& a, const MatX& b);
+
+/// max |λ_i(a)| by Eigen's EigenSolver (a square).
+double spectral_radius(const MatX& a);
+
+/// e^m by Eigen's MatrixFunctions (m square).
+MatX expm(const MatX& m);
+
+/// Relative residual of the discrete Riccati equation with cross weight S, evaluated in long
+/// double: R(X) = AᵀXA − (AᵀXB + S)(R + BᵀXB)⁻¹(BᵀXA + Sᵀ) + Q − X, returned as
+/// ‖R(X)‖ / (‖Q‖ + ‖AᵀXA‖ + ‖correction‖) (Frobenius norms). The filter's prior Riccati
+/// equation is the case A = Φᵀ, B = Cᵀ, S = 0.
+double dare_residual_long(const MatX& a, const MatX& b, const MatX& q, const MatX& r, const MatX& s, const MatX& x);
+
+/// The stabilizing solution of X = AᵀX(I + GX)⁻¹A + Q, G = BR⁻¹Bᵀ, by structure-preserving
+/// doubling in long double (an oracle independent of the QZ method under test).
+MatX dare_doubling_long(const MatX& a, const MatX& b, const MatX& q, const MatX& r);
 
 /// Φ(t), Γ(t), Q_d(t).
 struct Triple {

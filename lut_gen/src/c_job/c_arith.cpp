@@ -88,8 +88,6 @@ struct Raw {
   double bound = 0;  // |expr| ≤ bound
 };
 
-double bound_of(const Val& v) { return v.count ? 65535.0 : std::ldexp(1.0, v.fmt.bits - 1); }
-
 std::string as16(const Val& v) { return v.fmt.bits == 16 ? v.expr : "(int16_t)(" + v.expr + ")"; }
 
 /// The exact product a·b (detail::wide_product), as cheaply as the widths allow.

@@ -11,6 +11,7 @@
 /// Float mirrors the floating Accumulator: left to right, the first term starting the sum.
 #pragma once
 
+#include <cmath>
 #include <string>
 #include <utility>
 #include <vector>
@@ -49,6 +50,10 @@ struct Val {
   bool is_zero() const { return kind == Kind::kZero; }  ///< Structural zero.
   bool is_one() const { return kind == Kind::kOne; }    ///< Structural one.
 };
+
+/// Largest magnitude of a value's integer: 65535 for a converter count (unsigned 16 bits),
+/// 2^(bits − 1) for a Q value.
+inline double bound_of(const Val& v) { return v.count ? 65535.0 : std::ldexp(1.0, v.fmt.bits - 1); }
 
 /// One accumulator term: ±x, ±a·b, or ±one() of the accumulator's format.
 struct Term {

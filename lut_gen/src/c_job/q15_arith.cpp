@@ -28,21 +28,19 @@ double range_of(const FixedFormats& f, const std::string& name) {
 }
 
 /// An integer term: C expression (int32 value), fraction, magnitude bound.
-struct Raw {
+struct Raw16 {
   std::string expr;
   int frac = 0;
   double bound = 0;
 };
 
-double bound_of(const Val& v) { return v.count ? 65535.0 : std::ldexp(1.0, v.fmt.bits - 1); }
-
-Raw product16(const Val& a0, const Val& b0) {
+Raw16 product16(const Val& a0, const Val& b0) {
   Val a = a0;
   Val b = b0;
   if (a.count) std::swap(a, b);
   if (a.count || a.fmt.bits != 16 || (!b.count && b.fmt.bits != 16))
     throw std::logic_error("q15: products take 16-bit factors (or a converter code)");
-  Raw r;
+  Raw16 r;
   r.frac = a.fmt.frac + (b.count ? 0 : b.fmt.frac);
   r.bound = bound_of(a) * bound_of(b);
   r.expr = b.count ? "os_m16u(" + a.expr + ", (uint16_t)(" + b.expr + "))" : "os_q15_m(" + a.expr + ", " + b.expr + ")";
@@ -86,16 +84,16 @@ void Q15Arith::accumulate(CodeWriter& w, const std::string& dest, Qty out, const
     w.line(dest + " = 0;");
     return;
   }
-  std::vector<Raw> raws;
+  std::vector<Raw16> raws;
   std::vector<bool> neg;
   for (const Term& t : terms) {
     if (t.kind == Term::Kind::kOne) {
       bool sat = false;
       const long long one = IntegerArith::one_raw(o, sat);
       if (sat) w.line("*sat = 1u;  /* one() does not fit this format */");
-      raws.push_back(Raw{int_literal(one, 16), o.frac, std::fabs(static_cast<double>(one))});
+      raws.push_back(Raw16{int_literal(one, 16), o.frac, std::fabs(static_cast<double>(one))});
     } else if (t.kind == Term::Kind::kValue) {
-      raws.push_back(Raw{t.a.expr, t.a.count ? 0 : t.a.fmt.frac, bound_of(t.a)});
+      raws.push_back(Raw16{t.a.expr, t.a.count ? 0 : t.a.fmt.frac, bound_of(t.a)});
     } else {
       raws.push_back(product16(t.a, t.b));
     }
@@ -108,10 +106,10 @@ void Q15Arith::accumulate(CodeWriter& w, const std::string& dest, Qty out, const
   }
   // The accumulator fraction B: the finest that keeps the worst-case sum below 2^31.
   int top = o.frac;
-  for (const Raw& r : raws) top = std::max(top, r.frac);
+  for (const Raw16& r : raws) top = std::max(top, r.frac);
   const auto bound_at = [&](int b) {
     double s = b > o.frac ? std::ldexp(1.0, b - o.frac - 1) : 0.0;
-    for (const Raw& r : raws) s += std::ldexp(r.bound, b - r.frac) + (r.frac > b ? 1.0 : 0.0);
+    for (const Raw16& r : raws) s += std::ldexp(r.bound, b - r.frac) + (r.frac > b ? 1.0 : 0.0);
     return s;
   };
   int base = top;
@@ -150,7 +148,7 @@ void Q15Arith::accumulate(CodeWriter& w, const std::string& dest, Qty out, const
 
 void Q15Arith::mul(CodeWriter& w, const std::string& dest, Qty to, const Val& a, const Val& b) const {
   const QFormat t = fmt(to);
-  const Raw p = product16(a, b);
+  const Raw16 p = product16(a, b);
   const int shift = p.frac - t.frac;
   std::string value = p.expr;
   double bound = p.bound;

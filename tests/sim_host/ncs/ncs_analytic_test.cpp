@@ -14,6 +14,7 @@
 #include "ncs_loop.hpp"
 #include "ncs_test_support.hpp"
 #include "oneshot/util/statistics.hpp"
+#include "support/build_flavor.hpp"
 
 namespace oneshot::ncs {
 namespace {
@@ -112,7 +113,8 @@ TEST(NcsAnalytic, OneTimingDrawAgainstAMonteCarloOverTheNoiseAlone) {
     ASSERT_EQ(r.analytic_refusal, "") << name(a);
     std::vector<double> cost;
     RunOptions mc;
-    for (std::uint64_t n = 1; n <= 1000; ++n) {
+    // 1000 noise draws; a quarter under the sanitizers.
+    for (std::uint64_t n = 1; n <= test::sanitized_length<std::uint64_t>(1000, 4); ++n) {
       mc.noise_seed = 1000 + n;
       cost.push_back(run(context(), a, sc, 7, mc).cost);
     }

@@ -17,6 +17,7 @@
 #include "scenario.hpp"
 #include "simulation.hpp"
 #include "table1_analytic.hpp"
+#include "support/build_flavor.hpp"
 
 namespace oneshot::sim {
 namespace {
@@ -91,8 +92,11 @@ TEST(LinearBoard, AnalyticMeanAgreesWithTheMonteCarloOfTheSameModelPairedPerSeed
   // large 1.25 0.68 0.68 0.48 0.95.
   const auto ctx = SimContext::reference();
   // Two scenarios: noise-dominated small steps with 20 ms jitter, larger steps with 5 ms.
-  for (const auto& [sc, seeds] : {std::pair{uniform_scenario("small", 20'000, 0.2, 0.5, 2.0), std::size_t{1000}},
-                                  std::pair{uniform_scenario("large", 5'000, 0.8, 1.0, 3.0), std::size_t{300}}}) {
+  // A quarter of the seeds under the sanitizers (the same paths, checked for memory and UB).
+  constexpr std::size_t kDiv = 4;
+  for (const auto& [sc, seeds] :
+       {std::pair{uniform_scenario("small", 20'000, 0.2, 0.5, 2.0), test::sanitized_length<std::size_t>(1000, kDiv)},
+        std::pair{uniform_scenario("large", 5'000, 0.8, 1.0, 3.0), test::sanitized_length<std::size_t>(300, kDiv)}}) {
     for (Approach a : kAllApproaches) {
       if (!approach_available(*ctx, a)) continue;
       std::vector<double> d;
