@@ -176,6 +176,7 @@ engine::SweepResults run_ncs_sweep(const NcsStudy& s, std::size_t seeds, unsigne
                                      {"utilization", c.set.utilization()},
                                      {"wcrt_us", static_cast<double>(c.wcrt.count()) * 1e-3},
                                      {"bcrt_us", static_cast<double>(c.bcrt.count()) * 1e-3}};
+  }
   if (one_shot && !s.scenarios.empty()) {  // the file's sensor rule and controller phase (the same in every scenario)
     const ncs::Scenario& x = s.scenarios[0];
     spec.config["one_shot"] = {{"send_on_delta", x.sod_delta}, {"time_steps", x.sod_time_steps},
