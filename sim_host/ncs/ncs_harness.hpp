@@ -88,12 +88,11 @@ class Harness {
     for (std::uint64_t k = half; SimTime{h_ * static_cast<std::int64_t>(k)} < end_; k += half) {
       kernel_.schedule(SimTime{h_ * static_cast<std::int64_t>(k)}, EventClass::kEnvironment, sw, k);
     }
-    if (sc.controller_cpu && one_shot(a)) throw std::invalid_argument("ncs: the one-shot controller has no CPU model");
     if (sc.controller_cpu && !delay_free(a)) {  // τ_c from the schedule (ncs_cpu.hpp)
       cpu_ = std::make_unique<engine::cpu::Cpu>(kernel_, sc.controller_cpu->set);
       cpu_task_ = sc.controller_cpu->task;
       cpu_->on_job([this](const engine::cpu::CpuJob& j) {
-        if (j.entity == cpu_task_ && !j.aborted) kernel_.schedule(kernel_.now(), EventClass::kCompute, computed_);
+        if (j.entity == cpu_task_ && !j.aborted) kernel_.schedule(kernel_.now(), EventClass::kCompute, computed_, j.index);
       });
       cpu_->start(end_);
     }
@@ -153,11 +152,13 @@ class Harness {
     return b;
   }
 
-  /// A frame reached the controller: `compute_h` runs τ_c later, τ_c drawn (compute_time())
-  /// or, on a CPU, the response of the job released now (the handler runs at its finish).
-  void start_computation(HandlerId compute_h) {
+  /// A frame reached the controller (or the one-shot controller's timer fired): `compute_h`
+  /// runs τ_c later with argument `arg`, τ_c drawn (compute_time()) or, on a CPU, the response
+  /// of the job released now (the handler runs at its finish, with the job's index: the
+  /// number of releases before it, which is `arg` when the loop releases once per `arg`).
+  void start_computation(HandlerId compute_h, std::uint64_t arg = 0) {
     if (!cpu_) {
-      kernel_.schedule_in(compute_time(), EventClass::kCompute, compute_h);
+      kernel_.schedule_in(compute_time(), EventClass::kCompute, compute_h, arg);
       return;
     }
     computed_ = compute_h;

@@ -90,6 +90,8 @@ class OneShotLaw {
 /// send-on-delta (OSK: every sample, the time rule at n_t = 1), controller on its timer at
 /// kh + φ taking the frames that arrived by then and sending τ_c later, actuator on its timer
 /// applying at (k+1)h the command stamped k+1 (else holding the last one: late, counted).
+/// With a controller CPU (Scenario::controller_cpu) the timer releases the controller's job
+/// (periodic at h, phase φ) and the command is computed and sent at its finish.
 RunResult run_one_shot(Harness& hs, Approach a) {
   using Trigger = node::SendOnDeltaTrigger<double, kP>;
   using Sensor = node::SensorNode<Board, Trigger, double, kP>;
@@ -160,7 +162,7 @@ RunResult run_one_shot(Harness& hs, Approach a) {
   auto ctrl_h = std::make_shared<HandlerId>(0);
   *ctrl_h = k.add_handler("controller timer", [&, ctrl_h](std::uint64_t n) {
     net.run_node(kController, [&]() { ctrl.on_receive(net.node_clock(kController)); });
-    k.schedule_in(hs.compute_time(), EventClass::kCompute, compute_h, n);
+    hs.start_computation(compute_h, n);  // τ_c drawn, or the controller job's response on its CPU
     const SimTime t_next = k.now() + hs.h_;
     if (t_next < hs.end_) k.schedule(t_next, EventClass::kCompute, *ctrl_h, n + 1);
   });

@@ -94,10 +94,11 @@ std::vector<CpuPlan> plan_cpus(const engine::StudyFile& f, std::int64_t h_us) {
       if (n.cpu != p.set.name || !n.job) continue;
       const std::string nf = at("nodes", i);
       engine::cpu::TaskSpec t = *n.job;
-      if (n.mode == "timer") {  // its own timer: periodic
+      if (n.mode == "timer") {  // its own timer: periodic, its first release at the node's phase
         t.external = false;
         t.sporadic = false;
         t.period = n.period;
+        t.offset = n.clock_offset;
       } else {
         Duration jmax{0};
         const auto one = [&](const engine::ScenarioSpec* s) {
@@ -212,6 +213,9 @@ void attach_controller_cpu(const engine::StudyFile& f, NcsStudy& s) {
       auto c = std::make_shared<ncs::ControllerCpu>();
       c->set = p.set;
       c->task = task;
+      // The one-shot controller's timer (kh + φ) releases its job in the loop: analysed as
+      // periodic at h (plan_cpus), run as released by the timer (the same instants).
+      c->set.tasks[task].external = true;
       c->wcrt = p.analysis.tasks[task].wcrt;
       c->bcrt = p.analysis.tasks[task].bcrt;
       for (ncs::Scenario& sc : s.scenarios) sc.controller_cpu = c;
