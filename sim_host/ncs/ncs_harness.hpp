@@ -96,6 +96,15 @@ class Harness {
       });
       cpu_->start(end_);
     }
+    if (sc.sensor_cpu && !delay_free(a)) {  // the sampling job (ncs_cpu.hpp); the loop sets its callbacks
+      if (a != Approach::kS && a != Approach::kSK) {
+        throw std::invalid_argument(std::string("ncs: the sensor on a CPU runs with S and SK only, not ") + name(a));
+      }
+      if (an_) throw std::invalid_argument("ncs: no analytic cost with the sensor on a CPU");
+      sensor_cpu_ = std::make_unique<engine::cpu::Cpu>(kernel_, sc.sensor_cpu->set);
+      sensor_task_ = sc.sensor_cpu->task;
+      sensor_cpu_->start(end_);
+    }
     const HandlerId end = kernel_.add_handler("end", [this](std::uint64_t) { advance(); });
     kernel_.schedule(end_, EventClass::kEnd, end);
     if (opt.analytic_mark_s > 0 && !an_) throw std::invalid_argument("an analytic mark needs an analytic run");
@@ -221,26 +230,31 @@ class Harness {
       result_.bus_legs.emplace_back(nm, st);
     }
     if (an_) an_->report(result_);
-    if (cpu_) {
-      CpuRunStats& c = result_.cpu;
-      const engine::cpu::CpuTaskStats& st = cpu_->stats()[cpu_task_];
-      c.present = true;
-      c.jobs = st.finished;
-      c.response_min = st.response_min;
-      c.response_max = st.response_max;
-      c.response_sum_us = st.response_sum_s * 1e6;
-      c.deadline_misses = st.deadline_misses;
-      for (std::size_t e = 0; e < cpu_->stats().size(); ++e) {
-        c.busy += cpu_->stats()[e].busy;
-        if (e != cpu_task_) c.other_misses += cpu_->stats()[e].deadline_misses;
-      }
-    }
+    if (cpu_) cpu_stats(*cpu_, cpu_task_, result_.cpu);
+    if (sensor_cpu_) cpu_stats(*sensor_cpu_, sensor_task_, result_.sensor_cpu);
     for (const auto& s : plant_.trace()) {
       const double t = engine::to_seconds(s.t);
       result_.truth.push_back(Point{t, {s.x[0], s.x[1]}});
       result_.setpoint.push_back(Point{t, {s.r[0], s.u[0]}});
     }
     return std::move(result_);
+  }
+
+  /// Job `task`'s statistics on `cpu` into `c`.
+  static void cpu_stats(const engine::cpu::Cpu& cpu, std::size_t task, CpuRunStats& c) {
+    const engine::cpu::CpuTaskStats& st = cpu.stats()[task];
+    c.present = true;
+    c.jobs = st.finished;
+    c.response_min = st.response_min;
+    c.response_max = st.response_max;
+    c.response_sum_us = st.response_sum_s * 1e6;
+    c.deadline_misses = st.deadline_misses;
+    c.sample_min = st.sample_min;
+    c.sample_max = st.sample_max;
+    for (std::size_t e = 0; e < cpu.stats().size(); ++e) {
+      c.busy += cpu.stats()[e].busy;
+      if (e != task) c.other_misses += cpu.stats()[e].deadline_misses;
+    }
   }
 
   const Context& ctx_;
@@ -270,6 +284,8 @@ class Harness {
   std::unique_ptr<engine::cpu::Cpu> cpu_;  ///< The controller's CPU (Scenario::controller_cpu).
   std::size_t cpu_task_ = 0;               ///< The controller's job in it.
   HandlerId computed_ = 0;                 ///< The loop's compute handler (set at each release).
+  std::unique_ptr<engine::cpu::Cpu> sensor_cpu_;  ///< The sensor's CPU (Scenario::sensor_cpu).
+  std::size_t sensor_task_ = 0;                   ///< The sensor's job in it.
 };
 
 /// The one-shot loop OS, OSp or OSK `a` on `hs` (ncs_one_shot_loop.cpp).

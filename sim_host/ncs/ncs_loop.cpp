@@ -5,6 +5,7 @@
 #include <memory>
 #include <optional>
 #include <stdexcept>
+#include <vector>
 
 #include "ncs_counters.hpp"
 #include "ncs_harness.hpp"
@@ -173,11 +174,39 @@ RunResult run_sampling(Harness& hs, Law law, Saturated saturated) {
                      check_act();
                      hs.lose_inbox(kActuator);
                    }}});
+  // The sensor on a CPU (ncs_cpu.hpp): the timer releases its job n, which samples at its
+  // sample point and sends at its finish (per job: its sequence number and sample).
+  struct SensorJob {
+    node::SequenceNumber seq = 0;
+    OutputVec y{};
+    bool sampled = false;
+  };
+  std::vector<SensorJob> jobs;
+  if (hs.sensor_cpu_) {
+    hs.sensor_cpu_->on_point([&](std::size_t e, std::uint64_t n, engine::cpu::CpuEventKind kind) {
+      if (e != hs.sensor_task_ || kind != engine::cpu::CpuEventKind::kSample || n >= jobs.size()) return;
+      jobs[n].y = hs.sample();
+      jobs[n].sampled = true;
+      ++samples;
+    });
+    hs.sensor_cpu_->on_job([&](const engine::cpu::CpuJob& j) {
+      if (j.entity != hs.sensor_task_ || j.aborted || j.index >= jobs.size() || !jobs[j.index].sampled) return;
+      const SensorJob& s = jobs[j.index];
+      net.run_node(kSensor, [&]() { sensor->on_sample(s.seq, net.node_clock(kSensor), s.y); });
+    });
+  }
   auto timer_h = std::make_shared<HandlerId>(0);
   *timer_h = k.add_handler("sample", [&, timer_h](std::uint64_t n) {
     if (sensor_restarted) {
       sensor_restarted = false;
       sensor_n0 = n;
+    }
+    if (hs.sensor_cpu_) {
+      jobs.push_back(SensorJob{static_cast<node::SequenceNumber>(n - sensor_n0), OutputVec{}, false});
+      hs.sensor_cpu_->release(hs.sensor_task_);
+      const SimTime t_next = k.now() + hs.h_;
+      if (t_next < hs.end_) k.schedule(t_next, EventClass::kSample, *timer_h, n + 1);
+      return;
     }
     const OutputVec y = hs.sample();
     ++samples;

@@ -187,24 +187,38 @@ std::string describe_cpus(const json& cpus) {
 
 void attach_controller_cpu(const engine::StudyFile& f, NcsStudy& s) {
   if (f.cpus.empty()) return;
+  std::optional<std::size_t> sensor_node, controller_node;
   for (std::size_t i = 0; i < f.nodes.size(); ++i) {
     const engine::NodeSpec& n = f.nodes[i];
     if (n.cpu.empty()) continue;
-    if (n.role != "controller") {
-      refuse(at("nodes", i) + ".cpu", "only the controller's job runs on a CPU in study ncs (the " + n.role +
-                                          " runs on its timer with the loop's own timing)");
+    if (n.role == "sensor") {
+      sensor_node = i;
+    } else if (n.role == "controller") {
+      controller_node = i;
+    } else {
+      refuse(at("nodes", i) + ".cpu", "the " + n.role + "'s job on a CPU is not modelled in study ncs (it runs on its timer "
+                                      "with the loop's own timing)");
     }
     for (std::size_t l = 0; l < f.links.size(); ++l) {
       if (!f.links[l].bus.empty()) {
-        refuse(at("nodes", i) + ".cpu", "a controller on a CPU with a leg on a CAN bus (" + at("links", l) +
-                                            ".bus) is not analysed together: the bus analysis takes tau_c as U[1, 5] ms");
+        refuse(at("nodes", i) + ".cpu", "a " + n.role + " on a CPU with a leg on a CAN bus (" + at("links", l) +
+                                            ".bus) is not analysed together: the bus analysis takes the loop's own timing");
       }
     }
   }
+  if (sensor_node && controller_node) {
+    refuse(at("nodes", *sensor_node) + ".cpu", "the sensor and the controller on CPUs together are not analysed: the controller "
+                                               "job's input jitter would take the sensor job's response spread");
+  }
   for (std::size_t a = 0; a < f.approaches.size(); ++a) {
-    if (f.approaches[a].kind == "S+") {
+    const std::string& k = f.approaches[a].kind;
+    if (controller_node && k == "S+") {
       refuse(at("approaches", a) + ".kind", "S+ designs on the mean tau_c, which the schedule of the controller's CPU gives only "
                                             "after the run");
+    }
+    if (sensor_node && k != "I" && k != "IK" && k != "S" && k != "SK") {
+      refuse(at("approaches", a) + ".kind", k + " with the sensor on a CPU: its sampling job runs with the sampling-synchronized "
+                                                "approaches S and SK only (I and IK: the delay-free references, not on the CPU)");
     }
   }
   const std::vector<CpuPlan> plans = plan_cpus(f, s.ctx->period_us());
@@ -213,13 +227,15 @@ void attach_controller_cpu(const engine::StudyFile& f, NcsStudy& s) {
       auto c = std::make_shared<ncs::ControllerCpu>();
       c->set = p.set;
       c->task = task;
-      // The one-shot controller's timer (kh + φ) releases its job in the loop: analysed as
-      // periodic at h (plan_cpus), run as released by the timer (the same instants).
+      // Timer jobs (the one-shot controller's at kh + φ, the sensor's at kh) are released by
+      // the node's timer in the loop: analysed as periodic (plan_cpus), run as released then.
       c->set.tasks[task].external = true;
       c->wcrt = p.analysis.tasks[task].wcrt;
       c->bcrt = p.analysis.tasks[task].bcrt;
-      for (ncs::Scenario& sc : s.scenarios) sc.controller_cpu = c;
-      static_cast<void>(node);
+      c->sample_min = p.analysis.tasks[task].sampling_latency_min;
+      c->sample_max = p.analysis.tasks[task].sampling_latency_max;
+      const bool sensor = sensor_node && node == *sensor_node;
+      for (ncs::Scenario& sc : s.scenarios) (sensor ? sc.sensor_cpu : sc.controller_cpu) = c;
     }
   }
 }

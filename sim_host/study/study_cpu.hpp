@@ -49,11 +49,14 @@ nlohmann::json cpus_json(const engine::StudyFile& f, const std::vector<CpuPlan>&
 /// The cpus section as text (one line per CPU, one per task).
 std::string describe_cpus(const nlohmann::json& cpus);
 
-/// Maps the controller's job onto the ncs loop (every scenario's controller_cpu);
-/// engine::InputError (no source) naming the field for what the loop does not run: a sensor's
-/// or actuator's job (`nodes[i].cpu`: they run on their timers), a controller on a CPU with a
-/// leg on a CAN bus (`nodes[i].cpu`), S+ (`approaches[i].kind`: it designs on the mean τ_c,
-/// which the schedule gives only after the run), and everything plan_cpus() refuses.
+/// Maps the node jobs onto the ncs loop: the controller's (every scenario's controller_cpu)
+/// or the sensor's (sensor_cpu: S and SK sample at its sample point, send at its finish);
+/// engine::InputError (no source) naming the field for what the loop does not run: an
+/// actuator's job (`nodes[i].cpu`), the sensor and the controller both on CPUs (the sensor's
+/// `nodes[i].cpu`), a node on a CPU with a leg on a CAN bus (`nodes[i].cpu`), S+ with the
+/// controller on a CPU (`approaches[i].kind`: it designs on the mean τ_c, which the schedule
+/// gives only after the run), approaches other than I, IK, S, SK with the sensor on a CPU
+/// (`approaches[i].kind`), and everything plan_cpus() refuses.
 void attach_controller_cpu(const engine::StudyFile& f, NcsStudy& s);
 
 }  // namespace oneshot::study
