@@ -109,7 +109,8 @@ class Cpu {
   /// Called at the instant a task job reaches its sample (kSample) or actuation (kActuate)
   /// point, with its entity and job index: while set, every dispatch schedules the running
   /// job's points not yet reached (class kCompute, before its completion at the same instant;
-  /// a preemption makes them stale). Without it no event is added (the runs stay as they were).
+  /// a preemption makes them stale); a point at offset 0 is told at CpuJob::start. Without it
+  /// no event is added (the runs stay as they were).
   void on_point(std::function<void(std::size_t entity, std::uint64_t index, CpuEventKind kind)> f);
 
   const TaskSet& task_set() const { return set_; }                  ///< The task set.
@@ -164,7 +165,7 @@ class Cpu {
   std::vector<Entity> ent_;
   std::vector<CpuTaskStats> stats_;
   HandlerId h_arrive_ = 0, h_ready_ = 0, h_complete_ = 0, h_abort_ = 0, h_dispatch_ = 0;
-  HandlerId h_point_ = 0;  // registered by on_point()
+  HandlerId h_point_ = 0, h_start_point_ = 0;  // registered by on_point()
   SimTime end_{0};
   static constexpr std::size_t kNone = static_cast<std::size_t>(-1);
   std::size_t running_ = kNone;       // entity whose head job holds the CPU
@@ -176,6 +177,7 @@ class Cpu {
   std::function<void(const CpuJob&)> on_job_;
   std::function<void(std::size_t, std::uint64_t, CpuEventKind)> on_point_;
   void point(std::uint64_t arg);
+  void start_point(std::uint64_t arg);
   bool log_enabled_ = false;
   std::size_t log_limit_ = 0;
   std::vector<CpuLogEntry> log_;
