@@ -1,6 +1,6 @@
 /// @file study_cpu.cpp
 /// @brief The CPUs of a study file: task sets with node jobs, their analysis, the ncs
-///        controller's job (see study_cpu.hpp).
+///        node jobs mapped onto the loop (see study_cpu.hpp).
 #include "study_cpu.hpp"
 
 #include <algorithm>
@@ -157,6 +157,9 @@ json cpus_json(const engine::StudyFile& f, const std::vector<CpuPlan>& plans) {
         if (task != k) continue;
         t["kind"] = f.nodes[node].mode == "timer" ? "node job (timer)" : "node job (on input arrival)";
         t["node"] = f.nodes[node].name;
+        if (f.nodes[node].role == "sensor") {  // it samples at its start: the analysed lag behind kh
+          t["sample_lag_us"] = {t.at("sampling_latency_min_us"), t.at("sampling_latency_max_us")};
+        }
       }
     }
     out.push_back(j);
@@ -178,7 +181,11 @@ std::string describe_cpus(const json& cpus) {
         o << "  " << (std::string(list) == "isrs" ? "isr" : t.at("kind").get<std::string>()) << " " << t.at("name").get<std::string>();
         if (t.contains("period_us")) o << " (T " << t.at("period_us") << " us, C " << t.at("bcet_us") << "-" << t.at("wcet_us") << " us, priority " << t.at("priority") << ")";
         o << ": WCRT " << wcrt << " us, BCRT " << t.at("bcrt_us") << " us, deadline " << t.at("deadline_us") << " us, "
-          << (t.at("schedulable").get<bool>() ? "schedulable" : "misses") << "\n";
+          << (t.at("schedulable").get<bool>() ? "schedulable" : "misses");
+        if (t.contains("sample_lag_us")) {  // the sensor's sample after its release at kh
+          o << ", sample lag " << t.at("sample_lag_us")[0] << "-" << t.at("sample_lag_us")[1] << " us";
+        }
+        o << "\n";
       }
     }
   }

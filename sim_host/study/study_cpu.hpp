@@ -1,7 +1,7 @@
 /// @file study_cpu.hpp
 /// @brief The CPUs of a study file (`cpus`, nodes' `cpu` and `job`): each CPU's task set with
 ///        the node jobs among its background tasks, its response-time analysis for `study
-///        check`, and the ncs controller's job mapped onto the loop (ncs_cpu.hpp).
+///        check`, and the ncs controller's or sensor's job mapped onto the loop (ncs_cpu.hpp).
 ///
 /// A node job on input arrival (an `arrival` node) is analysed as sporadic with minimum
 /// inter-arrival h − J: h the plant's period, J the largest spread of its input's arrival over
@@ -43,7 +43,8 @@ std::vector<CpuPlan> plan_cpus(const engine::StudyFile& f, std::int64_t h_us);
 
 /// The "cpus" section of `study check`: per CPU its name, scheduler, context switch,
 /// utilization, input_jitter_us, schedulable (first_miss, reason) and per task and ISR the
-/// analysis (cpu_analysis.hpp analysis_json(): wcrt_us, bcrt_us, …) with "node" for node jobs.
+/// analysis (cpu_analysis.hpp analysis_json(): wcrt_us, bcrt_us, …) with "node" for node jobs
+/// and, for the sensor's, "sample_lag_us" [min, max]: its sample's analysed lag behind kh.
 nlohmann::json cpus_json(const engine::StudyFile& f, const std::vector<CpuPlan>& plans);
 
 /// The cpus section as text (one line per CPU, one per task).

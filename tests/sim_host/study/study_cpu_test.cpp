@@ -416,6 +416,12 @@ TEST(StudyCpuSensor, EverySampleLagsKhWithinTheAnalysedBounds) {
     const NcsStudy s = sensor_study(j, 2);
     const ncs::ControllerCpu& c = *s.scenarios[0].sensor_cpu;
     ASSERT_LT(c.sample_min, c.sample_max);
+    // study check gives the same lag bounds (the sensor job's "sample_lag_us").
+    const nlohmann::json chk =
+        resolve_study(engine::parse_study(j.dump(), sensor_cpu_path(), &ncs_schema(), ONESHOT_STUDY_EXAMPLES_DIR));
+    const nlohmann::json& bounds = chk.at("cpus")[0].at("tasks")[3].at("sample_lag_us");
+    EXPECT_EQ(bounds[0].get<double>(), static_cast<double>(c.sample_min.count()) * 1e-3);
+    EXPECT_EQ(bounds[1].get<double>(), static_cast<double>(c.sample_max.count()) * 1e-3);
     const double h_s = static_cast<double>(s.ctx->period_us()) * 1e-6;
     double lo = 1e9, hi = -1e9;
     std::size_t n = 0;
