@@ -61,9 +61,8 @@ class Harness {
         end_(engine::from_seconds(sc.duration_s, "ncs scenario duration")) {
     net_.set_faults(opt.faults);
     opt_faults_empty_ = opt.faults.empty();
-    if (one_shot(a) && (opt.analytic || opt.trace_step_s > 0)) {
-      throw std::invalid_argument(std::string("ncs: ") + name(a) + " has no analytic cost nor trace");
-    }
+    if (one_shot(a) && opt.analytic) throw std::invalid_argument(std::string("ncs: ") + name(a) + " has no analytic cost");
+    if (opt.record_messages) net_.record_messages();
     if (!legs_from_file(sc) && !(sc.max_delay_ms * 1000 >= static_cast<double>(ctx.timing().leg_min_us))) {
       throw std::invalid_argument("ncs scenario " + sc.name + ": d must be at least 0.5 ms");
     }
@@ -140,6 +139,7 @@ class Harness {
   /// Routes leg `name` from `source` to `destination`: over its CAN bus when the scenario puts
   /// it on one (not for the delay-free loops I, IK), else over a link.
   void route_leg(std::uint8_t source, std::uint8_t destination, const char* name) {
+    leg_routes_.push_back({{source, destination}, name});
     const auto b = sc_.bus_legs.find(name);
     if (b == sc_.bus_legs.end() || delay_free(approach_)) {
       net_.route(source, destination, add_leg(name));
@@ -218,7 +218,15 @@ class Harness {
   /// Runs the kernel to the end and collects the cost, trace and injected faults.
   RunResult finish() {
     kernel_.run_until(end_);
+    result_.events = kernel_.events_run();
     result_.injected = net_.fault_counters();
+    for (const engine::MessageRecord& m : net_.messages()) {
+      for (const auto& [route, nm] : leg_routes_) {
+        if (route != std::make_pair(m.source, m.destination)) continue;
+        result_.messages.push_back(MessageEvent{nm, engine::to_seconds(m.sent), engine::to_seconds(m.arrival), m.lost,
+                                                m.delivered});
+      }
+    }
     result_.cost = plant_.cost().total();
     for (const auto& [nm, l] : legs_) result_.links.emplace_back(nm, l->statistics());
     for (const auto& [nm, route] : bus_legs_) {
@@ -280,6 +288,7 @@ class Harness {
   std::vector<std::pair<std::string, engine::Link*>> legs_;
   std::vector<std::pair<std::string, std::pair<std::uint8_t, std::uint8_t>>> bus_legs_;  ///< Name, route.
   std::vector<std::pair<std::string, engine::CanBus*>> buses_;
+  std::vector<std::pair<std::pair<std::uint8_t, std::uint8_t>, std::string>> leg_routes_;  ///< Route, leg name.
   std::vector<std::unique_ptr<engine::CanTraffic>> traffic_;
   std::unique_ptr<engine::cpu::Cpu> cpu_;  ///< The controller's CPU (Scenario::controller_cpu).
   std::size_t cpu_task_ = 0;               ///< The controller's job in it.

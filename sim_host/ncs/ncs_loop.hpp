@@ -51,6 +51,8 @@ struct RunOptions {
   /// expected cost at this instant (s) in RunResult::analytic_at_mark,
   /// as a run of this duration would end with it; the run itself is unchanged.
   double analytic_mark_s = 0;
+  /// Log every message of the legs in RunResult::messages (observes only: the run is unchanged).
+  bool record_messages = false;
 };
 
 /// One row of a recorded sample or estimate.
@@ -72,6 +74,15 @@ struct CpuRunStats {
   engine::Duration busy{0};       ///< CPU time used by every task and ISR (context switches included).
   engine::Duration sample_min{0};  ///< Smallest sample − release of the job (the sensor's).
   engine::Duration sample_max{0};  ///< Largest.
+};
+
+/// One message of a leg (RunOptions::record_messages), in the order sent.
+struct MessageEvent {
+  std::string leg;         ///< "as", "sc" or "ca".
+  double sent_s = 0;       ///< Handed to the link (queued on the bus).
+  double arrival_s = 0;    ///< Arrival when delivered (may lie after the run's end: in flight then).
+  bool lost = false;       ///< Dropped by the leg's loss model.
+  bool delivered = false;  ///< Not lost (a bus leg's: its last frame ended within the run).
 };
 
 /// What a run returns.
@@ -101,6 +112,8 @@ struct RunResult {
   std::vector<std::pair<std::string, engine::BusRouteStatistics>> bus_legs;
   CpuRunStats cpu;               ///< The controller's CPU (Scenario::controller_cpu; I, IK: none).
   CpuRunStats sensor_cpu;        ///< The sensor's CPU (Scenario::sensor_cpu; I, IK: none).
+  std::vector<MessageEvent> messages;  ///< RunOptions::record_messages: every message of the legs.
+  std::uint64_t events = 0;      ///< Kernel events run (the engine's event queue pops).
   std::vector<Point> truth;      ///< True state every trace step (x1, x2).
   std::vector<Point> samples;    ///< Samples y at their instants.
   std::vector<Point> sample_truth;  ///< C x at the same instants (noise-free output).

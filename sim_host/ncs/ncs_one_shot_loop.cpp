@@ -153,6 +153,7 @@ RunResult run_one_shot(Harness& hs, Approach a) {
     const double det = p(0, 0) * p(1, 1) - p(0, 1) * p(1, 0);
     hs.estimate(kk, xh);
     if (!(det > 0)) return;  // a singular P (noise scale 0): no NEES term
+    static_assert(kN == 2, "the NEES below inverts a 2 x 2 covariance in closed form");
     // eᵀ P⁻¹ e with P⁻¹ = [[p11, −p01], [−p10, p00]] / det
     const double q = (e0 * e0 * p(1, 1) - e0 * e1 * (p(0, 1) + p(1, 0)) + e1 * e1 * p(0, 0)) / det;
     if (!std::isfinite(q)) return;

@@ -54,7 +54,11 @@ json link_summary(const engine::LinkConfig& c) {
           {"order", c.fifo ? "fifo" : "any"}};
 }
 
-bool one_shot_kind(const std::string& kind) { return kind == "OS" || kind == "OSp" || kind == "OSK"; }
+bool one_shot_kind(const std::string& kind) {
+  for (ncs::Approach k : ncs::kOneShotApproaches)
+    if (kind == ncs::name(k)) return true;
+  return false;
+}
 
 bool has_estimator(const std::string& kind) {
   return kind == "AK" || kind == "AKx" || kind == "AKl" || kind == "SK" || kind == "IK" || one_shot_kind(kind);

@@ -1,18 +1,24 @@
 /// @file study_cli.cpp
 /// @brief `oneshot-sim study check FILE`, `oneshot-sim study run FILE` and `oneshot-sim study
-///        report FILE OUTDIR`: study files (`oneshot-study/1`, docs/study-files.md) from the
+///        report FILE OUTDIR` (with traced runs), `oneshot-sim study bench FILE` (events and
+///        wall time of the sweep): study files (`oneshot-study/1`, docs/study-files.md) from the
 ///        command line; `merge` finishes the shards of `study run`.
+#include <algorithm>
 #include <chrono>
+#include <cstdio>
+#include <ctime>
 #include <filesystem>
 #include <iostream>
 #include <memory>
 #include <optional>
 #include <sstream>
 #include <string>
+#include <thread>
 
 #include "oneshot/engine/study_file.hpp"
 #include "oneshot/sim/study_descriptor.hpp"
 #include "oneshot/util/output_files.hpp"
+#include "ncs_loop.hpp"
 #include "study_check.hpp"
 #include "study_file_report.hpp"
 #include "study_ncs_runner.hpp"
@@ -79,6 +85,15 @@ struct ReportCli {
   unsigned threads = 0;
   bool no_plots = false;
   double max_duration_s = 0;
+  std::string trace;  ///< --trace: approaches to trace, comma-separated (empty: the default selection).
+};
+
+struct BenchCli {
+  std::string file;
+  std::size_t seeds = 0;
+  unsigned threads = 0;
+  double max_duration_s = 0;
+  std::string json;
 };
 
 /// The file's ncs loop, its scenarios cut at `max_duration_s` when the option was given.
@@ -98,6 +113,58 @@ std::string simulated_time_text(const study::NcsStudy& s, const CLI::Option* max
   if (max_duration->count() > 0) t << " (capped by --max-duration " << max_duration_s << ")";
   t << ".";
   return t.str();
+}
+
+/// `study bench`: the file's sweep (approaches x scenarios x seeds, ncs::run with the sweep's
+/// seeds) timed, each run's kernel events counted (an event: one pop of the engine's event
+/// queue, whatever its handler: sampling, timers, computations, deliveries, set-point
+/// switches, CAN frames and background traffic).
+nlohmann::json bench(const study::NcsStudy& s, std::size_t seeds, unsigned threads) {
+  engine::SweepSpec spec;
+  spec.study = "study";
+  spec.experiment = "bench";
+  for (ncs::Approach a : s.approaches) spec.approaches.emplace_back(ncs::name(a));
+  for (const ncs::Scenario& x : s.scenarios) spec.scenarios.push_back(x.name);
+  spec.first_seed = s.first_seed;
+  spec.seeds = seeds == 0 ? s.seeds : seeds;
+  spec.metrics = {"cost", "events", "simulated_s", "run_s"};
+  spec.config = {{"study_file", s.source}};
+  const unsigned used = threads == 0 ? std::max(1U, std::thread::hardware_concurrency()) : threads;
+  const std::clock_t cpu0 = std::clock();
+  const auto start = std::chrono::steady_clock::now();
+  const engine::SweepResults r = engine::run_sweep(
+      spec, engine::Shard{}, used,
+      [&s](std::size_t a, std::size_t k, std::uint64_t seed) {
+        const auto t0 = std::chrono::steady_clock::now();
+        const ncs::RunResult x = ncs::run(*s.ctx, s.approaches[a], s.scenarios[k], seed, ncs::RunOptions{});
+        const double run_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+        return std::vector<double>{x.cost, static_cast<double>(x.events), s.scenarios[k].duration_s, run_s};
+      },
+      "study bench");
+  const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  const double cpu = static_cast<double>(std::clock() - cpu0) / CLOCKS_PER_SEC;
+  double events = 0;
+  double simulated = 0;
+  const std::size_t ev = r.metric("events");
+  const std::size_t sim = r.metric("simulated_s");
+  const std::size_t rs = r.metric("run_s");
+  nlohmann::json per = nlohmann::json::object();  // per approach: its runs' events and their time on their thread
+  for (std::size_t a = 0; a < spec.approaches.size(); ++a) {
+    double ea = 0;
+    double ta = 0;
+    for (std::size_t x = 0; x < spec.scenarios.size(); ++x)
+      for (std::size_t k = 0; k < spec.seeds; ++k) {
+        ea += r.at(a, x, k, ev);
+        ta += r.at(a, x, k, rs);
+        simulated += r.at(a, x, k, sim);
+      }
+    events += ea;
+    per[spec.approaches[a]] = {{"events", ea}, {"run_s", ta}, {"events_per_run_s", ta > 0 ? ea / ta : 0.0}};
+  }
+  return {{"per_approach", per}, {"study_file", s.source}, {"runs", spec.runs()}, {"seeds", spec.seeds}, {"threads", used},
+          {"events", events}, {"simulated_s", simulated}, {"wall_s", wall}, {"cpu_s", cpu},
+          {"events_per_s", events / wall}, {"events_per_s_per_thread", events / wall / used},
+          {"events_per_cpu_s", cpu > 0 ? events / cpu : 0.0}};
 }
 
 constexpr const char* kMaxDurationHelp = "cap every scenario's simulated seconds (at least one period h; default: the file's)";
@@ -167,23 +234,59 @@ void add_study_commands(CLI::App* group) {
     cmd->add_option("--seeds", c->seeds, "seeds per scenario (default: the file's seeds.count)")->check(CLI::Range(2, 10000000));
     cmd->add_option("--threads", c->threads, "worker threads (0: every core)")->capture_default_str();
     const CLI::Option* max_duration = cmd->add_option("--max-duration", c->max_duration_s, kMaxDurationHelp);
-    cmd->add_flag("--no-plots", c->no_plots, "no plot (no gnuplot); the report links none");
-    cmd->callback([c, max_duration]() {
+    cmd->add_flag("--no-plots", c->no_plots, "no plot (no gnuplot): the cost table's and the traces' CSV files only");
+    const CLI::Option* trace = cmd->add_option(
+        "--trace", c->trace,
+        "approaches traced on the first scenario and seed, comma-separated (default: every approach, at most 10): "
+        "CSV of states, estimates, input and messages, and a plot each");
+    cmd->callback([c, max_duration, trace]() {
       const Checked k = check_file(c->file);
       const study::NcsStudy s = runnable(k, max_duration, c->max_duration_s);
+      if (trace->count() > 0 && c->trace.empty()) throw engine::InputError("field '--trace': an empty approach name");
+      const std::vector<std::size_t> traced = study::trace_selection(s, c->trace);  // refused before anything is written
       util::make_directory(c->out);
       const engine::SweepResults r = study::run_ncs_sweep(s, c->seeds, c->threads, engine::Shard{});
-      const nlohmann::json j = study::run_outputs(r, c->out, !c->no_plots);
+      nlohmann::json j = study::run_outputs(r, c->out, !c->no_plots);
+      nlohmann::json traces = study::write_traces(s, traced, c->out, !c->no_plots);
+      for (std::size_t a : traced) {  // the traced run is the sweep's: the same cost, bit for bit
+        const std::string an = r.spec.approaches[a];
+        if (traces.contains(an)) traces[an]["same_cost_as_sweep"] = traces[an].at("cost").get<double>() == r.at(a, 0, 0, r.metric("cost"));
+      }
+      j["traces"] = traces;
       nlohmann::json resolution = k.resolution;  // the grid that ran: --seeds overrides the file's count
       resolution["seeds"]["count"] = r.spec.seeds;
       resolution["grid"]["runs"] = r.spec.runs();
       const std::string md = study::report_markdown(c->file, study::describe_resolution(resolution),
                                                     simulated_time_text(s, max_duration, c->max_duration_s), r, j,
-                                                    c->no_plots ? "" : "table.png");
+                                                    c->no_plots ? "" : "table.png") +
+                             study::traces_markdown(traces, r, !c->no_plots);
       util::write_text((std::filesystem::path(c->out) / "report.md").string(), md);
       util::write_json((std::filesystem::path(c->out) / "report.json").string(), j);
       std::cout << "study report: " << r.spec.runs() << " runs, written to " << (std::filesystem::path(c->out) / "report.md").string()
                 << "\n";
+    });
+  }
+  {
+    auto c = std::make_shared<BenchCli>();
+    CLI::App* cmd = group->add_subcommand(
+        "bench", "Time a study file's sweep as `study run` runs it and count its kernel events (queue pops): events, wall "
+                 "and CPU time, events per second per thread and per CPU second (docs/study-files.md, Speed)");
+    cmd->add_option("file", c->file, "study file (oneshot-study/1)")->required();
+    cmd->add_option("--seeds", c->seeds, "seeds per scenario (default: the file's seeds.count)")->check(CLI::Range(2, 10000000));
+    cmd->add_option("--threads", c->threads, "worker threads (0: every core)")->capture_default_str();
+    const CLI::Option* max_duration = cmd->add_option("--max-duration", c->max_duration_s, kMaxDurationHelp);
+    cmd->add_option("--json", c->json, "write the figures as JSON to PATH, or '-' for standard output");
+    cmd->callback([c, max_duration]() {
+      const study::NcsStudy s = runnable(check_file(c->file), max_duration, c->max_duration_s);
+      const nlohmann::json j = bench(s, c->seeds, c->threads);
+      if (!c->json.empty()) util::write_json(c->json, j);
+      if (c->json != "-") {
+        std::printf("study bench %s: %zu runs (%zu seeds) on %u threads: %.0f events, %.1f s simulated, wall %.2f s, CPU %.2f s; "
+                    "%.3g events/s per thread, %.3g events per CPU second\n",
+                    c->file.c_str(), j.at("runs").get<std::size_t>(), j.at("seeds").get<std::size_t>(), j.at("threads").get<unsigned>(),
+                    j.at("events").get<double>(), j.at("simulated_s").get<double>(), j.at("wall_s").get<double>(),
+                    j.at("cpu_s").get<double>(), j.at("events_per_s_per_thread").get<double>(), j.at("events_per_cpu_s").get<double>());
+      }
     });
   }
 }

@@ -87,7 +87,9 @@ NcsStudy map_ncs_study(const engine::StudyFile& file) {
     std::map<std::string, std::string> by_role;  // role → node name
     // One-shot loops (OS, OSp, OSK): the controller runs a timer at kh + φ, the sensor may send on delta.
     bool one_shot = false;
-    for (const engine::ApproachSpec& a : file.approaches) one_shot = one_shot || a.kind == "OS" || a.kind == "OSp" || a.kind == "OSK";
+    for (const engine::ApproachSpec& a : file.approaches) {
+      for (ncs::Approach k : ncs::kOneShotApproaches) one_shot = one_shot || a.kind == ncs::name(k);
+    }
     std::string sod_field;  // the sensor's send-on-delta trigger ("" when it has none)
     std::vector<double> sod_delta;
     std::uint32_t sod_time_steps = 0;
@@ -284,6 +286,17 @@ NcsStudy map_ncs_study(const engine::StudyFile& file) {
         }
       }
       out.scenarios.push_back(sc);
+    }
+    if (one_shot) {
+      // The one-shot filter corrects the outputs one at a time (a scalar correction each):
+      // exact only for a diagonal measurement covariance.
+      const auto r = out.ctx->controller_design(1).r;
+      for (std::size_t i = 0; i < ncs::kP; ++i)
+        for (std::size_t k = 0; k < ncs::kP; ++k)
+          if (i != k && r(i, k) != 0) {
+            refuse("plant.file", "the one-shot filter corrects the outputs one at a time: the measurement covariance R must "
+                                 "be diagonal (R(" + std::to_string(i) + "," + std::to_string(k) + ") is not 0)");
+          }
     }
     attach_controller_cpu(file, out);  // study_cpu.hpp: τ_c from the controller's CPU, when it has one
     out.first_seed = file.first_seed;

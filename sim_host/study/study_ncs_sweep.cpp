@@ -15,6 +15,7 @@
 #include "ncs_experiments.hpp"
 #include "ncs_loop.hpp"
 #include "oneshot/engine/sweep_statistics.hpp"
+#include "oneshot/util/statistics.hpp"
 
 namespace oneshot::study {
 namespace {
@@ -180,6 +181,7 @@ engine::SweepResults run_ncs_sweep(const NcsStudy& s, std::size_t seeds, unsigne
                                      {"utilization", c.set.utilization()},
                                      {"wcrt_us", static_cast<double>(c.wcrt.count()) * 1e-3},
                                      {"bcrt_us", static_cast<double>(c.bcrt.count()) * 1e-3}};
+    spec.config["compute_us"] = "cpu";  // τ_c is the job's response on the CPU, not the U[min, max] draw
   }
   if (sensor_on_cpu) {  // likewise: shards of files with other sensor jobs do not merge
     const ncs::ControllerCpu& c = *s.scenarios[0].sensor_cpu;
@@ -345,31 +347,51 @@ void add_cpu_stats(nlohmann::json& j, const engine::SweepResults& results) {
   j["markdown_cpu"] = md;
 }
 
-}  // namespace
-
-namespace {
-
 /// Adds "one_shot" (per one-shot approach: the filter's NEES, mean and 95 % interval over
 /// seeds of the scenario mean, and the sensor's send rate, overall and per scenario) and its
 /// table to the markdown.
 void add_one_shot(nlohmann::json& j, const engine::SweepResults& results) {
   const engine::SweepSpec& spec = results.spec;
-  const engine::SweepSummary nees = engine::summarize_metric(results, results.metric("nees"), 0);
+  const std::size_t nees_i = results.metric("nees");
+  const std::size_t steps_i = results.metric("nees_steps");
   const std::size_t sampled = results.metric("sensor.samples");
   const std::size_t sent = results.metric("sensor.sent");
-  std::string md = "\n| approach | NEES (n = 2) | 95 % CI | samples sent |\n|---|---:|---:|---:|\n";
+  // A run without a regular P (noise scale 0) has no NEES: left out, never counted as 0. Per seed
+  // the mean over the scenarios that have one, then the mean and interval over the seeds.
+  const auto summary = [](const std::vector<double>& v) {
+    if (v.empty()) return nlohmann::json::array({nullptr, nullptr});
+    const util::Summary m = util::summarize(v);
+    return nlohmann::json::array({m.mean, m.ci95});
+  };
+  std::string md = "\n| approach | NEES (n = " + std::to_string(ncs::kN) +
+                   ") | 95 % CI | samples sent |\n|---|---:|---:|---:|\n";
   for (std::size_t a = 0; a < spec.approaches.size(); ++a) {
     if (!ncs::one_shot(ncs::parse_any_approach(spec.approaches[a]))) continue;
-    nlohmann::json e = {{"nees_mean", nees.value[a].mean}, {"nees_ci95", nees.value[a].ci95}};
+    std::vector<double> per_seed;
+    for (std::size_t k = 0; k < spec.seeds; ++k) {
+      double sum = 0;
+      std::size_t count = 0;
+      for (std::size_t x = 0; x < spec.scenarios.size(); ++x) {
+        if (results.at(a, x, k, steps_i) > 0) {
+          sum += results.at(a, x, k, nees_i);
+          ++count;
+        }
+      }
+      if (count > 0) per_seed.push_back(sum / static_cast<double>(count));
+    }
+    const nlohmann::json overall = summary(per_seed);
+    nlohmann::json e = {{"nees_mean", overall[0]}, {"nees_ci95", overall[1]}};
     double n_all = 0, s_all = 0;
     for (std::size_t x = 0; x < spec.scenarios.size(); ++x) {
       double n = 0, sn = 0;
+      std::vector<double> nees;
       for (std::size_t k = 0; k < spec.seeds; ++k) {
         n += results.at(a, x, k, sampled);
         sn += results.at(a, x, k, sent);
+        if (results.at(a, x, k, steps_i) > 0) nees.push_back(results.at(a, x, k, nees_i));
       }
-      e["per_scenario"][spec.scenarios[x]] = {{"nees_mean", nees.per_scenario[a][x].mean},
-                                              {"nees_ci95", nees.per_scenario[a][x].ci95},
+      const nlohmann::json m = summary(nees);
+      e["per_scenario"][spec.scenarios[x]] = {{"nees_mean", m[0]}, {"nees_ci95", m[1]},
                                               {"samples", n}, {"sent", sn}, {"send_rate", n > 0 ? sn / n : 0.0}};
       n_all += n;
       s_all += sn;
@@ -379,8 +401,12 @@ void add_one_shot(nlohmann::json& j, const engine::SweepResults& results) {
     e["send_rate"] = n_all > 0 ? s_all / n_all : 0.0;
     j["one_shot"][spec.approaches[a]] = e;
     char row[200];
-    std::snprintf(row, sizeof row, "| %s | %.4f | ± %.4f | %.4f |\n", spec.approaches[a].c_str(), nees.value[a].mean,
-                  nees.value[a].ci95, e["send_rate"].get<double>());
+    if (overall[0].is_null()) {
+      std::snprintf(row, sizeof row, "| %s | — | — | %.4f |\n", spec.approaches[a].c_str(), e["send_rate"].get<double>());
+    } else {
+      std::snprintf(row, sizeof row, "| %s | %.4f | ± %.4f | %.4f |\n", spec.approaches[a].c_str(), overall[0].get<double>(),
+                    overall[1].get<double>(), e["send_rate"].get<double>());
+    }
     md += row;
   }
   j["markdown"] = j.at("markdown").get<std::string>() + md;

@@ -133,6 +133,10 @@ void Network::run_node(std::uint8_t address, const std::function<void()>& f) {
       std::vector<std::vector<std::uint8_t>> extra;
       if (r.faults != nullptr) r.faults->apply(kernel_.now(), frame.bytes, extra);
       const auto arrival = r.link->transmit(kernel_.now());
+      if (record_) {
+        MessageRecord m{frame.source, frame.destination, kernel_.now(), arrival.value_or(kernel_.now()), !arrival, arrival.has_value()};
+        messages_.push_back(m);
+      }
       if (!arrival) continue;
       const std::uint8_t src = frame.source;
       const std::uint8_t dst = frame.destination;
@@ -148,9 +152,16 @@ void Network::run_node(std::uint8_t address, const std::function<void()>& f) {
         r.bus->queue(r.id, 8, fragment_id_, 0);
         left -= 8;
       }
+      const std::uint8_t frame_source = frame.source;
+      const std::uint8_t frame_destination = frame.destination;
       const std::uint64_t slot = park(std::move(frame));
       slot_bus_[slot] = {r.bus_stats, kernel_.now()};
       ++bus_stats_[r.bus_stats].sent;
+      if (record_) {
+        slot_record_.resize(in_flight_.size());
+        slot_record_[slot] = messages_.size();
+        messages_.push_back(MessageRecord{frame_source, frame_destination, kernel_.now(), kernel_.now(), false, false});
+      }
       r.bus->queue(r.id, left, bus_deliver_id_, slot);
     }
   }
@@ -164,6 +175,11 @@ void Network::deliver_from_bus(std::uint64_t slot) {
   st.max_delay = std::max(st.max_delay, d);
   st.total_delay += d;
   ++st.delivered;
+  if (record_ && slot < slot_record_.size()) {
+    MessageRecord& m = messages_[slot_record_[slot]];
+    m.arrival = kernel_.now();
+    m.delivered = true;
+  }
   deliver(slot);
 }
 

@@ -3,8 +3,11 @@
 ///        continuous plant over the simulated network (links, CAN bus): with zero or
 ///        constant delays the loop equals the same loop computed directly, bit for bit
 ///        (the noise-free invariant, here with noise too); losses are counted consistently
-///        by links and nodes; stamps carry the sender's clock offset; the run is deterministic.
+///        by links and nodes; stamps carry the sender's clock offset; the run is deterministic;
+///        the message log observes only and agrees with the link's counters and delays.
 #include <gtest/gtest.h>
+
+#include <vector>
 
 #include "oneshot/engine/continuous_plant.hpp"
 #include "oneshot/engine/network.hpp"
@@ -76,11 +79,12 @@ struct Outcome {
   node::ActuatorStatistics actuator;
   LinkStatistics sc;
   McuInstant last_stamp{};
+  std::vector<MessageRecord> messages;  ///< With `record`: every message routed.
 };
 
 /// The loop over the network: sensor (address 1) → link "sc" → controller (2) → "ca" or
 /// a CAN bus → actuator (3) → plant.
-Outcome networked(std::uint64_t seed, LinkConfig sc, LinkConfig ca, bool ca_on_can) {
+Outcome networked(std::uint64_t seed, LinkConfig sc, LinkConfig ca, bool ca_on_can, bool record = false) {
   Kernel k(seed);
   Plant plant = started_plant(k);
   RandomStream noise = k.stream("measurement");
@@ -100,7 +104,9 @@ Outcome networked(std::uint64_t seed, LinkConfig sc, LinkConfig ca, bool ca_on_c
   });
   sc.name = "sc";
   ca.name = "ca";
-  net.route(1, 2, net.add_link(sc));
+  if (record) net.record_messages();
+  Link& sc_link = net.add_link(sc);
+  net.route(1, 2, sc_link);
   if (ca_on_can) {
     net.route(2, 3, net.add_can_bus(CanBusConfig{"can", 500'000, false}), 0x10);
   } else {
@@ -117,8 +123,8 @@ Outcome networked(std::uint64_t seed, LinkConfig sc, LinkConfig ca, bool ca_on_c
   k.schedule(SimTime{0}, EventClass::kSample, *sample_id, 0);
   k.schedule(kEnd, EventClass::kEnd, end);
   k.run_until(kEnd);
-  return {plant.cost().total(), sensor.statistics(), ctrl.statistics(), act.statistics(), LinkStatistics{},
-          ctrl.latest().stamp};
+  return {plant.cost().total(), sensor.statistics(), ctrl.statistics(), act.statistics(), sc_link.statistics(),
+          ctrl.latest().stamp, net.messages()};
 }
 
 /// The same loop computed directly: u = −L y applied `delay` after each sample.
@@ -188,6 +194,49 @@ TEST(NetworkedLoop, LossesAreCountedConsistentlyAndStampsCarryTheClockOffset) {
   // The last measurement used was stamped by the sensor's clock, 7 µs ahead.
   EXPECT_EQ((a.last_stamp.ticks() - 7) % 50'000, 0U);
   EXPECT_NE(networked(6, lossy, constant(1000), false).cost, a.cost);
+}
+
+TEST(NetworkedLoop, TheMessageLogObservesOnly) {
+  LinkConfig lossy;
+  lossy.delay.kind = DelayModel::Kind::kUniform;
+  lossy.delay.min = from_us(500);
+  lossy.delay.max = from_us(150'000);
+  lossy.loss.kind = LossModel::Kind::kBernoulli;
+  lossy.loss.p = 0.2;
+  for (const bool can : {false, true}) {
+    const Outcome plain = networked(5, lossy, constant(1000), can);
+    const Outcome logged = networked(5, lossy, constant(1000), can, true);
+    EXPECT_EQ(logged.cost, plain.cost) << can;
+    EXPECT_TRUE(plain.messages.empty());
+    std::uint64_t sc_sent = 0, sc_lost = 0, ca_sent = 0;
+    SimTime last_sent{0};
+    for (const MessageRecord& m : logged.messages) {
+      EXPECT_GE(m.sent, last_sent);  // in the order sent
+      last_sent = m.sent;
+      EXPECT_NE(m.lost, m.delivered);  // every link message either lost or with its arrival; the bus delivers all here
+      if (m.source == 1) {
+        ++sc_sent;
+        sc_lost += m.lost;
+        if (m.delivered) {
+          EXPECT_GE(m.arrival - m.sent, from_us(500));
+          EXPECT_LE(m.arrival - m.sent, from_us(150'000));
+        }
+      } else {
+        ++ca_sent;
+        EXPECT_EQ(m.destination, 3);
+        EXPECT_FALSE(m.lost);
+        if (can) {
+          EXPECT_GE(m.arrival - m.sent, from_us(540));  // two 135-bit frames at 500 kbit/s, after those queued before
+        } else {
+          EXPECT_EQ(m.arrival - m.sent, from_us(1000));  // the constant delay
+        }
+      }
+    }
+    EXPECT_EQ(sc_sent, logged.sc.sent);
+    EXPECT_EQ(sc_lost, logged.sc.lost);
+    EXPECT_GT(sc_lost, 0U);
+    EXPECT_EQ(ca_sent, logged.controller.sends);
+  }
 }
 
 }  // namespace

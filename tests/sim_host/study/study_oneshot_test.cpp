@@ -76,6 +76,27 @@ TEST(StudyOneShot, AtZeroDeltaTheHeldValueLoopIsThePeriodicLoop) {
   }
 }
 
+TEST(StudyOneShot, EveryPeriodGetsItsCommandWhenTheChainFitsInAPeriod) {
+  // Lossless sc, every sample sent (δy = 0): the controller's timer at kh + 20 ms, τ_c ≤ 5 ms and
+  // ca ≤ 10 ms put command k+1 at the actuator before (k+1)h, so none is late and the actuator
+  // applies one command per period from h on (the first period runs on the initial input).
+  const NcsStudy s = os_study(lossless_delta(0), 2);
+  for (const ncs::Approach a : {ncs::Approach::kOS, ncs::Approach::kOSp, ncs::Approach::kOSK}) {
+    for (std::uint64_t seed = 1; seed <= 3; ++seed) {
+      const ncs::RunResult r = ncs::run(*s.ctx, a, s.scenarios[0], seed, ncs::RunOptions{});
+      const auto periods = static_cast<std::uint32_t>(std::llround(s.scenarios[0].duration_s * 1e6 / s.ctx->period_us()));
+      EXPECT_EQ(r.late, 0U) << ncs::name(a) << " " << seed;
+      EXPECT_EQ(r.commands, periods - 1) << ncs::name(a) << " " << seed;
+    }
+  }
+  // With δy > 0 the held value is used (R̄ > R) where the sensor stays silent: OS and OSp differ.
+  const NcsStudy d = os_study(lossless_delta(0.02), 2);
+  const ncs::RunResult os = ncs::run(*d.ctx, ncs::Approach::kOS, d.scenarios[0], 1, ncs::RunOptions{});
+  const ncs::RunResult osp = ncs::run(*d.ctx, ncs::Approach::kOSp, d.scenarios[0], 1, ncs::RunOptions{});
+  EXPECT_LT(os.sent, os.sampled);
+  EXPECT_NE(os.cost, osp.cost);
+}
+
 TEST(StudyOneShot, SendsFallAsDeltaGrows) {
   double last = 0;
   bool first = true;

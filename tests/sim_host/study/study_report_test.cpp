@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
@@ -15,6 +16,7 @@
 #include <string>
 #include <vector>
 
+#include "ncs_loop.hpp"
 #include "oneshot/engine/study_file.hpp"
 #include "study_ncs_runner.hpp"
 #include "study_ncs_sweep.hpp"
@@ -77,7 +79,7 @@ TEST(StudyReport, NamesEveryApproachWithTheCostsOfStudyRun) {
   ASSERT_EQ(run.exit_code, 0) << run.output;
   const std::string out = test::fresh_dir("oneshot_study_report", "report");
   const test::CommandResult rep =
-      test::run_command({ONESHOT_SIM_PATH, "study", "report", kExample, out, "--seeds", "2", "--threads", "2"});
+      test::run_command({ONESHOT_SIM_PATH, "study", "report", kExample, out, "--seeds", "2", "--threads", "2", "--trace", "AK"});
   ASSERT_EQ(rep.exit_code, 0) << rep.output;
   const nlohmann::json j = read_json(run_json);
   const std::string md = test::read_file(out + "/report.md");
@@ -136,7 +138,10 @@ TEST(StudyReport, BadInputWritesNothing) {
   const std::vector<std::pair<std::vector<std::string>, std::string>> cases = {
       {{dir + "/study.json"}, "field 'scenarios[0].params.amplitude_volts'"},
       {{ONESHOT_ENGINE_EXAMPLE_STUDY}, "field 'study'"},                     // a file the loop cannot run
-      {{kExample, "--max-duration", "0.01"}, "field '--max-duration'"}};  // below h = 50 ms
+      {{kExample, "--max-duration", "0.01"}, "field '--max-duration'"},  // below h = 50 ms
+      {{kExample, "--trace", "AK,XX"}, "field '--trace'"},              // no such approach
+      {{kExample, "--trace", "AK,AK"}, "field '--trace'"},              // twice
+      {{kExample, "--trace", ""}, "field '--trace'"}};
   for (const auto& [args, field] : cases) {
     const std::string out = test::fresh_dir("oneshot_study_report", "bad_out");
     std::vector<std::string> argv = {ONESHOT_SIM_PATH, "study", "report", args[0], out};
@@ -212,6 +217,150 @@ TEST(StudyReport, FuzzRunCorpusFilesRunWithinTheHarnessBound) {
     for (double v : r.values) EXPECT_TRUE(std::isfinite(v)) << f.path();
   }
   EXPECT_GE(files, 3U);
+}
+
+/// The rows of a CSV file (header included), split at commas (an empty field stays empty).
+std::vector<std::vector<std::string>> csv_rows(const std::string& path) {
+  std::vector<std::vector<std::string>> rows;
+  std::stringstream in(test::read_file(path));
+  for (std::string line; std::getline(in, line);) {
+    std::vector<std::string>& row = rows.emplace_back();
+    std::stringstream l(line);
+    for (std::string c; std::getline(l, c, ',');) row.push_back(c);
+    if (!line.empty() && line.back() == ',') row.emplace_back();
+  }
+  return rows;
+}
+
+TEST(StudyReport, TracingARunLeavesItsCostBitForBit) {
+  // Every approach of the three shipped examples (links with loss, CAN legs, the one-shot
+  // loops) on the first scenario and seed, cut at 3 s: traced and message-logged as `study
+  // report --trace` runs it, and plain as the sweep runs it.
+  for (const char* f : {"ncs.json", "ncs_can.json", "sod_ge_oneshot.json"}) {
+    NcsStudy s = map_ncs_study(engine::load_study(std::string(ONESHOT_STUDY_EXAMPLES_DIR) + "/" + f, &ncs_schema()));
+    cap_duration(s, 3, "--max-duration");
+    ncs::RunOptions traced;
+    traced.trace_step_s = 1e-3;
+    traced.record_messages = true;
+    for (ncs::Approach a : s.approaches) {
+      const ncs::RunResult plain = ncs::run(*s.ctx, a, s.scenarios[0], s.first_seed, ncs::RunOptions{});
+      const ncs::RunResult t = ncs::run(*s.ctx, a, s.scenarios[0], s.first_seed, traced);
+      EXPECT_EQ(t.cost, plain.cost) << f << " " << ncs::name(a);
+      EXPECT_EQ(t.commands, plain.commands) << f << " " << ncs::name(a);
+      EXPECT_EQ(t.events, plain.events) << f << " " << ncs::name(a);
+      EXPECT_TRUE(plain.messages.empty());
+      EXPECT_EQ(t.truth.size(), 3001U) << f << " " << ncs::name(a);  // 0, 1 ms, ..., 3 s
+      EXPECT_GT(t.events, 0U);
+    }
+  }
+}
+
+TEST(StudyReport, TracesHaveTheirColumnsAndTheRunsMessages) {
+  // The one-shot example: its leg sc loses messages (Gilbert-Elliott), OSK has an estimator, I none.
+  const std::string file = std::string(ONESHOT_STUDY_EXAMPLES_DIR) + "/sod_ge_oneshot.json";
+  const std::string out = test::fresh_dir("oneshot_study_report", "traces");
+  const test::CommandResult r = test::run_command({ONESHOT_SIM_PATH, "study", "report", file, out, "--seeds", "2", "--threads", "2",
+                                                   "--max-duration", "3", "--trace", "OSK,I"});
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const nlohmann::json rep = read_json(out + "/report.json");
+  ASSERT_EQ(rep.at("traces").size(), 2U);
+  NcsStudy s = map_ncs_study(engine::load_study(file, &ncs_schema()));
+  cap_duration(s, 3, "--max-duration");
+  const std::string md = test::read_file(out + "/report.md");
+  EXPECT_NE(md.find("### Traces"), std::string::npos);
+  for (ncs::Approach a : {ncs::Approach::kOSK, ncs::Approach::kI}) {
+    const std::string an = ncs::name(a);
+    const nlohmann::json& e = rep.at("traces").at(an);
+    EXPECT_TRUE(e.at("same_cost_as_sweep").get<bool>()) << an;
+    EXPECT_NE(md.find("![" + an + " trace](trace_" + an + ".png)"), std::string::npos) << an;
+    EXPECT_TRUE(std::filesystem::exists(out + "/trace_" + an + ".png")) << an;
+    const auto states = csv_rows(out + "/trace_" + an + "_states.csv");
+    ASSERT_GT(states.size(), 1U);
+    EXPECT_EQ(states[0], (std::vector<std::string>{"t_s", "x1", "x2", "r1", "u"}));
+    EXPECT_EQ(states.size(), 3002U) << an;  // header + every ms of 3 s
+    EXPECT_EQ(std::filesystem::exists(out + "/trace_" + an + "_estimates.csv"), a == ncs::Approach::kOSK) << an;
+    if (a == ncs::Approach::kOSK) {
+      const auto est = csv_rows(out + "/trace_" + an + "_estimates.csv");
+      EXPECT_EQ(est[0], (std::vector<std::string>{"t_s", "xhat1", "xhat2"}));
+      EXPECT_GT(est.size(), 50U);  // a computation every h = 50 ms
+    }
+    // The message rows against the link counters of the same run (untraced).
+    const ncs::RunResult run = ncs::run(*s.ctx, a, s.scenarios[0], s.first_seed, ncs::RunOptions{});
+    EXPECT_EQ(e.at("cost").get<double>(), run.cost);
+    const auto msgs = csv_rows(out + "/trace_" + an + "_messages.csv");
+    ASSERT_FALSE(msgs.empty());
+    EXPECT_EQ(msgs[0], (std::vector<std::string>{"leg", "leg_index", "sent_s", "arrival_s", "lost", "delivered"}));
+    std::map<std::string, std::array<std::uint64_t, 3>> seen;  // sent, delivered, lost
+    for (std::size_t i = 1; i < msgs.size(); ++i) {
+      ASSERT_EQ(msgs[i].size(), 6U) << i;
+      auto& c = seen[msgs[i][0]];
+      ++c[0];
+      const bool lost = msgs[i][4] == "1";
+      EXPECT_EQ(msgs[i][5] == "1", !lost) << i;  // links: every message not lost has its arrival
+      if (lost) {
+        ++c[2];
+        EXPECT_TRUE(msgs[i][3].empty()) << i;
+      } else {
+        ++c[1];
+        EXPECT_GE(std::stod(msgs[i][3]), std::stod(msgs[i][2])) << i;
+      }
+    }
+    ASSERT_FALSE(run.links.empty());
+    std::uint64_t lost_total = 0;
+    for (const auto& [leg, st] : run.links) {
+      EXPECT_EQ(seen[leg][0], st.sent) << an << " " << leg;
+      EXPECT_EQ(seen[leg][1], st.sent - st.lost) << an << " " << leg;
+      EXPECT_EQ(seen[leg][2], st.lost) << an << " " << leg;
+      EXPECT_EQ(e.at("messages").at(leg).at("lost").get<std::uint64_t>(), st.lost) << an << " " << leg;
+      lost_total += st.lost;
+    }
+    EXPECT_EQ(seen.size(), run.links.size()) << an;
+    if (a == ncs::Approach::kOSK) {
+      EXPECT_GT(lost_total, 0U);  // the file's sc leg loses some in 3 s
+    }
+  }
+}
+
+TEST(StudyReport, NoPlotsWritesTheTracesCsvOnly) {
+  const std::string out = test::fresh_dir("oneshot_study_report", "traces_no_plots");
+  const test::CommandResult r = test::run_command({ONESHOT_SIM_PATH, "study", "report", kExample, out, "--seeds", "2", "--threads",
+                                                   "2", "--max-duration", "2.5", "--no-plots", "--trace", "S,AK"});
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  std::size_t csv = 0;
+  for (const auto& f : std::filesystem::directory_iterator(out)) {
+    EXPECT_NE(f.path().extension(), ".png") << f.path();
+    EXPECT_NE(f.path().extension(), ".gp") << f.path();
+    csv += f.path().filename().string().rfind("trace_", 0) == 0 && f.path().extension() == ".csv";
+  }
+  EXPECT_EQ(csv, 5U);  // S: states, messages; AK: states, estimates, messages
+  EXPECT_EQ(read_json(out + "/report.json").at("traces").size(), 2U);
+}
+
+TEST(StudyReport, BenchCountsTheSweepsKernelEvents) {
+  // `study bench`'s events are the kernel events of the sweep's runs, counted here one run at a time.
+  const std::string file = std::string(ONESHOT_STUDY_EXAMPLES_DIR) + "/sod_ge_oneshot.json";
+  const std::string dir = test::made_dir("oneshot_study_report", "bench");
+  const test::CommandResult r = test::run_command({ONESHOT_SIM_PATH, "study", "bench", file, "--seeds", "2", "--threads", "2",
+                                                   "--max-duration", "2.5", "--json", dir + "/bench.json"});
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const nlohmann::json j = read_json(dir + "/bench.json");
+  NcsStudy s = map_ncs_study(engine::load_study(file, &ncs_schema()));
+  cap_duration(s, 2.5, "--max-duration");
+  double total = 0;
+  for (ncs::Approach a : s.approaches) {
+    double events = 0;
+    for (const ncs::Scenario& x : s.scenarios)
+      for (std::uint64_t seed = s.first_seed; seed < s.first_seed + 2; ++seed)
+        events += static_cast<double>(ncs::run(*s.ctx, a, x, seed, ncs::RunOptions{}).events);
+    EXPECT_EQ(j.at("per_approach").at(ncs::name(a)).at("events").get<double>(), events) << ncs::name(a);
+    EXPECT_GT(events, 0);
+    total += events;
+  }
+  EXPECT_EQ(j.at("events").get<double>(), total);
+  EXPECT_EQ(j.at("runs").get<std::size_t>(), s.approaches.size() * s.scenarios.size() * 2);
+  EXPECT_EQ(j.at("threads").get<unsigned>(), 2U);
+  EXPECT_GT(j.at("wall_s").get<double>(), 0);
+  EXPECT_NEAR(j.at("events_per_s_per_thread").get<double>(), total / j.at("wall_s").get<double>() / 2, 1e-9 * total);
 }
 
 }  // namespace

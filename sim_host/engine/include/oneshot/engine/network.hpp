@@ -50,6 +50,17 @@ struct BusRouteStatistics {
   Duration total_delay{0};      ///< Sum over the delivered messages.
 };
 
+/// One message a route carried, as Network::record_messages() logs it: the instant it was
+/// handed to its link or queued on its bus and its fate.
+struct MessageRecord {
+  std::uint8_t source = 0;       ///< Sending node's address.
+  std::uint8_t destination = 0;  ///< Receiving node's address.
+  SimTime sent{0};               ///< Handed to the link / queued on the bus.
+  SimTime arrival{0};            ///< Arrival (delivered ones; a link's may lie after the run's end: in flight).
+  bool lost = false;             ///< Dropped by the link's loss model (arrival meaningless).
+  bool delivered = false;        ///< An arrival is known (a link's: not lost; a bus's: its last frame ended).
+};
+
 /// Nodes, links, buses and routes of one run.
 class Network {
  public:
@@ -91,6 +102,11 @@ class Network {
   /// Faults injected so far (every link, and the restarts).
   FaultCounters fault_counters() const;
 
+  /// From now on, logs every message routed (observes only: the run is unchanged).
+  void record_messages() { record_ = true; }
+  /// The messages logged since record_messages(), in the order they were sent.
+  const std::vector<MessageRecord>& messages() const { return messages_; }
+
   /// Frames sent, frames refused because no route exists (a configuration error: counted,
   /// and run_node() throws on the first).
   std::uint64_t frames_sent() const { return frames_sent_; }
@@ -123,6 +139,9 @@ class Network {
   HandlerId bus_deliver_id_ = 0;
   HandlerId fragment_id_ = 0;
   std::uint64_t frames_sent_ = 0;
+  bool record_ = false;
+  std::vector<MessageRecord> messages_;
+  std::vector<std::size_t> slot_record_;  ///< Beside in_flight_ (bus routes, when recording): index in messages_.
 };
 
 }  // namespace oneshot::engine
