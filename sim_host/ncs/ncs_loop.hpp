@@ -72,6 +72,8 @@ struct CpuRunStats {
   std::uint64_t deadline_misses = 0;  ///< Controller jobs past their deadline (or aborted).
   std::uint64_t other_misses = 0;     ///< Background tasks' and ISRs' misses.
   engine::Duration busy{0};       ///< CPU time used by every task and ISR (context switches included).
+  engine::Duration sample_min{0};  ///< Smallest sample − release of the job (the sensor's).
+  engine::Duration sample_max{0};  ///< Largest.
 };
 
 /// One message of a leg (RunOptions::record_messages), in the order sent.
@@ -109,6 +111,7 @@ struct RunResult {
   /// (queueing + transmission of every frame). Their sent counts are in `links` too (lost 0).
   std::vector<std::pair<std::string, engine::BusRouteStatistics>> bus_legs;
   CpuRunStats cpu;               ///< The controller's CPU (Scenario::controller_cpu; I, IK: none).
+  CpuRunStats sensor_cpu;        ///< The sensor's CPU (Scenario::sensor_cpu; I, IK: none).
   std::vector<MessageEvent> messages;  ///< RunOptions::record_messages: every message of the legs.
   std::uint64_t events = 0;      ///< Kernel events run (the engine's event queue pops).
   std::vector<Point> truth;      ///< True state every trace step (x1, x2).

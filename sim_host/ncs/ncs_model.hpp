@@ -91,6 +91,10 @@ struct Scenario {
   /// ncs_cpu.hpp): τ_c is its response time in the schedule instead of U[1, 5] ms; null:
   /// the draw. The delay-free loops (I, IK) keep τ_c = 0.
   std::shared_ptr<const ControllerCpu> controller_cpu;
+  /// The sensor's sampling job on a modeled CPU (ncs_cpu.hpp; S and SK only, else
+  /// std::invalid_argument): it samples at the job's sample point and sends at its finish;
+  /// null: the sensor samples and sends at kh.
+  std::shared_ptr<const ControllerCpu> sensor_cpu;
   /// τ_c ~ U[first, second] in whole µs instead of Timing's U[1, 5] ms (without a CPU; study
   /// files do not set it: a constant τ_c is the oracle of a lone constant job on a CPU).
   std::optional<std::pair<std::int64_t, std::int64_t>> compute_us;

@@ -1,6 +1,6 @@
 /// @file study_cpu.cpp
 /// @brief The CPUs of a study file: task sets with node jobs, their analysis, the ncs
-///        controller's job (see study_cpu.hpp).
+///        node jobs mapped onto the loop (see study_cpu.hpp).
 #include "study_cpu.hpp"
 
 #include <algorithm>
@@ -94,10 +94,11 @@ std::vector<CpuPlan> plan_cpus(const engine::StudyFile& f, std::int64_t h_us) {
       if (n.cpu != p.set.name || !n.job) continue;
       const std::string nf = at("nodes", i);
       engine::cpu::TaskSpec t = *n.job;
-      if (n.mode == "timer") {  // its own timer: periodic
+      if (n.mode == "timer") {  // its own timer: periodic, its first release at the node's phase
         t.external = false;
         t.sporadic = false;
         t.period = n.period;
+        t.offset = n.clock_offset;
       } else {
         Duration jmax{0};
         const auto one = [&](const engine::ScenarioSpec* s) {
@@ -156,6 +157,9 @@ json cpus_json(const engine::StudyFile& f, const std::vector<CpuPlan>& plans) {
         if (task != k) continue;
         t["kind"] = f.nodes[node].mode == "timer" ? "node job (timer)" : "node job (on input arrival)";
         t["node"] = f.nodes[node].name;
+        if (f.nodes[node].role == "sensor") {  // it samples at its start: the analysed lag behind kh
+          t["sample_lag_us"] = {t.at("sampling_latency_min_us"), t.at("sampling_latency_max_us")};
+        }
       }
     }
     out.push_back(j);
@@ -177,7 +181,11 @@ std::string describe_cpus(const json& cpus) {
         o << "  " << (std::string(list) == "isrs" ? "isr" : t.at("kind").get<std::string>()) << " " << t.at("name").get<std::string>();
         if (t.contains("period_us")) o << " (T " << t.at("period_us") << " us, C " << t.at("bcet_us") << "-" << t.at("wcet_us") << " us, priority " << t.at("priority") << ")";
         o << ": WCRT " << wcrt << " us, BCRT " << t.at("bcrt_us") << " us, deadline " << t.at("deadline_us") << " us, "
-          << (t.at("schedulable").get<bool>() ? "schedulable" : "misses") << "\n";
+          << (t.at("schedulable").get<bool>() ? "schedulable" : "misses");
+        if (t.contains("sample_lag_us")) {  // the sensor's sample after its release at kh
+          o << ", sample lag " << t.at("sample_lag_us")[0] << "-" << t.at("sample_lag_us")[1] << " us";
+        }
+        o << "\n";
       }
     }
   }
@@ -186,24 +194,38 @@ std::string describe_cpus(const json& cpus) {
 
 void attach_controller_cpu(const engine::StudyFile& f, NcsStudy& s) {
   if (f.cpus.empty()) return;
+  std::optional<std::size_t> sensor_node, controller_node;
   for (std::size_t i = 0; i < f.nodes.size(); ++i) {
     const engine::NodeSpec& n = f.nodes[i];
     if (n.cpu.empty()) continue;
-    if (n.role != "controller") {
-      refuse(at("nodes", i) + ".cpu", "only the controller's job runs on a CPU in study ncs (the " + n.role +
-                                          " runs on its timer with the loop's own timing)");
+    if (n.role == "sensor") {
+      sensor_node = i;
+    } else if (n.role == "controller") {
+      controller_node = i;
+    } else {
+      refuse(at("nodes", i) + ".cpu", "the " + n.role + "'s job on a CPU is not modelled in study ncs (it runs on its timer "
+                                      "with the loop's own timing)");
     }
     for (std::size_t l = 0; l < f.links.size(); ++l) {
       if (!f.links[l].bus.empty()) {
-        refuse(at("nodes", i) + ".cpu", "a controller on a CPU with a leg on a CAN bus (" + at("links", l) +
-                                            ".bus) is not analysed together: the bus analysis takes tau_c as U[1, 5] ms");
+        refuse(at("nodes", i) + ".cpu", "a " + n.role + " on a CPU with a leg on a CAN bus (" + at("links", l) +
+                                            ".bus) is not analysed together: the bus analysis takes the loop's own timing");
       }
     }
   }
+  if (sensor_node && controller_node) {
+    refuse(at("nodes", *sensor_node) + ".cpu", "the sensor and the controller on CPUs together are not analysed: the controller "
+                                               "job's input jitter would take the sensor job's response spread");
+  }
   for (std::size_t a = 0; a < f.approaches.size(); ++a) {
-    if (f.approaches[a].kind == "S+") {
+    const std::string& k = f.approaches[a].kind;
+    if (controller_node && k == "S+") {
       refuse(at("approaches", a) + ".kind", "S+ designs on the mean tau_c, which the schedule of the controller's CPU gives only "
                                             "after the run");
+    }
+    if (sensor_node && k != "I" && k != "IK" && k != "S" && k != "SK") {
+      refuse(at("approaches", a) + ".kind", k + " with the sensor on a CPU: its sampling job runs with the sampling-synchronized "
+                                                "approaches S and SK only (I and IK: the delay-free references, not on the CPU)");
     }
   }
   const std::vector<CpuPlan> plans = plan_cpus(f, s.ctx->period_us());
@@ -212,10 +234,15 @@ void attach_controller_cpu(const engine::StudyFile& f, NcsStudy& s) {
       auto c = std::make_shared<ncs::ControllerCpu>();
       c->set = p.set;
       c->task = task;
+      // Timer jobs (the one-shot controller's at kh + φ, the sensor's at kh) are released by
+      // the node's timer in the loop: analysed as periodic (plan_cpus), run as released then.
+      c->set.tasks[task].external = true;
       c->wcrt = p.analysis.tasks[task].wcrt;
       c->bcrt = p.analysis.tasks[task].bcrt;
-      for (ncs::Scenario& sc : s.scenarios) sc.controller_cpu = c;
-      static_cast<void>(node);
+      c->sample_min = p.analysis.tasks[task].sampling_latency_min;
+      c->sample_max = p.analysis.tasks[task].sampling_latency_max;
+      const bool sensor = sensor_node && node == *sensor_node;
+      for (ncs::Scenario& sc : s.scenarios) (sensor ? sc.sensor_cpu : sc.controller_cpu) = c;
     }
   }
 }

@@ -1,7 +1,7 @@
 /// @file study_cpu.hpp
 /// @brief The CPUs of a study file (`cpus`, nodes' `cpu` and `job`): each CPU's task set with
 ///        the node jobs among its background tasks, its response-time analysis for `study
-///        check`, and the ncs controller's job mapped onto the loop (ncs_cpu.hpp).
+///        check`, and the ncs controller's or sensor's job mapped onto the loop (ncs_cpu.hpp).
 ///
 /// A node job on input arrival (an `arrival` node) is analysed as sporadic with minimum
 /// inter-arrival h − J: h the plant's period, J the largest spread of its input's arrival over
@@ -43,17 +43,21 @@ std::vector<CpuPlan> plan_cpus(const engine::StudyFile& f, std::int64_t h_us);
 
 /// The "cpus" section of `study check`: per CPU its name, scheduler, context switch,
 /// utilization, input_jitter_us, schedulable (first_miss, reason) and per task and ISR the
-/// analysis (cpu_analysis.hpp analysis_json(): wcrt_us, bcrt_us, …) with "node" for node jobs.
+/// analysis (cpu_analysis.hpp analysis_json(): wcrt_us, bcrt_us, …) with "node" for node jobs
+/// and, for the sensor's, "sample_lag_us" [min, max]: its sample's analysed lag behind kh.
 nlohmann::json cpus_json(const engine::StudyFile& f, const std::vector<CpuPlan>& plans);
 
 /// The cpus section as text (one line per CPU, one per task).
 std::string describe_cpus(const nlohmann::json& cpus);
 
-/// Maps the controller's job onto the ncs loop (every scenario's controller_cpu);
-/// engine::InputError (no source) naming the field for what the loop does not run: a sensor's
-/// or actuator's job (`nodes[i].cpu`: they run on their timers), a controller on a CPU with a
-/// leg on a CAN bus (`nodes[i].cpu`), S+ (`approaches[i].kind`: it designs on the mean τ_c,
-/// which the schedule gives only after the run), and everything plan_cpus() refuses.
+/// Maps the node jobs onto the ncs loop: the controller's (every scenario's controller_cpu)
+/// or the sensor's (sensor_cpu: S and SK sample at its sample point, send at its finish);
+/// engine::InputError (no source) naming the field for what the loop does not run: an
+/// actuator's job (`nodes[i].cpu`), the sensor and the controller both on CPUs (the sensor's
+/// `nodes[i].cpu`), a node on a CPU with a leg on a CAN bus (`nodes[i].cpu`), S+ with the
+/// controller on a CPU (`approaches[i].kind`: it designs on the mean τ_c, which the schedule
+/// gives only after the run), approaches other than I, IK, S, SK with the sensor on a CPU
+/// (`approaches[i].kind`), and everything plan_cpus() refuses.
 void attach_controller_cpu(const engine::StudyFile& f, NcsStudy& s);
 
 }  // namespace oneshot::study

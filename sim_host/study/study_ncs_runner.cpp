@@ -102,10 +102,6 @@ NcsStudy map_ncs_study(const engine::StudyFile& file) {
         refuse(f + ".address", "the ncs loop's " + n.role + " has address " + std::to_string(address.at(n.role)));
       }
       const bool timed_controller = one_shot && n.role == "controller";
-      if (timed_controller && !n.cpu.empty()) {
-        refuse(f + ".cpu", "the one-shot controller runs on its timer: its job on a CPU is not modelled (the CPU models the "
-                           "controller of the arrival-driven approaches)");
-      }
       if (n.clock_offset.count() != 0 && !timed_controller) {
         refuse(f + ".clock_offset_us", "study ncs runs its nodes on one clock (0 only; the one-shot controller's gives its phase)");
       }

@@ -119,6 +119,10 @@ engine::SweepResults run_ncs_sweep(const NcsStudy& s, std::size_t seeds, unsigne
   if (analytic && one_shot) {
     throw engine::InputError("field '--analytic': the one-shot approaches (OS, OSp, OSK) have no analytic cost");
   }
+  const bool sensor_on_cpu = !s.scenarios.empty() && s.scenarios[0].sensor_cpu != nullptr;
+  if (analytic && sensor_on_cpu) {
+    throw engine::InputError("field '--analytic': no analytic cost with the sensor on a CPU (its samples lag kh by the schedule)");
+  }
   engine::SweepSpec spec;
   spec.study = "study";
   spec.experiment = "run";
@@ -178,6 +182,15 @@ engine::SweepResults run_ncs_sweep(const NcsStudy& s, std::size_t seeds, unsigne
                                      {"wcrt_us", static_cast<double>(c.wcrt.count()) * 1e-3},
                                      {"bcrt_us", static_cast<double>(c.bcrt.count()) * 1e-3}};
     spec.config["compute_us"] = "cpu";  // τ_c is the job's response on the CPU, not the U[min, max] draw
+  }
+  if (sensor_on_cpu) {  // likewise: shards of files with other sensor jobs do not merge
+    const ncs::ControllerCpu& c = *s.scenarios[0].sensor_cpu;
+    spec.config["sensor_cpu"] = {{"cpu", c.set.name},
+                                 {"job", c.set.tasks[c.task].name},
+                                 {"utilization", c.set.utilization()},
+                                 {"sample_min_us", static_cast<double>(c.sample_min.count()) * 1e-3},
+                                 {"sample_max_us", static_cast<double>(c.sample_max.count()) * 1e-3},
+                                 {"wcrt_us", static_cast<double>(c.wcrt.count()) * 1e-3}};
   }
   if (one_shot && !s.scenarios.empty()) {  // the file's sensor rule and controller phase (the same in every scenario)
     const ncs::Scenario& x = s.scenarios[0];

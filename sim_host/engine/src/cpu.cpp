@@ -52,6 +52,43 @@ Cpu::Cpu(Kernel& kernel, TaskSet set) : kernel_(kernel), set_(std::move(set)) {
 
 const std::string& Cpu::entity_name(std::size_t e) const { return specs_.at(e)->name; }
 
+void Cpu::on_point(std::function<void(std::size_t, std::uint64_t, CpuEventKind)> f) {
+  if (!on_point_) {
+    h_point_ = kernel_.add_handler("cpu point", [this](std::uint64_t arg) { point(arg); });
+    h_start_point_ = kernel_.add_handler("cpu start point", [this](std::uint64_t arg) { start_point(arg); });
+  }
+  on_point_ = std::move(f);
+}
+
+void Cpu::start_point(std::uint64_t arg) {
+  // A point at the job's start (offset 0): at its start as CpuJob::start gives it, even when
+  // the context switch before it was cut short (as the job's recorded sample / actuation).
+  const std::size_t e = arg >> 32;
+  for (Job& j : ent_[e].pending) {
+    if ((j.index & 0xFFFFFFFFULL) != (arg & 0xFFFFFFFFULL)) continue;
+    for (const bool act : {false, true}) {
+      if ((act ? j.act_off : j.sample_off).count() != 0) continue;
+      bool& told = act ? j.actuate_told : j.sample_told;
+      if (told) continue;
+      told = true;
+      on_point_(e, j.index, act ? CpuEventKind::kActuate : CpuEventKind::kSample);
+    }
+    return;
+  }
+}
+
+void Cpu::point(std::uint64_t arg) {
+  // arg: the dispatch generation (low bits) and the kind (bit 0: actuation).
+  if ((arg >> 1) != (generation_ & (~std::uint64_t{0} >> 1)) || running_ == kNone || ent_[running_].isr) return;
+  account();
+  Job& j = ent_[running_].pending.front();
+  const bool act = (arg & 1U) != 0;
+  bool& told = act ? j.actuate_told : j.sample_told;
+  if (told) return;
+  told = true;
+  on_point_(running_, j.index, act ? CpuEventKind::kActuate : CpuEventKind::kSample);
+}
+
 void Cpu::start(SimTime end) {
   end_ = end;
   for (std::size_t e = 0; e < ent_.size(); ++e) {
@@ -291,6 +328,7 @@ void Cpu::dispatch() {
     last_task_job_ = j.index;
   }
   j.cs_left += cs;  // a switch cut short by an ISR is finished after it
+  const bool first = !j.started;
   if (!j.started) {
     j.started = true;
     j.start = now + cs;
@@ -312,6 +350,18 @@ void Cpu::dispatch() {
     record(chosen, j.index, CpuEventKind::kResume);
   }
   run_since_ = now;
+  if (on_point_ && !ent_[chosen].isr) {  // the points this dispatch reaches, before the completion
+    const std::uint64_t g = (generation_ & (~std::uint64_t{0} >> 1)) << 1;
+    if (first && (j.sample_off.count() == 0 || j.act_off.count() == 0)) {
+      kernel_.schedule(j.start, EventClass::kCompute, h_start_point_, pack(chosen, j.index));
+    }
+    if (!j.sample_told && j.sample_off.count() > 0) {
+      kernel_.schedule(now + j.cs_left + (j.sample_off - j.own), EventClass::kCompute, h_point_, g);
+    }
+    if (!j.actuate_told && j.act_off.count() > 0) {
+      kernel_.schedule(now + j.cs_left + (j.act_off - j.own), EventClass::kCompute, h_point_, g | 1U);
+    }
+  }
   kernel_.schedule(now + j.remaining, EventClass::kCompute, h_complete_, generation_);
 }
 

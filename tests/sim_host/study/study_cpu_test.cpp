@@ -4,7 +4,9 @@
 ///        constant job equal to the loop with that constant τ_c, the check's analysis against
 ///        hand-computed response times, a heavier background raising the mean τ_c and the
 ///        cost, the same bytes on 1 and 2 threads and from merged shards, and bad `cpus`
-///        input refused naming the field.
+///        input refused naming the field; the sensor's sampling job: every sample's lag
+///        behind kh within the analysed sampling latencies, a lone constant job equal to the
+///        loop with sc later by its C, refusals (examples/ncs_cpu_sensor.json).
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -283,6 +285,139 @@ TEST(StudyCpu, CommandLine) {
   EXPECT_NE(rn.exit_code, 0);
   EXPECT_NE(rn.output.find("field 'cpus[0].tasks[2]'"), std::string::npos) << rn.output;
   EXPECT_FALSE(std::filesystem::exists(out));
+}
+
+// ---- The sensor's sampling job on a CPU (examples/ncs_cpu_sensor.json): released by its timer
+// at kh, it samples at its start and sends at its finish.
+
+std::string sensor_cpu_path() { return std::string(ONESHOT_STUDY_EXAMPLES_DIR) + "/ncs_cpu_sensor.json"; }
+
+nlohmann::json sensor_cpu_json() { return nlohmann::json::parse(test::read_file(sensor_cpu_path())); }
+
+/// The file `j` mapped onto the loop, every scenario `duration_s` long.
+NcsStudy sensor_study(const nlohmann::json& j, double duration_s) {
+  NcsStudy s = map_ncs_study(engine::parse_study(j.dump(), sensor_cpu_path(), &ncs_schema(), ONESHOT_STUDY_EXAMPLES_DIR));
+  for (ncs::Scenario& x : s.scenarios) x.duration_s = duration_s;
+  return s;
+}
+
+TEST(StudyCpuSensor, EverySampleLagsKhWithinTheAnalysedBounds) {
+  for (const char* scheduler : {"fixed_priority", "fixed_priority_nonpreemptive", "edf"}) {
+    nlohmann::json j = sensor_cpu_json();
+    j["cpus"][0]["scheduler"] = scheduler;
+    const NcsStudy s = sensor_study(j, 2);
+    const ncs::ControllerCpu& c = *s.scenarios[0].sensor_cpu;
+    ASSERT_LT(c.sample_min, c.sample_max);
+    // study check gives the same lag bounds (the sensor job's "sample_lag_us").
+    const nlohmann::json chk =
+        resolve_study(engine::parse_study(j.dump(), sensor_cpu_path(), &ncs_schema(), ONESHOT_STUDY_EXAMPLES_DIR));
+    const nlohmann::json& bounds = chk.at("cpus")[0].at("tasks")[3].at("sample_lag_us");
+    EXPECT_EQ(bounds[0].get<double>(), static_cast<double>(c.sample_min.count()) * 1e-3);
+    EXPECT_EQ(bounds[1].get<double>(), static_cast<double>(c.sample_max.count()) * 1e-3);
+    const double h_s = static_cast<double>(s.ctx->period_us()) * 1e-6;
+    double lo = 1e9, hi = -1e9;
+    std::size_t n = 0;
+    for (ncs::Approach a : {ncs::Approach::kS, ncs::Approach::kSK}) {
+      for (const ncs::Scenario& sc : s.scenarios) {
+        for (std::uint64_t seed = 1; seed <= 20; ++seed) {
+          const ncs::RunResult r = ncs::run(*s.ctx, a, sc, seed, ncs::RunOptions{});
+          ASSERT_TRUE(r.sensor_cpu.present);
+          EXPECT_EQ(r.sensor_cpu.jobs, 40U);
+          EXPECT_EQ(r.sensor_cpu.deadline_misses, 0U);
+          EXPECT_GE(r.sensor_cpu.response_min, c.bcrt);
+          EXPECT_LE(r.sensor_cpu.response_max, c.wcrt);
+          ASSERT_EQ(r.samples.size(), 40U);
+          for (std::size_t k = 0; k < r.samples.size(); ++k) {  // the observed instants: lag behind kh
+            const double lag = r.samples[k].t_s - static_cast<double>(k) * h_s;
+            lo = std::min(lo, lag);
+            hi = std::max(hi, lag);
+            ++n;
+          }
+          EXPECT_GE(r.sensor_cpu.sample_min, c.sample_min);
+          EXPECT_LE(r.sensor_cpu.sample_max, c.sample_max);
+        }
+      }
+    }
+    const double ns = 1e-9;
+    EXPECT_GE(lo, static_cast<double>(c.sample_min.count()) * ns - 1e-12) << scheduler;
+    EXPECT_LE(hi, static_cast<double>(c.sample_max.count()) * ns + 1e-12) << scheduler;
+    EXPECT_GT(hi - lo, 1e-4) << scheduler;  // a real sampling jitter (the background preempts)
+    std::printf("%s: %zu samples lag kh by %.1f .. %.1f us within [%.1f, %.1f]\n", scheduler, n, lo * 1e6, hi * 1e6,
+                static_cast<double>(c.sample_min.count()) * 1e-3, static_cast<double>(c.sample_max.count()) * 1e-3);
+  }
+}
+
+TEST(StudyCpuSensor, ALoneConstantJobIsTheLoopWithItsFrameLaterByC) {
+  nlohmann::json j = sensor_cpu_json();
+  j["cpus"][0].erase("tasks");
+  j["cpus"][0].erase("isrs");
+  j["cpus"][0]["context_switch_us"] = 0;
+  j["nodes"][0]["job"] = {{"wcet_us", 345}, {"bcet_us", 345}, {"priority", 1}};
+  const NcsStudy on_cpu = sensor_study(j, 3);
+  // The oracle: no CPU, the sensor sampling at kh and sc's delay 345 us longer (the same draws).
+  nlohmann::json k = j;
+  k.erase("cpus");
+  k["nodes"][0].erase("cpu");
+  k["nodes"][0].erase("job");
+  for (nlohmann::json& l : k["links"]) {
+    if (l["name"] != "sc") continue;
+    l["delay"]["min_us"] = l["delay"]["min_us"].get<int>() + 345;
+    l["delay"]["max_us"] = l["delay"]["max_us"].get<int>() + 345;
+  }
+  const NcsStudy shifted = sensor_study(k, 3);
+  EXPECT_EQ(on_cpu.scenarios[0].sensor_cpu->sample_min, engine::Duration{0});
+  EXPECT_EQ(on_cpu.scenarios[0].sensor_cpu->sample_max, engine::Duration{0});
+  for (ncs::Approach a : on_cpu.approaches) {
+    for (std::size_t s = 0; s < on_cpu.scenarios.size(); ++s) {
+      for (std::uint64_t seed = 1; seed <= 3; ++seed) {
+        const ncs::RunResult x = ncs::run(*on_cpu.ctx, a, on_cpu.scenarios[s], seed, ncs::RunOptions{});
+        const ncs::RunResult y = ncs::run(*shifted.ctx, a, shifted.scenarios[s], seed, ncs::RunOptions{});
+        EXPECT_NEAR(x.cost, y.cost, 1e-12 * std::fabs(y.cost)) << ncs::name(a) << " seed " << seed;
+        EXPECT_EQ(x.commands, y.commands);
+        ASSERT_EQ(x.samples.size(), y.samples.size());
+        for (std::size_t i = 0; i < x.samples.size(); ++i) EXPECT_EQ(x.samples[i].t_s, y.samples[i].t_s);
+        if (x.sensor_cpu.present) {
+          EXPECT_EQ(x.sensor_cpu.response_max, engine::from_us(345));
+        }
+      }
+    }
+  }
+}
+
+TEST(StudyCpuSensor, SameBytesOnOneAndTwoThreadsAndWhatTheLoopCannotRunIsRefused) {
+  const NcsStudy s = sensor_study(sensor_cpu_json(), 1.5);
+  const std::string one = run_outputs(run_ncs_sweep(s, 3, 1, engine::Shard{}), temp_dir("sensor_one"), false).dump();
+  const std::string two = run_outputs(run_ncs_sweep(s, 3, 2, engine::Shard{}), temp_dir("sensor_two"), false).dump();
+  EXPECT_EQ(one, two);
+  try {
+    static_cast<void>(run_ncs_sweep(s, 1, 1, engine::Shard{}, true));
+    ADD_FAILURE() << "--analytic accepted";
+  } catch (const engine::InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("field '--analytic'"), std::string::npos) << e.what();
+  }
+  const auto refused = [](const std::function<void(nlohmann::json&)>& edit, const std::string& expect) {
+    nlohmann::json j = sensor_cpu_json();
+    edit(j);
+    try {
+      static_cast<void>(sensor_study(j, 1));
+      ADD_FAILURE() << "accepted, expected " << expect;
+    } catch (const engine::InputError& e) {
+      EXPECT_NE(std::string(e.what()).find(expect), std::string::npos) << e.what();
+    }
+  };
+  const nlohmann::json as = {{"name", "as"}, {"from", "actuator"}, {"to", "sensor"},
+                             {"delay", {{"model", "uniform"}, {"min_us", 500}, {"max_us", 4000}, {"resolution_us", 1}}}};
+  refused([&](nlohmann::json& j) { j["links"].push_back(as); j["approaches"].push_back({{"name", "A"}, {"kind", "A"}}); },
+          "field 'approaches[4].kind'");  // actuation-synchronized: the sensor samples on the request
+  refused([&](nlohmann::json& j) { j["links"].push_back(as); j["approaches"].push_back({{"name", "AKl"}, {"kind", "AKl"}}); },
+          "field 'approaches[4].kind'");  // AKl's D assumes the exact instant t_k − D
+  refused([](nlohmann::json& j) { j["approaches"].push_back({{"name", "S+"}, {"kind", "S+"}}); }, "field 'approaches[4].kind'");
+  refused([](nlohmann::json& j) { j["nodes"][1]["cpu"] = "dspic"; j["nodes"][1]["job"] = {{"wcet_us", 1000}, {"priority", 5}}; },
+          "field 'nodes[0].cpu'");  // sensor and controller together: not analysed
+  refused([](nlohmann::json& j) { j["nodes"][2]["cpu"] = "dspic"; j["nodes"][2]["job"] = {{"wcet_us", 100}, {"priority", 5}}; },
+          "field 'nodes[2].cpu'");  // the actuator's job: not modelled
+  refused([](nlohmann::json& j) { j["nodes"][0]["job"] = {{"wcet_us", 60000}, {"priority", 3}}; }, "field 'nodes[0].job.wcet_us'");
+  refused([](nlohmann::json& j) { j["nodes"][0]["job"]["deadline_us"] = 300; }, "field 'nodes[0].job'");  // it misses
 }
 
 }  // namespace

@@ -4,14 +4,20 @@
 ///        noise the held-value loop OS is the periodic loop OSK bit for bit, the sensor sends
 ///        fewer samples as δy grows, delivered + lost = sent on the lossy leg, the filter's NEES
 ///        is near n = 2 when it is consistent (every sample, no loss), the same bytes on 1 and
-///        2 threads, and what the loop cannot run is refused naming the field.
+///        2 threads, and what the loop cannot run is refused naming the field. The one-shot
+///        controller's job on a CPU (examples/ncs_cpu_one_shot.json): every τ_c within the
+///        analysed [BCRT, WCRT], a lone constant job equal to the loop with that constant τ_c,
+///        the timer job analysed as periodic at h, the same bytes on 1 and 2 threads, refusals.
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 #include <functional>
 
+#include "ncs_cpu.hpp"
 #include "ncs_loop.hpp"
 #include "oneshot/engine/study_file.hpp"
+#include "study_check.hpp"
 #include "study_ncs_runner.hpp"
 #include "study_ncs_sweep.hpp"
 #include "support/temp_files.hpp"
@@ -214,6 +220,113 @@ TEST(StudyOneShot, WhatTheLoopCannotRunIsRefusedNamingTheField) {
   } catch (const engine::InputError& e) {
     EXPECT_NE(std::string(e.what()).find("field '--analytic'"), std::string::npos) << e.what();
   }
+}
+
+// ---- The one-shot controller's job on a CPU (examples/ncs_cpu_one_shot.json): its timer at
+// kh + φ releases the job, the command leaves at its finish.
+
+std::string one_shot_cpu_path() { return std::string(ONESHOT_STUDY_EXAMPLES_DIR) + "/ncs_cpu_one_shot.json"; }
+
+/// The one-shot CPU file after `edit`, mapped onto the loop, every scenario `duration_s` long.
+NcsStudy one_shot_cpu_study(const std::function<void(nlohmann::json&)>& edit, double duration_s) {
+  nlohmann::json j = nlohmann::json::parse(test::read_file(one_shot_cpu_path()));
+  edit(j);
+  NcsStudy s = map_ncs_study(engine::parse_study(j.dump(), one_shot_cpu_path(), &ncs_schema(), ONESHOT_STUDY_EXAMPLES_DIR));
+  for (ncs::Scenario& x : s.scenarios) x.duration_s = duration_s;
+  return s;
+}
+
+TEST(StudyCpuOneShot, EveryControllerResponseIsWithinTheAnalysedBounds) {
+  for (const char* scheduler : {"fixed_priority", "fixed_priority_nonpreemptive", "edf"}) {
+    const NcsStudy s = one_shot_cpu_study([&](nlohmann::json& j) { j["cpus"][0]["scheduler"] = scheduler; }, 2);
+    const nlohmann::json j = run_outputs(run_ncs_sweep(s, 20, 2, engine::Shard{}), temp_dir(scheduler), false);
+    const ncs::ControllerCpu& c = *s.scenarios[0].controller_cpu;
+    EXPECT_GT(c.wcrt, c.bcrt);
+    for (const char* a : {"OS", "OSp", "OSK"}) {
+      const nlohmann::json& e = j.at("cpu").at(a);
+      EXPECT_EQ(e.at("jobs").get<double>(), 20 * 2 * 40) << scheduler << " " << a;  // one job per timer, nothing lost
+      EXPECT_GE(e.at("min_us").get<double>(), static_cast<double>(c.bcrt.count()) * 1e-3) << scheduler << " " << a;
+      EXPECT_LE(e.at("max_us").get<double>(), static_cast<double>(c.wcrt.count()) * 1e-3) << scheduler << " " << a;
+      EXPECT_TRUE(e.at("within_bounds").get<bool>());
+      EXPECT_EQ(e.at("deadline_misses").get<double>(), 0);
+      std::printf("%s %s: tau_c %.1f .. %.1f us (mean %.1f) within [%.1f, %.1f]\n", scheduler, a, e.at("min_us").get<double>(),
+                  e.at("max_us").get<double>(), e.at("mean_us").get<double>(), e.at("bcrt_us").get<double>(),
+                  e.at("wcrt_us").get<double>());
+    }
+    EXPECT_EQ(j.at("cpu").at("I").at("jobs").get<double>(), 0);  // delay-free: not on the CPU
+  }
+}
+
+TEST(StudyCpuOneShot, ALoneConstantJobIsTheLoopWithThatConstantTauC) {
+  const auto lone = [](nlohmann::json& j) {
+    j["cpus"][0].erase("tasks");
+    j["cpus"][0].erase("isrs");
+    j["cpus"][0]["context_switch_us"] = 0;
+    j["nodes"][1]["job"] = {{"wcet_us", 2345}, {"bcet_us", 2345}, {"priority", 1}};
+  };
+  const NcsStudy on_cpu = one_shot_cpu_study(lone, 3);
+  NcsStudy constant = on_cpu;
+  for (ncs::Scenario& x : constant.scenarios) {
+    x.controller_cpu = nullptr;
+    x.compute_us = std::make_pair(std::int64_t{2345}, std::int64_t{2345});
+  }
+  EXPECT_EQ(on_cpu.scenarios[0].controller_cpu->wcrt, engine::from_us(2345));
+  EXPECT_EQ(on_cpu.scenarios[0].controller_cpu->bcrt, engine::from_us(2345));
+  for (ncs::Approach a : on_cpu.approaches) {
+    for (std::size_t k = 0; k < on_cpu.scenarios.size(); ++k) {
+      for (std::uint64_t seed = 1; seed <= 3; ++seed) {
+        const ncs::RunResult x = ncs::run(*on_cpu.ctx, a, on_cpu.scenarios[k], seed, ncs::RunOptions{});
+        const ncs::RunResult y = ncs::run(*constant.ctx, a, constant.scenarios[k], seed, ncs::RunOptions{});
+        EXPECT_NEAR(x.cost, y.cost, 1e-12 * std::fabs(y.cost)) << ncs::name(a) << " seed " << seed;
+        EXPECT_EQ(x.commands, y.commands);
+        EXPECT_EQ(x.late, y.late);
+        EXPECT_EQ(x.sent, y.sent);
+        if (x.cpu.jobs > 0) {
+          EXPECT_EQ(x.cpu.response_min, engine::from_us(2345));
+          EXPECT_EQ(x.cpu.response_max, engine::from_us(2345));
+        }
+      }
+    }
+  }
+}
+
+TEST(StudyCpuOneShot, CheckAnalysesTheTimerJobAsPeriodicAtItsPhase) {
+  nlohmann::json j = nlohmann::json::parse(test::read_file(one_shot_cpu_path()));
+  // One background task (T 10 ms, C 2 ms) above the job (C 3 ms): WCRT 5 ms, BCRT 3 ms.
+  j["cpus"][0]["context_switch_us"] = 0;
+  j["cpus"][0].erase("isrs");
+  j["cpus"][0]["tasks"] = {{{"name", "bg"}, {"period_us", 10000}, {"wcet_us", 2000}, {"priority", 1}}};
+  j["nodes"][1]["job"] = {{"wcet_us", 3000}, {"priority", 2}};
+  const nlohmann::json r =
+      resolve_study(engine::parse_study(j.dump(), one_shot_cpu_path(), &ncs_schema(), ONESHOT_STUDY_EXAMPLES_DIR));
+  const nlohmann::json& job = r.at("cpus")[0].at("tasks")[1];
+  EXPECT_EQ(job.at("node"), "controller");
+  EXPECT_EQ(job.at("kind"), "node job (timer)");
+  EXPECT_EQ(job.at("period_us").get<double>(), 50000);  // h, not h − J: its own timer
+  EXPECT_EQ(job.at("deadline_us").get<double>(), 50000);
+  EXPECT_EQ(job.at("wcrt_us").get<double>(), 5000);
+  EXPECT_EQ(job.at("bcrt_us").get<double>(), 3000);
+}
+
+TEST(StudyCpuOneShot, SameBytesOnOneAndTwoThreadsAndBadJobsRefused) {
+  const NcsStudy s = one_shot_cpu_study([](nlohmann::json&) {}, 1.5);
+  const std::string one = run_outputs(run_ncs_sweep(s, 3, 1, engine::Shard{}), temp_dir("os_one"), false).dump();
+  const std::string two = run_outputs(run_ncs_sweep(s, 3, 2, engine::Shard{}), temp_dir("os_two"), false).dump();
+  EXPECT_EQ(one, two);
+  EXPECT_TRUE(nlohmann::json::parse(two).contains("cpu"));
+  const auto refused = [](const std::function<void(nlohmann::json&)>& edit, const std::string& expect) {
+    try {
+      static_cast<void>(one_shot_cpu_study(edit, 1));
+      ADD_FAILURE() << "accepted, expected " << expect;
+    } catch (const engine::InputError& e) {
+      EXPECT_NE(std::string(e.what()).find(expect), std::string::npos) << e.what();
+    }
+  };
+  refused([](nlohmann::json& j) { j["nodes"][1]["job"] = {{"wcet_us", 60000}, {"priority", 3}}; }, "field 'nodes[1].job.wcet_us'");  // > h
+  refused([](nlohmann::json& j) { j["nodes"][1]["job"]["deadline_us"] = 1500; }, "field 'nodes[1].job'");  // it misses
+  refused([](nlohmann::json& j) { j["nodes"][1].erase("job"); }, "field 'nodes[1].job'");
+  refused([](nlohmann::json& j) { j["nodes"][0]["cpu"] = "dspic"; j["nodes"][0]["job"] = {{"wcet_us", 100}, {"priority", 5}}; },
+          "field 'nodes[0].cpu'");  // the sensor runs on its timer
 }
 
 }  // namespace

@@ -106,6 +106,12 @@ class Cpu {
   void enable_log(std::size_t max_entries) { log_enabled_ = true; log_limit_ = max_entries; }
   /// Called for every finished or aborted job.
   void on_job(std::function<void(const CpuJob&)> f) { on_job_ = std::move(f); }
+  /// Called at the instant a task job reaches its sample (kSample) or actuation (kActuate)
+  /// point, with its entity and job index: while set, every dispatch schedules the running
+  /// job's points not yet reached (class kCompute, before its completion at the same instant;
+  /// a preemption makes them stale); a point at offset 0 is told at CpuJob::start. Without it
+  /// no event is added (the runs stay as they were).
+  void on_point(std::function<void(std::size_t entity, std::uint64_t index, CpuEventKind kind)> f);
 
   const TaskSet& task_set() const { return set_; }                  ///< The task set.
   const std::vector<CpuTaskStats>& stats() const { return stats_; }  ///< Per task, then per ISR.
@@ -128,6 +134,7 @@ class Cpu {
     Duration cs_left{0};                 // context switch still to run in this dispatch
     SimTime sample{-1}, actuate{-1};
     bool started = false;
+    bool sample_told = false, actuate_told = false;  // on_point called
   };
   struct Entity {
     const TaskSpec* spec = nullptr;
@@ -158,6 +165,7 @@ class Cpu {
   std::vector<Entity> ent_;
   std::vector<CpuTaskStats> stats_;
   HandlerId h_arrive_ = 0, h_ready_ = 0, h_complete_ = 0, h_abort_ = 0, h_dispatch_ = 0;
+  HandlerId h_point_ = 0, h_start_point_ = 0;  // registered by on_point()
   SimTime end_{0};
   static constexpr std::size_t kNone = static_cast<std::size_t>(-1);
   std::size_t running_ = kNone;       // entity whose head job holds the CPU
@@ -167,6 +175,9 @@ class Cpu {
   std::uint64_t generation_ = 0;
   SimTime dispatch_at_{-1};
   std::function<void(const CpuJob&)> on_job_;
+  std::function<void(std::size_t, std::uint64_t, CpuEventKind)> on_point_;
+  void point(std::uint64_t arg);
+  void start_point(std::uint64_t arg);
   bool log_enabled_ = false;
   std::size_t log_limit_ = 0;
   std::vector<CpuLogEntry> log_;

@@ -1,0 +1,303 @@
+/// @file ncs_harness.hpp
+/// @brief What every loop of study `ncs` shares (private to ncs_loop.cpp and
+///        ncs_one_shot_loop.cpp): the Harness (kernel, plant, network, set-point, noise and
+///        timing streams, the controller's CPU) and the loops' type aliases and addresses.
+#pragma once
+
+#include <memory>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "ncs_analytic.hpp"
+#include "ncs_cpu.hpp"
+#include "ncs_live_nodes.hpp"
+#include "ncs_loop.hpp"
+#include "oneshot/engine/can_traffic.hpp"
+#include "oneshot/engine/continuous_plant.hpp"
+#include "oneshot/engine/cpu.hpp"
+#include "oneshot/engine/kernel.hpp"
+#include "oneshot/engine/network.hpp"
+#include "oneshot/host/host_network.hpp"
+#include "oneshot/node/message.hpp"
+#include "oneshot/plant_structure.hpp"
+
+namespace oneshot::ncs::loop {
+
+using Board = host::HostNetwork;
+using Structure = DenseStructure<kN, kM, kP>;
+using Ref = node::SquareWaveReference<double, kN, kM>;
+using Plant = engine::ContinuousPlant<kN, kM, kP, 1>;
+using engine::Duration;
+using engine::EventClass;
+using engine::HandlerId;
+using engine::SimTime;
+using InputVec = Vector<double, kM>;
+using OutputVec = Vector<double, kP>;
+
+// The live run's addresses (ncs_live.hpp): the frame checks of ncs_live_nodes.hpp name them.
+constexpr std::uint8_t kSensor = kLiveSensor;
+constexpr std::uint8_t kController = kLiveController;
+constexpr std::uint8_t kActuator = kLiveActuator;
+
+/// What every loop shares: kernel, plant, network, set-point, noise and timing streams.
+class Harness {
+ public:
+  Harness(const Context& ctx, Approach a, const Scenario& sc, std::uint64_t seed, const RunOptions& opt)
+      : ctx_(ctx),
+        approach_(a),
+        sc_(sc),
+        design_(ctx.controller_design(sc.noise_scale)),
+        disc_(ctx.discretizer_model(sc.noise_scale)),
+        kernel_(seed),
+        plant_(plant_config(ctx, sc, noisy(a, opt)),
+               engine::RandomStream(opt.noise_seed != 0 ? opt.noise_seed : seed, "process")),
+        net_(kernel_),
+        measurement_(opt.noise_seed != 0 ? opt.noise_seed : seed, "measurement"),
+        compute_(kernel_.stream("compute")),
+        ref_(reference(ctx, sc)),
+        noisy_(noisy(a, opt)),
+        h_(engine::from_us(ctx.period_us())),
+        end_(engine::from_seconds(sc.duration_s, "ncs scenario duration")) {
+    net_.set_faults(opt.faults);
+    opt_faults_empty_ = opt.faults.empty();
+    if (one_shot(a) && opt.analytic) throw std::invalid_argument(std::string("ncs: ") + name(a) + " has no analytic cost");
+    if (opt.record_messages) net_.record_messages();
+    if (!legs_from_file(sc) && !(sc.max_delay_ms * 1000 >= static_cast<double>(ctx.timing().leg_min_us))) {
+      throw std::invalid_argument("ncs scenario " + sc.name + ": d must be at least 0.5 ms");
+    }
+    const auto chol = measurement_cholesky(design_);
+    for (std::size_t i = 0; i < 3; ++i) r_chol_[i] = chol[i];
+    const live::InputRange range = live::actuator_range(ctx);
+    u_min_ = range.lo;
+    u_max_ = range.hi;
+    const Vector<double, kN> x0 = ref_.state(0);
+    plant_.set_state(x0);
+    plant_.set_reference(x0, ref_.input(0));
+    if (opt.analytic) an_ = make_tracker(ctx, sc, a, design_, opt, x0, ref_.input(0));
+    if (opt.trace_step_s > 0) plant_.record_trace(engine::from_seconds(opt.trace_step_s, "trace step"), kernel_.stream("trace"));
+    // Set-point switches on the kh grid (before anything else at that instant but the plant).
+    const HandlerId sw = kernel_.add_handler("setpoint", [this](std::uint64_t k) {
+      advance();
+      const auto kk = static_cast<node::SequenceNumber>(k);
+      plant_.set_reference(ref_.state(kk), ref_.input(kk));
+      if (an_) an_->set_reference(ref_.state(kk), ref_.input(kk));
+    });
+    const std::uint64_t half = half_wave_periods(ctx, sc);
+    for (std::uint64_t k = half; SimTime{h_ * static_cast<std::int64_t>(k)} < end_; k += half) {
+      kernel_.schedule(SimTime{h_ * static_cast<std::int64_t>(k)}, EventClass::kEnvironment, sw, k);
+    }
+    if (sc.controller_cpu && !delay_free(a)) {  // τ_c from the schedule (ncs_cpu.hpp)
+      cpu_ = std::make_unique<engine::cpu::Cpu>(kernel_, sc.controller_cpu->set);
+      cpu_task_ = sc.controller_cpu->task;
+      cpu_->on_job([this](const engine::cpu::CpuJob& j) {
+        if (j.entity == cpu_task_ && !j.aborted) kernel_.schedule(kernel_.now(), EventClass::kCompute, computed_, j.index);
+      });
+      cpu_->start(end_);
+    }
+    if (sc.sensor_cpu && !delay_free(a)) {  // the sampling job (ncs_cpu.hpp); the loop sets its callbacks
+      if (a != Approach::kS && a != Approach::kSK) {
+        throw std::invalid_argument(std::string("ncs: the sensor on a CPU runs with S and SK only, not ") + name(a));
+      }
+      if (an_) throw std::invalid_argument("ncs: no analytic cost with the sensor on a CPU");
+      sensor_cpu_ = std::make_unique<engine::cpu::Cpu>(kernel_, sc.sensor_cpu->set);
+      sensor_task_ = sc.sensor_cpu->task;
+      sensor_cpu_->start(end_);
+    }
+    const HandlerId end = kernel_.add_handler("end", [this](std::uint64_t) { advance(); });
+    kernel_.schedule(end_, EventClass::kEnd, end);
+    if (opt.analytic_mark_s > 0 && !an_) throw std::invalid_argument("an analytic mark needs an analytic run");
+    if (an_ && opt.analytic_mark_s > 0) {  // observes only: the plant and tracker are not advanced
+      const SimTime mark{engine::from_seconds(opt.analytic_mark_s, "analytic mark")};
+      if (mark > end_) throw std::invalid_argument("the analytic mark is after the end of the run");
+      const HandlerId at_mark = kernel_.add_handler("analytic mark", [this](std::uint64_t) {
+        result_.analytic_at_mark = an_->cost_at(kernel_.now());
+      });
+      kernel_.schedule(mark, EventClass::kRecord, at_mark);
+    }
+  }
+
+  /// Whether a run of `a` under `opt` draws process and measurement noise.
+  static bool noisy(Approach a, const RunOptions& opt) { return !opt.noise_free && !opt.analytic && a != Approach::kI; }
+
+  /// The plant (and the analytic tracker) at now.
+  void advance() {
+    plant_.advance_to(kernel_.now());
+    if (an_) an_->flow_to(kernel_.now());
+  }
+
+  /// Leg `name`'s link of this scenario and approach.
+  engine::LinkConfig leg(const char* name) const { return ncs::leg(ctx_, sc_, approach_, name); }
+
+  /// Adds leg `name` to the network and remembers it for the run's link counters.
+  engine::Link& add_leg(const char* name) {
+    engine::Link& l = net_.add_link(leg(name));
+    legs_.emplace_back(name, &l);
+    return l;
+  }
+
+  /// Routes leg `name` from `source` to `destination`: over its CAN bus when the scenario puts
+  /// it on one (not for the delay-free loops I, IK), else over a link.
+  void route_leg(std::uint8_t source, std::uint8_t destination, const char* name) {
+    leg_routes_.push_back({{source, destination}, name});
+    const auto b = sc_.bus_legs.find(name);
+    if (b == sc_.bus_legs.end() || delay_free(approach_)) {
+      net_.route(source, destination, add_leg(name));
+      return;
+    }
+    net_.route(source, destination, bus(b->second), b->second.id);
+    bus_legs_.emplace_back(name, std::make_pair(source, destination));
+  }
+
+  /// The bus of `leg`, built with its background traffic on first use.
+  engine::CanBus& bus(const BusLeg& leg) {
+    for (const auto& [nm, b] : buses_)
+      if (nm == leg.bus.name) return *b;
+    engine::CanBus& b = net_.add_can_bus(leg.bus);
+    buses_.emplace_back(leg.bus.name, &b);
+    if (!leg.background.empty()) {
+      traffic_.push_back(std::make_unique<engine::CanTraffic>(kernel_, b, leg.background, leg.offsets, end_));
+    }
+    return b;
+  }
+
+  /// A frame reached the controller (or the one-shot controller's timer fired): `compute_h`
+  /// runs τ_c later with argument `arg`, τ_c drawn (compute_time()) or, on a CPU, the response
+  /// of the job released now (the handler runs at its finish, with the job's index: the
+  /// number of releases before it, which is `arg` when the loop releases once per `arg`).
+  void start_computation(HandlerId compute_h, std::uint64_t arg = 0) {
+    if (!cpu_) {
+      kernel_.schedule_in(compute_time(), EventClass::kCompute, compute_h, arg);
+      return;
+    }
+    computed_ = compute_h;
+    cpu_->release(cpu_task_);
+  }
+
+  /// τ_c of the next computation (whole µs), 0 for the delay-free loops.
+  Duration compute_time() {
+    if (delay_free(approach_)) return Duration{0};
+    if (sc_.compute_us) return engine::from_us(compute_.uniform_int(sc_.compute_us->first, sc_.compute_us->second));
+    return engine::from_us(compute_.uniform_int(ctx_.timing().compute_min_us, ctx_.timing().compute_max_us));
+  }
+
+  /// The plant at now and a sample y = C x + v.
+  OutputVec sample() {
+    advance();
+    OutputVec y = plant_.output();
+    if (noisy_) {
+      const double n0 = measurement_.normal();
+      const double n1 = measurement_.normal();
+      y[0] += r_chol_[0] * n0;
+      y[1] += r_chol_[1] * n0 + r_chol_[2] * n1;
+    }
+    const double t = engine::to_seconds(kernel_.now());
+    const OutputVec clean = plant_.output();
+    result_.samples.push_back(Point{t, {y[0], y[1]}});
+    result_.sample_truth.push_back(Point{t, {clean[0], clean[1]}});
+    if (an_) an_->sample(kernel_.now(), y);
+    return y;
+  }
+
+  /// The plant at now, then input `u` from now on (a command applied).
+  void apply(const InputVec& u) {
+    advance();
+    plant_.set_input(u);
+    if (an_) an_->apply(u);
+    ++result_.commands;
+  }
+
+  /// Records estimate x̂ of period k (at kh).
+  void estimate(node::SequenceNumber k, const Vector<double, kN>& x) {
+    result_.estimates.push_back(Point{static_cast<double>(k) * engine::to_seconds(h_), {x[0], x[1]}});
+  }
+
+  /// Node `address` restarts: whatever its interface held is lost.
+  void lose_inbox(std::uint8_t address) { net_.node(address).interface.inbox.clear(); }
+
+  /// Runs the kernel to the end and collects the cost, trace and injected faults.
+  RunResult finish() {
+    kernel_.run_until(end_);
+    result_.events = kernel_.events_run();
+    result_.injected = net_.fault_counters();
+    for (const engine::MessageRecord& m : net_.messages()) {
+      for (const auto& [route, nm] : leg_routes_) {
+        if (route != std::make_pair(m.source, m.destination)) continue;
+        result_.messages.push_back(MessageEvent{nm, engine::to_seconds(m.sent), engine::to_seconds(m.arrival), m.lost,
+                                                m.delivered});
+      }
+    }
+    result_.cost = plant_.cost().total();
+    for (const auto& [nm, l] : legs_) result_.links.emplace_back(nm, l->statistics());
+    for (const auto& [nm, route] : bus_legs_) {
+      const engine::BusRouteStatistics& st = net_.bus_route_statistics(route.first, route.second);
+      engine::LinkStatistics ls;
+      ls.sent = st.sent;
+      ls.max_delay = st.max_delay;
+      result_.links.emplace_back(nm, ls);
+      result_.bus_legs.emplace_back(nm, st);
+    }
+    if (an_) an_->report(result_);
+    if (cpu_) cpu_stats(*cpu_, cpu_task_, result_.cpu);
+    if (sensor_cpu_) cpu_stats(*sensor_cpu_, sensor_task_, result_.sensor_cpu);
+    for (const auto& s : plant_.trace()) {
+      const double t = engine::to_seconds(s.t);
+      result_.truth.push_back(Point{t, {s.x[0], s.x[1]}});
+      result_.setpoint.push_back(Point{t, {s.r[0], s.u[0]}});
+    }
+    return std::move(result_);
+  }
+
+  /// Job `task`'s statistics on `cpu` into `c`.
+  static void cpu_stats(const engine::cpu::Cpu& cpu, std::size_t task, CpuRunStats& c) {
+    const engine::cpu::CpuTaskStats& st = cpu.stats()[task];
+    c.present = true;
+    c.jobs = st.finished;
+    c.response_min = st.response_min;
+    c.response_max = st.response_max;
+    c.response_sum_us = st.response_sum_s * 1e6;
+    c.deadline_misses = st.deadline_misses;
+    c.sample_min = st.sample_min;
+    c.sample_max = st.sample_max;
+    for (std::size_t e = 0; e < cpu.stats().size(); ++e) {
+      c.busy += cpu.stats()[e].busy;
+      if (e != task) c.other_misses += cpu.stats()[e].deadline_misses;
+    }
+  }
+
+  const Context& ctx_;
+  Approach approach_;
+  const Scenario& sc_;
+  Design design_;
+  Disc disc_;
+  engine::Kernel kernel_;
+  Plant plant_;
+  engine::Network net_;
+  engine::RandomStream measurement_;
+  engine::RandomStream compute_;
+  Ref ref_;
+  bool noisy_;
+  bool opt_faults_empty_ = true;
+  Duration h_;
+  SimTime end_;
+  double r_chol_[3] = {};
+  InputVec u_min_;
+  InputVec u_max_;
+  RunResult result_;
+  std::unique_ptr<AnalyticTracker> an_;
+  std::vector<std::pair<std::string, engine::Link*>> legs_;
+  std::vector<std::pair<std::string, std::pair<std::uint8_t, std::uint8_t>>> bus_legs_;  ///< Name, route.
+  std::vector<std::pair<std::string, engine::CanBus*>> buses_;
+  std::vector<std::pair<std::pair<std::uint8_t, std::uint8_t>, std::string>> leg_routes_;  ///< Route, leg name.
+  std::vector<std::unique_ptr<engine::CanTraffic>> traffic_;
+  std::unique_ptr<engine::cpu::Cpu> cpu_;  ///< The controller's CPU (Scenario::controller_cpu).
+  std::size_t cpu_task_ = 0;               ///< The controller's job in it.
+  HandlerId computed_ = 0;                 ///< The loop's compute handler (set at each release).
+  std::unique_ptr<engine::cpu::Cpu> sensor_cpu_;  ///< The sensor's CPU (Scenario::sensor_cpu).
+  std::size_t sensor_task_ = 0;                   ///< The sensor's job in it.
+};
+
+/// The one-shot loop OS, OSp or OSK `a` on `hs` (ncs_one_shot_loop.cpp).
+RunResult run_one_shot(Harness& hs, Approach a);
+
+}  // namespace oneshot::ncs::loop
