@@ -33,7 +33,7 @@ namespace oneshot::ncs {
 namespace {
 
 using namespace live;
-using Board = host::HostNetwork;
+using ReplayBoard = host::HostNetwork;
 using Plant = engine::ContinuousPlant<kN, kM, kP, 1>;
 using engine::EventClass;
 using engine::SimTime;
@@ -131,9 +131,9 @@ ReplayResult replay_live(const std::string& dir, bool ideal_instants) {
     plant.set_reference(ref.state(0), ref.input(0));
     host::HostNetworkState net[4];
     for (std::uint8_t a = 1; a <= 3; ++a) net[a].address = a;
-    std::optional<node::SyncActuatorNode<Board, double, kM>> act(std::in_place, kLiveSensor, InputVec{});
-    std::optional<node::SyncSensorNode<Board, double, kP, kM>> sensor(std::in_place, kLiveController, late_us);
-    using Ctrl = node::SyncControllerNode<Board, Est, Ref, double, kN, kP, kM>;
+    std::optional<node::SyncActuatorNode<ReplayBoard, double, kM>> act(std::in_place, kLiveSensor, InputVec{});
+    std::optional<node::SyncSensorNode<ReplayBoard, double, kP, kM>> sensor(std::in_place, kLiveController, late_us);
+    using Ctrl = node::SyncControllerNode<ReplayBoard, Est, Ref, double, kN, kP, kM>;
     std::optional<Ctrl> ctrl(std::in_place, kLiveActuator, design.l, u_min, u_max, est, ref);
     check_requests(*ctx, *sensor);
     check_reports(*ctx, *ctrl);

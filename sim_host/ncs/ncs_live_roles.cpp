@@ -30,7 +30,7 @@ using namespace live;
 using posix::monotonic_ns;
 using posix::wait_readable;
 using Plant = engine::ContinuousPlant<kN, kM, kP, 1>;
-using Board = posix::UdpNetwork;
+using UdpBoard = posix::UdpNetwork;
 
 /// Processes keep serving this long after the end (frames in flight), then exit.
 constexpr std::int64_t kTailNs = 300'000'000;
@@ -177,7 +177,7 @@ int run_sensor(const LiveRun& r, const std::shared_ptr<const Context>& ctx, int 
     logged(send, peer, d, n);
   };
   posix::ScopedUdpNetwork scope(net);
-  std::optional<node::SyncSensorNode<Board, double, kP, kM>> sensor(std::in_place, kLiveController, late_us);
+  std::optional<node::SyncSensorNode<UdpBoard, double, kP, kM>> sensor(std::in_place, kLiveController, late_us);
   check_requests(*ctx, *sensor);
   Restarts restarts(r, "sensor");
   double restarted = 0;
@@ -253,7 +253,7 @@ int controller_loop(const LiveRun& r, const Context& ctx, Est est, int net_fd, c
     u_min[j] = ctx.design().u_min[j];
     u_max[j] = ctx.design().u_max[j];
   }
-  using Ctrl = node::SyncControllerNode<Board, Est, Ref, double, kN, kP, kM>;
+  using Ctrl = node::SyncControllerNode<UdpBoard, Est, Ref, double, kN, kP, kM>;
   std::optional<Ctrl> ctrl(std::in_place, kLiveActuator, d.l, u_min, u_max, est, reference(ctx, r.scenario));
   check_reports(ctx, *ctrl);
   Restarts restarts(r, "controller");
@@ -303,7 +303,7 @@ int run_actuator(const LiveRun& r, const std::shared_ptr<const Context>& ctx, in
   posix::UdpNetworkState net;
   attach(net, net_fd, kLiveActuator, r, log, c);
   posix::ScopedUdpNetwork scope(net);
-  std::optional<node::SyncActuatorNode<Board, double, kM>> act(std::in_place, kLiveSensor, InputVec{});
+  std::optional<node::SyncActuatorNode<UdpBoard, double, kM>> act(std::in_place, kLiveSensor, InputVec{});
   check_commands(*ctx, *act);
   Restarts restarts(r, "actuator");
   double restarted = 0;

@@ -13,6 +13,7 @@
 
 #include "ncs_cpu.hpp"
 #include "ncs_model.hpp"
+#include "study_fields.hpp"
 
 namespace oneshot::study {
 namespace {
@@ -20,10 +21,6 @@ namespace {
 using engine::Duration;
 using engine::InputError;
 using nlohmann::json;
-
-std::string at(const char* list, std::size_t i) { return std::string(list) + "[" + std::to_string(i) + "]"; }
-
-[[noreturn]] void refuse(const std::string& field, const std::string& why) { throw InputError("field '" + field + "': " + why); }
 
 double us(Duration d) { return static_cast<double>(d.count()) * 1e-3; }
 

@@ -11,17 +11,12 @@
 
 #include "ncs_live.hpp"
 #include "study_cpu.hpp"
+#include "study_fields.hpp"
 
 namespace oneshot::study {
 namespace {
 
 using engine::InputError;
-
-std::string at(const char* list, std::size_t i) { return std::string(list) + "[" + std::to_string(i) + "]"; }
-
-[[noreturn]] void refuse(const std::string& field, const std::string& why) {
-  throw InputError("field '" + field + "': " + why);
-}
 
 /// Why approach I, the reference of every ratio, would cost exactly 0 on `sc` ("" when it does
 /// not): it starts on the set-point without delay or noise, so it costs nothing until the first
