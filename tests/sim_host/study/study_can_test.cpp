@@ -15,30 +15,13 @@
 #include "study_ncs_runner.hpp"
 #include "study_ncs_sweep.hpp"
 #include "support/build_flavor.hpp"
+#include "study_example.hpp"
 #include "support/temp_files.hpp"
 
 namespace oneshot::study {
 namespace {
 
-std::string can_path() { return std::string(ONESHOT_STUDY_EXAMPLES_DIR) + "/ncs_can.json"; }
-
-nlohmann::json can_json() { return nlohmann::json::parse(test::read_file(can_path())); }
-
-engine::StudyFile parse(const nlohmann::json& j) {
-  return engine::parse_study(j.dump(), can_path(), &ncs_schema(), ONESHOT_STUDY_EXAMPLES_DIR);
-}
-
-/// The file after `edit`, mapped onto the loop with the check's bounds, every scenario
-/// `duration_s` long.
-NcsStudy can_study(const std::function<void(nlohmann::json&)>& edit, double duration_s) {
-  nlohmann::json j = can_json();
-  edit(j);
-  const engine::StudyFile f = parse(j);
-  NcsStudy s = map_ncs_study(f);
-  for (ncs::Scenario& x : s.scenarios) x.duration_s = duration_s;
-  attach_bus_bounds(s, resolve_study(f));
-  return s;
-}
+const test_support::StudyExample kCan("ncs_can.json");
 
 std::string temp_dir(const char* name) { return test::fresh_dir("oneshot_study_can_test", name); }
 
@@ -54,7 +37,7 @@ double message_us(std::int64_t bytes, std::int64_t bit_rate) {
 }
 
 TEST(StudyCan, WithoutBackgroundEveryDelayIsTheTransmissionTime) {
-  const NcsStudy s = can_study([](nlohmann::json& j) { j["buses"][0].erase("background"); }, 4);
+  const NcsStudy s = kCan.study([](nlohmann::json& j) { j["buses"][0].erase("background"); }, 4);
   const nlohmann::json j = run_outputs(run_ncs_sweep(s, 3, 2, engine::Shard{}), temp_dir("quiet"), false);
   // The loop's messages: header (sequence, stamp: 8 bytes) + p = 2 doubles (sc), + m = 1 double (ca).
   const double sc_us = message_us(8 + 2 * 8, 125'000);
@@ -75,9 +58,9 @@ TEST(StudyCan, WithoutBackgroundEveryDelayIsTheTransmissionTime) {
 }
 
 TEST(StudyCan, CheckAnalysesTheLoopMessagesInFramesWithTheirChainedJitter) {
-  nlohmann::json j = can_json();
+  nlohmann::json j = kCan.json();
   j["buses"][0].erase("background");
-  const nlohmann::json r = resolve_study(parse(j));
+  const nlohmann::json r = resolve_study(kCan.parse(j));
   const nlohmann::json& m = r.at("buses")[0].at("messages");
   ASSERT_EQ(m.size(), 2U);
   const nlohmann::json& sc = m[0];
@@ -102,7 +85,7 @@ TEST(StudyCan, CheckAnalysesTheLoopMessagesInFramesWithTheirChainedJitter) {
 /// Mean delay of leg `leg` under S with the background periods multiplied by `scale`, after
 /// checking every observed delay against the analysis (`seeds` seeds, 4 s per scenario).
 double mean_delay_checked(double scale, const char* leg, std::size_t seeds) {
-  const NcsStudy s = can_study(
+  const NcsStudy s = kCan.study(
       [scale](nlohmann::json& j) {
         for (auto& b : j["buses"][0]["background"]) b["period_us"] = std::llround(b["period_us"].get<double>() * scale);
       },
@@ -139,7 +122,7 @@ TEST(StudyCan, WithBackgroundDelaysStayWithinTheBoundAndTheMeanGrowsWithTheLoad)
 }
 
 TEST(StudyCan, SameBytesOnOneAndTwoThreadsAndFromMergedShards) {
-  const NcsStudy s = can_study([](nlohmann::json&) {}, 2.5);
+  const NcsStudy s = kCan.study([](nlohmann::json&) {}, 2.5);
   const std::string one = run_outputs(run_ncs_sweep(s, 4, 1, engine::Shard{}), temp_dir("one"), false).dump();
   const std::string two = run_outputs(run_ncs_sweep(s, 4, 2, engine::Shard{}), temp_dir("two"), false).dump();
   EXPECT_EQ(one, two);
@@ -152,36 +135,24 @@ TEST(StudyCan, SameBytesOnOneAndTwoThreadsAndFromMergedShards) {
   EXPECT_TRUE(nlohmann::json::parse(two).contains("bus_delays"));
 }
 
-/// Mapping the edited file is refused, the message containing `expect`.
-void expect_refused(const std::function<void(nlohmann::json&)>& edit, const std::string& expect) {
-  nlohmann::json j = can_json();
-  edit(j);
-  try {
-    static_cast<void>(map_ncs_study(parse(j)));
-    ADD_FAILURE() << "accepted, expected " << expect;
-  } catch (const engine::InputError& e) {
-    EXPECT_NE(std::string(e.what()).find(expect), std::string::npos) << e.what();
-  }
-}
-
 TEST(StudyCan, BadBusReferencesAreRefusedNamingTheField) {
-  expect_refused([](nlohmann::json& j) { j["links"][0]["bus"] = "can1"; }, "field 'links[0].bus'");  // no such bus
-  expect_refused([](nlohmann::json& j) { j["links"][1]["id"] = 80; }, "field 'links[1].id'");  // the background's
-  expect_refused([](nlohmann::json& j) { j["links"][0]["id"] = 4096; }, "field 'links[0].id'");  // beyond 11 bits
+  kCan.expect_refused([](nlohmann::json& j) { j["links"][0]["bus"] = "can1"; }, "field 'links[0].bus'");  // no such bus
+  kCan.expect_refused([](nlohmann::json& j) { j["links"][1]["id"] = 80; }, "field 'links[1].id'");  // the background's
+  kCan.expect_refused([](nlohmann::json& j) { j["links"][0]["id"] = 4096; }, "field 'links[0].id'");  // beyond 11 bits
   // A bus leg takes its delay from the bus: delay, loss and order are not its keys (schema).
-  expect_refused([](nlohmann::json& j) { j["links"][0]["delay"] = {{"model", "constant"}, {"delay_us", 100}}; }, "links[0]");
-  expect_refused([](nlohmann::json& j) { j["links"][1]["loss"] = {{"model", "bernoulli"}, {"p", 0.1}}; }, "links[1]");
-  expect_refused([](nlohmann::json& j) { j["scenarios"][0]["links"] = {{"sc", {{"delay", {{"model", "constant"}, {"delay_us", 1}}}}}}; },
+  kCan.expect_refused([](nlohmann::json& j) { j["links"][0]["delay"] = {{"model", "constant"}, {"delay_us", 100}}; }, "links[0]");
+  kCan.expect_refused([](nlohmann::json& j) { j["links"][1]["loss"] = {{"model", "bernoulli"}, {"p", 0.1}}; }, "links[1]");
+  kCan.expect_refused([](nlohmann::json& j) { j["scenarios"][0]["links"] = {{"sc", {{"delay", {{"model", "constant"}, {"delay_us", 1}}}}}}; },
                  "scenarios[0].links");
   // What the run cannot do on a bus.
-  expect_refused([](nlohmann::json& j) { j["approaches"].push_back({{"name", "A"}, {"kind", "A"}}); }, "field 'approaches[4].kind'");
-  expect_refused([](nlohmann::json& j) { j["approaches"].push_back({{"name", "S+"}, {"kind", "S+"}}); }, "field 'approaches[4].kind'");
-  expect_refused(
+  kCan.expect_refused([](nlohmann::json& j) { j["approaches"].push_back({{"name", "A"}, {"kind", "A"}}); }, "field 'approaches[4].kind'");
+  kCan.expect_refused([](nlohmann::json& j) { j["approaches"].push_back({{"name", "S+"}, {"kind", "S+"}}); }, "field 'approaches[4].kind'");
+  kCan.expect_refused(
       [](nlohmann::json& j) {
         j["links"].push_back({{"name", "as"}, {"from", "actuator"}, {"to", "sensor"}, {"bus", "can0"}, {"id", 300}});
       },
       "field 'links[2].bus'");
-  expect_refused(
+  kCan.expect_refused(
       [](nlohmann::json& j) { j["buses"].push_back({{"name", "spare"}, {"bit_rate", 250000}}); }, "field 'buses[1]'");  // unused
 }
 

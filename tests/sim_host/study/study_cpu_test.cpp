@@ -23,27 +23,15 @@
 #include "study_ncs_runner.hpp"
 #include "study_ncs_sweep.hpp"
 #include "support/run_command.hpp"
+#include "study_cpu_checks.hpp"
+#include "study_example.hpp"
 #include "support/temp_files.hpp"
 
 namespace oneshot::study {
 namespace {
 
-std::string cpu_path() { return std::string(ONESHOT_STUDY_EXAMPLES_DIR) + "/ncs_cpu.json"; }
-
-nlohmann::json cpu_json() { return nlohmann::json::parse(test::read_file(cpu_path())); }
-
-engine::StudyFile parse(const nlohmann::json& j) {
-  return engine::parse_study(j.dump(), cpu_path(), &ncs_schema(), ONESHOT_STUDY_EXAMPLES_DIR);
-}
-
-/// The file after `edit`, mapped onto the loop, every scenario `duration_s` long.
-NcsStudy cpu_study(const std::function<void(nlohmann::json&)>& edit, double duration_s) {
-  nlohmann::json j = cpu_json();
-  edit(j);
-  NcsStudy s = map_ncs_study(parse(j));
-  for (ncs::Scenario& x : s.scenarios) x.duration_s = duration_s;
-  return s;
-}
+const test_support::StudyExample kCpu("ncs_cpu.json");
+const test_support::StudyExample kSensorCpu("ncs_cpu_sensor.json");
 
 std::string temp_dir(const char* name) { return test::fresh_dir("oneshot_study_cpu_test", name); }
 
@@ -56,70 +44,32 @@ void only(nlohmann::json& j, std::initializer_list<const char*> keep) {
 
 TEST(StudyCpu, EveryControllerResponseIsWithinTheAnalysedBounds) {
   for (const char* scheduler : {"fixed_priority", "fixed_priority_nonpreemptive", "edf"}) {
-    const NcsStudy s = cpu_study(
+    const NcsStudy s = kCpu.study(
         [&](nlohmann::json& j) {
           j["cpus"][0]["scheduler"] = scheduler;
           only(j, {"I", "S", "A", "AKl"});
         },
         2);
     const nlohmann::json j = run_outputs(run_ncs_sweep(s, 30, 2, engine::Shard{}), temp_dir(scheduler), false);
-    const ncs::ControllerCpu& c = *s.scenarios[0].controller_cpu;
-    for (const char* a : {"S", "A", "AKl"}) {
-      const nlohmann::json& e = j.at("cpu").at(a);
-      EXPECT_EQ(e.at("jobs").get<double>(), 30 * 2 * 40) << scheduler << " " << a;  // one job per period, nothing lost
-      EXPECT_GE(e.at("min_us").get<double>(), static_cast<double>(c.bcrt.count()) * 1e-3) << scheduler << " " << a;
-      EXPECT_LE(e.at("max_us").get<double>(), static_cast<double>(c.wcrt.count()) * 1e-3) << scheduler << " " << a;
-      EXPECT_TRUE(e.at("within_bounds").get<bool>());
-      EXPECT_EQ(e.at("deadline_misses").get<double>(), 0);
-      EXPECT_EQ(e.at("other_misses").get<double>(), 0);
-      std::printf("%s %s: tau_c %.1f .. %.1f us (mean %.1f) within [%.1f, %.1f]\n", scheduler, a, e.at("min_us").get<double>(),
-                  e.at("max_us").get<double>(), e.at("mean_us").get<double>(), e.at("bcrt_us").get<double>(),
-                  e.at("wcrt_us").get<double>());
-    }
-    EXPECT_EQ(j.at("cpu").at("I").at("jobs").get<double>(), 0);  // delay-free: not on the CPU
+    // One job per period (30 seeds x 2 scenarios x 40 periods), nothing lost.
+    test_support::expect_controller_jobs_within_bounds(j, *s.scenarios[0].controller_cpu, {"S", "A", "AKl"}, 30 * 2 * 40,
+                                                       scheduler);
   }
 }
 
 TEST(StudyCpu, ALoneConstantJobIsTheLoopWithThatConstantTauC) {
-  const auto lone = [](nlohmann::json& j) {
-    j["cpus"][0].erase("tasks");
-    j["cpus"][0].erase("isrs");
-    j["cpus"][0]["context_switch_us"] = 0;
-    j["nodes"][1]["job"] = {{"wcet_us", 2345}, {"bcet_us", 2345}, {"priority", 1}};
-  };
-  const NcsStudy on_cpu = cpu_study(lone, 3);
-  NcsStudy constant = on_cpu;
-  for (ncs::Scenario& x : constant.scenarios) {
-    x.controller_cpu = nullptr;
-    x.compute_us = std::make_pair(std::int64_t{2345}, std::int64_t{2345});
-  }
-  EXPECT_EQ(on_cpu.scenarios[0].controller_cpu->wcrt, engine::from_us(2345));
-  EXPECT_EQ(on_cpu.scenarios[0].controller_cpu->bcrt, engine::from_us(2345));
-  for (ncs::Approach a : on_cpu.approaches) {
-    for (std::size_t k = 0; k < on_cpu.scenarios.size(); ++k) {
-      for (std::uint64_t seed = 1; seed <= 3; ++seed) {
-        const ncs::RunResult x = ncs::run(*on_cpu.ctx, a, on_cpu.scenarios[k], seed, ncs::RunOptions{});
-        const ncs::RunResult y = ncs::run(*constant.ctx, a, constant.scenarios[k], seed, ncs::RunOptions{});
-        EXPECT_NEAR(x.cost, y.cost, 1e-12 * std::fabs(y.cost)) << ncs::name(a) << " seed " << seed;
-        EXPECT_EQ(x.commands, y.commands);
-        if (x.cpu.jobs > 0) {
-          EXPECT_EQ(x.cpu.response_min, engine::from_us(2345));
-          EXPECT_EQ(x.cpu.response_max, engine::from_us(2345));
-        }
-      }
-    }
-  }
+  test_support::expect_lone_constant_job_is_the_constant_delay(kCpu);
 }
 
 TEST(StudyCpu, CheckGivesTheHandComputedResponseTimes) {
-  nlohmann::json j = cpu_json();
+  nlohmann::json j = kCpu.json();
   // One background task (T 10 ms, C 2 ms) above the job (C 3 ms constant), no switches or ISRs:
   // WCRT = 3 + 2 = 5 ms (one preemption), BCRT = 3 ms (Redell-Sanfridson: ceil((3 - 10)/10) = 0).
   j["cpus"][0]["context_switch_us"] = 0;
   j["cpus"][0].erase("isrs");
   j["cpus"][0]["tasks"] = {{{"name", "bg"}, {"period_us", 10000}, {"wcet_us", 2000}, {"priority", 1}}};
   j["nodes"][1]["job"] = {{"wcet_us", 3000}, {"priority", 2}};
-  const nlohmann::json r = resolve_study(parse(j));
+  const nlohmann::json r = resolve_study(kCpu.parse(j));
   const nlohmann::json& c = r.at("cpus")[0];
   EXPECT_TRUE(c.at("schedulable").get<bool>());
   // Inputs: h = 50 ms, the actuation-synchronized approaches chain as and sc (U[0.5, 4] ms each):
@@ -134,18 +84,18 @@ TEST(StudyCpu, CheckGivesTheHandComputedResponseTimes) {
   EXPECT_EQ(c.at("tasks")[0].at("wcrt_us").get<double>(), 2000);
   // Sampling approaches only: J = the spread of sc alone.
   only(j, {"I", "S", "SK"});
-  EXPECT_EQ(resolve_study(parse(j)).at("cpus")[0].at("input_jitter_us").get<double>(), 3500);
+  EXPECT_EQ(resolve_study(kCpu.parse(j)).at("cpus")[0].at("input_jitter_us").get<double>(), 3500);
   // AKl's D = max sc + max ca + WCRT.
-  nlohmann::json k = cpu_json();
+  nlohmann::json k = kCpu.json();
   k["cpus"][0] = j["cpus"][0];
   k["nodes"][1]["job"] = j["nodes"][1]["job"];
-  const NcsStudy s = map_ncs_study(parse(k));
+  const NcsStudy s = map_ncs_study(kCpu.parse(k));
   EXPECT_EQ(s.ctx->worst_chain_us(s.scenarios[0]), 4000 + 4000 + 5000);
 }
 
 /// Mean τ_c and the paired cost of `approach` with the background tasks' periods × `scale`.
 std::pair<double, double> load_point(double scale, const char* approach) {
-  const NcsStudy s = cpu_study(
+  const NcsStudy s = kCpu.study(
       [&](nlohmann::json& j) {
         for (auto& t : j["cpus"][0]["tasks"]) t["period_us"] = std::llround(t["period_us"].get<double>() * scale);
         only(j, {"I", approach});
@@ -178,7 +128,7 @@ TEST(StudyCpu, AHeavierBackgroundRaisesTheMeanResponseAndTheCost) {
 }
 
 TEST(StudyCpu, SameBytesOnOneAndTwoThreadsAndFromMergedShards) {
-  const NcsStudy s = cpu_study([](nlohmann::json&) {}, 1.5);
+  const NcsStudy s = kCpu.study([](nlohmann::json&) {}, 1.5);
   const std::string one = run_outputs(run_ncs_sweep(s, 3, 1, engine::Shard{}), temp_dir("one"), false).dump();
   const std::string two = run_outputs(run_ncs_sweep(s, 3, 2, engine::Shard{}), temp_dir("two"), false).dump();
   EXPECT_EQ(one, two);
@@ -192,18 +142,7 @@ TEST(StudyCpu, SameBytesOnOneAndTwoThreadsAndFromMergedShards) {
 }
 
 /// Parsing, checking and mapping the edited file is refused, the message containing `expect`.
-void expect_refused(const std::function<void(nlohmann::json&)>& edit, const std::string& expect) {
-  nlohmann::json j = cpu_json();
-  edit(j);
-  try {
-    const engine::StudyFile f = parse(j);
-    static_cast<void>(resolve_study(f));
-    static_cast<void>(map_ncs_study(f));
-    ADD_FAILURE() << "accepted, expected " << expect;
-  } catch (const engine::InputError& e) {
-    EXPECT_NE(std::string(e.what()).find(expect), std::string::npos) << e.what();
-  }
-}
+void expect_refused(const test_support::Edit& edit, const std::string& expect) { kCpu.expect_refused(edit, expect, true); }
 
 TEST(StudyCpu, BadCpusAreRefusedNamingTheField) {
   expect_refused([](nlohmann::json& j) { j["nodes"][1]["cpu"] = "arm"; }, "field 'nodes[1].cpu'");  // dangling
@@ -231,9 +170,9 @@ TEST(StudyCpu, BadCpusAreRefusedNamingTheField) {
 
 TEST(StudyCpu, CommandLine) {
   // check prints every task's analysis, the node job's as the JSON gives it.
-  const test::CommandResult ok = test::run_command({ONESHOT_SIM_PATH, "study", "check", cpu_path()});
+  const test::CommandResult ok = test::run_command({ONESHOT_SIM_PATH, "study", "check", kCpu.path()});
   ASSERT_EQ(ok.exit_code, 0) << ok.output;
-  const nlohmann::json r = resolve_study(parse(cpu_json()));
+  const nlohmann::json r = resolve_study(kCpu.parse(kCpu.json()));
   const nlohmann::json& c = r.at("cpus")[0];
   EXPECT_NE(ok.output.find("cpu dspic: fixed_priority"), std::string::npos) << ok.output;
   for (const nlohmann::json& t : c.at("tasks")) {
@@ -245,7 +184,7 @@ TEST(StudyCpu, CommandLine) {
   EXPECT_NE(ok.output.find("node job (on input arrival) controller"), std::string::npos) << ok.output;
   // Its JSON: AKl's D = max sc + max ca + the controller job's WCRT (legs U[0.5, 4] ms).
   const std::string cj = test::made_dir("oneshot_study_cpu_test", "cli_json") + "/check.json";
-  ASSERT_EQ(test::run_command({ONESHOT_SIM_PATH, "study", "check", cpu_path(), "--json", cj}).exit_code, 0);
+  ASSERT_EQ(test::run_command({ONESHOT_SIM_PATH, "study", "check", kCpu.path(), "--json", cj}).exit_code, 0);
   const nlohmann::json cr = nlohmann::json::parse(test::read_file(cj));
   EXPECT_EQ(cr.at("cpus")[0], c);
   for (const nlohmann::json& a : cr.at("approaches")) {
@@ -257,7 +196,7 @@ TEST(StudyCpu, CommandLine) {
   // report: the CPU section with study run's figures.
   const std::string rep = test::fresh_dir("oneshot_study_cpu_test", "cli_report");
   const test::CommandResult rp = test::run_command(
-      {ONESHOT_SIM_PATH, "study", "report", cpu_path(), rep, "--seeds", "2", "--max-duration", "2.5", "--no-plots", "--threads", "1"});
+      {ONESHOT_SIM_PATH, "study", "report", kCpu.path(), rep, "--seeds", "2", "--max-duration", "2.5", "--no-plots", "--threads", "1"});
   ASSERT_EQ(rp.exit_code, 0) << rp.output;
   const std::string md = test::read_file(rep + "/report.md");
   const nlohmann::json rj = nlohmann::json::parse(test::read_file(rep + "/report.json"));
@@ -268,7 +207,7 @@ TEST(StudyCpu, CommandLine) {
                 s_cpu.at("mean_us").get<double>(), s_cpu.at("max_us").get<double>());
   EXPECT_NE(md.find(row), std::string::npos) << row << "\n" << md;
   // An unschedulable CPU: check and run refuse it in one line naming the task, nothing written.
-  nlohmann::json bad = cpu_json();
+  nlohmann::json bad = kCpu.json();
   bad["plant"]["file"] = std::string(ONESHOT_STUDY_EXAMPLES_DIR) + "/../../../lut_gen/plants/networked_board.json";
   bad["cpus"][0]["tasks"][2]["wcet_us"] = 12000;
   const std::string dir = test::made_dir("oneshot_study_cpu_test", "cli_bad");
@@ -290,27 +229,21 @@ TEST(StudyCpu, CommandLine) {
 // ---- The sensor's sampling job on a CPU (examples/ncs_cpu_sensor.json): released by its timer
 // at kh, it samples at its start and sends at its finish.
 
-std::string sensor_cpu_path() { return std::string(ONESHOT_STUDY_EXAMPLES_DIR) + "/ncs_cpu_sensor.json"; }
-
-nlohmann::json sensor_cpu_json() { return nlohmann::json::parse(test::read_file(sensor_cpu_path())); }
-
 /// The file `j` mapped onto the loop, every scenario `duration_s` long.
 NcsStudy sensor_study(const nlohmann::json& j, double duration_s) {
-  NcsStudy s = map_ncs_study(engine::parse_study(j.dump(), sensor_cpu_path(), &ncs_schema(), ONESHOT_STUDY_EXAMPLES_DIR));
-  for (ncs::Scenario& x : s.scenarios) x.duration_s = duration_s;
-  return s;
+  return kSensorCpu.study([&j](nlohmann::json& x) { x = j; }, duration_s);
 }
 
 TEST(StudyCpuSensor, EverySampleLagsKhWithinTheAnalysedBounds) {
   for (const char* scheduler : {"fixed_priority", "fixed_priority_nonpreemptive", "edf"}) {
-    nlohmann::json j = sensor_cpu_json();
+    nlohmann::json j = kSensorCpu.json();
     j["cpus"][0]["scheduler"] = scheduler;
     const NcsStudy s = sensor_study(j, 2);
     const ncs::ControllerCpu& c = *s.scenarios[0].sensor_cpu;
     ASSERT_LT(c.sample_min, c.sample_max);
     // study check gives the same lag bounds (the sensor job's "sample_lag_us").
     const nlohmann::json chk =
-        resolve_study(engine::parse_study(j.dump(), sensor_cpu_path(), &ncs_schema(), ONESHOT_STUDY_EXAMPLES_DIR));
+        resolve_study(kSensorCpu.parse(j));
     const nlohmann::json& bounds = chk.at("cpus")[0].at("tasks")[3].at("sample_lag_us");
     EXPECT_EQ(bounds[0].get<double>(), static_cast<double>(c.sample_min.count()) * 1e-3);
     EXPECT_EQ(bounds[1].get<double>(), static_cast<double>(c.sample_max.count()) * 1e-3);
@@ -348,7 +281,7 @@ TEST(StudyCpuSensor, EverySampleLagsKhWithinTheAnalysedBounds) {
 }
 
 TEST(StudyCpuSensor, ALoneConstantJobIsTheLoopWithItsFrameLaterByC) {
-  nlohmann::json j = sensor_cpu_json();
+  nlohmann::json j = kSensorCpu.json();
   j["cpus"][0].erase("tasks");
   j["cpus"][0].erase("isrs");
   j["cpus"][0]["context_switch_us"] = 0;
@@ -385,7 +318,7 @@ TEST(StudyCpuSensor, ALoneConstantJobIsTheLoopWithItsFrameLaterByC) {
 }
 
 TEST(StudyCpuSensor, SameBytesOnOneAndTwoThreadsAndWhatTheLoopCannotRunIsRefused) {
-  const NcsStudy s = sensor_study(sensor_cpu_json(), 1.5);
+  const NcsStudy s = sensor_study(kSensorCpu.json(), 1.5);
   const std::string one = run_outputs(run_ncs_sweep(s, 3, 1, engine::Shard{}), temp_dir("sensor_one"), false).dump();
   const std::string two = run_outputs(run_ncs_sweep(s, 3, 2, engine::Shard{}), temp_dir("sensor_two"), false).dump();
   EXPECT_EQ(one, two);
@@ -396,7 +329,7 @@ TEST(StudyCpuSensor, SameBytesOnOneAndTwoThreadsAndWhatTheLoopCannotRunIsRefused
     EXPECT_NE(std::string(e.what()).find("field '--analytic'"), std::string::npos) << e.what();
   }
   const auto refused = [](const std::function<void(nlohmann::json&)>& edit, const std::string& expect) {
-    nlohmann::json j = sensor_cpu_json();
+    nlohmann::json j = kSensorCpu.json();
     edit(j);
     try {
       static_cast<void>(sensor_study(j, 1));

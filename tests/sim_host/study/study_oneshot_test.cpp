@@ -20,27 +20,15 @@
 #include "study_check.hpp"
 #include "study_ncs_runner.hpp"
 #include "study_ncs_sweep.hpp"
+#include "study_cpu_checks.hpp"
+#include "study_example.hpp"
 #include "support/temp_files.hpp"
 
 namespace oneshot::study {
 namespace {
 
-std::string os_path() { return std::string(ONESHOT_STUDY_EXAMPLES_DIR) + "/sod_ge_oneshot.json"; }
-
-nlohmann::json os_json() { return nlohmann::json::parse(test::read_file(os_path())); }
-
-engine::StudyFile parse(const nlohmann::json& j) {
-  return engine::parse_study(j.dump(), os_path(), &ncs_schema(), ONESHOT_STUDY_EXAMPLES_DIR);
-}
-
-/// The example after `edit`, mapped onto the loop, every scenario `duration_s` long.
-NcsStudy os_study(const std::function<void(nlohmann::json&)>& edit, double duration_s) {
-  nlohmann::json j = os_json();
-  edit(j);
-  NcsStudy s = map_ncs_study(parse(j));
-  for (ncs::Scenario& x : s.scenarios) x.duration_s = duration_s;
-  return s;
-}
+const test_support::StudyExample kOs("sod_ge_oneshot.json");
+const test_support::StudyExample kOsCpu("ncs_cpu_one_shot.json");
 
 std::string temp_dir(const char* name) { return test::fresh_dir("oneshot_study_os_test", name); }
 
@@ -53,7 +41,7 @@ std::function<void(nlohmann::json&)> lossless_delta(double delta) {
 }
 
 TEST(StudyOneShot, AtZeroDeltaTheHeldValueLoopIsThePeriodicLoop) {
-  const NcsStudy s = os_study(lossless_delta(0), 4);
+  const NcsStudy s = kOs.study(lossless_delta(0), 4);
   ncs::RunOptions quiet;
   quiet.noise_free = true;
   for (std::size_t x = 0; x < s.scenarios.size(); ++x) {
@@ -80,7 +68,7 @@ TEST(StudyOneShot, EveryPeriodGetsItsCommandWhenTheChainFitsInAPeriod) {
   // Lossless sc, every sample sent (δy = 0): the controller's timer at kh + 20 ms, τ_c ≤ 5 ms and
   // ca ≤ 10 ms put command k+1 at the actuator before (k+1)h, so none is late and the actuator
   // applies one command per period from h on (the first period runs on the initial input).
-  const NcsStudy s = os_study(lossless_delta(0), 2);
+  const NcsStudy s = kOs.study(lossless_delta(0), 2);
   for (const ncs::Approach a : {ncs::Approach::kOS, ncs::Approach::kOSp, ncs::Approach::kOSK}) {
     for (std::uint64_t seed = 1; seed <= 3; ++seed) {
       const ncs::RunResult r = ncs::run(*s.ctx, a, s.scenarios[0], seed, ncs::RunOptions{});
@@ -90,7 +78,7 @@ TEST(StudyOneShot, EveryPeriodGetsItsCommandWhenTheChainFitsInAPeriod) {
     }
   }
   // With δy > 0 the held value is used (R̄ > R) where the sensor stays silent: OS and OSp differ.
-  const NcsStudy d = os_study(lossless_delta(0.02), 2);
+  const NcsStudy d = kOs.study(lossless_delta(0.02), 2);
   const ncs::RunResult os = ncs::run(*d.ctx, ncs::Approach::kOS, d.scenarios[0], 1, ncs::RunOptions{});
   const ncs::RunResult osp = ncs::run(*d.ctx, ncs::Approach::kOSp, d.scenarios[0], 1, ncs::RunOptions{});
   EXPECT_LT(os.sent, os.sampled);
@@ -101,7 +89,7 @@ TEST(StudyOneShot, SendsFallAsDeltaGrows) {
   double last = 0;
   bool first = true;
   for (double delta : {0.0, 0.005, 0.01, 0.02, 0.05, 0.1}) {
-    const NcsStudy s = os_study(lossless_delta(delta), 6);
+    const NcsStudy s = kOs.study(lossless_delta(delta), 6);
     double sent = 0, sampled = 0;
     for (const ncs::Approach a : {ncs::Approach::kOS, ncs::Approach::kOSp}) {
       for (const ncs::Scenario& x : s.scenarios) {
@@ -122,7 +110,7 @@ TEST(StudyOneShot, SendsFallAsDeltaGrows) {
 }
 
 TEST(StudyOneShot, OnTheLossyLegDeliveredAndLostAddUpToSent) {
-  const NcsStudy s = os_study([](nlohmann::json&) {}, 6);
+  const NcsStudy s = kOs.study([](nlohmann::json&) {}, 6);
   const engine::SweepResults r = run_ncs_sweep(s, 4, 2, engine::Shard{});
   const std::size_t sent = r.metric("sc.sent");
   const std::size_t delivered = r.metric("sc.delivered");
@@ -154,7 +142,7 @@ TEST(StudyOneShot, OnTheLossyLegDeliveredAndLostAddUpToSent) {
 
 TEST(StudyOneShot, NeesIsNearTheStateDimensionWhenTheFilterIsConsistent) {
   // Every sample, no loss: the filter's model is the loop's (inputs applied at kh, exact Q_d).
-  const NcsStudy s = os_study(lossless_delta(0.02), 100);
+  const NcsStudy s = kOs.study(lossless_delta(0.02), 100);
   NcsStudy osk = s;
   osk.approaches = {ncs::Approach::kI, ncs::Approach::kOSK};
   const nlohmann::json j = run_outputs(run_ncs_sweep(osk, 20, 2, engine::Shard{}), temp_dir("nees"), false);
@@ -167,53 +155,41 @@ TEST(StudyOneShot, NeesIsNearTheStateDimensionWhenTheFilterIsConsistent) {
 }
 
 TEST(StudyOneShot, SameBytesOnOneAndTwoThreads) {
-  const NcsStudy s = os_study([](nlohmann::json&) {}, 3);
+  const NcsStudy s = kOs.study([](nlohmann::json&) {}, 3);
   const std::string one = run_outputs(run_ncs_sweep(s, 3, 1, engine::Shard{}), temp_dir("one"), false).dump();
   const std::string two = run_outputs(run_ncs_sweep(s, 3, 2, engine::Shard{}), temp_dir("two"), false).dump();
   EXPECT_EQ(one, two);
   EXPECT_TRUE(nlohmann::json::parse(two).contains("one_shot"));
 }
 
-/// Mapping the edited file is refused, the message containing `expect`.
-void expect_refused(const std::function<void(nlohmann::json&)>& edit, const std::string& expect) {
-  nlohmann::json j = os_json();
-  edit(j);
-  try {
-    static_cast<void>(map_ncs_study(parse(j)));
-    ADD_FAILURE() << "accepted, expected " << expect;
-  } catch (const engine::InputError& e) {
-    EXPECT_NE(std::string(e.what()).find(expect), std::string::npos) << e.what();
-  }
-}
-
 TEST(StudyOneShot, WhatTheLoopCannotRunIsRefusedNamingTheField) {
-  expect_refused([](nlohmann::json& j) { j["nodes"][0]["trigger"]["delta"] = {0.02}; }, "field 'nodes[0].trigger.delta'");
-  expect_refused([](nlohmann::json& j) { j["nodes"][0]["trigger"]["delta"] = {0.02, 0.02, 0.02}; },
+  kOs.expect_refused([](nlohmann::json& j) { j["nodes"][0]["trigger"]["delta"] = {0.02}; }, "field 'nodes[0].trigger.delta'");
+  kOs.expect_refused([](nlohmann::json& j) { j["nodes"][0]["trigger"]["delta"] = {0.02, 0.02, 0.02}; },
                  "field 'nodes[0].trigger.delta'");
   // S, SK cannot use a send-on-delta sensor (nor a timer controller).
-  expect_refused([](nlohmann::json& j) { j["approaches"].push_back({{"name", "S"}, {"kind", "S"}}); }, "field 'approaches[5].kind'");
-  expect_refused([](nlohmann::json& j) { j["approaches"].push_back({{"name", "SK"}, {"kind", "SK"}}); }, "field 'approaches[5].kind'");
+  kOs.expect_refused([](nlohmann::json& j) { j["approaches"].push_back({{"name", "S"}, {"kind", "S"}}); }, "field 'approaches[5].kind'");
+  kOs.expect_refused([](nlohmann::json& j) { j["approaches"].push_back({{"name", "SK"}, {"kind", "SK"}}); }, "field 'approaches[5].kind'");
   // Send-on-delta without a one-shot approach.
-  expect_refused(
+  kOs.expect_refused(
       [](nlohmann::json& j) {
         j["approaches"] = nlohmann::json::parse(R"([{"name": "I", "kind": "I"}, {"name": "IK", "kind": "IK"}])");
       },
       "field 'nodes[0].trigger'");
   // OS and OSp need a send-on-delta sensor; OSK does not.
-  expect_refused([](nlohmann::json& j) { j["nodes"][0].erase("trigger"); }, "field 'approaches[2].kind'");
+  kOs.expect_refused([](nlohmann::json& j) { j["nodes"][0].erase("trigger"); }, "field 'approaches[2].kind'");
   // The controller's phase: 0 < φ < h, a timer at h.
-  expect_refused([](nlohmann::json& j) { j["nodes"][1]["clock_offset_us"] = 0; }, "field 'nodes[1].clock_offset_us'");
-  expect_refused([](nlohmann::json& j) { j["nodes"][1]["clock_offset_us"] = 50000; }, "field 'nodes[1].clock_offset_us'");
-  expect_refused([](nlohmann::json& j) { j["nodes"][1]["period_us"] = 25000; }, "field 'nodes[1].period_us'");
-  expect_refused(
+  kOs.expect_refused([](nlohmann::json& j) { j["nodes"][1]["clock_offset_us"] = 0; }, "field 'nodes[1].clock_offset_us'");
+  kOs.expect_refused([](nlohmann::json& j) { j["nodes"][1]["clock_offset_us"] = 50000; }, "field 'nodes[1].clock_offset_us'");
+  kOs.expect_refused([](nlohmann::json& j) { j["nodes"][1]["period_us"] = 25000; }, "field 'nodes[1].period_us'");
+  kOs.expect_refused(
       [](nlohmann::json& j) {
         j["nodes"][1]["mode"] = "arrival";
         j["nodes"][1].erase("period_us");
       },
       "field 'nodes[1].mode'");
-  expect_refused([](nlohmann::json& j) { j["nodes"][0]["clock_offset_us"] = 100; }, "field 'nodes[0].clock_offset_us'");
+  kOs.expect_refused([](nlohmann::json& j) { j["nodes"][0]["clock_offset_us"] = 100; }, "field 'nodes[0].clock_offset_us'");
   // No analytic cost for the one-shot loops.
-  const NcsStudy s = os_study([](nlohmann::json&) {}, 3);
+  const NcsStudy s = kOs.study([](nlohmann::json&) {}, 3);
   try {
     static_cast<void>(run_ncs_sweep(s, 2, 1, engine::Shard{}, true));
     ADD_FAILURE() << "--analytic accepted";
@@ -225,80 +201,30 @@ TEST(StudyOneShot, WhatTheLoopCannotRunIsRefusedNamingTheField) {
 // ---- The one-shot controller's job on a CPU (examples/ncs_cpu_one_shot.json): its timer at
 // kh + φ releases the job, the command leaves at its finish.
 
-std::string one_shot_cpu_path() { return std::string(ONESHOT_STUDY_EXAMPLES_DIR) + "/ncs_cpu_one_shot.json"; }
-
-/// The one-shot CPU file after `edit`, mapped onto the loop, every scenario `duration_s` long.
-NcsStudy one_shot_cpu_study(const std::function<void(nlohmann::json&)>& edit, double duration_s) {
-  nlohmann::json j = nlohmann::json::parse(test::read_file(one_shot_cpu_path()));
-  edit(j);
-  NcsStudy s = map_ncs_study(engine::parse_study(j.dump(), one_shot_cpu_path(), &ncs_schema(), ONESHOT_STUDY_EXAMPLES_DIR));
-  for (ncs::Scenario& x : s.scenarios) x.duration_s = duration_s;
-  return s;
-}
-
 TEST(StudyCpuOneShot, EveryControllerResponseIsWithinTheAnalysedBounds) {
   for (const char* scheduler : {"fixed_priority", "fixed_priority_nonpreemptive", "edf"}) {
-    const NcsStudy s = one_shot_cpu_study([&](nlohmann::json& j) { j["cpus"][0]["scheduler"] = scheduler; }, 2);
+    const NcsStudy s = kOsCpu.study([&](nlohmann::json& j) { j["cpus"][0]["scheduler"] = scheduler; }, 2);
     const nlohmann::json j = run_outputs(run_ncs_sweep(s, 20, 2, engine::Shard{}), temp_dir(scheduler), false);
     const ncs::ControllerCpu& c = *s.scenarios[0].controller_cpu;
     EXPECT_GT(c.wcrt, c.bcrt);
-    for (const char* a : {"OS", "OSp", "OSK"}) {
-      const nlohmann::json& e = j.at("cpu").at(a);
-      EXPECT_EQ(e.at("jobs").get<double>(), 20 * 2 * 40) << scheduler << " " << a;  // one job per timer, nothing lost
-      EXPECT_GE(e.at("min_us").get<double>(), static_cast<double>(c.bcrt.count()) * 1e-3) << scheduler << " " << a;
-      EXPECT_LE(e.at("max_us").get<double>(), static_cast<double>(c.wcrt.count()) * 1e-3) << scheduler << " " << a;
-      EXPECT_TRUE(e.at("within_bounds").get<bool>());
-      EXPECT_EQ(e.at("deadline_misses").get<double>(), 0);
-      std::printf("%s %s: tau_c %.1f .. %.1f us (mean %.1f) within [%.1f, %.1f]\n", scheduler, a, e.at("min_us").get<double>(),
-                  e.at("max_us").get<double>(), e.at("mean_us").get<double>(), e.at("bcrt_us").get<double>(),
-                  e.at("wcrt_us").get<double>());
-    }
-    EXPECT_EQ(j.at("cpu").at("I").at("jobs").get<double>(), 0);  // delay-free: not on the CPU
+    // One job per timer (20 seeds x 2 scenarios x 40 periods), nothing lost.
+    test_support::expect_controller_jobs_within_bounds(j, c, {"OS", "OSp", "OSK"}, 20 * 2 * 40, scheduler);
   }
 }
 
 TEST(StudyCpuOneShot, ALoneConstantJobIsTheLoopWithThatConstantTauC) {
-  const auto lone = [](nlohmann::json& j) {
-    j["cpus"][0].erase("tasks");
-    j["cpus"][0].erase("isrs");
-    j["cpus"][0]["context_switch_us"] = 0;
-    j["nodes"][1]["job"] = {{"wcet_us", 2345}, {"bcet_us", 2345}, {"priority", 1}};
-  };
-  const NcsStudy on_cpu = one_shot_cpu_study(lone, 3);
-  NcsStudy constant = on_cpu;
-  for (ncs::Scenario& x : constant.scenarios) {
-    x.controller_cpu = nullptr;
-    x.compute_us = std::make_pair(std::int64_t{2345}, std::int64_t{2345});
-  }
-  EXPECT_EQ(on_cpu.scenarios[0].controller_cpu->wcrt, engine::from_us(2345));
-  EXPECT_EQ(on_cpu.scenarios[0].controller_cpu->bcrt, engine::from_us(2345));
-  for (ncs::Approach a : on_cpu.approaches) {
-    for (std::size_t k = 0; k < on_cpu.scenarios.size(); ++k) {
-      for (std::uint64_t seed = 1; seed <= 3; ++seed) {
-        const ncs::RunResult x = ncs::run(*on_cpu.ctx, a, on_cpu.scenarios[k], seed, ncs::RunOptions{});
-        const ncs::RunResult y = ncs::run(*constant.ctx, a, constant.scenarios[k], seed, ncs::RunOptions{});
-        EXPECT_NEAR(x.cost, y.cost, 1e-12 * std::fabs(y.cost)) << ncs::name(a) << " seed " << seed;
-        EXPECT_EQ(x.commands, y.commands);
-        EXPECT_EQ(x.late, y.late);
-        EXPECT_EQ(x.sent, y.sent);
-        if (x.cpu.jobs > 0) {
-          EXPECT_EQ(x.cpu.response_min, engine::from_us(2345));
-          EXPECT_EQ(x.cpu.response_max, engine::from_us(2345));
-        }
-      }
-    }
-  }
+  test_support::expect_lone_constant_job_is_the_constant_delay(kOsCpu);
 }
 
 TEST(StudyCpuOneShot, CheckAnalysesTheTimerJobAsPeriodicAtItsPhase) {
-  nlohmann::json j = nlohmann::json::parse(test::read_file(one_shot_cpu_path()));
+  nlohmann::json j = kOsCpu.json();
   // One background task (T 10 ms, C 2 ms) above the job (C 3 ms): WCRT 5 ms, BCRT 3 ms.
   j["cpus"][0]["context_switch_us"] = 0;
   j["cpus"][0].erase("isrs");
   j["cpus"][0]["tasks"] = {{{"name", "bg"}, {"period_us", 10000}, {"wcet_us", 2000}, {"priority", 1}}};
   j["nodes"][1]["job"] = {{"wcet_us", 3000}, {"priority", 2}};
   const nlohmann::json r =
-      resolve_study(engine::parse_study(j.dump(), one_shot_cpu_path(), &ncs_schema(), ONESHOT_STUDY_EXAMPLES_DIR));
+      resolve_study(engine::parse_study(j.dump(), kOsCpu.path(), &ncs_schema(), ONESHOT_STUDY_EXAMPLES_DIR));
   const nlohmann::json& job = r.at("cpus")[0].at("tasks")[1];
   EXPECT_EQ(job.at("node"), "controller");
   EXPECT_EQ(job.at("kind"), "node job (timer)");
@@ -309,14 +235,14 @@ TEST(StudyCpuOneShot, CheckAnalysesTheTimerJobAsPeriodicAtItsPhase) {
 }
 
 TEST(StudyCpuOneShot, SameBytesOnOneAndTwoThreadsAndBadJobsRefused) {
-  const NcsStudy s = one_shot_cpu_study([](nlohmann::json&) {}, 1.5);
+  const NcsStudy s = kOsCpu.study([](nlohmann::json&) {}, 1.5);
   const std::string one = run_outputs(run_ncs_sweep(s, 3, 1, engine::Shard{}), temp_dir("os_one"), false).dump();
   const std::string two = run_outputs(run_ncs_sweep(s, 3, 2, engine::Shard{}), temp_dir("os_two"), false).dump();
   EXPECT_EQ(one, two);
   EXPECT_TRUE(nlohmann::json::parse(two).contains("cpu"));
   const auto refused = [](const std::function<void(nlohmann::json&)>& edit, const std::string& expect) {
     try {
-      static_cast<void>(one_shot_cpu_study(edit, 1));
+      static_cast<void>(kOsCpu.study(edit, 1));
       ADD_FAILURE() << "accepted, expected " << expect;
     } catch (const engine::InputError& e) {
       EXPECT_NE(std::string(e.what()).find(expect), std::string::npos) << e.what();
