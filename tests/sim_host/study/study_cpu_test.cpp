@@ -328,16 +328,7 @@ TEST(StudyCpuSensor, SameBytesOnOneAndTwoThreadsAndWhatTheLoopCannotRunIsRefused
   } catch (const engine::InputError& e) {
     EXPECT_NE(std::string(e.what()).find("field '--analytic'"), std::string::npos) << e.what();
   }
-  const auto refused = [](const std::function<void(nlohmann::json&)>& edit, const std::string& expect) {
-    nlohmann::json j = kSensorCpu.json();
-    edit(j);
-    try {
-      static_cast<void>(sensor_study(j, 1));
-      ADD_FAILURE() << "accepted, expected " << expect;
-    } catch (const engine::InputError& e) {
-      EXPECT_NE(std::string(e.what()).find(expect), std::string::npos) << e.what();
-    }
-  };
+  const auto refused = [](const test_support::Edit& edit, const std::string& expect) { kSensorCpu.expect_refused(edit, expect); };
   const nlohmann::json as = {{"name", "as"}, {"from", "actuator"}, {"to", "sensor"},
                              {"delay", {{"model", "uniform"}, {"min_us", 500}, {"max_us", 4000}, {"resolution_us", 1}}}};
   refused([&](nlohmann::json& j) { j["links"].push_back(as); j["approaches"].push_back({{"name", "A"}, {"kind", "A"}}); },
