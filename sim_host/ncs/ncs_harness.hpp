@@ -4,6 +4,7 @@
 ///        timing streams, the controller's CPU) and the loops' type aliases and addresses.
 #pragma once
 
+#include <functional>
 #include <memory>
 #include <string>
 #include <utility>
@@ -40,26 +41,48 @@ constexpr std::uint8_t kSensor = kLiveSensor;
 constexpr std::uint8_t kController = kLiveController;
 constexpr std::uint8_t kActuator = kLiveActuator;
 
+/// The engine of a run: kernel, network and the CAN buses with their background traffic;
+/// one per run, shared by the loops of a run of several (run_loops()).
+struct World {
+  /// The engine seeded with `seed`.
+  explicit World(std::uint64_t seed) : kernel(seed), net(kernel) {}
+  engine::Kernel kernel;   ///< Events.
+  engine::Network net;     ///< Nodes, links, buses.
+  std::vector<std::pair<std::string, engine::CanBus*>> buses;   ///< Buses by name (built on first use).
+  std::vector<std::unique_ptr<engine::CanTraffic>> traffic;     ///< Their background streams.
+};
+
 /// What every loop shares: kernel, plant, network, set-point, noise and timing streams.
 class Harness {
  public:
-  Harness(const Context& ctx, Approach a, const Scenario& sc, std::uint64_t seed, const RunOptions& opt)
+  /// A loop on its own engine, or (`world`, `on`) one of several loops on a shared one: its
+  /// random streams then named "<loop>/<source>", its nodes at the loop's addresses.
+  Harness(const Context& ctx, Approach a, const Scenario& sc, std::uint64_t seed, const RunOptions& opt,
+          World* world = nullptr, const LoopOnBus* on = nullptr)
       : ctx_(ctx),
         approach_(a),
         sc_(sc),
         design_(ctx.controller_design(sc.noise_scale)),
         disc_(ctx.discretizer_model(sc.noise_scale)),
-        kernel_(seed),
+        prefix_(on != nullptr ? on->name + "/" : std::string()),
+        own_world_(world == nullptr ? std::make_unique<World>(seed) : nullptr),
+        world_(world == nullptr ? *own_world_ : *world),
+        kernel_(world_.kernel),
         plant_(plant_config(ctx, sc, noisy(a, opt)),
-               engine::RandomStream(opt.noise_seed != 0 ? opt.noise_seed : seed, "process")),
-        net_(kernel_),
-        measurement_(opt.noise_seed != 0 ? opt.noise_seed : seed, "measurement"),
-        compute_(kernel_.stream("compute")),
+               engine::RandomStream(opt.noise_seed != 0 ? opt.noise_seed : seed, prefix_ + "process")),
+        net_(world_.net),
+        measurement_(opt.noise_seed != 0 ? opt.noise_seed : seed, prefix_ + "measurement"),
+        compute_(kernel_.stream(prefix_ + "compute")),
         ref_(reference(ctx, sc)),
         noisy_(noisy(a, opt)),
         h_(engine::from_us(ctx.period_us())),
         end_(engine::from_seconds(sc.duration_s, "ncs scenario duration")) {
-    net_.set_faults(opt.faults);
+    if (on != nullptr) {
+      sensor_at_ = on->sensor;
+      controller_at_ = on->controller;
+      actuator_at_ = on->actuator;
+    }
+    if (own_world_ || !opt.faults.empty()) net_.set_faults(opt.faults);  // a shared run has none
     opt_faults_empty_ = opt.faults.empty();
     if (one_shot(a) && opt.analytic) throw std::invalid_argument(std::string("ncs: ") + name(a) + " has no analytic cost");
     if (opt.record_messages) net_.record_messages();
@@ -75,7 +98,7 @@ class Harness {
     plant_.set_state(x0);
     plant_.set_reference(x0, ref_.input(0));
     if (opt.analytic) an_ = make_tracker(ctx, sc, a, design_, opt, x0, ref_.input(0));
-    if (opt.trace_step_s > 0) plant_.record_trace(engine::from_seconds(opt.trace_step_s, "trace step"), kernel_.stream("trace"));
+    if (opt.trace_step_s > 0) plant_.record_trace(engine::from_seconds(opt.trace_step_s, "trace step"), kernel_.stream(prefix_ + "trace"));
     // Set-point switches on the kh grid (before anything else at that instant but the plant).
     const HandlerId sw = kernel_.add_handler("setpoint", [this](std::uint64_t k) {
       advance();
@@ -127,7 +150,11 @@ class Harness {
   }
 
   /// Leg `name`'s link of this scenario and approach.
-  engine::LinkConfig leg(const char* name) const { return ncs::leg(ctx_, sc_, approach_, name); }
+  engine::LinkConfig leg(const char* name) const {
+    engine::LinkConfig c = ncs::leg(ctx_, sc_, approach_, name);
+    c.name = prefix_ + c.name;  // its streams "link/<loop>/<leg>/..." in a run of several loops
+    return c;
+  }
 
   /// Adds leg `name` to the network and remembers it for the run's link counters.
   engine::Link& add_leg(const char* name) {
@@ -151,12 +178,12 @@ class Harness {
 
   /// The bus of `leg`, built with its background traffic on first use.
   engine::CanBus& bus(const BusLeg& leg) {
-    for (const auto& [nm, b] : buses_)
+    for (const auto& [nm, b] : world_.buses)
       if (nm == leg.bus.name) return *b;
     engine::CanBus& b = net_.add_can_bus(leg.bus);
-    buses_.emplace_back(leg.bus.name, &b);
+    world_.buses.emplace_back(leg.bus.name, &b);
     if (!leg.background.empty()) {
-      traffic_.push_back(std::make_unique<engine::CanTraffic>(kernel_, b, leg.background, leg.offsets, end_));
+      world_.traffic.push_back(std::make_unique<engine::CanTraffic>(kernel_, b, leg.background, leg.offsets, end_));
     }
     return b;
   }
@@ -217,7 +244,11 @@ class Harness {
 
   /// Runs the kernel to the end and collects the cost, trace and injected faults.
   RunResult finish() {
-    kernel_.run_until(end_);
+    if (inner_) {
+      inner_();  // the next loop of a shared run: it runs the kernel
+    } else {
+      kernel_.run_until(end_);
+    }
     result_.events = kernel_.events_run();
     result_.injected = net_.fault_counters();
     for (const engine::MessageRecord& m : net_.messages()) {
@@ -270,9 +301,12 @@ class Harness {
   const Scenario& sc_;
   Design design_;
   Disc disc_;
-  engine::Kernel kernel_;
+  std::string prefix_;               ///< "" or "<loop>/": the loop's random streams' prefix.
+  std::unique_ptr<World> own_world_;  ///< The engine of a loop run alone.
+  World& world_;                     ///< The engine the loop runs on.
+  engine::Kernel& kernel_;
   Plant plant_;
-  engine::Network net_;
+  engine::Network& net_;
   engine::RandomStream measurement_;
   engine::RandomStream compute_;
   Ref ref_;
@@ -287,9 +321,11 @@ class Harness {
   std::unique_ptr<AnalyticTracker> an_;
   std::vector<std::pair<std::string, engine::Link*>> legs_;
   std::vector<std::pair<std::string, std::pair<std::uint8_t, std::uint8_t>>> bus_legs_;  ///< Name, route.
-  std::vector<std::pair<std::string, engine::CanBus*>> buses_;
   std::vector<std::pair<std::pair<std::uint8_t, std::uint8_t>, std::string>> leg_routes_;  ///< Route, leg name.
-  std::vector<std::unique_ptr<engine::CanTraffic>> traffic_;
+  std::uint8_t sensor_at_ = kSensor;          ///< The sensor's address.
+  std::uint8_t controller_at_ = kController;  ///< The controller's.
+  std::uint8_t actuator_at_ = kActuator;      ///< The actuator's.
+  std::function<void()> inner_;  ///< Set in a shared run but for its last loop: runs the next loop (finish()).
   std::unique_ptr<engine::cpu::Cpu> cpu_;  ///< The controller's CPU (Scenario::controller_cpu).
   std::size_t cpu_task_ = 0;               ///< The controller's job in it.
   HandlerId computed_ = 0;                 ///< The loop's compute handler (set at each release).

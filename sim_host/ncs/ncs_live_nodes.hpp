@@ -84,11 +84,12 @@ void check_reports(const Context& ctx, Controller& ctrl) {
   ctrl.set_period_us(ctx.period_us());
 }
 
-/// Frame checks of the live actuator: commands from the controller only, in its range.
+/// Frame checks of the live actuator: commands from the controller (at `controller`) only,
+/// in its range.
 template <typename Actuator>
-void check_commands(const Context& ctx, Actuator& act) {
+void check_commands(const Context& ctx, Actuator& act, std::uint8_t controller = kLiveController) {
   const InputRange u = actuator_range(ctx);
-  act.expect_source(kLiveController);
+  act.expect_source(controller);
   act.set_command_range(u.lo, u.hi);
 }
 

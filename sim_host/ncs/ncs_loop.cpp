@@ -2,6 +2,7 @@
 /// @brief One run of study `ncs` on the engine (see ncs_loop.hpp).
 #include "ncs_loop.hpp"
 
+#include <functional>
 #include <memory>
 #include <optional>
 #include <stdexcept>
@@ -131,11 +132,12 @@ RunResult run_sampling(Harness& hs, Law law, Saturated saturated) {
   using Sensor = node::SensorNode<Board, Trigger, double, kP>;
   using Ctrl = node::ControllerNode<Board, Law, double, kP, kM>;
   using Act = node::ActuatorNode<Board, double, kM>;
-  std::optional<Sensor> sensor(std::in_place, kController, Trigger(1));
-  std::optional<Ctrl> ctrl(std::in_place, kActuator, node::ControllerMode::kOnArrival, law);
+  const std::uint8_t sensor_at = hs.sensor_at_, controller_at = hs.controller_at_, actuator_at = hs.actuator_at_;
+  std::optional<Sensor> sensor(std::in_place, controller_at, Trigger(1));
+  std::optional<Ctrl> ctrl(std::in_place, actuator_at, node::ControllerMode::kOnArrival, law);
   std::optional<Act> act(std::in_place, node::ActuatorMode::kOnArrival, InputVec{});
-  const auto check_ctrl = [&]() { ctrl->expect_source(kSensor); };  // samples: finite (the plant is not clamped)
-  const auto check_act = [&]() { live::check_commands(hs.ctx_, *act); };
+  const auto check_ctrl = [&]() { ctrl->expect_source(sensor_at); };  // samples: finite (the plant is not clamped)
+  const auto check_act = [&]() { live::check_commands(hs.ctx_, *act, controller_at); };
   check_ctrl();
   check_act();
   std::uint64_t sensor_n0 = 0;  // sample index of the sensor's power-on (its sequence = n − n0)
@@ -145,34 +147,34 @@ RunResult run_sampling(Harness& hs, Law law, Saturated saturated) {
   std::uint32_t samples = 0;  // the sequence number of the next sample (no restart in analytic runs)
   const HandlerId compute_h = k.add_handler("compute", [&](std::uint64_t) {
     const Law before = ctrl->law();
-    net.run_node(kController, [&]() { ctrl->on_receive(net.node_clock(kController)); });
+    net.run_node(controller_at, [&]() { ctrl->on_receive(net.node_clock(controller_at)); });
     if (hs.an_) hs.an_->compute_law(before, samples - 1);
   });
-  net.add_node(kSensor, "sensor", Duration{0}, nullptr);
-  net.add_node(kController, "controller", Duration{0},
+  net.add_node(sensor_at, "sensor", Duration{0}, nullptr);
+  net.add_node(controller_at, "controller", Duration{0},
                [&]() { hs.start_computation(compute_h); });
-  net.add_node(kActuator, "actuator", Duration{0}, [&]() {
+  net.add_node(actuator_at, "actuator", Duration{0}, [&]() {
     act->on_receive();
     InputVec u;
     if (act->take_output(u)) hs.apply(u);
   });
-  hs.route_leg(kSensor, kController, "sc");
-  hs.route_leg(kController, kActuator, "ca");
+  hs.route_leg(sensor_at, controller_at, "sc");
+  hs.route_leg(controller_at, actuator_at, "ca");
   net.arm_faults({{"sensor",
                    [&]() {
-                     sensor.emplace(kController, Trigger(1));
+                     sensor.emplace(controller_at, Trigger(1));
                      sensor_restarted = true;
                    }},
                   {"controller",
                    [&]() {
-                     ctrl.emplace(kActuator, node::ControllerMode::kOnArrival, law);
+                     ctrl.emplace(actuator_at, node::ControllerMode::kOnArrival, law);
                      check_ctrl();
-                     hs.lose_inbox(kController);
+                     hs.lose_inbox(controller_at);
                    }},
                   {"actuator", [&]() {
                      act.emplace(node::ActuatorMode::kOnArrival, InputVec{});
                      check_act();
-                     hs.lose_inbox(kActuator);
+                     hs.lose_inbox(actuator_at);
                    }}});
   // The sensor on a CPU (ncs_cpu.hpp): the timer releases its job n, which samples at its
   // sample point and sends at its finish (per job: its sequence number and sample).
@@ -192,7 +194,7 @@ RunResult run_sampling(Harness& hs, Law law, Saturated saturated) {
     hs.sensor_cpu_->on_job([&](const engine::cpu::CpuJob& j) {
       if (j.entity != hs.sensor_task_ || j.aborted || j.index >= jobs.size() || !jobs[j.index].sampled) return;
       const SensorJob& s = jobs[j.index];
-      net.run_node(kSensor, [&]() { sensor->on_sample(s.seq, net.node_clock(kSensor), s.y); });
+      net.run_node(sensor_at, [&]() { sensor->on_sample(s.seq, net.node_clock(sensor_at), s.y); });
     });
   }
   auto timer_h = std::make_shared<HandlerId>(0);
@@ -211,7 +213,7 @@ RunResult run_sampling(Harness& hs, Law law, Saturated saturated) {
     const OutputVec y = hs.sample();
     ++samples;
     const auto seq = static_cast<node::SequenceNumber>(n - sensor_n0);
-    net.run_node(kSensor, [&]() { sensor->on_sample(seq, net.node_clock(kSensor), y); });
+    net.run_node(sensor_at, [&]() { sensor->on_sample(seq, net.node_clock(sensor_at), y); });
     const SimTime t_next = k.now() + hs.h_;
     if (t_next < hs.end_) k.schedule(t_next, EventClass::kSample, *timer_h, n + 1);
   });
@@ -235,8 +237,12 @@ RunResult run(const Context& ctx, Approach a, const Scenario& sc, std::uint64_t 
   return r;
 }
 
-RunResult run_approach(const Context& ctx, Approach a, const Scenario& sc, std::uint64_t seed, const RunOptions& options) {
-  Harness hs(ctx, a, sc, seed, options);
+namespace {
+
+/// Approach `a`'s loop on `hs`.
+RunResult run_on(Harness& hs, Approach a) {
+  const Context& ctx = hs.ctx_;
+  const Scenario& sc = hs.sc_;
   const Vector<double, kN> x0 = hs.ref_.state(0);
   using HalfEst = node::HalfKalmanEstimator<Fmt, Structure, Disc>;
   using Pred = node::SampledStatePredictor<Fmt, Structure, Disc>;
@@ -278,6 +284,32 @@ RunResult run_approach(const Context& ctx, Approach a, const Scenario& sc, std::
       return run_one_shot(hs, a);
   }
   throw std::logic_error("ncs: unknown approach");
+}
+
+}  // namespace
+
+RunResult run_approach(const Context& ctx, Approach a, const Scenario& sc, std::uint64_t seed, const RunOptions& options) {
+  Harness hs(ctx, a, sc, seed, options);
+  return run_on(hs, a);
+}
+
+std::vector<RunResult> run_loops(const std::vector<LoopOnBus>& loops, Approach a, std::uint64_t seed) {
+  if (loops.empty()) throw std::invalid_argument("ncs: run_loops needs a loop");
+  if (a != Approach::kI && a != Approach::kS && a != Approach::kSK && a != Approach::kIK) {
+    throw std::invalid_argument(std::string("ncs: several loops in one run take I, S, SK, IK, not ") + name(a));
+  }
+  World world(seed);
+  std::vector<RunResult> out(loops.size());
+  // Loop i's nodes and timers are set up, then loop i + 1's inside its finish(); the last runs
+  // the kernel, and each collects its results as the calls return.
+  std::function<void(std::size_t)> run_from = [&](std::size_t i) {
+    const LoopOnBus& l = loops[i];
+    Harness hs(*l.ctx, a, *l.scenario, seed, RunOptions{}, &world, &l);
+    if (i + 1 < loops.size()) hs.inner_ = [&run_from, i]() { run_from(i + 1); };
+    out[i] = run_on(hs, a);
+  };
+  run_from(0);
+  return out;
 }
 
 }  // namespace oneshot::ncs

@@ -143,6 +143,22 @@ std::vector<std::string> node_names();
 /// refuse_nonlinear_runs() when a command was clamped, late or an estimator run inexact).
 RunResult run(const Context& ctx, Approach a, const Scenario& scenario, std::uint64_t seed, const RunOptions& options);
 
+/// One loop of a run of several loops on one engine (their legs on the same CAN buses).
+struct LoopOnBus {
+  const Context* ctx = nullptr;        ///< Its plant and design.
+  const Scenario* scenario = nullptr;  ///< Its scenario (legs, buses; the same duration in every loop).
+  std::string name;                    ///< Prefixes its random streams: "<name>/process", "link/<name>/sc/…".
+  std::uint8_t sensor = 0;             ///< Its sensor's address (unique in the run).
+  std::uint8_t controller = 0;         ///< Its controller's.
+  std::uint8_t actuator = 0;           ///< Its actuator's.
+};
+
+/// Runs the sampling loop `a` (I, S, SK, IK; std::invalid_argument otherwise) of every loop
+/// of `loops` together in one engine run with `seed`: one kernel, one network, their bus legs
+/// on the same buses (arbitration by identifier with each other and the background traffic,
+/// stream "can/<bus>/jitter"), each loop's streams named per loop. One result per loop, in order.
+std::vector<RunResult> run_loops(const std::vector<LoopOnBus>& loops, Approach a, std::uint64_t seed);
+
 /// The run without the analytic post-checks.
 RunResult run_approach(const Context& ctx, Approach a, const Scenario& scenario, std::uint64_t seed, const RunOptions& options);
 

@@ -22,11 +22,17 @@ namespace {
 using engine::InputError;
 using nlohmann::json;
 
-/// The smallest timer period of the file (0 when no node runs a timer).
-engine::Duration loop_period(const engine::StudyFile& f) {
+/// The smallest timer period of the loop of node `node` (a file without `loops`: of the
+/// file; 0 when no node runs a timer).
+engine::Duration loop_period(const engine::StudyFile& f, const std::string& node) {
+  const engine::LoopSpec* loop = nullptr;
+  for (const engine::LoopSpec& l : f.loops)
+    if (l.sensor == node || l.controller == node || l.actuator == node) loop = &l;
   engine::Duration p{0};
-  for (const engine::NodeSpec& n : f.nodes)
+  for (const engine::NodeSpec& n : f.nodes) {
+    if (loop != nullptr && n.name != loop->sensor && n.name != loop->controller && n.name != loop->actuator) continue;
     if (n.mode == "timer" && (p.count() == 0 || n.period < p)) p = n.period;
+  }
   return p;
 }
 
@@ -42,10 +48,12 @@ struct SendWindow {
 /// p doubles; the actuation-synchronized loops, whose report is longer, do not run on a
 /// bus), ca a command (header + m doubles), as a request (header + m doubles); otherwise
 /// kLoopFramePayloadBytes (one frame).
-std::size_t loop_message_bytes(const engine::StudyFile& f, const std::string& link) {
+std::size_t loop_message_bytes(const engine::StudyFile& f, const engine::LinkSpec& link) {
   if (f.study != "ncs") return kLoopFramePayloadBytes;
-  if (link == "sc") return node::encoded_size<double, ncs::kP>();
-  if (link == "ca" || link == "as") return node::encoded_size<double, ncs::kM>();
+  // The leg by the roles it joins (a file with several loops names its links freely).
+  const std::string from = f.node(link.from).role, to = f.node(link.to).role;
+  if (from == "sensor" && to == "controller") return node::encoded_size<double, ncs::kP>();
+  if ((from == "controller" && to == "actuator") || (from == "actuator" && to == "sensor")) return node::encoded_size<double, ncs::kM>();
   return kLoopFramePayloadBytes;
 }
 
@@ -131,7 +139,6 @@ json bus_messages(std::vector<engine::CanStream> streams, const std::vector<std:
 
 json analyze_buses(const engine::StudyFile& f) {
   json out = json::array();
-  const engine::Duration period = loop_period(f);
   // Buses: the streams of each, then their analysis together (a loop message's jitter may
   // come from a message on a bus before it in its chain: iterated to a fixed point).
   struct Bus {
@@ -153,9 +160,9 @@ json analyze_buses(const engine::StudyFile& f) {
     for (const engine::LinkSpec& l : f.links) {
       if (l.bus != bus.config.name) continue;
       const engine::NodeSpec& from = f.node(l.from);
-      const engine::Duration t = from.mode == "timer" ? from.period : period;
+      const engine::Duration t = from.mode == "timer" ? from.period : loop_period(f, l.from);
       if (t.count() <= 0) throw InputError("field '" + field + "': link " + l.name + " has no period (no timer node)");
-      const std::size_t bytes = loop_message_bytes(f, l.name);
+      const std::size_t bytes = loop_message_bytes(f, l);
       engine::CanStream st;
       st.name = l.name;
       st.id = l.id;

@@ -110,6 +110,40 @@ json plant_section(const engine::StudyFile& f, json& designs) {
 }  // namespace
 
 json resolve_study(const engine::StudyFile& f) {
+  if (!f.loops.empty()) {  // per loop its plant and designs; the links and the buses of the whole file
+    json r;
+    for (std::size_t i = 0; i < f.loops.size(); ++i) {
+      engine::StudyFile v = loop_view(f, i);
+      v.buses.clear();
+      for (engine::LinkSpec& l : v.links) l.bus.clear();  // analysed below, with every loop's traffic
+      const json ri = resolve_study(v);
+      if (i == 0) r = ri;
+      const engine::LoopSpec& l = f.loops[i];
+      r["loops"].push_back({{"name", l.name}, {"sensor", l.sensor}, {"controller", l.controller}, {"actuator", l.actuator},
+                            {"plant", ri.at("plant")}, {"approaches", ri.at("approaches")}});
+    }
+    try {
+      r["links"] = json::array();
+      for (const engine::LinkSpec& l : f.links) {
+        json e = {{"name", l.name}, {"from", l.from}, {"to", l.to}};
+        if (l.bus.empty()) {
+          e["base"] = link_summary(f.link_config(l.name));
+          for (const engine::ScenarioSpec& s : f.scenarios)
+            if (s.delays.count(l.name) != 0 || s.losses.count(l.name) != 0) e["scenarios"][s.name] = link_summary(f.link_config(l.name, &s));
+        } else {
+          e["bus"] = l.bus;
+          e["id"] = l.id;
+        }
+        r["links"].push_back(e);
+      }
+      r.erase("buses");
+      if (!f.buses.empty()) r["buses"] = analyze_buses(f);
+      r["source"] = f.source;
+    } catch (const InputError& e) {
+      throw InputError(f.source + ": " + e.what());
+    }
+    return r;
+  }
   try {
     json r;
     r["source"] = f.source;
@@ -202,6 +236,7 @@ void add_ncs_designs(json& r, const NcsStudy& s) {
 }
 
 void attach_bus_bounds(NcsStudy& s, const json& r) {
+  for (NcsStudy& l : s.loops) attach_bus_bounds(l, r);
   s.bus_response_us.assign(s.scenarios.size(), {});
   if (!r.contains("buses")) return;
   for (std::size_t k = 0; k < s.scenarios.size(); ++k) {
@@ -210,8 +245,12 @@ void attach_bus_bounds(NcsStudy& s, const json& r) {
       const json& list = b.contains("scenarios") && b.at("scenarios").contains(name) ? b.at("scenarios").at(name) : b.at("messages");
       for (const json& m : list) {
         if (m.at("kind") != "link") continue;
+        std::string leg = s.link_names.empty() ? m.at("name").get<std::string>() : "";  // "" when another loop's
+        for (const auto& [g, nm] : s.link_names)
+          if (nm == m.at("name").get<std::string>()) leg = g;
+        if (leg.empty()) continue;
         const json& w = m.at("worst_response_us");
-        s.bus_response_us[k][m.at("name").get<std::string>()] = w.is_null() ? std::nullopt : std::optional<double>(w.get<double>());
+        s.bus_response_us[k][leg] = w.is_null() ? std::nullopt : std::optional<double>(w.get<double>());
       }
     }
   }
@@ -219,19 +258,33 @@ void attach_bus_bounds(NcsStudy& s, const json& r) {
 
 std::string describe_resolution(const json& r) {
   std::ostringstream o;
-  const json& p = r.at("plant");
   o << "study file " << r.at("source").get<std::string>() << " (study " << r.at("study").get<std::string>() << ")\n";
-  o << "plant: " << p.at("kind").get<std::string>() << ", n = " << p.at("n") << ", m = " << p.at("m") << ", p = " << p.at("p");
-  if (p.contains("name")) o << " (" << p.at("name").get<std::string>() << ", h = " << p.at("period_us") << " us)";
-  o << "\n";
-  for (const json& a : r.at("approaches")) {
-    o << "approach " << a.at("name").get<std::string>() << " (" << a.at("kind").get<std::string>()
+  const auto plant_line = [&o](const json& p) {
+    o << "plant: " << p.at("kind").get<std::string>() << ", n = " << p.at("n") << ", m = " << p.at("m") << ", p = " << p.at("p");
+    if (p.contains("name")) o << " (" << p.at("name").get<std::string>() << ", h = " << p.at("period_us") << " us)";
+    o << "\n";
+  };
+  const auto approach_lines = [&o](const json& list, const char* indent) {
+  for (const json& a : list) {
+    o << indent << "approach " << a.at("name").get<std::string>() << " (" << a.at("kind").get<std::string>()
       << "): " << a.at("design").get<std::string>();
     if (a.contains("lqr_gain")) o << "; L = " << a.at("lqr_gain").dump() << ", closed-loop radius " << a.at("closed_loop_spectral_radius");
     if (a.contains("kalman_gain")) o << "; K = " << a.at("kalman_gain").dump() << ", estimator radius " << a.at("estimator_spectral_radius");
     o << "\n";
     if (a.contains("per_scenario"))
       for (const auto& [sc, g] : a.at("per_scenario").items()) o << "  " << sc << ": " << g.dump() << "\n";
+  }
+  };
+  if (r.contains("loops")) {  // several loops: each with its plant and designs
+    for (const json& l : r.at("loops")) {
+      o << "loop " << l.at("name").get<std::string>() << ": sensor " << l.at("sensor").get<std::string>() << ", controller "
+        << l.at("controller").get<std::string>() << ", actuator " << l.at("actuator").get<std::string>() << "\n  ";
+      plant_line(l.at("plant"));
+      approach_lines(l.at("approaches"), "  ");
+    }
+  } else {
+    plant_line(r.at("plant"));
+    approach_lines(r.at("approaches"), "");
   }
   for (const json& l : r.at("links")) {
     o << "link " << l.at("name").get<std::string>() << " " << l.at("from").get<std::string>() << " -> "

@@ -136,7 +136,9 @@ nlohmann::json bench(const study::NcsStudy& s, std::size_t seeds, unsigned threa
       spec, engine::Shard{}, used,
       [&s](std::size_t a, std::size_t k, std::uint64_t seed) {
         const auto t0 = std::chrono::steady_clock::now();
-        const ncs::RunResult x = ncs::run(*s.ctx, s.approaches[a], s.scenarios[k], seed, ncs::RunOptions{});
+        // Several loops: one run of them all on the shared engine (its events; the first loop's cost).
+        const ncs::RunResult x = s.loops.empty() ? ncs::run(*s.ctx, s.approaches[a], s.scenarios[k], seed, ncs::RunOptions{})
+                                                 : ncs::run_loops(study::loops_on_bus(s, k), s.approaches[a], seed)[0];
         const double run_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
         return std::vector<double>{x.cost, static_cast<double>(x.events), s.scenarios[k].duration_s, run_s};
       },
@@ -243,10 +245,33 @@ void add_study_commands(CLI::App* group) {
       const Checked k = check_file(c->file);
       const study::NcsStudy s = runnable(k, max_duration, c->max_duration_s);
       if (trace->count() > 0 && c->trace.empty()) throw engine::InputError("field '--trace': an empty approach name");
-      const std::vector<std::size_t> traced = study::trace_selection(s, c->trace);  // refused before anything is written
+      if (trace->count() > 0 && !s.loops.empty()) throw engine::InputError("field '--trace': no traces of a file with several loops (loops[])");
+      const std::vector<std::size_t> traced = s.loops.empty() ? study::trace_selection(s, c->trace)  // refused before anything is written
+                                                              : std::vector<std::size_t>{};
       util::make_directory(c->out);
       const engine::SweepResults r = study::run_ncs_sweep(s, c->seeds, c->threads, engine::Shard{});
       nlohmann::json j = study::run_outputs(r, c->out, !c->no_plots);
+      if (!s.loops.empty()) {  // several loops: a section per loop, then the loops against each other
+        nlohmann::json resolution = k.resolution;
+        resolution["seeds"]["count"] = r.spec.seeds;
+        std::string md;
+        for (std::size_t i = 0; i < s.loops.size(); ++i) {
+          const std::string name = s.loops[i].loop;
+          md += "# Loop " + name + "\n\n" +
+                study::report_markdown(c->file, study::describe_resolution(resolution),
+                                       simulated_time_text(s, max_duration, c->max_duration_s), study::loop_results(r, i),
+                                       j.at("loops").at(name), c->no_plots ? "" : name + "/table.png");
+        }
+        md += "# The loops on one bus\n\nEach loop on the shared bus against the same loop alone on it (the other loops "
+              "absent), the same seeds: the cost and the observed delays of its frames; the worst-case responses count "
+              "every loop's frames (study check).\n" + j.at("markdown_interference").get<std::string>() +
+              "\nNo traces: `study report` traces files with one loop.\n";
+        util::write_text((std::filesystem::path(c->out) / "report.md").string(), md);
+        util::write_json((std::filesystem::path(c->out) / "report.json").string(), j);
+        std::cout << "study report: " << r.spec.runs() << " runs, written to " << (std::filesystem::path(c->out) / "report.md").string()
+                  << "\n";
+        return;
+      }
       nlohmann::json traces = study::write_traces(s, traced, c->out, !c->no_plots);
       for (std::size_t a : traced) {  // the traced run is the sweep's: the same cost, bit for bit
         const std::string an = r.spec.approaches[a];

@@ -14,6 +14,7 @@
 /// plants) is refused with the field and the reason.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <map>
 #include <memory>
@@ -21,6 +22,7 @@
 #include <string>
 #include <vector>
 
+#include "ncs_live.hpp"
 #include "ncs_model.hpp"
 #include "oneshot/engine/study_file.hpp"
 
@@ -58,7 +60,22 @@ struct NcsStudy {
   std::vector<std::map<std::string, std::optional<double>>> bus_response_us;
   std::uint64_t first_seed = 1;               ///< Seed of the first replication.
   std::size_t seeds = 0;                      ///< Replications.
+  /// A file with several loops (`loops[]`): this loop's name (its random streams' prefix
+  /// "<loop>/"); "" for the one loop of a file without.
+  std::string loop;
+  /// Its nodes' addresses in the run: sensor, controller, actuator.
+  std::array<std::uint8_t, 3> addresses{ncs::kLiveSensor, ncs::kLiveController, ncs::kLiveActuator};
+  /// Leg name ("sc", "ca", "as") → the file's link name (the same name without `loops`).
+  std::map<std::string, std::string> link_names;
+  /// A file with several loops: every loop mapped (file order; this study's own fields are the
+  /// first loop's). Empty for a file without `loops`.
+  std::vector<NcsStudy> loops;
 };
+
+/// Loop `i` of a file with several loops as a file of its own: its plant, its three nodes,
+/// the links between them (names kept), the file's buses, approaches and scenarios (their
+/// overrides of the loop's links only); no `loops`, no CPUs.
+engine::StudyFile loop_view(const engine::StudyFile& file, std::size_t i);
 
 /// The plant file a study file names, relative paths taken from the study file's folder.
 std::string plant_file_path(const engine::StudyFile& file);

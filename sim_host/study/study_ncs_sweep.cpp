@@ -112,26 +112,11 @@ std::array<double, std::size(kCpuMetrics)> cpu_metrics(const ncs::RunResult& r) 
 
 }  // namespace
 
-engine::SweepResults run_ncs_sweep(const NcsStudy& s, std::size_t seeds, unsigned threads, const engine::Shard& shard,
-                                   bool analytic) {
-  bool one_shot = false;
-  for (ncs::Approach a : s.approaches) one_shot = one_shot || ncs::one_shot(a);
-  if (analytic && one_shot) {
-    throw engine::InputError("field '--analytic': the one-shot approaches (OS, OSp, OSK) have no analytic cost");
-  }
-  const bool sensor_on_cpu = !s.scenarios.empty() && s.scenarios[0].sensor_cpu != nullptr;
-  if (analytic && sensor_on_cpu) {
-    throw engine::InputError("field '--analytic': no analytic cost with the sensor on a CPU (its samples lag kh by the schedule)");
-  }
-  engine::SweepSpec spec;
-  spec.study = "study";
-  spec.experiment = "run";
-  for (ncs::Approach a : s.approaches) spec.approaches.emplace_back(ncs::name(a));
+nlohmann::json loop_sweep_config(const NcsStudy& s) {
   nlohmann::json sc = nlohmann::json::array();
   const std::vector<std::string> on_bus = bus_links(s);
   for (std::size_t i = 0; i < s.scenarios.size(); ++i) {
     const ncs::Scenario& x = s.scenarios[i];
-    spec.scenarios.push_back(x.name);
     nlohmann::json bus_legs = nlohmann::json::object();
     for (const auto& [nm, b] : x.bus_legs) {
       nlohmann::json wcrt = nullptr;
@@ -153,26 +138,66 @@ engine::SweepResults run_ncs_sweep(const NcsStudy& s, std::size_t seeds, unsigne
                   {"legs", legs}});
     if (!x.bus_legs.empty()) sc.back()["bus_legs"] = bus_legs;
   }
+  nlohmann::json config = {{"study_file", s.source},
+                           {"plant", s.ctx->plant().name},
+                           {"plant_source", s.ctx->plant().source},
+                           {"noise_free", false},
+                           {"links", s.links},
+                           {"compute_us", {s.ctx->timing().compute_min_us, s.ctx->timing().compute_max_us}},
+                           {"scenarios", sc}};
+  if (!on_bus.empty()) config["bus_links"] = on_bus;  // only then: the spec of files without stays as it was
+  return config;
+}
+
+std::vector<std::string> loop_sweep_metrics(const NcsStudy& s) {
+  std::vector<std::string> metrics = {"cost", "late", "saturated", "faults"};
+  for (const std::string& l : s.links)
+    for (const char* c : kLinkCounters) metrics.push_back(l + "." + c);
+  for (const std::string& l : bus_links(s))
+    for (const char* c : kBusDelayMetrics) metrics.push_back(l + "." + c);
+  return metrics;
+}
+
+std::vector<double> loop_sweep_values(const NcsStudy& s, std::size_t a, const ncs::RunResult& r) {
+  std::vector<double> v{r.cost, static_cast<double>(r.late), static_cast<double>(r.saturated), static_cast<double>(r.faults)};
+  for (const std::string& l : s.links) {
+    const auto c = link_counts(r, link_counter_map(s.approaches[a], l), l);
+    v.insert(v.end(), c.begin(), c.end());
+  }
+  for (const std::string& l : bus_links(s)) {
+    const auto d = bus_delays(r, l);
+    v.insert(v.end(), d.begin(), d.end());
+  }
+  return v;
+}
+
+engine::SweepResults run_ncs_sweep(const NcsStudy& s, std::size_t seeds, unsigned threads, const engine::Shard& shard,
+                                   bool analytic) {
+  if (!s.loops.empty()) return run_loops_sweep(s, seeds, threads, shard, analytic);  // study_loops_sweep.cpp
+  bool one_shot = false;
+  for (ncs::Approach a : s.approaches) one_shot = one_shot || ncs::one_shot(a);
+  if (analytic && one_shot) {
+    throw engine::InputError("field '--analytic': the one-shot approaches (OS, OSp, OSK) have no analytic cost");
+  }
+  const bool sensor_on_cpu = !s.scenarios.empty() && s.scenarios[0].sensor_cpu != nullptr;
+  if (analytic && sensor_on_cpu) {
+    throw engine::InputError("field '--analytic': no analytic cost with the sensor on a CPU (its samples lag kh by the schedule)");
+  }
+  engine::SweepSpec spec;
+  spec.study = "study";
+  spec.experiment = "run";
+  for (ncs::Approach a : s.approaches) spec.approaches.emplace_back(ncs::name(a));
+  for (const ncs::Scenario& x : s.scenarios) spec.scenarios.push_back(x.name);
+  const std::vector<std::string> on_bus = bus_links(s);
   spec.first_seed = s.first_seed;
   spec.seeds = seeds == 0 ? s.seeds : seeds;
-  spec.metrics = {"cost", "late", "saturated", "faults"};
-  for (const std::string& l : s.links)
-    for (const char* c : kLinkCounters) spec.metrics.push_back(l + "." + c);
-  for (const std::string& l : on_bus)
-    for (const char* c : kBusDelayMetrics) spec.metrics.push_back(l + "." + c);
+  spec.metrics = loop_sweep_metrics(s);
   const bool on_cpu = !s.scenarios.empty() && s.scenarios[0].controller_cpu != nullptr;
   if (on_cpu)
     for (const char* c : kCpuMetrics) spec.metrics.push_back(std::string("cpu.") + c);
   // Only with one-shot approaches: the spec of other files stays as it was.
   if (one_shot) spec.metrics.insert(spec.metrics.end(), std::begin(kOneShotMetrics), std::end(kOneShotMetrics));
-  spec.config = {{"study_file", s.source},
-                 {"plant", s.ctx->plant().name},
-                 {"plant_source", s.ctx->plant().source},
-                 {"noise_free", false},
-                 {"links", s.links},
-                 {"compute_us", {s.ctx->timing().compute_min_us, s.ctx->timing().compute_max_us}},
-                 {"scenarios", sc}};
-  if (!on_bus.empty()) spec.config["bus_links"] = on_bus;  // only then: the spec of files without stays as it was
+  spec.config = loop_sweep_config(s);
   if (on_cpu) {  // likewise
     const ncs::ControllerCpu& c = *s.scenarios[0].controller_cpu;
     spec.config["controller_cpu"] = {{"cpu", c.set.name},
@@ -415,6 +440,7 @@ void add_one_shot(nlohmann::json& j, const engine::SweepResults& results) {
 }  // namespace
 
 nlohmann::json run_outputs(const engine::SweepResults& results, const std::string& out_dir, bool plots) {
+  if (results.spec.config.contains("loops")) return loops_outputs(results, out_dir, plots);  // study_loops_sweep.cpp
   nlohmann::json j = ncs::table_outputs(results, out_dir, plots);
   const engine::SweepSpec& spec = results.spec;
   j["experiment"] = "study run";

@@ -8,9 +8,11 @@
 #include <iterator>
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include <nlohmann/json.hpp>
 
+#include "ncs_loop.hpp"
 #include "oneshot/engine/sweep.hpp"
 #include "study_ncs_runner.hpp"
 
@@ -40,6 +42,40 @@ constexpr std::size_t link_counter_index(std::string_view name) {
   while (i < std::size(kLinkCounters) && name != kLinkCounters[i]) ++i;
   return i;
 }
+
+/// The sweep configuration of the one loop `s` (spec.config of a file without `loops`:
+/// study_file, plant, links, compute_us, scenarios with their legs and bus legs, bus_links).
+nlohmann::json loop_sweep_config(const NcsStudy& s);
+/// The per-run metrics of the one loop `s`: cost, late, saturated, faults, per link the
+/// kLinkCounters, per leg on a bus the kBusDelayMetrics.
+std::vector<std::string> loop_sweep_metrics(const NcsStudy& s);
+/// Run `r` of approach index `a` of `s` as the values of loop_sweep_metrics().
+std::vector<double> loop_sweep_values(const NcsStudy& s, std::size_t a, const ncs::RunResult& r);
+
+/// The sweep of a file with several loops (s.loops; study_loops_sweep.cpp): each run is
+/// ncs::run_loops() of every loop on the shared engine, and each loop once more alone on it
+/// (the same seed: common random numbers), metrics "<loop>/<metric>" (loop_sweep_metrics())
+/// and "<loop>/alone.cost", "<loop>/alone.<leg>.<bus delay metric>"; the configuration
+/// {"study_file", "loops": [loop_sweep_config() + "name", ...]}. `analytic` is refused
+/// (engine::InputError naming `--analytic`).
+engine::SweepResults run_loops_sweep(const NcsStudy& s, std::size_t seeds, unsigned threads, const engine::Shard& shard,
+                                     bool analytic);
+
+/// The loops of `s` (a file with several loops) on scenario index `scenario`, for ncs::run_loops().
+std::vector<ncs::LoopOnBus> loops_on_bus(const NcsStudy& s, std::size_t scenario);
+
+/// Loop `i` of the sweep of a file with several loops as the sweep of a one-loop file (its
+/// metrics without the "<loop>/" prefix, its configuration; the alone runs left out).
+engine::SweepResults loop_results(const engine::SweepResults& results, std::size_t i);
+
+/// The summary of a complete sweep of several loops: "loops": per loop run_outputs() of
+/// loop_results() (files in out_dir/<loop>), "interference": per loop and approach the paired
+/// comparison of the loop's cost on the shared bus against alone on it (per seed the scenario
+/// mean of shared − alone: mean, ci95; ratio shared / alone), and per leg on a bus the observed
+/// delays (messages, min_us, mean_us, max_us) shared and alone beside the check's worst-case
+/// response (counting every loop's frames) and within_bound; "markdown" every loop's table and
+/// the interference tables ("markdown_interference" these alone); "order_text" per loop.
+nlohmann::json loops_outputs(const engine::SweepResults& results, const std::string& out_dir, bool plots);
 
 /// Runs the sweep (or one shard) of `s` with `seeds` replications (0: the file's count) on
 /// `threads` threads (0: every core). The runs are ncs::run() on the file's scenarios: same

@@ -107,6 +107,46 @@ void unique_names(const std::vector<T>& items, const std::string& f) {
   }
 }
 
+/// The loops of a file with `loops[]` into s.loops: each names its sensor, controller and
+/// actuator (declared nodes of those roles, in no other loop); every node in a loop; every
+/// link within one loop.
+void parse_loops(const json& loops, StudyFile& s) {
+  if (loops.empty()) throw InputError("field 'loops': must not be empty (omit it for the one loop of the file)");
+  std::map<std::string, std::string> loop_of;  // node -> loop
+  for (std::size_t i = 0; i < loops.size(); ++i) {
+    const std::string f = at("loops", i);
+    require_keys(loops[i], f, {"name", "plant", "sensor", "controller", "actuator"});
+    LoopSpec l;
+    l.name = string_of(loops[i], f, "name");
+    if (l.name.empty() || l.name.find('/') != std::string::npos) throw InputError("field '" + f + ".name': not empty, no '/' (it prefixes stream names)");
+    l.plant = detail::parse_plant(member(loops[i], f, "plant"), f + ".plant");
+    const std::pair<const char*, std::string*> roles[] = {{"sensor", &l.sensor}, {"controller", &l.controller}, {"actuator", &l.actuator}};
+    for (const auto& [role, slot] : roles) {
+      const std::string g = f + "." + role;
+      *slot = string_of(loops[i], f, role);
+      const NodeSpec* n = nullptr;
+      for (const NodeSpec& x : s.nodes)
+        if (x.name == *slot) n = &x;
+      if (n == nullptr) throw InputError("field '" + g + "': no node '" + *slot + "'");
+      if (n->role != role) throw InputError("field '" + g + "': node '" + *slot + "' is a " + n->role + ", not a " + role);
+      const auto [it, fresh] = loop_of.emplace(*slot, l.name);
+      if (!fresh) throw InputError("field '" + g + "': node '" + *slot + "' is already in loop '" + it->second + "'");
+    }
+    s.loops.push_back(l);
+  }
+  unique_names(s.loops, "loops");
+  for (std::size_t i = 0; i < s.nodes.size(); ++i) {
+    if (loop_of.count(s.nodes[i].name) == 0) throw InputError("field '" + at("nodes", i) + "': node '" + s.nodes[i].name + "' is in no loop");
+  }
+  for (std::size_t i = 0; i < s.links.size(); ++i) {
+    const LinkSpec& l = s.links[i];
+    if (loop_of.at(l.from) != loop_of.at(l.to)) {
+      throw InputError("field '" + at("links", i) + ".to': '" + l.to + "' is in loop '" + loop_of.at(l.to) + "', '" + l.from +
+                       "' in loop '" + loop_of.at(l.from) + "' (a link joins two nodes of one loop)");
+    }
+  }
+}
+
 }  // namespace
 
 const NodeSpec& StudyFile::node(const std::string& name) const {
@@ -131,8 +171,8 @@ StudyFile parse_study(const std::string& text, const std::string& source, const 
                       const std::string& base_dir) {
   const json root = parse_json_strict(text, source);
   try {
-    require_keys(root, "study file", {"schema", "study", "description", "plant", "duration_s", "seeds", "nodes", "links",
-                                      "buses", "cpus", "approaches", "scenarios"});
+    require_keys(root, "study file", {"schema", "study", "description", "plant", "loops", "duration_s", "seeds", "nodes",
+                                      "links", "buses", "cpus", "approaches", "scenarios"});
     StudyFile s;
     s.source = source;
     if (string_of(root, "study file", "schema") != kStudySchemaVersion) {
@@ -143,7 +183,9 @@ StudyFile parse_study(const std::string& text, const std::string& source, const 
       throw InputError("field 'study': '" + s.study + "' is not the study '" + schema->study + "'");
     }
     s.description = root.contains("description") ? string_of(root, "study file", "description") : std::string();
-    s.plant = detail::parse_plant(member(root, "study file", "plant"), "plant");
+    const bool several_loops = root.contains("loops");
+    if (several_loops && root.contains("plant")) throw InputError("field 'plant': with loops[] each loop has its own (loops[i].plant)");
+    if (!several_loops) s.plant = detail::parse_plant(member(root, "study file", "plant"), "plant");
     s.duration_s = number_in(root, "study file", "duration_s", 1e-6, 1e6);
     const json& seeds = member(root, "study file", "seeds");
     require_keys(seeds, "seeds", {"first", "count"});
@@ -277,6 +319,7 @@ StudyFile parse_study(const std::string& text, const std::string& source, const 
       s.links.push_back(link);
     }
     unique_names(s.links, "links");
+    if (several_loops) parse_loops(array_of(root, "study file", "loops", false), s);
 
     const json& approaches = array_of(root, "study file", "approaches", false);
     if (approaches.empty()) throw InputError("field 'approaches': must not be empty");

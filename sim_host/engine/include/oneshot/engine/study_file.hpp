@@ -126,12 +126,24 @@ struct ScenarioSpec {
   std::map<std::string, LossModel> losses;   ///< Link name → loss override.
 };
 
+/// One loop of a file with several (`loops[]`): its plant and the names of its three nodes.
+struct LoopSpec {
+  std::string name;        ///< Unique name (prefixes its random streams: "<name>/process", ...).
+  PlantSpec plant;         ///< Its plant (the same forms as the top-level `plant`).
+  std::string sensor;      ///< Its sensor node (role sensor).
+  std::string controller;  ///< Its controller node (role controller).
+  std::string actuator;    ///< Its actuator node (role actuator).
+};
+
 /// A parsed study file.
 struct StudyFile {
   std::string source;                   ///< Where it came from.
   std::string study;                    ///< Study code that runs it.
   std::string description;              ///< Free text.
-  PlantSpec plant;                      ///< The plant.
+  PlantSpec plant;                      ///< The plant (a file without `loops`).
+  /// Several loops in one file (empty: the file is one loop, its plant `plant`). Every node
+  /// is in exactly one loop, every link joins two nodes of one loop; `plant` is then unset.
+  std::vector<LoopSpec> loops;
   double duration_s = 0;                ///< Simulated time per run.
   std::uint64_t first_seed = 1;         ///< Seed of the first replication.
   std::size_t seeds = 0;                ///< Replications.
