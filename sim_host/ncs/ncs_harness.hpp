@@ -64,7 +64,7 @@ class Harness {
         sc_(sc),
         design_(ctx.controller_design(sc.noise_scale)),
         disc_(ctx.discretizer_model(sc.noise_scale)),
-        prefix_(on != nullptr ? on->name + "/" : std::string()),
+        prefix_(on != nullptr && !on->name.empty() ? on->name + "/" : std::string()),
         own_world_(world == nullptr ? std::make_unique<World>(seed) : nullptr),
         world_(world == nullptr ? *own_world_ : *world),
         kernel_(world_.kernel),

@@ -147,7 +147,9 @@ RunResult run(const Context& ctx, Approach a, const Scenario& scenario, std::uin
 struct LoopOnBus {
   const Context* ctx = nullptr;        ///< Its plant and design.
   const Scenario* scenario = nullptr;  ///< Its scenario (legs, buses; the same duration in every loop).
-  std::string name;                    ///< Prefixes its random streams: "<name>/process", "link/<name>/sc/…".
+  /// Prefixes its random streams: "<name>/process", "link/<name>/sc/…" (empty: no prefix, the
+  /// streams of a loop run alone by run()).
+  std::string name;
   std::uint8_t sensor = 0;             ///< Its sensor's address (unique in the run).
   std::uint8_t controller = 0;         ///< Its controller's.
   std::uint8_t actuator = 0;           ///< Its actuator's.

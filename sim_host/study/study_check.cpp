@@ -116,7 +116,15 @@ json resolve_study(const engine::StudyFile& f) {
       engine::StudyFile v = loop_view(f, i);
       v.buses.clear();
       for (engine::LinkSpec& l : v.links) l.bus.clear();  // analysed below, with every loop's traffic
-      const json ri = resolve_study(v);
+      json ri;
+      try {
+        ri = resolve_study(v);
+      } catch (const InputError& e) {  // the loop's plant: named loops[i].plant
+        std::string what = e.what();
+        const std::string prefix = f.source + ": field 'plant";
+        if (what.rfind(prefix, 0) == 0) what.replace(0, prefix.size(), f.source + ": field 'loops[" + std::to_string(i) + "].plant");
+        throw InputError(what);
+      }
       if (i == 0) r = ri;
       const engine::LoopSpec& l = f.loops[i];
       r["loops"].push_back({{"name", l.name}, {"sensor", l.sensor}, {"controller", l.controller}, {"actuator", l.actuator},

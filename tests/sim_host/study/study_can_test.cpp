@@ -3,14 +3,23 @@
 ///        without background traffic every message's delay is its transmission time (closed
 ///        form), with it every delay is within the check's worst-case response time and the
 ///        mean grows with the background load, the same bytes on 1 and 2 threads and from
-///        merged shards, and bad bus references refused naming the field.
+///        merged shards, and bad bus references refused naming the field. Several loops on one
+///        bus (examples/two_loops_can.json): apart in time each loop costs what it costs alone,
+///        bit for bit (and a loop without a stream prefix what ncs::run gives); together every
+///        delay within the check's bound that counts both loops' frames, the second loop's
+///        frames delaying the first's; the same bytes on 1 and 2 threads and from shards; the
+///        loops' refusals naming the field.
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <cstdio>
 #include <functional>
+#include <string>
+#include <tuple>
+#include <vector>
 
 #include "oneshot/engine/study_file.hpp"
+#include "ncs_loop.hpp"
 #include "study_check.hpp"
 #include "study_ncs_runner.hpp"
 #include "study_ncs_sweep.hpp"
@@ -154,6 +163,154 @@ TEST(StudyCan, BadBusReferencesAreRefusedNamingTheField) {
       "field 'links[2].bus'");
   kCan.expect_refused(
       [](nlohmann::json& j) { j["buses"].push_back({{"name", "spare"}, {"bit_rate", 250000}}); }, "field 'buses[1]'");  // unused
+}
+
+const test_support::StudyExample kLoops("two_loops_can.json");
+
+/// The two-loop example after `edit`, every scenario `duration_s` long, with the check's bounds.
+NcsStudy loops_study(const test_support::Edit& edit, double duration_s) {
+  nlohmann::json j = kLoops.json();
+  edit(j);
+  const engine::StudyFile f = kLoops.parse(j);
+  NcsStudy s = map_ncs_study(f);
+  cap_duration(s, duration_s, "test");
+  attach_bus_bounds(s, resolve_study(f));
+  return s;
+}
+
+/// A point-to-point leg at constant delay `delay_us` (FIFO).
+nlohmann::json p2p(const char* name, const char* from, const char* to, int delay_us) {
+  return {{"name", name}, {"from", from}, {"to", to}, {"delay", {{"model", "constant"}, {"delay_us", delay_us}}}, {"order", "fifo"}};
+}
+
+TEST(StudyLoops, ApartInTimeEachLoopCostsWhatItCostsAlone) {
+  // No background. The board's sc on the bus at kh (1620 us: [0, 1.62] ms after a multiple of
+  // 50 ms), its ca point to point; the servo's sc point to point at 2 ms, its ca on the bus
+  // 2 ms + tau_c (U[1, 5] ms) after kh: within [3, 8.08] ms after a multiple of 10 ms. The bus
+  // never holds both loops' frames at once: each loop runs as alone, bit for bit.
+  const NcsStudy s = loops_study(
+      [](nlohmann::json& j) {
+        j["buses"][0].erase("background");
+        j["links"][1] = p2p("ca", "board_controller", "board_actuator", 0);
+        j["links"][2] = p2p("servo_sc", "servo_sensor", "servo_controller", 2000);
+      },
+      4);
+  ASSERT_EQ(s.loops.size(), 2U);
+  const engine::SweepResults r = run_ncs_sweep(s, 3, 2, engine::Shard{});
+  for (const char* loop : {"board", "servo"}) {
+    const std::size_t shared = r.metric(std::string(loop) + "/cost"), alone = r.metric(std::string(loop) + "/alone.cost");
+    for (std::size_t a = 0; a < r.spec.approaches.size(); ++a)
+      for (std::size_t x = 0; x < r.spec.scenarios.size(); ++x)
+        for (std::size_t k = 0; k < r.spec.seeds; ++k) EXPECT_EQ(r.at(a, x, k, shared), r.at(a, x, k, alone)) << loop << " " << a;
+  }
+  const nlohmann::json j = run_outputs(r, temp_dir("apart"), false);
+  for (const auto& [loop, leg, c_us] : {std::tuple<const char*, const char*, double>{"board", "sc", message_us(24, 250'000)},
+                                        {"servo", "ca", message_us(16, 250'000)}}) {
+    for (const char* a : {"S", "SK"}) {
+      const nlohmann::json& d = j.at("interference").at(loop).at(a).at("bus_delays").at(leg);
+      EXPECT_EQ(d.at("shared").at("min_us").get<double>(), c_us) << loop << " " << a;  // the transmission, no queueing
+      EXPECT_EQ(d.at("shared").at("max_us").get<double>(), c_us) << loop << " " << a;
+      EXPECT_EQ(d.at("shared"), d.at("alone")) << loop << " " << a;
+      EXPECT_EQ(j.at("interference").at(loop).at(a).at("shared_minus_alone_mean").get<double>(), 0);
+    }
+  }
+  // A loop without a stream prefix on the shared engine is the loop of ncs::run: same streams.
+  ncs::LoopOnBus bare = loops_on_bus(s, 0)[0];
+  bare.name.clear();
+  for (ncs::Approach a : s.approaches) {
+    const ncs::RunResult one = ncs::run(*s.ctx, a, s.scenarios[0], 7, ncs::RunOptions{});
+    EXPECT_EQ(ncs::run_loops({bare}, a, 7)[0].cost, one.cost) << ncs::name(a);
+  }
+}
+
+TEST(StudyLoops, TogetherEveryDelayIsWithinTheBoundCountingBothLoopsAndTheServoDelaysTheBoard) {
+  const std::size_t seeds = test::sanitized_length<std::size_t>(10, 3);
+  const NcsStudy s = loops_study([](nlohmann::json&) {}, 4);
+  const nlohmann::json j = run_outputs(run_ncs_sweep(s, seeds, 2, engine::Shard{}), temp_dir("together"), false);
+  for (const char* loop : {"board", "servo"}) {
+    for (const char* a : {"S", "SK"}) {
+      for (const auto& [leg, d] : j.at("interference").at(loop).at(a).at("bus_delays").items()) {
+        ASSERT_FALSE(d.at("worst_response_us").is_null()) << loop << " " << leg;
+        EXPECT_LE(d.at("shared").at("max_us").get<double>(), d.at("worst_response_us").get<double>()) << loop << " " << a << " " << leg;
+        EXPECT_LE(d.at("alone").at("max_us").get<double>(), d.at("worst_response_us").get<double>()) << loop << " " << a << " " << leg;
+        EXPECT_TRUE(d.at("within_bound").get<bool>());
+      }
+    }
+  }
+  // The servo's sc (id 200) wins over the board's (256) whenever both sample at once (every
+  // 100 ms): the board's frames wait, its mean delay and its cost grow.
+  const nlohmann::json& board = j.at("interference").at("board").at("S");
+  EXPECT_GT(board.at("bus_delays").at("sc").at("shared").at("mean_us").get<double>(),
+            board.at("bus_delays").at("sc").at("alone").at("mean_us").get<double>());
+  EXPECT_GT(board.at("bus_delays").at("sc").at("shared").at("max_us").get<double>(),
+            board.at("bus_delays").at("sc").at("alone").at("max_us").get<double>());
+  EXPECT_GT(board.at("shared_minus_alone_mean").get<double>(), 0);
+  // I and IK do not use the bus: the same cost shared and alone.
+  for (const char* loop : {"board", "servo"})
+    for (const char* a : {"I", "IK"}) EXPECT_EQ(j.at("interference").at(loop).at(a).at("shared_minus_alone_mean").get<double>(), 0);
+  // The check's bound of the board's sc counts the servo's frames: larger than with the servo's legs off the bus.
+  const auto board_sc_wcrt = [](const nlohmann::json& r) {
+    for (const nlohmann::json& m : r.at("buses")[0].at("messages"))
+      if (m.at("name") == "sc") return m.at("worst_response_us").get<double>();
+    return -1.0;
+  };
+  nlohmann::json off = kLoops.json();
+  off["links"][2] = p2p("servo_sc", "servo_sensor", "servo_controller", 0);
+  off["links"][3] = p2p("servo_ca", "servo_controller", "servo_actuator", 0);
+  const double with = board_sc_wcrt(resolve_study(kLoops.parse(kLoops.json())));
+  const double without = board_sc_wcrt(resolve_study(kLoops.parse(off)));
+  EXPECT_GT(with, without);
+  EXPECT_GE(with - without, message_us(24, 250'000));  // at least one servo report ahead of it
+}
+
+TEST(StudyLoops, SameBytesOnOneAndTwoThreadsAndFromMergedShards) {
+  const NcsStudy s = loops_study([](nlohmann::json&) {}, 2.5);
+  const std::string one = run_outputs(run_ncs_sweep(s, 3, 1, engine::Shard{}), temp_dir("loops_one"), false).dump();
+  const std::string two = run_outputs(run_ncs_sweep(s, 3, 2, engine::Shard{}), temp_dir("loops_two"), false).dump();
+  EXPECT_EQ(one, two);
+  std::vector<engine::SweepResults> parts;
+  for (std::size_t i = 0; i < 2; ++i) {
+    const engine::SweepResults p = run_ncs_sweep(s, 3, 1, engine::Shard{i, 2});
+    parts.push_back(engine::shard_from_json(nlohmann::json::parse(engine::shard_to_json(p).dump())));
+  }
+  EXPECT_EQ(run_outputs(engine::merge_shards(parts), temp_dir("loops_merged"), false).dump(), two);
+  EXPECT_TRUE(nlohmann::json::parse(two).at("loops").contains("servo"));
+}
+
+TEST(StudyLoops, RefusalsNameTheField) {
+  const auto& e = kLoops;
+  e.expect_refused([](nlohmann::json& j) { j["loops"][1]["sensor"] = "board_sensor"; }, "field 'loops[1].sensor'");  // in two loops
+  e.expect_refused([](nlohmann::json& j) { j["loops"][0]["controller"] = "nobody"; }, "field 'loops[0].controller'");  // dangling
+  e.expect_refused([](nlohmann::json& j) { j["loops"][0]["sensor"] = "board_controller"; }, "field 'loops[0].sensor'");  // its role
+  e.expect_refused([](nlohmann::json& j) { j["loops"][1]["name"] = "board"; }, "field 'loops[1].name'");
+  e.expect_refused([](nlohmann::json& j) { j["loops"][0]["period_us"] = 1; }, "field 'loops[0].period_us'");  // unknown key
+  e.expect_refused([](nlohmann::json& j) { j["loops"] = nlohmann::json::array(); }, "field 'loops'");
+  e.expect_refused([](nlohmann::json& j) { j["plant"] = j["loops"][0]["plant"]; }, "field 'plant'");  // beside loops
+  e.expect_refused(
+      [](nlohmann::json& j) { j["nodes"].push_back({{"name", "spare"}, {"role", "sensor"}, {"address", 9}, {"period_us", 20000}}); },
+      "field 'nodes[6]'");  // in no loop
+  e.expect_refused([](nlohmann::json& j) { j["links"][3]["from"] = "board_controller"; }, "field 'links[3].to'");  // across loops
+  e.expect_refused([](nlohmann::json& j) { j["loops"][1]["plant"]["file"] = "nowhere.json"; }, "field 'loops[1].plant.file'", true);
+  e.expect_refused([](nlohmann::json& j) { j["nodes"][3]["period_us"] = 50000; }, "field 'nodes[3].period_us'");  // not the servo's h
+  e.expect_refused(
+      [](nlohmann::json& j) {
+        j["nodes"][4]["mode"] = "timer";
+        j["nodes"][4]["period_us"] = 20000;
+      },
+      "field 'nodes[4].mode'");  // the servo's controller computes on arrival
+  e.expect_refused([](nlohmann::json& j) { j["approaches"].push_back({{"name", "A"}, {"kind", "A"}}); }, "field 'approaches[4].kind'");
+  e.expect_refused([](nlohmann::json& j) { j["cpus"] = {{{"name", "mcu"}, {"scheduler", "fixed_priority"}}}; }, "field 'cpus'");
+  e.expect_refused(
+      [](nlohmann::json& j) { j["links"][2] = {{"name", "servo_x"}, {"from", "servo_sensor"}, {"to", "servo_actuator"}, {"bus", "can0"}, {"id", 200}}; },
+      "field 'links[2]'");  // not a leg of the loop
+  // The run's options.
+  const NcsStudy s = loops_study([](nlohmann::json&) {}, 2.5);
+  try {
+    static_cast<void>(run_ncs_sweep(s, 2, 1, engine::Shard{}, true));
+    ADD_FAILURE() << "--analytic accepted";
+  } catch (const engine::InputError& x) {
+    EXPECT_NE(std::string(x.what()).find("field '--analytic'"), std::string::npos) << x.what();
+  }
 }
 
 }  // namespace
