@@ -30,6 +30,7 @@
 #include <filesystem>
 #include <fstream>
 #include <optional>
+#include <map>
 #include <set>
 #include <string>
 
@@ -147,7 +148,20 @@ void require_unique(const std::vector<T>& items, F name, const std::string& what
 void check_study(const e::StudyFile& s, const e::StudySchema* schema) {
   require(std::isfinite(s.duration_s) && s.duration_s > 0 && s.duration_s <= 1e6, "duration_s out of range");
   require(s.seeds >= 2 && s.seeds <= 10'000'000, "seed count out of range");
-  check_plant(s.plant);
+  if (s.loops.empty()) {
+    check_plant(s.plant);
+  } else {  // several loops: each with its plant and three nodes of their roles, every node in one loop, links within one
+    require_unique(s.loops, [](const e::LoopSpec& l) { return l.name; }, "loops");
+    std::map<std::string, std::string> loop_of;
+    for (const e::LoopSpec& l : s.loops) {
+      check_plant(l.plant);
+      require(s.node(l.sensor).role == "sensor" && s.node(l.controller).role == "controller" && s.node(l.actuator).role == "actuator",
+              "loops: a node of the wrong role accepted");
+      for (const std::string* n : {&l.sensor, &l.controller, &l.actuator}) require(loop_of.emplace(*n, l.name).second, "loops: a node in two loops");
+    }
+    for (const e::NodeSpec& n : s.nodes) require(loop_of.count(n.name) != 0, "loops: a node in no loop accepted");
+    for (const e::LinkSpec& l : s.links) require(loop_of.at(l.from) == loop_of.at(l.to), "loops: a link across loops accepted");
+  }
   require_unique(s.nodes, [](const e::NodeSpec& n) { return n.name; }, "nodes");
   std::set<int> addresses;
   for (const e::NodeSpec& n : s.nodes) {

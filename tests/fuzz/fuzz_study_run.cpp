@@ -21,6 +21,7 @@
 #include <cmath>
 #include <cstdint>
 #include <string>
+#include <vector>
 
 #include "fuzz_oracle.hpp"
 #include "study_fuzz_support.hpp"
@@ -60,6 +61,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     s = st::map_ncs_study(file);
     const std::size_t scenarios = std::max<std::size_t>(1, kMaxRuns / s.approaches.size());
     if (s.scenarios.size() > scenarios) s.scenarios.resize(scenarios);
+    for (st::NcsStudy& l : s.loops)  // several loops: each loop's scenarios too
+      if (l.scenarios.size() > scenarios) l.scenarios.resize(scenarios);
     const double h_s = static_cast<double>(s.ctx->period_us()) * 1e-6;
     st::cap_duration(s, std::fmax(h_s, std::fmin(kMaxDurationS, kMaxPeriods * h_s)), "--max-duration");
   } catch (const e::InputError& x) {
@@ -69,18 +72,27 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   bool analytic = size % 2 == 1;
   // The one-shot loops have no analytic cost (refused naming '--analytic': StudyOneShot.*).
   for (oneshot::ncs::Approach a : s.approaches) analytic = analytic && !oneshot::ncs::one_shot(a);
+  analytic = analytic && s.loops.empty();  // several loops: refused naming '--analytic' (StudyLoops.*)
   const e::SweepResults r = st::run_ncs_sweep(s, 1, 1, e::Shard{}, analytic);
   require(r.complete(), "study run: a run missing");
   for (double v : r.values) require(std::isfinite(v), "study run: a non-finite metric");
+  std::vector<const st::NcsStudy*> loops{&s};  // several loops: each, its metrics "<loop>/..."
+  if (!s.loops.empty()) {
+    loops.clear();
+    for (const st::NcsStudy& l : s.loops) loops.push_back(&l);
+  }
   for (std::size_t a = 0; a < r.spec.approaches.size(); ++a) {
     for (std::size_t k = 0; k < r.spec.scenarios.size(); ++k) {
-      const double periods = s.scenarios[k].duration_s * 1e6 / static_cast<double>(s.ctx->period_us());
-      for (const std::string& l : s.links) {
-        const auto at = [&](const char* c) { return r.at(a, k, 0, r.metric(l + "." + c)); };
-        const std::string where = r.spec.approaches[a] + " on " + r.spec.scenarios[k] + ", link " + l;
-        require(at("sent") <= periods + 2, where + ": more frames than periods (" + std::to_string(at("sent")) + ")");
-        require(at("delivered") + at("lost") == at("sent"), where + ": delivered + lost != sent");
-        require(at("late") + at("refused") <= at("delivered"), where + ": more late or refused frames than delivered");
+      for (const st::NcsStudy* loop : loops) {
+        const std::string prefix = loop->loop.empty() ? "" : loop->loop + "/";
+        const double periods = loop->scenarios[k].duration_s * 1e6 / static_cast<double>(loop->ctx->period_us());
+        for (const std::string& l : loop->links) {
+          const auto at = [&](const char* c) { return r.at(a, k, 0, r.metric(prefix + l + "." + c)); };
+          const std::string where = r.spec.approaches[a] + " on " + r.spec.scenarios[k] + ", link " + l;
+          require(at("sent") <= periods + 2, where + ": more frames than periods (" + std::to_string(at("sent")) + ")");
+          require(at("delivered") + at("lost") == at("sent"), where + ": delivered + lost != sent");
+          require(at("late") + at("refused") <= at("delivered"), where + ": more late or refused frames than delivered");
+        }
       }
     }
   }
