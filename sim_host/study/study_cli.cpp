@@ -257,8 +257,8 @@ void add_study_commands(CLI::App* group) {
         std::string md;
         for (std::size_t i = 0; i < s.loops.size(); ++i) {
           const std::string name = s.loops[i].loop;
-          md += "# Loop " + name + "\n\n" +
-                study::report_markdown(c->file, study::describe_resolution(resolution),
+          md += (i == 0 ? "" : "\n") + std::string("# Loop ") + name + "\n\n" +
+                study::report_markdown(c->file, i == 0 ? study::describe_resolution(resolution) : "(every loop: as in loop " + s.loops[0].loop + "'s section)\n",
                                        simulated_time_text(s, max_duration, c->max_duration_s), study::loop_results(r, i),
                                        j.at("loops").at(name), c->no_plots ? "" : name + "/table.png");
         }
