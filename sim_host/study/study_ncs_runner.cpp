@@ -120,6 +120,7 @@ NcsStudy map_ncs_loops(const engine::StudyFile& file) {
         if (p != std::string::npos) what.replace(p, from.size(), ".links." + nm + "'");
       }
       if (what.rfind("field 'plant", 0) == 0) what.replace(0, 12, "field '" + at("loops", i) + ".plant");
+      if (what.rfind("field 'links':", 0) == 0) what.replace(0, 14, "field '" + at("loops", i) + "': its links:");
       throw InputError(what);
     }
     part.loop = loop.name;

@@ -303,6 +303,7 @@ TEST(StudyLoops, RefusalsNameTheField) {
   e.expect_refused(
       [](nlohmann::json& j) { j["links"][2] = {{"name", "servo_x"}, {"from", "servo_sensor"}, {"to", "servo_actuator"}, {"bus", "can0"}, {"id", 200}}; },
       "field 'links[2]'");  // not a leg of the loop
+  e.expect_refused([](nlohmann::json& j) { j["links"].erase(3); }, "field 'loops[1]'");  // the servo without its ca
   // The run's options.
   const NcsStudy s = loops_study([](nlohmann::json&) {}, 2.5);
   try {
