@@ -72,6 +72,13 @@ struct NcsStudy {
   std::vector<NcsStudy> loops;
 };
 
+/// A file with several loops (`loops[]`) mapped loop by loop (study_loops_map.cpp): each loop's
+/// view (loop_view(), addresses 1, 2, 3, links named by the leg they are) through
+/// map_ncs_study(), refusals named in the file's fields (`nodes[i]`, `links[i]`,
+/// `loops[i].plant`, `loops[i]`); the sampling approaches I, S, SK, IK only, no CPUs. The result
+/// is the first loop's study with every loop in NcsStudy::loops.
+NcsStudy map_ncs_loops(const engine::StudyFile& file);
+
 /// Loop `i` of a file with several loops as a file of its own: its plant, its three nodes,
 /// the links between them (names kept), the file's buses, approaches and scenarios (their
 /// overrides of the loop's links only); no `loops`, no CPUs.
