@@ -1,9 +1,11 @@
 /// @file study_file_test.cpp
 /// @brief The study file: the documented example parses to what it says, a study's
-///        schema is enforced, and every malformed input is refused with its field named.
+///        schema is enforced, every malformed input is refused with its field named, and a
+///        file with several loops (loops[]) gives each its plant and nodes.
 #include <gtest/gtest.h>
 
 #include <fstream>
+#include <functional>
 #include <sstream>
 
 #include "oneshot/engine/study_file.hpp"
@@ -115,6 +117,55 @@ TEST(StudyFile, MalformedFilesNameTheField) {
     } catch (const InputError& e) {
       EXPECT_NE(std::string(e.what()).find(c.expected), std::string::npos) << e.what();
       EXPECT_EQ(std::string(e.what()).rfind("f.json", 0), 0U) << e.what();
+    }
+  }
+}
+
+TEST(StudyFile, SeveralLoopsEachHaveTheirPlantAndNodes) {
+  const StudySchema schema = example_schema();
+  nlohmann::json j = nlohmann::json::parse(example_text());
+  const nlohmann::json plant = j.at("plant");
+  j.erase("plant");
+  j["loops"] = {{{"name", "one"}, {"plant", plant}, {"sensor", "sensor"}, {"controller", "controller"}, {"actuator", "actuator"}}};
+  const StudyFile f = parse_study(j.dump(), "f.json", &schema);
+  ASSERT_EQ(f.loops.size(), 1U);
+  EXPECT_EQ(f.loops[0].plant.kind, PlantSpec::Kind::kContinuous);
+  EXPECT_EQ(f.loops[0].plant.continuous.a(0, 1), -23.8);
+  EXPECT_EQ(f.loops[0].controller, "controller");
+  EXPECT_TRUE(f.plant.file.empty());  // the top-level plant is unset
+  // Without loops: the one loop of the file, as before.
+  EXPECT_TRUE(parse_study(example_text(), "f.json", &schema).loops.empty());
+  struct Case {
+    std::function<void(nlohmann::json&)> edit;
+    const char* expected;
+  };
+  const Case cases[] = {
+      {[&](nlohmann::json& x) { x["plant"] = plant; }, "field 'plant'"},
+      {[](nlohmann::json& x) { x["loops"] = nlohmann::json::array(); }, "field 'loops'"},
+      {[](nlohmann::json& x) { x["loops"][0]["period_us"] = 5; }, "field 'loops[0].period_us'"},
+      {[](nlohmann::json& x) { x["loops"][0].erase("plant"); }, "field 'loops[0].plant'"},
+      {[](nlohmann::json& x) { x["loops"][0]["plant"] = {{"file", 3}}; }, "loops[0].plant"},
+      {[](nlohmann::json& x) { x["loops"][0]["name"] = "a/b"; }, "field 'loops[0].name'"},
+      {[](nlohmann::json& x) { x["loops"][0]["sensor"] = "nobody"; }, "field 'loops[0].sensor'"},
+      {[](nlohmann::json& x) { x["loops"][0]["actuator"] = "sensor"; }, "field 'loops[0].actuator'"},
+      {[](nlohmann::json& x) { x["loops"].push_back(x["loops"][0]); }, "field 'loops[1].sensor'"},  // a node in two loops
+      {[](nlohmann::json& x) {
+         x["loops"].push_back(x["loops"][0]);
+         x["nodes"].push_back({{"name", "s2"}, {"role", "sensor"}, {"address", 9}, {"period_us", 1000}});
+         x["loops"][1]["sensor"] = "s2";
+       },
+       "field 'loops[1].controller'"},
+      {[](nlohmann::json& x) { x["nodes"].push_back({{"name", "spare"}, {"role", "sensor"}, {"address", 9}, {"period_us", 1000}}); },
+       "field 'nodes[3]'"},  // in no loop
+  };
+  for (const Case& c : cases) {
+    nlohmann::json x = j;
+    c.edit(x);
+    try {
+      parse_study(x.dump(), "f.json", &schema);
+      ADD_FAILURE() << "accepted; expected an error naming " << c.expected;
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find(c.expected), std::string::npos) << e.what();
     }
   }
 }
