@@ -137,7 +137,7 @@ nlohmann::json arrival_outputs(const engine::SweepResults& r, const std::string&
   util::write_csv(path_in(out_dir, "arrival_pmf.csv"), {"t", "D0.5", "D1", "D2", "D3"}, pmf);
   if (plots) {
     std::ostringstream g;
-    g << "set terminal pngcairo size 1200,500 font 'Sans,11' noenhanced\nset output 'arrival.png'\n"
+    g << util::gnuplot_png_terminal(1200, 500) << "set output 'arrival.png'\n"
          "set datafile separator ','\nset multiplot layout 1,2\nset grid\n"
          "set title '(1 - loss) x Poisson pmf of the delay (whole periods)'\nset xlabel 'delay t (periods)'\n"
          "set ylabel 'probability'\nset style data linespoints\n"
@@ -212,7 +212,7 @@ nlohmann::json run_closed_loop_experiment(const DroppingPlant& plant, const Stud
                    rows, util::NonFinite::kMissing);
     if (opt.plots) {
       std::ostringstream g;
-      g << "set terminal pngcairo size 1200," << 300 * lambdas.size() << " font 'Sans,10' noenhanced\n"
+      g << util::gnuplot_png_terminal(1200, static_cast<int>(300 * lambdas.size()), 10)
         << "set output 'closed_loop_trace.png'\nset datafile separator ','\nset multiplot layout " << lambdas.size()
         << ",1\nset grid\nset xlabel 't (s)'\n";
       for (std::size_t s = 0; s < lambdas.size(); ++s)
@@ -322,7 +322,7 @@ nlohmann::json closed_loop_outputs(const engine::SweepResults& r, const std::str
   engine::write_runs_csv(r, path_in(out_dir, "closed_loop_runs.csv"), util::NonFinite::kMissing);
   if (plots) {
     std::ostringstream g;
-    g << "set terminal pngcairo size 1200,500 font 'Sans,11' noenhanced\nset output 'closed_loop.png'\n"
+    g << util::gnuplot_png_terminal(1200, 500) << "set output 'closed_loop.png'\n"
          "set datafile separator ','\nset multiplot layout 1,2\nset grid\nset logscale y\nset format y '10^{%L}'\n"
          "set xlabel 'lambda'\nset key top right\nset offsets 0.01,0.01,0,0\n"
          "set title 'time-mean |x - xhat(k|Y_k)|^2: median and 10-90 % band'\n"
@@ -437,7 +437,7 @@ nlohmann::json hold_outputs(const engine::SweepResults& r, const std::string& ou
   engine::write_runs_csv(r, path_in(out_dir, "hold_runs.csv"), util::NonFinite::kMissing);
   if (plots) {
     std::ostringstream g;
-    g << "set terminal pngcairo size 1000,550 font 'Sans,11' noenhanced\nset output 'hold.png'\n"
+    g << util::gnuplot_png_terminal(1000, 550) << "set output 'hold.png'\n"
          "set datafile separator ','\nset grid\nset logscale y\nset xlabel 'T_hold (periods)'\n"
          "set ylabel 'time-mean squared error'\nset key top right\n"
          "set title 'E6: current and anchor error against T_hold (median, 10-90 % band)'\n"
