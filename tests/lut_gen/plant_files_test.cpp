@@ -13,6 +13,7 @@
 #include "oneshot/design/controller_synthesis.hpp"
 #include "oneshot/design/dense_ops.hpp"
 #include "support/eigen_reference.hpp"
+#include "support/shipped_plants.hpp"
 #include "support/test_plants.hpp"
 
 namespace oneshot::design {

@@ -7,6 +7,7 @@
 #include "oneshot/design/controller_synthesis.hpp"
 #include "oneshot/design/plant_description.hpp"
 #include "support/run_command.hpp"
+#include "support/shipped_plants.hpp"
 #include "support/test_plants.hpp"
 
 namespace oneshot {

@@ -22,14 +22,6 @@ design::PlantDescription unstable_plant();
 /// Three-state chain with damping (dense Φ).
 design::PlantDescription three_state_plant();
 
-/// The plant files shipped in lut_gen/plants/ (every one of them is loaded by the tests).
-inline constexpr const char* kShippedPlantFiles[] = {"reference_board.json", "networked_board.json",
-                                                     "sinopoli_dropping.json", "send_on_delta_oscillator.json",
-                                                     "hdd_numre.json"};
-
-/// A plant file's name without its extension: its parameterized test case's name.
-inline std::string plant_file_stem(const std::string& file) { return file.substr(0, file.find('.')); }
-
 /// The reference JSON with the value at `pointer` (JSON pointer, e.g. "/noise/R")
 /// replaced by `value_json`, or removed when value_json is empty.
 std::string reference_with(const std::string& pointer, const std::string& value_json);
