@@ -1,5 +1,5 @@
 /// @file experiments.cpp
-/// @brief E1 (arrival), E4/E5 (closed loop) and E6 (hold) sweeps of the dropping study.
+/// @brief E1 (arrival) and E4/E5 (closed loop) sweeps of the dropping study (E6: hold_experiment.cpp).
 #include "experiments.hpp"
 
 #include <cmath>
@@ -17,50 +17,12 @@
 #include "oneshot/plant_structure.hpp"
 #include "oneshot/util/output_files.hpp"
 #include "study_format.hpp"
+#include "sweep_parts.hpp"
 
 namespace oneshot::dropping {
 namespace {
 
 using util::path_in;
-
-nlohmann::json finish(const engine::SweepResults& r, const StudyOptions& opt, const std::string& experiment,
-                      nlohmann::json (*outputs)(const engine::SweepResults&, const std::string&, bool)) {
-  if (!opt.shard.whole()) return engine::write_shard_file(r, opt.out_dir, experiment, opt.shard);
-  util::make_directory(opt.out_dir);
-  return outputs(r, opt.out_dir, opt.plots);
-}
-
-std::vector<double> cell(const engine::SweepResults& r, std::size_t a, std::size_t s, std::size_t m) {
-  std::vector<double> v(r.spec.seeds);
-  for (std::size_t k = 0; k < r.spec.seeds; ++k) v[k] = r.at(a, s, k, m);
-  return v;
-}
-
-std::string plant_digest(const DroppingPlant& p) {
-  char b[20];
-  std::snprintf(b, sizeof b, "%016llx",
-                static_cast<unsigned long long>(engine::stream_id(p.plant.source == "built-in sinopoli_dropping.json"
-                                                                      ? dropping_plant_json()
-                                                                      : p.plant.name + p.plant.source)));
-  return b;
-}
-
-/// A faulted run's counters, with its cost over the clean run's of the same seed (run here).
-std::vector<double> with_faults(std::vector<double> v, const DroppingPlant& plant, RunConfig c, const RunMetrics& m,
-                                std::uint64_t seed) {
-  if (c.faults.empty()) return v;
-  sim::RunFaultCounts f;
-  f.injected = static_cast<double>(m.injected.injected());
-  f.refused_non_finite = m.refused_non_finite;
-  f.refused_sequence = m.refused_sequence;
-  f.stale = m.stale;
-  f.estimator_resets = m.estimate_non_finite;
-  c.faults = engine::FaultSpec{};
-  c.trace = false;
-  f.ratio_to_clean = m.cost / run_closed_loop(plant, c, seed).cost;
-  sim::append_fault_values(v, f);
-  return v;
-}
 
 const char* const kClosedLoopApproaches[] = {"buffered", "buffered-bernoulli", "unaware-R0.05", "unaware-R2.5"};
 
@@ -137,7 +99,7 @@ nlohmann::json arrival_outputs(const engine::SweepResults& r, const std::string&
   util::write_csv(path_in(out_dir, "arrival_pmf.csv"), {"t", "D0.5", "D1", "D2", "D3"}, pmf);
   if (plots) {
     std::ostringstream g;
-    g << "set terminal pngcairo size 1200,500 font 'Sans,11' noenhanced\nset output 'arrival.png'\n"
+    g << util::gnuplot_png_terminal(1200, 500) << "set output 'arrival.png'\n"
          "set datafile separator ','\nset multiplot layout 1,2\nset grid\n"
          "set title '(1 - loss) x Poisson pmf of the delay (whole periods)'\nset xlabel 'delay t (periods)'\n"
          "set ylabel 'probability'\nset style data linespoints\n"
@@ -212,7 +174,7 @@ nlohmann::json run_closed_loop_experiment(const DroppingPlant& plant, const Stud
                    rows, util::NonFinite::kMissing);
     if (opt.plots) {
       std::ostringstream g;
-      g << "set terminal pngcairo size 1200," << 300 * lambdas.size() << " font 'Sans,10' noenhanced\n"
+      g << util::gnuplot_png_terminal(1200, static_cast<int>(300 * lambdas.size()), 10)
         << "set output 'closed_loop_trace.png'\nset datafile separator ','\nset multiplot layout " << lambdas.size()
         << ",1\nset grid\nset xlabel 't (s)'\n";
       for (std::size_t s = 0; s < lambdas.size(); ++s)
@@ -322,7 +284,7 @@ nlohmann::json closed_loop_outputs(const engine::SweepResults& r, const std::str
   engine::write_runs_csv(r, path_in(out_dir, "closed_loop_runs.csv"), util::NonFinite::kMissing);
   if (plots) {
     std::ostringstream g;
-    g << "set terminal pngcairo size 1200,500 font 'Sans,11' noenhanced\nset output 'closed_loop.png'\n"
+    g << util::gnuplot_png_terminal(1200, 500) << "set output 'closed_loop.png'\n"
          "set datafile separator ','\nset multiplot layout 1,2\nset grid\nset logscale y\nset format y '10^{%L}'\n"
          "set xlabel 'lambda'\nset key top right\nset offsets 0.01,0.01,0,0\n"
          "set title 'time-mean |x - xhat(k|Y_k)|^2: median and 10-90 % band'\n"
@@ -334,120 +296,6 @@ nlohmann::json closed_loop_outputs(const engine::SweepResults& r, const std::str
     util::run_gnuplot(out_dir, "closed_loop.gp", g.str());
   }
   j["files"] = {"closed_loop.csv", "closed_loop_runs.csv", "closed_loop.png"};
-  return j;
-}
-
-// ---------------------------------------------------------------- E6: T_hold
-
-std::size_t buffered_filter_bytes(int t_hold) {
-  using Fmt = UniformFormat<double>;
-  using St = DenseStructure<kN, kM, kP>;
-  switch (t_hold) {
-    case 1: return sizeof(node::BufferedKalman<Fmt, St, 1>);
-    case 2: return sizeof(node::BufferedKalman<Fmt, St, 2>);
-    case 3: return sizeof(node::BufferedKalman<Fmt, St, 3>);
-    case 4: return sizeof(node::BufferedKalman<Fmt, St, 4>);
-    case 5: return sizeof(node::BufferedKalman<Fmt, St, 5>);
-    case 6: return sizeof(node::BufferedKalman<Fmt, St, 6>);
-    case 7: return sizeof(node::BufferedKalman<Fmt, St, 7>);
-    case 8: return sizeof(node::BufferedKalman<Fmt, St, 8>);
-    default: throw std::invalid_argument("T_hold must be 1 ... 8");
-  }
-}
-
-nlohmann::json run_hold(const DroppingPlant& plant, const StudyOptions& opt, int max_hold, const std::vector<double>& delays) {
-  if (max_hold < 1 || max_hold > 8) throw std::invalid_argument("--max-hold must be 1 ... 8");
-  engine::SweepSpec spec;
-  spec.study = "dropping";
-  spec.experiment = "hold";
-  spec.approaches = {"buffered"};
-  nlohmann::json sc = nlohmann::json::array();
-  for (double d : delays)
-    for (int t = 1; t <= max_hold; ++t) {
-      spec.scenarios.push_back("T" + std::to_string(t) + "-D" + fmt_g(d));
-      sc.push_back({{"T_hold", t}, {"D", d}, {"lambda", arrival_probability(t, d, opt.loss)},
-                    {"filter_bytes", buffered_filter_bytes(t)}});
-    }
-  spec.first_seed = opt.seed;
-  spec.seeds = opt.seeds;
-  spec.metrics = {"err", "err_anchor", "trace_p", "trace_p_anchor", "gamma", "corrections", "cost", "over_delayed"};
-  spec.config = {{"plant", plant.plant.name}, {"plant_digest", plant_digest(plant)}, {"loss", opt.loss},
-                 {"steps", opt.steps}, {"scenarios", sc}};
-  sim::add_fault_metrics(spec, opt.faults, "cost");
-  const engine::SweepResults r = engine::run_sweep(
-      spec, opt.shard, opt.threads,
-      [&](std::size_t, std::size_t s, std::uint64_t seed) {
-        const nlohmann::json& c = spec.config.at("scenarios").at(s);
-        RunConfig rc;
-        rc.t_hold = c.at("T_hold").get<int>();
-        rc.mean_delay_periods = c.at("D").get<double>();
-        rc.loss = opt.loss;
-        rc.steps = opt.steps;
-        rc.faults = opt.faults;
-        const RunMetrics m = run_closed_loop(plant, rc, seed);
-        return with_faults({m.err, m.err_anchor, m.trace_p, m.trace_p_anchor, m.gamma, m.corrections, m.cost,
-                            m.over_delayed},
-                           plant, rc, m, seed);
-      },
-      "dropping hold");
-  return finish(r, opt, "hold", hold_outputs);
-}
-
-nlohmann::json hold_outputs(const engine::SweepResults& r, const std::string& out_dir, bool plots) {
-  util::make_directory(out_dir);
-  const nlohmann::json& cfg = r.spec.config;
-  nlohmann::json j;
-  j["experiment"] = "hold";
-  j["steps"] = cfg.at("steps");
-  j["seeds"] = r.spec.seeds;
-  j["first_seed"] = r.spec.first_seed;
-  if (cfg.contains("inject")) j["inject"] = cfg.at("inject");
-  std::ostringstream md;
-  md << "| D | T_hold | λ(T_hold) | γ freq | current \\|x − x̂(k\\|Y_k)\\|² median [10–90 %] | mean ± CI | anchor "
-        "\\|x_n − x̂(n\\|n)\\|² median [10–90 %] | tr P_k median | predictions / corrections per step | filter bytes "
-        "(double) |\n|---|---|---|---|---|---|---|---|---|---|\n";
-  std::vector<std::vector<double>> csv;
-  for (std::size_t s = 0; s < r.spec.scenarios.size(); ++s) {
-    const nlohmann::json& c = cfg.at("scenarios").at(s);
-    const int t = c.at("T_hold").get<int>();
-    nlohmann::json js = c;
-    for (const char* m : {"err", "err_anchor", "trace_p", "trace_p_anchor", "gamma", "corrections", "cost", "over_delayed"})
-      js[m] = tail_json(engine::tail_summary(cell(r, 0, s, r.metric(m))));
-    const engine::TailSummary te = engine::tail_summary(cell(r, 0, s, r.metric("err")));
-    const engine::TailSummary ta = engine::tail_summary(cell(r, 0, s, r.metric("err_anchor")));
-    const engine::TailSummary tp = engine::tail_summary(cell(r, 0, s, r.metric("trace_p")));
-    const engine::TailSummary tg = engine::tail_summary(cell(r, 0, s, r.metric("gamma")));
-    const engine::TailSummary tc = engine::tail_summary(cell(r, 0, s, r.metric("corrections")));
-    js["predictions_per_step"] = t + 1;
-    if (cfg.contains("inject")) js["faults"] = sim::fault_row(r, 0, s);
-    j["per_cell"].push_back(js);
-    md << "| " << fmt_g(c.at("D").get<double>()) << " | " << t << " | " << fmt_f(c.at("lambda").get<double>(), 4) << " | "
-       << fmt_f(tg.mean.mean, 4) << " | " << band_md(te) << " | " << mean_md(te) << " | " << band_md(ta) << " | "
-       << fmt_g(tp.median) << " | " << t + 1 << " / " << fmt_f(tc.mean.mean, 2) << " | "
-       << c.at("filter_bytes").get<std::size_t>() << " |\n";
-    csv.push_back({c.at("D").get<double>(), static_cast<double>(t), te.median, te.p10, te.p90, ta.median, ta.p10, ta.p90,
-                   tc.mean.mean});
-  }
-  j["markdown"] = md.str();
-  if (cfg.contains("inject")) j["markdown_faults"] = sim::fault_markdown(r);
-  util::write_csv(path_in(out_dir, "hold.csv"),
-                 {"D", "T_hold", "err_median", "err_p10", "err_p90", "anchor_median", "anchor_p10", "anchor_p90",
-                  "corrections"},
-                 csv, util::NonFinite::kMissing);
-  engine::write_runs_csv(r, path_in(out_dir, "hold_runs.csv"), util::NonFinite::kMissing);
-  if (plots) {
-    std::ostringstream g;
-    g << "set terminal pngcairo size 1000,550 font 'Sans,11' noenhanced\nset output 'hold.png'\n"
-         "set datafile separator ','\nset grid\nset logscale y\nset xlabel 'T_hold (periods)'\n"
-         "set ylabel 'time-mean squared error'\nset key top right\n"
-         "set title 'E6: current and anchor error against T_hold (median, 10-90 % band)'\n"
-         "plot 'hold.csv' skip 1 using ($1==1?$2:1/0):3:4:5 with yerrorlines lw 2 title 'current, D = 1', "
-         "'' skip 1 using ($1==2?$2+0.05:1/0):3:4:5 with yerrorlines lw 2 title 'current, D = 2', "
-         "'' skip 1 using ($1==1?$2+0.1:1/0):6:7:8 with yerrorlines dt 2 title 'anchor, D = 1', "
-         "'' skip 1 using ($1==2?$2+0.15:1/0):6:7:8 with yerrorlines dt 2 title 'anchor, D = 2'\n";
-    util::run_gnuplot(out_dir, "hold.gp", g.str());
-  }
-  j["files"] = {"hold.csv", "hold_runs.csv", "hold.png"};
   return j;
 }
 

@@ -67,7 +67,7 @@ nlohmann::json run_mare_curve(const DroppingPlant& plant, const StudyOptions& op
                  {"lambda", "converged", "trace_p", "iterations", "K1", "K2", "K3", "certified", "trace_times_distance"}, csv);
   if (opt.plots) {
     std::ostringstream g;
-    g << "set terminal pngcairo size 1200,500 font 'Sans,11' noenhanced\nset output 'mare_curve.png'\n"
+    g << util::gnuplot_png_terminal(1200, 500) << "set output 'mare_curve.png'\n"
          "set datafile separator ','\nset datafile missing 'nan'\nset multiplot layout 1,2\nset grid\n"
          "set logscale y\nset format y '10^{%L}'\nset xlabel 'lambda'\nset ylabel 'tr Pbar'\n"
          "set arrow 1 from " << plant.lambda_sys << ", graph 0 to " << plant.lambda_sys
@@ -80,7 +80,7 @@ nlohmann::json run_mare_curve(const DroppingPlant& plant, const StudyOptions& op
          "set title 'zoom [0.34, 0.42]'\nset xrange [0.34:0.42]\nreplot\nunset multiplot\n";
     util::run_gnuplot(dir, "mare_curve.gp", g.str());
     std::ostringstream k;
-    k << "set terminal pngcairo size 900,500 font 'Sans,11' noenhanced\nset output 'mare_gain.png'\n"
+    k << util::gnuplot_png_terminal(900, 500) << "set output 'mare_gain.png'\n"
          "set datafile separator ','\nset datafile missing 'nan'\nset grid\nset xlabel 'lambda'\nset ylabel 'Kbar'\n"
          "set title 'E3: Kbar(lambda) = M C^T (C M C^T + R)^-1 at the MARE fixed point'\nset xrange ["
       << b.hi << ":1]\nplot for [c=5:7] 'mare_curve.csv' skip 1 using 1:c with lines lw 2 title columnhead(c)\n";

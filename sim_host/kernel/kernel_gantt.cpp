@@ -54,7 +54,7 @@ nlohmann::json write_gantt(const Cpu& cpu, engine::Duration span, const std::str
                       {"files", {"gantt.csv"}}};
   if (plots) {
     std::ostringstream g;
-    g << "set terminal pngcairo size 1200," << 160 + 40 * cpu.entities() << " font 'Sans,10' noenhanced\n"
+    g << util::gnuplot_png_terminal(1200, static_cast<int>(160 + 40 * cpu.entities()), 10)
       << "set output 'gantt.png'\nset datafile separator ','\nset xlabel 'time (ms)'\nset grid xtics\n"
       << "set yrange [-0.7:" << static_cast<double>(cpu.entities()) - 0.3 << "]\nset xrange [0:" << end_ms << "]\n"
       << "set title " << util::gnuplot_quote("first hyperperiod (at most 1 s): " + std::to_string(span.count() / 1000) + " us") << "\nset ytics (";

@@ -51,7 +51,7 @@ void write_x1(const std::string& path, const std::vector<const RunResult*>& runs
 std::string x1_plot(const std::string& png, const std::string& csv, const std::string& title,
                     const std::vector<std::string>& names) {
   std::ostringstream g;
-  g << "set terminal pngcairo size 1100,600 font 'Sans,11' noenhanced\nset output '" << png
+  g << util::gnuplot_png_terminal(1100, 600) << "set output '" << png
     << "'\nset datafile separator ','\nset grid\nset key outside right\nset xlabel 't (s)'\nset ylabel 'v1 (V)'\n"
     << "set title '" << title << "'\nplot '" << csv << "' using 1:" << names.size() + 2
     << " skip 1 with lines lc rgb 'gray' dt 2 title 'set-point'";
@@ -134,7 +134,7 @@ nlohmann::json run_e1(const Context& ctx, std::uint64_t seed, double duration_s,
                       {"files", {"e1_samples.csv", "e1_estimates.csv", "e1_truth.csv"}}};
   if (plots) {
     std::ostringstream g;
-    g << "set terminal pngcairo size 1100,800 font 'Sans,11' noenhanced\nset output 'e1.png'\n"
+    g << util::gnuplot_png_terminal(1100, 800) << "set output 'e1.png'\n"
       << "set datafile separator ','\nset grid\nset key outside right\nset multiplot layout 2,1 title 'E1: noisy samples and AK estimates ("
       << describe(sc) << ", seed " << seed << ")'\n";
     for (int c = 1; c <= 2; ++c) {

@@ -64,12 +64,12 @@ void add_common(CLI::App* cmd, CliCommon& c, const std::string& default_out) {
                   "number format of the control job (q15: approach B as the generated 16-bit C99 job, "
                   "float_poly: as the generated float job with Phi/Gamma/Q_d polynomial in tau; the other "
                   "approaches in double)")
-      ->check(CLI::IsMember({"float", "double", "fixed", "q15", "float_poly"}))
+      ->check(CLI::IsMember(number_format_names()))
       ->capture_default_str();
   cmd->add_option("--discretizer", c.discretizer,
                   "Phi/Gamma/Qd of the one-shot filters: table (exact between grid points), nearest (table at "
                   "the nearest grid point, the original design) or generic (matrix exponentials)")
-      ->check(CLI::IsMember({"table", "nearest", "generic"}))
+      ->check(CLI::IsMember(discretizer_names()))
       ->capture_default_str();
   cmd->add_option("--noise-model", c.noise, "process noise per prediction: exact Qd(tau) or the original constant Q")
       ->check(CLI::IsMember({"exact", "constant"}))

@@ -30,14 +30,8 @@ struct CliCommon {
   /// The options as the experiments take them.
   CommonOptions resolve() const {
     CommonOptions o = opt;
-    o.format = format == "double" ? NumberFormat::kDouble
-               : format == "fixed" ? NumberFormat::kFixed
-               : format == "q15"   ? NumberFormat::kQ15
-               : format == "float_poly" ? NumberFormat::kFloatPoly
-                                   : NumberFormat::kFloat;
-    o.discretizer = discretizer == "generic"   ? DiscretizerKind::kGeneric
-                    : discretizer == "nearest" ? DiscretizerKind::kNearest
-                                               : DiscretizerKind::kTable;
+    o.format = number_format_named(format).value_or(NumberFormat::kFloat);
+    o.discretizer = discretizer_named(discretizer).value_or(DiscretizerKind::kTable);
     o.noise = noise == "constant" ? NoiseModel::kConstant : NoiseModel::kExact;
     o.board.update = pwm == "period" ? PwmUpdate::kNextPeriod : PwmUpdate::kImmediate;
     o.plots = !no_plots;

@@ -11,6 +11,7 @@
 #include "oneshot/engine/cpu.hpp"
 #include "oneshot/engine/cpu_analysis.hpp"
 #include "oneshot/engine/sweep_statistics.hpp"
+#include "oneshot/util/enum_names.hpp"
 #include "oneshot/util/output_files.hpp"
 
 namespace oneshot::sim {
@@ -21,7 +22,10 @@ using namespace engine::cpu;
 
 using util::path_in;
 
-constexpr ControlPriority kPositions[] = {ControlPriority::kHighest, ControlPriority::kRateMonotonic, ControlPriority::kLowest};
+/// The control task's priority positions, in the order of the grid, and their names.
+constexpr util::EnumName<ControlPriority> kPositions[] = {{ControlPriority::kHighest, "highest"},
+                                                          {ControlPriority::kRateMonotonic, "rate_monotonic"},
+                                                          {ControlPriority::kLowest, "lowest"}};
 
 /// The other tasks: name, period (µs), share of the non-control utilization, sporadic max gap.
 struct Other {
@@ -71,14 +75,7 @@ std::string fmt(const char* f, double a, double b = 0) {
 
 }  // namespace
 
-const char* to_string(ControlPriority p) {
-  switch (p) {
-    case ControlPriority::kHighest: return "highest";
-    case ControlPriority::kRateMonotonic: return "rate_monotonic";
-    case ControlPriority::kLowest: return "lowest";
-  }
-  return "?";
-}
+const char* to_string(ControlPriority p) { return util::enum_name(kPositions, p); }
 
 ExecModel control_job_model(const KernelExperimentOptions& k) {
   if (k.exectime_file.empty()) {
@@ -159,14 +156,14 @@ nlohmann::json run_kernel_experiment(const SimContext& ctx, const CommonOptions&
   spec.metrics = {"cost", "sampling_latency_max_ms", "response_max_ms"};
   std::vector<TaskSet> sets;
   nlohmann::json configs = nlohmann::json::array(), excluded = nlohmann::json::array();
-  for (ControlPriority p : kPositions) {
+  for (const auto& [p, p_name] : kPositions) {
     for (double u : k.utilizations) {
       TaskSet s = kernel_task_set(job, h_us, u, p, k);
       const Analysis a = analyze(s);
       const TaskBound& b = a.tasks.front();
-      const std::string name = fmt("U%.2f/", u) + to_string(p);
+      const std::string name = fmt("U%.2f/", u) + p_name;
       nlohmann::json c = {{"name", name}, {"utilization", s.utilization()}, {"target_utilization", u},
-                          {"priority", to_string(p)}, {"control_priority", s.tasks.front().priority},
+                          {"priority", p_name}, {"control_priority", s.tasks.front().priority},
                           {"control_wcrt_us", b.bounded ? nlohmann::json(static_cast<double>(b.wcrt.count()) * 1e-3) : nlohmann::json(nullptr)},
                           {"control_bcrt_us", static_cast<double>(b.bcrt.count()) * 1e-3},
                           {"set_schedulable", a.schedulable}};
@@ -233,7 +230,7 @@ nlohmann::json kernel_outputs(const engine::SweepResults& r, const std::string& 
       resp_max = std::max(resp_max, r.at(0, s, k, resp));
     }
     std::size_t pos = 0;
-    while (to_string(kPositions[pos]) != c.at("priority").get<std::string>()) ++pos;
+    while (c.at("priority").get<std::string>() != kPositions[pos].name) ++pos;
     const double u = c.at("target_utilization").get<double>();
     md << "| " << c.at("priority").get<std::string>() << " | " << fmt("%.2f", u) << " | "
        << fmt("%.2f", c.at("control_wcrt_us").get<double>() * 1e-3) << " | " << fmt("%.2f", lat_max) << " | "
@@ -276,14 +273,14 @@ nlohmann::json kernel_outputs(const engine::SweepResults& r, const std::string& 
     while (a < na && spec.approaches[a] != letter) ++a;
     if (a == na || ns == 0) continue;
     const double own = sm.per_scenario_ratio[a][0].mean;  // first configuration: highest priority, lowest U
-    for (ControlPriority p : kPositions) {
+    for (const auto& [p, p_name] : kPositions) {
       const nlohmann::json vs_a = largest(a, p, 1.01), vs_own = largest(a, p, own * 1.01);
-      j["largest_utilization_within_1pct"][letter][to_string(p)] = vs_a;
-      j["largest_utilization_within_1pct_of_own_least_jitter"][letter][to_string(p)] = vs_own;
+      j["largest_utilization_within_1pct"][letter][p_name] = vs_a;
+      j["largest_utilization_within_1pct_of_own_least_jitter"][letter][p_name] = vs_own;
       auto text = [](const nlohmann::json& v) {
         return v.is_null() ? std::string("none of the grid") : fmt("U = %.2f", v.get<double>());
       };
-      th << "| " << letter << " | " << to_string(p) << " | " << text(vs_a) << " | " << text(vs_own) << fmt(" (%.4f)", own)
+      th << "| " << letter << " | " << p_name << " | " << text(vs_a) << " | " << text(vs_own) << fmt(" (%.4f)", own)
          << " |\n";
     }
   }
@@ -318,7 +315,7 @@ nlohmann::json kernel_outputs(const engine::SweepResults& r, const std::string& 
       << "set datafile separator ','\nset grid\nset xlabel 'CPU utilization'\nset ylabel 'cost / cost of A'\n"
       << "set key top left\nset multiplot layout 1,3\n";
     for (std::size_t p = 0; p < 3; ++p) {
-      g << "set title " << util::gnuplot_quote(std::string("control task priority: ") + to_string(kPositions[p])) << "\nplot ";
+      g << "set title " << util::gnuplot_quote(std::string("control task priority: ") + kPositions[p].name) << "\nplot ";
       for (std::size_t a = 1; a < na; ++a) {
         g << (a > 1 ? ", " : "") << "'kernel.csv' skip 1 using ($1==" << p << "?$2:1/0):" << 2 * a + 1 << ":" << 2 * a + 2
           << " with yerrorlines title " << util::gnuplot_quote(spec.approaches[a] + "/A");

@@ -29,6 +29,13 @@ struct CommonOptions {
 /// The run options of approach `a` under the common options (format, discretizer, noise, board).
 RunOptions run_options(const CommonOptions& opt, Approach a);
 
+/// The file `name` in the experiment's output folder.
+std::string path_in(const CommonOptions& opt, const std::string& name);
+
+/// What every experiment's JSON summary starts with: plant, number format, discretizer, noise
+/// model and seed.
+nlohmann::json common_json(const SimContext& ctx, const CommonOptions& opt);
+
 /// Experiment 1: noisy measured v1 beside the estimated states (half Kalman, one-shot).
 nlohmann::json run_noise_experiment(const SimContext& ctx, const CommonOptions& opt, double duration_s);
 

@@ -22,28 +22,27 @@
 #include "oneshot/host/host_board.hpp"
 #include "oneshot/plant_structure.hpp"
 #include "oneshot/sim/pil_link.hpp"
+#include "oneshot/util/enum_names.hpp"
 
 namespace oneshot::sim {
 
-const char* to_string(NumberFormat f) {
-  switch (f) {
-    case NumberFormat::kFloat: return "float";
-    case NumberFormat::kDouble: return "double";
-    case NumberFormat::kFixed: return "fixed";
-    case NumberFormat::kQ15: return "q15";
-    case NumberFormat::kFloatPoly: return "float_poly";
-  }
-  return "?";
-}
+namespace {
 
-const char* to_string(DiscretizerKind d) {
-  switch (d) {
-    case DiscretizerKind::kTable: return "table";
-    case DiscretizerKind::kNearest: return "nearest";
-    case DiscretizerKind::kGeneric: return "generic";
-  }
-  return "?";
-}
+constexpr util::EnumName<NumberFormat> kNumberFormatNames[] = {
+    {NumberFormat::kFloat, "float"}, {NumberFormat::kDouble, "double"}, {NumberFormat::kFixed, "fixed"},
+    {NumberFormat::kQ15, "q15"},     {NumberFormat::kFloatPoly, "float_poly"}};
+constexpr util::EnumName<DiscretizerKind> kDiscretizerNames[] = {
+    {DiscretizerKind::kTable, "table"}, {DiscretizerKind::kNearest, "nearest"}, {DiscretizerKind::kGeneric, "generic"}};
+
+}  // namespace
+
+const char* to_string(NumberFormat f) { return util::enum_name(kNumberFormatNames, f); }
+std::optional<NumberFormat> number_format_named(const std::string& name) { return util::enum_value(kNumberFormatNames, name); }
+std::vector<std::string> number_format_names() { return util::enum_names(kNumberFormatNames); }
+
+const char* to_string(DiscretizerKind d) { return util::enum_name(kDiscretizerNames, d); }
+std::optional<DiscretizerKind> discretizer_named(const std::string& name) { return util::enum_value(kDiscretizerNames, name); }
+std::vector<std::string> discretizer_names() { return util::enum_names(kDiscretizerNames); }
 
 Approach parse_approach(const std::string& letter) {
   if (letter.size() == 1) {

@@ -14,6 +14,7 @@
 #include <cstdint>
 #include <functional>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -43,10 +44,18 @@ enum class NumberFormat : std::uint8_t {
   kFloatPoly,  ///< Approach B as the generated float_poly C99 job (oneshot_job.c); the others in double.
 };
 
-/// Name of a number format ("float", "double", "fixed", "q15").
+/// Name of a number format ("float", "double", "fixed", "q15", "float_poly").
 const char* to_string(NumberFormat f);
+/// The number format called `name` (its to_string), or nothing.
+std::optional<NumberFormat> number_format_named(const std::string& name);
+/// Every number format's name, in declaration order.
+std::vector<std::string> number_format_names();
 /// Name of a discretizer ("table", "nearest", "generic").
 const char* to_string(DiscretizerKind d);
+/// The discretizer called `name` (its to_string), or nothing.
+std::optional<DiscretizerKind> discretizer_named(const std::string& name);
+/// Every discretizer's name: table, nearest, generic.
+std::vector<std::string> discretizer_names();
 
 /// Options of one run.
 struct RunOptions {

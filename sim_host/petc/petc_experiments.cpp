@@ -15,8 +15,6 @@ namespace oneshot::sim::petc {
 
 namespace {
 
-const char* kPng = "set terminal pngcairo size 1100,700 font 'Sans,11' noenhanced\n";
-
 std::string fmt(double x, int digits = 4) { return util::format_g(x, digits); }
 
 std::vector<double> log_grid(double lo, double hi, std::size_t n) {
@@ -220,7 +218,7 @@ nlohmann::json gpi_outputs(const engine::SweepResults& r, const std::string& out
   util::write_json(util::path_in(out_dir, "gpi.json"), j);
   if (plots) {
     std::ostringstream g;
-    g << kPng << "set output 'gpi.png'\nset multiplot layout 1,2\n"
+    g << util::gnuplot_png_terminal(1100, 700) << "set output 'gpi.png'\nset multiplot layout 1,2\n"
       << "set title 'GPI = 0.45 U_c + 0.45 U_a + 0.1 N_E (mean over seeds)'\nset xlabel 'log10 sigma_s = delta_s'\n"
       << "set ylabel 'log10 sigma_c = delta_c'\nset view map\nset datafile separator ','\n"
       << "plot 'gpi.csv' every ::1 using (log10($1)):(log10($2)):3 with points pt 5 ps 4 palette notitle\n"
@@ -256,7 +254,7 @@ nlohmann::json run_traces(const PetcSetup& setup, std::uint64_t seed, const std:
     j[c.name] = {{"seed", seed}, {"N_E", v[3]}, {"d_error_rms", v[17]}, {"d_rms", v[18]}, {"N_max", v[12]}};
     if (plots) {
       std::ostringstream g;
-      g << kPng << "set output 'trace_case" << tag << ".png'\nset datafile separator ','\nset multiplot layout 2,1\n"
+      g << util::gnuplot_png_terminal(1100, 700) << "set output 'trace_case" << tag << ".png'\nset datafile separator ','\nset multiplot layout 2,1\n"
         << "set title 'case " << tag << " (" << c.label << "), seed " << seed << ": d and d_hat'\nset xlabel 'k'\n"
         << "plot 'trace_case" << tag << ".csv' every ::1 using 1:4 with lines title 'd', '' every ::1 using 1:5 with "
         << "lines title 'd_hat'\nset title 'multiplicity N at each arrival'\n"

@@ -17,9 +17,9 @@
 #include "oneshot/node/interlaced_controller.hpp"
 #include "oneshot/node/mtm_trigger.hpp"
 #include "oneshot/node/packet_buffer.hpp"
-#include "oneshot/node/petc_controller.hpp"
 #include "petc_frames.hpp"
 #include "petc_hold_controller.hpp"
+#include "petc_numre_controller.hpp"
 
 namespace oneshot::sim::petc {
 
@@ -29,31 +29,6 @@ constexpr std::size_t kPlantStates = 12;
 constexpr std::size_t kPlantOnly = 10;
 using Dob = node::DisturbanceObserver<double, kDobSections, kDobMaxDelay>;
 using node::SendCause;
-
-template <std::size_t R, std::size_t C>
-Matrix<double, R, C> fixed(const DenseMatrix& d, const char* what) {
-  if (d.rows != R || d.cols != C)
-    throw std::invalid_argument(std::string("petc: ") + what + " is " + std::to_string(d.rows) + "x" +
-                                std::to_string(d.cols) + ", the study is compiled for " + std::to_string(R) + "x" +
-                                std::to_string(C));
-  Matrix<double, R, C> m;
-  for (std::size_t i = 0; i < R; ++i)
-    for (std::size_t j = 0; j < C; ++j) m(i, j) = d(i, j);
-  return m;
-}
-
-template <std::size_t N>
-node::NumreModel<double, N> numre_model(const EstimatorModel& e) {
-  node::NumreModel<double, N> m;
-  m.a = fixed<N, N>(e.a, "A");
-  m.b = fixed<N, 1>(e.b, "B");
-  m.b_w = fixed<N, 1>(e.b_w, "B_w");
-  m.c = fixed<1, N>(e.c, "C");
-  m.c_bar = fixed<1, N>(e.c_bar, "C_bar");
-  m.w = e.w;
-  m.v = e.v;
-  return m;
-}
 
 Law make_law(const PetcSetup& s) {
   node::InterlacedConfig<double, 1, 2> cfg;
@@ -71,55 +46,6 @@ Law make_law(const PetcSetup& s) {
 }
 
 Dob make_dob(const PetcSetup& s) { return Dob(dob_config(s)); }
-
-/// NUMRE controller node wrapped for the loop, compiled for the model's `Structure` (the
-/// augmented model: the M4F image's HddStructure, so the multiply-adds are the image's).
-template <std::size_t N, typename Observer, typename Structure = node::DenseModelStructure<N>>
-class NumreController {
- public:
-  using Node = node::PetcController<double, N, kHorizon, Law, Observer, Structure>;
-  NumreController(const EstimatorModel& m, bool frozen, const Law& law, const Observer& obs, const Trigger& trig,
-                  double r)
-      : node_(std::make_unique<Node>(fitting(numre_model<N>(m)), frozen ? node::NoiseAccumulation::kFrozen
-                                                                        : node::NoiseAccumulation::kSum,
-                                     law, obs, trig, r)) {}
-  /// A deep copy (the power-on node kept for a restart).
-  NumreController(const NumreController& o) : node_(std::make_unique<Node>(*o.node_)), last_macs_(o.last_macs_) {}
-  NumreController& operator=(const NumreController&) = delete;
-  /// Restart: the power-on node `p` again (its estimator resets so far are kept in the count).
-  void restart_as(const NumreController& p) {
-    resets_ += node_->statistics().estimator_resets;
-    *node_ = *p.node_;
-  }
-  /// Estimates that turned non-finite (reset by the node), restarts included.
-  std::uint32_t estimator_resets() const { return resets_ + node_->statistics().estimator_resets; }
-  SendCause arrive(std::uint32_t k, double y) {
-    const std::uint64_t before = node_->macs();
-    const SendCause c = node_->on_arrival(k, y);
-    last_macs_ = node_->macs() - before;
-    return c;
-  }
-  const double* packet() const { return node_->packet(); }
-  std::uint64_t macs() const { return node_->macs(); }
-  std::uint64_t last_macs() const { return last_macs_; }
-  std::uint32_t multiplicity() const { return node_->estimator().last_multiplicity(); }
-  double d_hat(std::uint32_t k) const { return node_->disturbance_estimate(k); }
-  void record_state(RunTrace& t) const {
-    const auto& x = node_->estimator().state();
-    t.x_hat.emplace_back(x.data(), x.data() + N);
-  }
-
- private:
-  std::unique_ptr<Node> node_;
-  std::uint64_t last_macs_ = 0;
-  std::uint32_t resets_ = 0;
-
-  /// The model, refused when it has a nonzero outside Structure.
-  static const node::NumreModel<double, N>& fitting(const node::NumreModel<double, N>& m) {
-    if (!Node::fits(m)) throw std::invalid_argument("petc: the NUMRE model has a nonzero outside its compiled structure");
-    return m;
-  }
-};
 
 Vector<double, 1> scalar(double x) {
   Vector<double, 1> v;
@@ -141,14 +67,14 @@ std::vector<double> simulate(const PetcSetup& s, const CaseSpec& c, std::uint64_
   const std::size_t steps = s.opt.steps;
   const EstimatorModel& m = s.plant.augmented;
   engine::DiscretePlantConfig<kPlantStates, 1, 1, 1> pc;
-  pc.phi = fixed<kPlantStates, kPlantStates>(m.a, "the plant's Phi");
-  pc.gamma = fixed<kPlantStates, 1>(m.b, "the plant's Gamma");
-  pc.c = fixed<1, kPlantStates>(m.c, "the plant's C");
-  const Matrix<double, kPlantStates, 1> bw = fixed<kPlantStates, 1>(m.b_w, "the plant's B_w");
+  pc.phi = model_matrix<kPlantStates, kPlantStates>(m.a, "the plant's Phi");
+  pc.gamma = model_matrix<kPlantStates, 1>(m.b, "the plant's Gamma");
+  pc.c = model_matrix<1, kPlantStates>(m.c, "the plant's C");
+  const Matrix<double, kPlantStates, 1> bw = model_matrix<kPlantStates, 1>(m.b_w, "the plant's B_w");
   pc.q = (bw * bw.transposed()) * m.w;
   pc.period = std::chrono::microseconds(s.plant.file.period_us);
   pc.process_noise = c.noise;
-  const Matrix<double, 1, kPlantStates> c_bar = fixed<1, kPlantStates>(m.c_bar, "the plant's C_bar");
+  const Matrix<double, 1, kPlantStates> c_bar = model_matrix<1, kPlantStates>(m.c_bar, "the plant's C_bar");
   const double sigma_v = std::sqrt(m.v);
 
   engine::Kernel kernel(seed);

@@ -118,7 +118,7 @@ nlohmann::json run_curve(const SodModel& model, const StudyOptions& opt, const s
   j["files"] = {"curve.csv"};
   if (opt.plots) {
     std::ostringstream g;
-    g << "set terminal pngcairo size 1100," << 450 * ns << " font 'Sans,11' noenhanced\nset output 'curve.png'\n"
+    g << util::gnuplot_png_terminal(1100, static_cast<int>(450 * ns)) << "set output 'curve.png'\n"
       << "set datafile separator ','\nset grid\nset logscale xy\nset multiplot layout " << ns << ",2\n"
       << "set xlabel 'packets per run (both nodes)'\nset key top right\n";
     for (std::size_t s = 0; s < ns; ++s)
@@ -224,7 +224,7 @@ nlohmann::json run_traces(const SodModel& model, const StudyOptions& opt, double
     }
   if (opt.plots) {
     std::ostringstream gp;
-    gp << "set terminal pngcairo size 1100,1000 font 'Sans,11' noenhanced\nset output 'e4_traces.png'\n"
+    gp << util::gnuplot_png_terminal(1100, 1000) << "set output 'e4_traces.png'\n"
        << "set datafile separator ','\nset datafile missing 'nan'\nset grid\nset multiplot layout 3,1\nset xlabel 't (s)'\n"
        << "set logscale y\nset title 'E4: mean squared error of x1 over " << opt.seeds << " runs, xi = " << loss << " (0.5 s bins)'\n"
        << "plot 'e4_error.csv' using 1:2 skip 1 with lines lw 2 title '(a) SOD', '' using 1:6 skip 1 with lines lw 2 title '(c) modified SOD'\n"

@@ -167,7 +167,7 @@ nlohmann::json run_grid(const SodModel& model, const StudyOptions& opt, const st
   j["files"] = {"e2_delta_t.csv"};
   if (opt.plots) {
     std::ostringstream g;
-    g << "set terminal pngcairo size 1100,500 font 'Sans,11' noenhanced\nset output 'e2_delta_t.png'\n"
+    g << util::gnuplot_png_terminal(1100, 500) << "set output 'e2_delta_t.png'\n"
       << "set datafile separator ','\nset datafile missing 'nan'\nset grid\nset multiplot layout 1,2\n"
       << "set xlabel 'delta_y'\nset logscale y\nset key top left\nset xrange [0:*]\n";
     for (int node = 1; node <= 2; ++node) {

@@ -186,7 +186,7 @@ nlohmann::json table_outputs(const engine::SweepResults& results, const std::str
   j["files"] = {"table.md", "table.csv", "table_runs.csv"};
   if (plots) {
     std::ostringstream g;
-    g << "set terminal pngcairo size 1100,500 font 'Sans,11' noenhanced\nset output 'table.png'\n"
+    g << util::gnuplot_png_terminal(1100, 500) << "set output 'table.png'\n"
       << "set datafile separator ','\nset grid\nset multiplot layout 1,2\nset xlabel 'loss rate xi'\nset key top left\n"
       << "set offsets 0.01, 0.01, 0, 0\n";
     for (int node = 1; node <= 2; ++node) {

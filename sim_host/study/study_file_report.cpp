@@ -82,7 +82,7 @@ std::string file_stem(const std::string& approach) {
 std::string trace_plot(const std::string& stem, const std::string& title, bool estimates, const std::vector<std::string>& legs,
                        double duration_s, double window_s) {
   std::ostringstream g;
-  g << "set terminal pngcairo size 1100,950 font 'Sans,10' noenhanced\nset output '" << stem << ".png'\n"
+  g << util::gnuplot_png_terminal(1100, 950, 10) << "set output '" << stem << ".png'\n"
     << "set datafile separator ','\nset grid\nset key outside right\nset lmargin 10\nset rmargin 22\nset multiplot layout 3,1 title '" << title << "'\n"
     << "set xrange [0:" << duration_s << "]\nset ylabel 'state (V)'\n"
     << "plot '" << stem << "_states.csv' using 1:2 skip 1 with lines lw 1.2 lc rgb '#000000' title 'x1', '' using 1:3 skip 1 "

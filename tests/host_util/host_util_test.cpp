@@ -1,5 +1,6 @@
 /// @file host_util_test.cpp
-/// @brief Host services: bounded reads, atomic writes, strict JSON, children without a shell.
+/// @brief Host services: bounded reads, atomic writes, strict JSON, children without a shell,
+///        enumeration name tables.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -12,6 +13,7 @@
 #include <unistd.h>
 
 #include "oneshot/util/child_process.hpp"
+#include "oneshot/util/enum_names.hpp"
 #include "oneshot/util/file_io.hpp"
 #include "oneshot/util/output_files.hpp"
 #include "oneshot/util/strict_json.hpp"
@@ -195,6 +197,22 @@ TEST(ChildProcess, WaitForIsBounded) {
   EXPECT_TRUE(quick.wait_for(60000));  // ends long before the bound
   EXPECT_TRUE(quick.wait().success());
   EXPECT_TRUE(quick.wait_for(0));  // already reaped
+}
+
+enum class Shade { kLight, kDark, kUnlisted };
+constexpr EnumName<Shade> kShadeNames[] = {{Shade::kLight, "light"}, {Shade::kDark, "dark"}};
+
+TEST(EnumNames, OneTableWritesReadsAndListsTheNames) {
+  for (const EnumName<Shade>& e : kShadeNames) {
+    EXPECT_STREQ(enum_name(kShadeNames, e.value), e.name);
+    EXPECT_EQ(enum_value(kShadeNames, e.name), e.value);
+  }
+  EXPECT_STREQ(enum_name(kShadeNames, Shade::kUnlisted), "?");
+  EXPECT_FALSE(enum_value(kShadeNames, "Light").has_value());  // exact, case-sensitive
+  EXPECT_FALSE(enum_value(kShadeNames, "").has_value());
+  EXPECT_EQ(enum_names(kShadeNames), (std::vector<std::string>{"light", "dark"}));
+  EXPECT_EQ(enum_name_list(kShadeNames), "light, dark");
+  static_assert(enum_name(kShadeNames, Shade::kDark)[0] == 'd', "usable in constant expressions");
 }
 
 }  // namespace

@@ -13,6 +13,7 @@
 #include "oneshot/design/controller_synthesis.hpp"
 #include "oneshot/design/dense_ops.hpp"
 #include "support/eigen_reference.hpp"
+#include "support/shipped_plants.hpp"
 #include "support/test_plants.hpp"
 
 namespace oneshot::design {
@@ -65,12 +66,8 @@ TEST_P(PlantFile, LoadsAndDesigns) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Shipped, PlantFile,
-                         ::testing::Values("reference_board.json", "networked_board.json", "sinopoli_dropping.json",
-                                           "send_on_delta_oscillator.json", "hdd_numre.json"),
-                         [](const ::testing::TestParamInfo<const char*>& i) {
-                           std::string s = i.param;
-                           return s.substr(0, s.find('.'));
-                         });
+                         ::testing::ValuesIn(test::kShippedPlantFiles),
+                         [](const ::testing::TestParamInfo<const char*>& i) { return test::plant_file_stem(i.param); });
 
 TEST(PlantFiles, ReferenceBoardKeepsItsDesign) {
   const DesignResult d = synthesize(load_plant_file(plant_path("reference_board.json")));

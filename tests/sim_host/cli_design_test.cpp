@@ -7,6 +7,7 @@
 #include "oneshot/design/controller_synthesis.hpp"
 #include "oneshot/design/plant_description.hpp"
 #include "support/run_command.hpp"
+#include "support/shipped_plants.hpp"
 #include "support/test_plants.hpp"
 
 namespace oneshot {
@@ -58,12 +59,8 @@ TEST_P(CliDesignPlantFile, PrintsTheDesignOfEveryShippedPlant) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Shipped, CliDesignPlantFile,
-                         ::testing::Values("reference_board.json", "networked_board.json", "sinopoli_dropping.json",
-                                           "send_on_delta_oscillator.json", "hdd_numre.json"),
-                         [](const ::testing::TestParamInfo<const char*>& i) {
-                           std::string s = i.param;
-                           return s.substr(0, s.find('.'));
-                         });
+                         ::testing::ValuesIn(test::kShippedPlantFiles),
+                         [](const ::testing::TestParamInfo<const char*>& i) { return test::plant_file_stem(i.param); });
 
 TEST(CliDesign, DeviceAndDirectoryAreClearErrors) {
   const auto dev = test::run_command(std::string(ONESHOT_SIM_PATH) + " design --plant /dev/zero");

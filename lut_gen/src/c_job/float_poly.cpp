@@ -73,22 +73,19 @@ std::optional<FloatPoly> design_float_poly(const PlantDescription& plant, const 
     for (std::size_t k = from; k < from + count; ++k) v.push_back(values[k][a]);
     return v;
   };
-  std::vector<long> slot_of(p.members.size(), -1);
-  for (std::size_t a = 0; a < p.members.size(); ++a) {
-    if (slot_of[a] >= 0) continue;
+  std::vector<double> max_value(p.members.size(), 0.0);
+  for (const auto& row : values)
+    for (std::size_t a = 0; a < row.size(); ++a) max_value[a] = std::max(max_value[a], std::fabs(row[a]));
+  const auto groups = shared_member_groups(p.members.size(), [&](std::size_t a, std::size_t b) {
+    for (const auto& row : values)
+      if (!(std::fabs(row[a] - row[b]) <= 1e-12 * max_value[a])) return false;
+    return true;
+  });
+  for (const auto& group : groups) {
+    const std::size_t a = group.front();
     FloatPolySlot slot;
-    slot.members.push_back(a);
-    slot_of[a] = static_cast<long>(p.slots.size());
-    for (const auto& row : values) slot.max_value = std::max(slot.max_value, std::fabs(row[a]));
-    for (std::size_t b = a + 1; b < p.members.size(); ++b) {
-      bool same = slot_of[b] < 0;
-      for (std::size_t k = 0; k < values.size() && same; ++k)
-        same = std::fabs(values[k][a] - values[k][b]) <= 1e-12 * slot.max_value;
-      if (same) {
-        slot.members.push_back(b);
-        slot_of[b] = slot_of[a];
-      }
-    }
+    slot.members = group;
+    slot.max_value = max_value[a];
     const float c0 = static_cast<float>(values[0][a]);
     if (static_cast<double>(c0) != values[0][a]) return std::nullopt;  // v(0) is 0 or 1 (the identity)
     const auto ft = column(a, 1, fit_t.size());

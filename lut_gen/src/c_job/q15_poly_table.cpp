@@ -93,6 +93,24 @@ std::vector<std::vector<double>> exact_member_values(const PlantDescription& pla
   });
 }
 
+std::vector<std::vector<std::size_t>> shared_member_groups(std::size_t count,
+                                                           const std::function<bool(std::size_t, std::size_t)>& same) {
+  std::vector<std::vector<std::size_t>> groups;
+  std::vector<bool> grouped(count, false);
+  for (std::size_t a = 0; a < count; ++a) {
+    if (grouped[a]) continue;
+    std::vector<std::size_t> g{a};
+    for (std::size_t b = a + 1; b < count; ++b) {
+      if (!grouped[b] && same(a, b)) {
+        g.push_back(b);
+        grouped[b] = true;
+      }
+    }
+    groups.push_back(std::move(g));
+  }
+  return groups;
+}
+
 Q15PolyTable design_q15_poly_table(const PlantDescription& plant, const DesignResult& design, const Arith& ar,
                                    std::int32_t g_us, std::int32_t range_us, std::vector<Q15Member> members,
                                    bool nearest) {
@@ -114,21 +132,15 @@ Q15PolyTable design_q15_poly_table(const PlantDescription& plant, const DesignRe
   const std::size_t per = static_cast<std::size_t>(kFitPoints + kCheckPoints);
   const auto r_of = [&](std::size_t k, std::size_t s) { return (times[k * per + s] - static_cast<double>(k) * g_us) / g_us; };
   // Slots: members with the same values (at every sample) and format share one polynomial.
-  std::vector<long> slot_of(t.members.size(), -1);
-  for (std::size_t a = 0; a < t.members.size(); ++a) {
-    if (slot_of[a] >= 0) continue;
+  const auto groups = shared_member_groups(t.members.size(), [&](std::size_t a, std::size_t b) {
+    if (ar.fmt(t.members[b].q).frac != ar.fmt(t.members[a].q).frac) return false;
+    for (const auto& row : values)
+      if (row[a] != row[b]) return false;
+    return true;
+  });
+  for (const auto& g : groups) {
     Q15Slot slot;
-    slot.members.push_back(a);
-    slot_of[a] = static_cast<long>(t.slots.size());
-    for (std::size_t b = a + 1; b < t.members.size(); ++b) {
-      if (slot_of[b] >= 0 || ar.fmt(t.members[b].q).frac != ar.fmt(t.members[a].q).frac) continue;
-      bool same = true;
-      for (std::size_t s = 0; s < values.size() && same; ++s) same = values[s][a] == values[s][b];
-      if (same) {
-        slot.members.push_back(b);
-        slot_of[b] = slot_of[a];
-      }
-    }
+    slot.members = g;
     t.slots.push_back(slot);
   }
   // Per slot: the lowest degree that fits every interval within 1/4 LSB, then the block exponent.

@@ -11,6 +11,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -51,6 +52,12 @@ struct Q15PolyTable {
 std::vector<std::vector<double>> exact_member_values(const PlantDescription& plant, const DesignResult& design,
                                                      const std::vector<Q15Member>& members,
                                                      const std::vector<double>& t_us);
+
+/// The members that share one stored polynomial: a group opens at the first member not yet
+/// grouped and takes every later ungrouped member b with same(a, b) (a its first member);
+/// groups in the order of their first members. Shared by the q15 table and float_poly.
+std::vector<std::vector<std::size_t>> shared_member_groups(std::size_t count,
+                                                           const std::function<bool(std::size_t, std::size_t)>& same);
 
 /// Least-squares a_e (e ∈ exps) of y(s) on the basis s^e: normal equations solved by
 /// Gauss-Jordan with partial pivoting (a singular column gives 0). Keep s in [0, 1] so that

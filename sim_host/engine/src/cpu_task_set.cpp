@@ -9,6 +9,7 @@
 #include <sstream>
 
 #include "oneshot/engine/json_fields.hpp"
+#include "oneshot/util/enum_names.hpp"
 #include "oneshot/util/file_io.hpp"
 
 namespace oneshot::engine::cpu {
@@ -160,11 +161,15 @@ ExecModel parse_exec_model(const nlohmann::json& j, const std::string& f, const 
 
 namespace {
 
+constexpr util::EnumName<SchedulerKind> kSchedulerNames[] = {{SchedulerKind::kFixedPriority, "fixed_priority"},
+                                                             {SchedulerKind::kFixedPriorityNonPreemptive, "fixed_priority_nonpreemptive"},
+                                                             {SchedulerKind::kEdf, "edf"}};
+constexpr util::EnumName<OverrunPolicy> kOverrunNames[] = {
+    {OverrunPolicy::kContinue, "continue"}, {OverrunPolicy::kSkip, "skip"}, {OverrunPolicy::kAbort, "abort"}};
+
 OverrunPolicy parse_overrun(const std::string& s, const std::string& field) {
-  if (s == "continue") return OverrunPolicy::kContinue;
-  if (s == "skip") return OverrunPolicy::kSkip;
-  if (s == "abort") return OverrunPolicy::kAbort;
-  fail(field, "unknown overrun policy '" + s + "' (continue, skip, abort)");
+  if (const auto p = util::enum_value(kOverrunNames, s)) return *p;
+  fail(field, "unknown overrun policy '" + s + "' (" + util::enum_name_list(kOverrunNames) + ")");
 }
 
 TaskSpec parse_task(const nlohmann::json& j, const std::string& f, bool isr, const std::string& base_dir) {
@@ -253,23 +258,9 @@ double TaskSet::utilization() const {
   return u;
 }
 
-const char* to_string(SchedulerKind s) {
-  switch (s) {
-    case SchedulerKind::kFixedPriority: return "fixed_priority";
-    case SchedulerKind::kFixedPriorityNonPreemptive: return "fixed_priority_nonpreemptive";
-    case SchedulerKind::kEdf: return "edf";
-  }
-  return "?";
-}
+const char* to_string(SchedulerKind s) { return util::enum_name(kSchedulerNames, s); }
 
-const char* to_string(OverrunPolicy p) {
-  switch (p) {
-    case OverrunPolicy::kContinue: return "continue";
-    case OverrunPolicy::kSkip: return "skip";
-    case OverrunPolicy::kAbort: return "abort";
-  }
-  return "?";
-}
+const char* to_string(OverrunPolicy p) { return util::enum_name(kOverrunNames, p); }
 
 TaskSet parse_task_set_json(const nlohmann::json& root, const std::string& prefix, const std::string& base_dir,
                             bool allow_no_tasks) {
@@ -278,15 +269,9 @@ TaskSet parse_task_set_json(const nlohmann::json& root, const std::string& prefi
   s.name = string_of(root, prefix, "name", true, "cpu");
   if (s.name.size() > 100) fail(at(prefix, "name"), "longer than 100 characters");
   const std::string sched = string_of(root, prefix, "scheduler");
-  if (sched == "fixed_priority") {
-    s.scheduler = SchedulerKind::kFixedPriority;
-  } else if (sched == "fixed_priority_nonpreemptive") {
-    s.scheduler = SchedulerKind::kFixedPriorityNonPreemptive;
-  } else if (sched == "edf") {
-    s.scheduler = SchedulerKind::kEdf;
-  } else {
-    fail(at(prefix, "scheduler"), "unknown scheduler '" + sched + "' (fixed_priority, fixed_priority_nonpreemptive, edf)");
-  }
+  const auto kind = util::enum_value(kSchedulerNames, sched);
+  if (!kind) fail(at(prefix, "scheduler"), "unknown scheduler '" + sched + "' (" + util::enum_name_list(kSchedulerNames) + ")");
+  s.scheduler = *kind;
   s.context_switch = us(integer_in(root, prefix, "context_switch_us", 0, 1'000'000, true, 0));
   std::set<std::string> names;
   for (const char* list : {"tasks", "isrs"}) {

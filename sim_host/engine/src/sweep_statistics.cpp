@@ -133,7 +133,7 @@ void write_summary_files(const SweepResults& r, const SweepSummary& sm, const st
     tics << (a ? ", " : "") << util::gnuplot_quote(r.spec.approaches[a]) << " " << a;
   }
   std::ostringstream g;
-  g << "set terminal pngcairo size 1100,700 font 'Sans,11' noenhanced\nset output " << util::gnuplot_quote(prefix + ".png") << "\n"
+  g << util::gnuplot_png_terminal(1100, 700) << "set output " << util::gnuplot_quote(prefix + ".png") << "\n"
     << "set datafile separator ','\nset grid ytics\nset style fill solid 0.6\nset boxwidth 0.6\nset key off\n"
     << "set xtics (" << tics.str() << ")\nset xrange [-0.6:" << static_cast<double>(r.spec.approaches.size()) - 0.4 << "]\nset yrange [0:*]\n"
     << "set ylabel "

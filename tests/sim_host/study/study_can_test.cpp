@@ -25,6 +25,7 @@
 #include "study_ncs_sweep.hpp"
 #include "support/build_flavor.hpp"
 #include "study_example.hpp"
+#include "study_sweep_checks.hpp"
 #include "support/temp_files.hpp"
 
 namespace oneshot::study {
@@ -131,17 +132,8 @@ TEST(StudyCan, WithBackgroundDelaysStayWithinTheBoundAndTheMeanGrowsWithTheLoad)
 }
 
 TEST(StudyCan, SameBytesOnOneAndTwoThreadsAndFromMergedShards) {
-  const NcsStudy s = kCan.study([](nlohmann::json&) {}, 2.5);
-  const std::string one = run_outputs(run_ncs_sweep(s, 4, 1, engine::Shard{}), temp_dir("one"), false).dump();
-  const std::string two = run_outputs(run_ncs_sweep(s, 4, 2, engine::Shard{}), temp_dir("two"), false).dump();
-  EXPECT_EQ(one, two);
-  std::vector<engine::SweepResults> parts;
-  for (std::size_t i = 0; i < 3; ++i) {
-    const engine::SweepResults p = run_ncs_sweep(s, 4, 1, engine::Shard{i, 3});
-    parts.push_back(engine::shard_from_json(nlohmann::json::parse(engine::shard_to_json(p).dump())));
-  }
-  EXPECT_EQ(run_outputs(engine::merge_shards(parts), temp_dir("merged"), false).dump(), two);
-  EXPECT_TRUE(nlohmann::json::parse(two).contains("bus_delays"));
+  test_support::expect_same_bytes_on_threads_and_shards(kCan.study([](nlohmann::json&) {}, 2.5), 4,
+                                                        "oneshot_study_can_test", "bus_delays");
 }
 
 TEST(StudyCan, BadBusReferencesAreRefusedNamingTheField) {

@@ -25,6 +25,7 @@
 #include "support/run_command.hpp"
 #include "study_cpu_checks.hpp"
 #include "study_example.hpp"
+#include "study_sweep_checks.hpp"
 #include "support/temp_files.hpp"
 
 namespace oneshot::study {
@@ -128,17 +129,8 @@ TEST(StudyCpu, AHeavierBackgroundRaisesTheMeanResponseAndTheCost) {
 }
 
 TEST(StudyCpu, SameBytesOnOneAndTwoThreadsAndFromMergedShards) {
-  const NcsStudy s = kCpu.study([](nlohmann::json&) {}, 1.5);
-  const std::string one = run_outputs(run_ncs_sweep(s, 3, 1, engine::Shard{}), temp_dir("one"), false).dump();
-  const std::string two = run_outputs(run_ncs_sweep(s, 3, 2, engine::Shard{}), temp_dir("two"), false).dump();
-  EXPECT_EQ(one, two);
-  std::vector<engine::SweepResults> parts;
-  for (std::size_t i = 0; i < 3; ++i) {
-    const engine::SweepResults p = run_ncs_sweep(s, 3, 1, engine::Shard{i, 3});
-    parts.push_back(engine::shard_from_json(nlohmann::json::parse(engine::shard_to_json(p).dump())));
-  }
-  EXPECT_EQ(run_outputs(engine::merge_shards(parts), temp_dir("merged"), false).dump(), two);
-  EXPECT_TRUE(nlohmann::json::parse(two).contains("cpu"));
+  test_support::expect_same_bytes_on_threads_and_shards(kCpu.study([](nlohmann::json&) {}, 1.5), 3,
+                                                        "oneshot_study_cpu_test", "cpu");
 }
 
 /// Parsing, checking and mapping the edited file is refused, the message containing `expect`.

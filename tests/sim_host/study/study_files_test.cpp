@@ -14,6 +14,7 @@
 #include "oneshot/engine/study_file.hpp"
 #include "study_ncs_runner.hpp"
 #include "study_ncs_sweep.hpp"
+#include "study_sweep_checks.hpp"
 #include "support/temp_files.hpp"
 
 namespace oneshot::study {
@@ -233,12 +234,7 @@ TEST(StudyFiles, MergedShardsGiveTheSameBytesAsOneRun) {
   for (const bool analytic : {false, true}) {
     const std::string whole =
         run_outputs(run_ncs_sweep(s, 4, 2, engine::Shard{}, analytic), temp_dir("whole"), false).dump();
-    std::vector<engine::SweepResults> parts;
-    for (std::size_t i = 0; i < 3; ++i) {
-      const engine::SweepResults p = run_ncs_sweep(s, 4, 1, engine::Shard{i, 3}, analytic);
-      parts.push_back(engine::shard_from_json(nlohmann::json::parse(engine::shard_to_json(p).dump())));
-    }
-    const std::string merged = run_outputs(engine::merge_shards(parts), temp_dir("merged"), false).dump();
+    const std::string merged = test_support::merged_shard_outputs(s, 4, temp_dir("merged"), analytic).dump();
     EXPECT_EQ(merged, whole) << "analytic " << analytic;
     EXPECT_EQ(nlohmann::json::parse(whole).contains("variance_reduction"), analytic);
   }
