@@ -26,7 +26,7 @@ namespace oneshot::ncs::loop {
 
 using Board = host::HostNetwork;
 using Structure = DenseStructure<kN, kM, kP>;
-using Ref = node::SquareWaveReference<double, kN, kM>;
+using Ref = SetpointReference;
 using Plant = engine::ContinuousPlant<kN, kM, kP, 1>;
 using engine::Duration;
 using engine::EventClass;
@@ -83,8 +83,8 @@ class Harness {
       plant_.set_reference(ref_.state(kk), ref_.input(kk));
       if (an_) an_->set_reference(ref_.state(kk), ref_.input(kk));
     });
-    const std::uint64_t half = half_wave_periods(ctx, sc);
-    for (std::uint64_t k = half; SimTime{h_ * static_cast<std::int64_t>(k)} < end_; k += half) {
+    const auto k_end = static_cast<std::uint64_t>((end_.count() + h_.count() - 1) / h_.count());
+    for (std::uint64_t k : ref_.switches(k_end)) {
       kernel_.schedule(SimTime{h_ * static_cast<std::int64_t>(k)}, EventClass::kEnvironment, sw, k);
     }
     if (sc.controller_cpu && !delay_free(a)) {  // τ_c from the schedule (ncs_cpu.hpp)

@@ -26,13 +26,13 @@
 #include <vector>
 
 #include "ncs_model.hpp"
+#include "ncs_reference.hpp"
 #include "oneshot/engine/continuous_plant.hpp"
 #include "oneshot/engine/jump_linear_cost.hpp"
 #include "oneshot/engine/fault_spec.hpp"
 #include "oneshot/engine/frame_faults.hpp"
 #include "oneshot/engine/link.hpp"
 #include "oneshot/engine/network.hpp"
-#include "oneshot/node/square_wave_reference.hpp"
 
 namespace oneshot::ncs {
 
@@ -123,8 +123,9 @@ struct RunResult {
 
 /// The plant of a run (process noise when `noisy`), shared by the simulation and the live plant.
 engine::ContinuousPlantConfig<kN, kM, kP, 1> plant_config(const Context& ctx, const Scenario& sc, bool noisy);
-/// The set-point square wave of a scenario (x_ref, u_ref per period index).
-node::SquareWaveReference<double, kN, kM> reference(const Context& ctx, const Scenario& sc);
+/// The set-point of a scenario (x_ref, u_ref per period index): its steps
+/// (Scenario::setpoint_changes) or the square wave ±A_r of period T_r.
+SetpointReference reference(const Context& ctx, const Scenario& sc);
 /// Network leg `name` ("as", "sc", "ca"): U[0.5, d] ms in whole µs, FIFO, or the scenario's
 /// leg from a study file (Scenario::legs); none for I, IK.
 engine::LinkConfig leg(const Context& ctx, const Scenario& sc, Approach a, const char* name);

@@ -6,6 +6,7 @@
 #include <array>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <optional>
 #include <utility>
 #include <vector>
@@ -110,6 +111,29 @@ std::array<double, std::size(kCpuMetrics)> cpu_metrics(const ncs::RunResult& r) 
           static_cast<double>(c.other_misses), static_cast<double>(c.busy.count()) * 1e-3};
 }
 
+/// A stepped set-point of scenario `x` for the sweep's configuration: its description, r_0, the
+/// number of changes on the kh grid and an FNV-1a hash of their periods and values (shards of
+/// files with other steps do not merge).
+nlohmann::json setpoint_json(const ncs::Scenario& x) {
+  std::uint64_t hash = 14695981039346656037ULL;
+  const auto mix = [&hash](std::uint64_t v) {
+    for (int b = 0; b < 8; ++b) {
+      hash ^= (v >> (8 * b)) & 0xFFU;
+      hash *= 1099511628211ULL;
+    }
+  };
+  for (const auto& [k, v] : *x.setpoint_changes) {
+    std::uint64_t bits = 0;
+    std::memcpy(&bits, &v, sizeof bits);
+    mix(k);
+    mix(bits);
+  }
+  char hex[17];
+  std::snprintf(hex, sizeof hex, "%016llx", static_cast<unsigned long long>(hash));
+  return {{"description", x.setpoint_description}, {"r0", x.setpoint_r0}, {"changes", x.setpoint_changes->size()},
+          {"changes_fnv1a", hex}};
+}
+
 }  // namespace
 
 engine::SweepResults run_ncs_sweep(const NcsStudy& s, std::size_t seeds, unsigned threads, const engine::Shard& shard,
@@ -152,6 +176,7 @@ engine::SweepResults run_ncs_sweep(const NcsStudy& s, std::size_t seeds, unsigne
                   {"s_plus_mean_tau_io_us", x.bus_legs.empty() ? nlohmann::json(s.ctx->mean_tau_io_us(x)) : nlohmann::json(nullptr)},
                   {"legs", legs}});
     if (!x.bus_legs.empty()) sc.back()["bus_legs"] = bus_legs;
+    if (x.setpoint_changes) sc.back()["reference"] = setpoint_json(x);  // only then: square-wave files' specs stay as they were
   }
   spec.first_seed = s.first_seed;
   spec.seeds = seeds == 0 ? s.seeds : seeds;
@@ -196,6 +221,10 @@ engine::SweepResults run_ncs_sweep(const NcsStudy& s, std::size_t seeds, unsigne
     const ncs::Scenario& x = s.scenarios[0];
     spec.config["one_shot"] = {{"send_on_delta", x.sod_delta}, {"time_steps", x.sod_time_steps},
                                {"controller_phase_us", x.controller_phase_us}};
+    if (x.sensor_mtm) {  // only then: the spec of send-on-delta files stays as it was
+      spec.config["one_shot"]["mtm"] = {{"sigma", x.mtm_sigma}, {"delta", x.mtm_delta}, {"k_max", x.mtm_k_max},
+                                        {"k_ref_max", x.mtm_k_ref_max}};
+    }
   }
   if (analytic) {  // only then, as ncs table: the spec stays as it was without
     spec.config["analytic"] = true;
