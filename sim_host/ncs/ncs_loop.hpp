@@ -98,11 +98,15 @@ struct RunResult {
   std::string analytic_refusal;    ///< Analytic runs: why the expected cost is not valid ("" when it is).
   double analytic_mismatch = 0;    ///< Analytic runs: largest |mean − simulated| (relative to max(1, |value|)).
   std::vector<double> counters;    ///< Node counters (ncs_counters.hpp, order of counter_names()).
-  /// One-shot loops: the controller's corrected estimate against the true state at its
-  /// sampling instant, mean of e_kᵀ P_k⁻¹ e_k over the computations whose P_k is regular
-  /// (not at noise scale 0; 0 for the other loops and when none is).
+  /// Loops whose controller runs a Kalman filter (filtered_approach()): the mean of
+  /// e_kᵀ P_k⁻¹ e_k, e_k the true state minus the filter's estimate, P_k its covariance, over
+  /// the computations whose P_k is regular (not at noise scale 0; 0 for the other loops and
+  /// when none is). SK, IK and the one-shot loops: x(kh) (the sample's instant) against
+  /// x̂_{k|k}, P_{k|k} after the corrections of period k; AK, AKx, AKl: x(t_k) against the
+  /// prediction x̂⁻_k, P⁻_k to the actuation instant, over the periods whose command k is
+  /// applied at t_k. Runs with injected faults: none.
   double nees = 0;
-  std::uint32_t nees_steps = 0;    ///< One-shot loops: computations in that mean.
+  std::uint32_t nees_steps = 0;    ///< Computations in that mean.
   std::uint32_t sent = 0;          ///< One-shot loops: samples the sensor sent (of `samples`).
   std::uint32_t sampled = 0;       ///< One-shot loops: samples the sensor took.
   /// Counters of the links the run built, by leg name (order of link_names()).

@@ -44,6 +44,12 @@ inline constexpr std::array<Approach, 9> kAllApproaches = {Approach::kI,   Appro
 inline constexpr std::array<Approach, 3> kOneShotApproaches = {Approach::kOS, Approach::kOSp, Approach::kOSK};
 /// True for the one-shot loops (OS, OSp, OSK).
 constexpr bool one_shot(Approach a) { return a == Approach::kOS || a == Approach::kOSp || a == Approach::kOSK; }
+/// True for the loops whose controller runs a Kalman filter with a covariance P (AK, AKx,
+/// AKl, SK, IK, OS, OSp, OSK): the ones with a NEES.
+constexpr bool filtered_approach(Approach a) {
+  return a == Approach::kAK || a == Approach::kAKx || a == Approach::kAKl || a == Approach::kSK || a == Approach::kIK ||
+         one_shot(a);
+}
 /// Short name ("I", "S", "A", "AK", "AKx", "AKl", "SK", "S+", "IK", "OS", "OSp", "OSK").
 const char* name(Approach a);
 /// One-line description.

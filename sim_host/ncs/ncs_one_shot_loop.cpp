@@ -178,8 +178,6 @@ RunResult run_one_shot(Harness& hs, Approach a) {
   engine::Network& net = hs.net_;
   engine::Kernel& k = hs.kernel_;
   std::vector<Vector<double, kN>> truth;  // x(kh) per sample k
-  double nees_sum = 0;
-  std::uint32_t nees_n = 0;
   net.add_node(kSensor, "sensor", Duration{0}, nullptr);
   net.add_node(kController, "controller", Duration{0}, nullptr);  // frames wait for its timer
   net.add_node(kActuator, "actuator", Duration{0}, [&]() { act.on_receive(); });
@@ -193,18 +191,8 @@ RunResult run_one_shot(Harness& hs, Approach a) {
     net.run_node(kController, [&]() { ctrl.on_timer(net.node_clock(kController), kk + 1); });
     if (ctrl.statistics().computations == runs || n >= truth.size()) return;
     const Vector<double, kN>& xh = ctrl.law().corrected();
-    const Matrix<double, kN, kN>& p = ctrl.law().corrected_covariance();
-    const double e0 = truth[n][0] - xh[0];
-    const double e1 = truth[n][1] - xh[1];
-    const double det = p(0, 0) * p(1, 1) - p(0, 1) * p(1, 0);
     hs.estimate(kk, xh);
-    if (!(det > 0)) return;  // a singular P (noise scale 0): no NEES term
-    static_assert(kN == 2, "the NEES below inverts a 2 x 2 covariance in closed form");
-    // eᵀ P⁻¹ e with P⁻¹ = [[p11, −p01], [−p10, p00]] / det
-    const double q = (e0 * e0 * p(1, 1) - e0 * e1 * (p(0, 1) + p(1, 0)) + e1 * e1 * p(0, 0)) / det;
-    if (!std::isfinite(q)) return;
-    nees_sum += q;
-    ++nees_n;
+    hs.add_nees(truth[n], xh, ctrl.law().corrected_covariance());  // x(kh) against x̂_{k|k}, P_{k|k}
   });
   auto ctrl_h = std::make_shared<HandlerId>(0);
   *ctrl_h = k.add_handler("controller timer", [&, ctrl_h](std::uint64_t n) {
@@ -242,8 +230,6 @@ RunResult run_one_shot(Harness& hs, Approach a) {
   r.late = act.statistics().late;
   r.saturated = ctrl.law().saturated();
   r.faults = ctrl.law().faults();
-  r.nees = nees_n > 0 ? nees_sum / nees_n : 0;
-  r.nees_steps = nees_n;
   r.sent = sensor.statistics().sends;
   r.sampled = sensor.statistics().samples;
   r.counters = concat(sampling_controller_counters(ctrl), actuator_counters(act));

@@ -188,8 +188,15 @@ engine::SweepResults run_ncs_sweep(const NcsStudy& s, std::size_t seeds, unsigne
   const bool on_cpu = !s.scenarios.empty() && s.scenarios[0].controller_cpu != nullptr;
   if (on_cpu)
     for (const char* c : kCpuMetrics) spec.metrics.push_back(std::string("cpu.") + c);
-  // Only with one-shot approaches: the spec of other files stays as it was.
-  if (one_shot) spec.metrics.insert(spec.metrics.end(), std::begin(kOneShotMetrics), std::end(kOneShotMetrics));
+  // Only with one-shot approaches: their metrics (NEES first); with other filtered approaches
+  // the NEES alone; files without a filter keep their spec.
+  bool filtered = false;
+  for (ncs::Approach a : s.approaches) filtered = filtered || ncs::filtered_approach(a);
+  if (one_shot) {
+    spec.metrics.insert(spec.metrics.end(), std::begin(kOneShotMetrics), std::end(kOneShotMetrics));
+  } else if (filtered) {
+    spec.metrics.insert(spec.metrics.end(), std::begin(kOneShotMetrics), std::begin(kOneShotMetrics) + 2);
+  }
   spec.config = {{"study_file", s.source},
                  {"plant", s.ctx->plant().name},
                  {"plant_source", s.ctx->plant().source},
@@ -241,7 +248,7 @@ engine::SweepResults run_ncs_sweep(const NcsStudy& s, std::size_t seeds, unsigne
   const std::vector<std::string>* bus = &on_bus;
   return engine::run_sweep(
       spec, shard, threads,
-      [study, counter_maps, bus, analytic, on_cpu, one_shot](std::size_t a, std::size_t k, std::uint64_t seed) {
+      [study, counter_maps, bus, analytic, on_cpu, one_shot, filtered](std::size_t a, std::size_t k, std::uint64_t seed) {
         const ncs::Approach ap = study->approaches[a];
         const ncs::RunResult r = ncs::run(*study->ctx, ap, study->scenarios[k], seed, ncs::RunOptions{});
         std::vector<double> v{r.cost, static_cast<double>(r.late), static_cast<double>(r.saturated),
@@ -258,7 +265,11 @@ engine::SweepResults run_ncs_sweep(const NcsStudy& s, std::size_t seeds, unsigne
           const auto c = cpu_metrics(r);
           v.insert(v.end(), c.begin(), c.end());
         }
-        if (one_shot) v.insert(v.end(), {r.nees, static_cast<double>(r.nees_steps), static_cast<double>(r.sampled), static_cast<double>(r.sent)});
+        if (one_shot) {
+          v.insert(v.end(), {r.nees, static_cast<double>(r.nees_steps), static_cast<double>(r.sampled), static_cast<double>(r.sent)});
+        } else if (filtered) {
+          v.insert(v.end(), {r.nees, static_cast<double>(r.nees_steps)});
+        }
         if (analytic) {  // ncs table --analytic's columns: the same run in analytic mode
           const auto x = ncs::analytic_metrics(*study->ctx, ap, study->scenarios[k], seed, ncs::RunOptions{});
           v.insert(v.end(), x.begin(), x.end());
@@ -441,6 +452,58 @@ void add_one_shot(nlohmann::json& j, const engine::SweepResults& results) {
   j["markdown"] = j.at("markdown").get<std::string>() + md;
 }
 
+/// Adds "nees" (per approach whose controller runs a Kalman filter: the NEES, mean and 95 %
+/// interval over seeds of the scenario mean, the computations it averages, and per scenario
+/// the same) and its table to the markdown.
+void add_nees(nlohmann::json& j, const engine::SweepResults& results) {
+  const engine::SweepSpec& spec = results.spec;
+  const std::size_t nees_i = results.metric("nees");
+  const std::size_t steps_i = results.metric("nees_steps");
+  const auto summary = [](const std::vector<double>& v) {
+    if (v.empty()) return nlohmann::json::array({nullptr, nullptr});
+    const util::Summary m = util::summarize(v);
+    return nlohmann::json::array({m.mean, m.ci95});
+  };
+  std::string md = "\n| approach | NEES (n = " + std::to_string(ncs::kN) + ") | 95 % CI | filter steps |\n|---|---:|---:|---:|\n";
+  for (std::size_t a = 0; a < spec.approaches.size(); ++a) {
+    if (!ncs::filtered_approach(ncs::parse_any_approach(spec.approaches[a]))) continue;
+    // Per seed the mean over the scenarios with a NEES (a singular P has none: left out, never 0).
+    std::vector<double> per_seed;
+    double steps = 0;
+    for (std::size_t k = 0; k < spec.seeds; ++k) {
+      double sum = 0;
+      std::size_t count = 0;
+      for (std::size_t x = 0; x < spec.scenarios.size(); ++x) {
+        steps += results.at(a, x, k, steps_i);
+        if (results.at(a, x, k, steps_i) > 0) {
+          sum += results.at(a, x, k, nees_i);
+          ++count;
+        }
+      }
+      if (count > 0) per_seed.push_back(sum / static_cast<double>(count));
+    }
+    const nlohmann::json overall = summary(per_seed);
+    nlohmann::json e = {{"nees_mean", overall[0]}, {"nees_ci95", overall[1]}, {"steps", steps}};
+    for (std::size_t x = 0; x < spec.scenarios.size(); ++x) {
+      std::vector<double> nees;
+      for (std::size_t k = 0; k < spec.seeds; ++k)
+        if (results.at(a, x, k, steps_i) > 0) nees.push_back(results.at(a, x, k, nees_i));
+      const nlohmann::json m = summary(nees);
+      e["per_scenario"][spec.scenarios[x]] = {{"nees_mean", m[0]}, {"nees_ci95", m[1]}};
+    }
+    j["nees"][spec.approaches[a]] = e;
+    char row[200];
+    if (overall[0].is_null()) {
+      std::snprintf(row, sizeof row, "| %s | — | — | %.0f |\n", spec.approaches[a].c_str(), steps);
+    } else {
+      std::snprintf(row, sizeof row, "| %s | %.4f | ± %.4f | %.0f |\n", spec.approaches[a].c_str(), overall[0].get<double>(),
+                    overall[1].get<double>(), steps);
+    }
+    md += row;
+  }
+  j["markdown"] = j.at("markdown").get<std::string>() + md;
+}
+
 }  // namespace
 
 nlohmann::json run_outputs(const engine::SweepResults& results, const std::string& out_dir, bool plots) {
@@ -468,7 +531,8 @@ nlohmann::json run_outputs(const engine::SweepResults& results, const std::strin
   }
   if (spec.config.contains("bus_links")) add_bus_delays(j, results);
   if (spec.config.contains("controller_cpu")) add_cpu_stats(j, results);
-  if (std::find(spec.metrics.begin(), spec.metrics.end(), "nees") != spec.metrics.end()) add_one_shot(j, results);
+  if (std::find(spec.metrics.begin(), spec.metrics.end(), "nees") != spec.metrics.end()) add_nees(j, results);
+  if (std::find(spec.metrics.begin(), spec.metrics.end(), "sensor.samples") != spec.metrics.end()) add_one_shot(j, results);
   return j;
 }
 

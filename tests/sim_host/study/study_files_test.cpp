@@ -297,6 +297,34 @@ TEST(StudyFiles, WhatTheLoopCannotRunIsRefusedNamingTheField) {
   EXPECT_THROW(parse_edited([](nlohmann::json& j) { j["scenarios"][0]["params"]["d"] = 3; }), engine::InputError);
 }
 
+TEST(StudyFiles, NeesOfEveryFilterAndTheWellTunedOneIsConsistent) {
+  // Every approach whose controller runs a Kalman filter reports its NEES (n = 2): e = x − x̂ against
+  // the filter's own P. AKx (the half Kalman filter with the exact Q_d(τ) of each interval) is the
+  // loop's model: its mean NEES over seeds lies within three 95 % intervals of n (plus 1 % for the
+  // first steps from P0 = 10 R). IK, delay-free, is scale-free: at noise scale s the error grows
+  // as √s and P as s, so with the same normalized draws its NEES is the same in every scenario.
+  // SK's filter takes the input as applied at the sample (it is applied τ later): its NEES is far
+  // above n. A has no filter, no NEES.
+  NcsStudy s = map_ncs_study(engine::load_study(example_path(), &ncs_schema()));
+  s.approaches = {ncs::Approach::kI, ncs::Approach::kA, ncs::Approach::kAKx, ncs::Approach::kSK, ncs::Approach::kIK};
+  s.scenarios = {s.scenarios[0], s.scenarios[3]};  // s = 1, d = 4 ms; s = 4, d = 14 ms
+  const nlohmann::json j = run_outputs(run_ncs_sweep(s, 20, 2, engine::Shard{}), temp_dir("nees"), false);
+  const nlohmann::json& nees = j.at("nees");
+  EXPECT_FALSE(nees.contains("A"));
+  EXPECT_FALSE(nees.contains("I"));
+  const double akx = nees.at("AKx").at("nees_mean").get<double>();
+  const double akx_ci = nees.at("AKx").at("nees_ci95").get<double>();
+  EXPECT_LT(std::fabs(akx - 2.0), 3 * akx_ci + 0.02) << akx << " +- " << akx_ci;
+  EXPECT_LT(akx_ci, 0.3);
+  const double sk = nees.at("SK").at("nees_mean").get<double>();
+  EXPECT_GT(sk - 3 * nees.at("SK").at("nees_ci95").get<double>(), 2.0) << sk;
+  const nlohmann::json& ik = nees.at("IK").at("per_scenario");
+  const double ik0 = ik.at(s.scenarios[0].name).at("nees_mean").get<double>();
+  EXPECT_NEAR(ik.at(s.scenarios[1].name).at("nees_mean").get<double>(), ik0, 1e-9 * ik0);
+  EXPECT_EQ(nees.at("IK").at("steps").get<double>(), 20 * 2 * 400);  // one per sample: 20 s at h = 50 ms
+  EXPECT_NE(j.at("markdown").get<std::string>().find("| AKx | "), std::string::npos);
+}
+
 TEST(StudyFiles, OtherStudiesAreRefusedNamingTheStudyField) {
   const engine::StudyFile f = engine::load_study(ONESHOT_ENGINE_EXAMPLE_STUDY, nullptr);
   try {
