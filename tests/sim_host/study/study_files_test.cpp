@@ -3,7 +3,8 @@
 ///        (the file's legs against the table's built-in ones), with --analytic the same
 ///        figures as `ncs table --analytic` and refused approaches reported with the reason,
 ///        per-link counters, shards merged to the same bytes as one run (with and without
-///        --analytic), and the refusals of what the loop cannot run.
+///        --analytic), the refusals of what the loop cannot run, and the NEES of every filter
+///        (the well-tuned AKx consistent, SK's not, IK's free of the noise scale).
 #include <gtest/gtest.h>
 
 #include <cmath>

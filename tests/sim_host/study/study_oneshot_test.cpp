@@ -8,6 +8,8 @@
 ///        controller's job on a CPU (examples/ncs_cpu_one_shot.json): every τ_c within the
 ///        analysed [BCRT, WCRT], a lone constant job equal to the loop with that constant τ_c,
 ///        the timer job analysed as periodic at h, the same bytes on 1 and 2 threads, refusals.
+///        The sensor under MTM: at σ = δ = 0, k_max = 1 the periodic loop bit for bit, its
+///        reference sends (one per set-point change), refusals, the same bytes on 1 and 2 threads.
 #include <gtest/gtest.h>
 
 #include <cmath>
