@@ -8,10 +8,12 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <functional>
 
 #include "ncs_experiments.hpp"
+#include "ncs_loop.hpp"
 #include "oneshot/engine/study_file.hpp"
 #include "study_ncs_runner.hpp"
 #include "study_ncs_sweep.hpp"
@@ -324,6 +326,29 @@ TEST(StudyFiles, NeesOfEveryFilterAndTheWellTunedOneIsConsistent) {
   EXPECT_NEAR(ik.at(s.scenarios[1].name).at("nees_mean").get<double>(), ik0, 1e-9 * ik0);
   EXPECT_EQ(nees.at("IK").at("steps").get<double>(), 20 * 2 * 400);  // one per sample: 20 s at h = 50 ms
   EXPECT_NE(j.at("markdown").get<std::string>().find("| AKx | "), std::string::npos);
+}
+
+TEST(StudyFiles, NeesOfTheFirstFilterStepIsChiSquareOverSeeds) {
+  // IK's first computation, at t = 0: the filter starts on the true state x0 with P0 = 10 R and
+  // corrects with y0 = x0 + v0 (C = I, R diagonal): K = 10/11 I, e = −K v0, P = 10/11 R, so its
+  // NEES is 10/11 v0ᵀ R⁻¹ v0 = 10/11 χ²(2). Over M seeds 11/10 Σ NEES is χ²(2M): within the
+  // two-sided 99.9 % interval (Wilson–Hilferty), one NEES term per run of one period.
+  NcsStudy s = map_ncs_study(engine::load_study(example_path(), &ncs_schema()));
+  ncs::Scenario x = s.scenarios[0];
+  x.duration_s = static_cast<double>(s.ctx->period_us()) * 1e-6;
+  const int m = 400;
+  double sum = 0;
+  for (int seed = 1; seed <= m; ++seed) {
+    const ncs::RunResult r = ncs::run(*s.ctx, ncs::Approach::kIK, x, static_cast<std::uint64_t>(seed), ncs::RunOptions{});
+    ASSERT_EQ(r.nees_steps, 1U);
+    sum += r.nees * 11.0 / 10.0;
+  }
+  const double k = 2.0 * m;
+  const auto quantile = [k](double z) { return k * std::pow(1 - 2 / (9 * k) + z * std::sqrt(2 / (9 * k)), 3); };
+  std::printf("IK first-step NEES: 11/10 sum over %d seeds %.1f, chi2(%.0f) 99.9 %% interval [%.1f, %.1f]\n", m, sum, k,
+              quantile(-3.29), quantile(3.29));
+  EXPECT_GT(sum, quantile(-3.29)) << sum;
+  EXPECT_LT(sum, quantile(3.29)) << sum;
 }
 
 TEST(StudyFiles, OtherStudiesAreRefusedNamingTheStudyField) {
