@@ -4,6 +4,7 @@
 ///        timing streams, the controller's CPU) and the loops' type aliases and addresses.
 #pragma once
 
+#include <cmath>
 #include <functional>
 #include <memory>
 #include <string>
@@ -27,7 +28,7 @@ namespace oneshot::ncs::loop {
 
 using Board = host::HostNetwork;
 using Structure = DenseStructure<kN, kM, kP>;
-using Ref = node::SquareWaveReference<double, kN, kM>;
+using Ref = SetpointReference;
 using Plant = engine::ContinuousPlant<kN, kM, kP, 1>;
 using engine::Duration;
 using engine::EventClass;
@@ -106,8 +107,8 @@ class Harness {
       plant_.set_reference(ref_.state(kk), ref_.input(kk));
       if (an_) an_->set_reference(ref_.state(kk), ref_.input(kk));
     });
-    const std::uint64_t half = half_wave_periods(ctx, sc);
-    for (std::uint64_t k = half; SimTime{h_ * static_cast<std::int64_t>(k)} < end_; k += half) {
+    const auto k_end = static_cast<std::uint64_t>((end_.count() + h_.count() - 1) / h_.count());
+    for (std::uint64_t k : ref_.switches(k_end)) {
       kernel_.schedule(SimTime{h_ * static_cast<std::int64_t>(k)}, EventClass::kEnvironment, sw, k);
     }
     if (sc.controller_cpu && !delay_free(a)) {  // τ_c from the schedule (ncs_cpu.hpp)
@@ -239,6 +240,22 @@ class Harness {
     result_.estimates.push_back(Point{static_cast<double>(k) * engine::to_seconds(h_), {x[0], x[1]}});
   }
 
+  /// Adds e_kᵀ P⁻¹ e_k, e_k = x − x̂, of the estimate `xh` with covariance `p` of the true state
+  /// `x` to the run's NEES (RunResult::nees); nothing when P is singular (noise scale 0) or the
+  /// value is not finite.
+  void add_nees(const Vector<double, kN>& x, const Vector<double, kN>& xh, const Matrix<double, kN, kN>& p) {
+    const double e0 = x[0] - xh[0];
+    const double e1 = x[1] - xh[1];
+    const double det = p(0, 0) * p(1, 1) - p(0, 1) * p(1, 0);
+    if (!(det > 0)) return;
+    static_assert(kN == 2, "the NEES below inverts a 2 x 2 covariance in closed form");
+    // eᵀ P⁻¹ e with P⁻¹ = [[p11, −p01], [−p10, p00]] / det
+    const double q = (e0 * e0 * p(1, 1) - e0 * e1 * (p(0, 1) + p(1, 0)) + e1 * e1 * p(0, 0)) / det;
+    if (!std::isfinite(q)) return;
+    nees_sum_ += q;
+    ++nees_n_;
+  }
+
   /// Node `address` restarts: whatever its interface held is lost.
   void lose_inbox(std::uint8_t address) { net_.node(address).interface.inbox.clear(); }
 
@@ -259,6 +276,8 @@ class Harness {
       }
     }
     result_.cost = plant_.cost().total();
+    result_.nees = nees_n_ > 0 ? nees_sum_ / nees_n_ : 0;
+    result_.nees_steps = nees_n_;
     for (const auto& [nm, l] : legs_) result_.links.emplace_back(nm, l->statistics());
     for (const auto& [nm, route] : bus_legs_) {
       const engine::BusRouteStatistics& st = net_.bus_route_statistics(route.first, route.second);
@@ -318,6 +337,8 @@ class Harness {
   InputVec u_min_;
   InputVec u_max_;
   RunResult result_;
+  double nees_sum_ = 0;        ///< Σ e_kᵀ P_k⁻¹ e_k (add_nees()).
+  std::uint32_t nees_n_ = 0;   ///< Its terms.
   std::unique_ptr<AnalyticTracker> an_;
   std::vector<std::pair<std::string, engine::Link*>> legs_;
   std::vector<std::pair<std::string, std::pair<std::uint8_t, std::uint8_t>>> bus_legs_;  ///< Name, route.

@@ -18,7 +18,7 @@
 namespace oneshot::ncs::live {
 
 using Structure = DenseStructure<kN, kM, kP>;
-using Ref = node::SquareWaveReference<double, kN, kM>;
+using Ref = SetpointReference;
 using InputVec = Vector<double, kM>;
 using OutputVec = Vector<double, kP>;
 using HalfEst = node::HalfKalmanEstimator<Fmt, Structure, Disc>;

@@ -6,6 +6,7 @@
 #include <memory>
 #include <optional>
 #include <stdexcept>
+#include <type_traits>
 #include <vector>
 
 #include "ncs_counters.hpp"
@@ -22,6 +23,15 @@
 
 namespace oneshot::ncs::loop {
 namespace {
+
+/// The Kalman law of the sampling loops SK, IK (its filter has a covariance: the NEES).
+using KalmanLaw = node::PeriodicKalmanLaw<Fmt, Structure, Ref>;
+/// True for a sampling loop's law with a Kalman filter.
+template <typename Law>
+constexpr bool kIsKalmanLaw = std::is_same_v<Law, KalmanLaw>;
+/// True for an actuation-synchronized estimator with a covariance (AK, AKx, AKl; not A's predictor).
+template <typename Estimator>
+constexpr bool kHasCovariance = !std::is_same_v<Estimator, node::SampledStatePredictor<Fmt, Structure, Disc>>;
 
 /// The actuation-synchronized loop with estimator `est` (brief §1).
 template <typename Estimator>
@@ -50,11 +60,25 @@ RunResult run_synchronized(Harness& hs, Estimator est, std::int32_t late_us) {
     // A report the interface refuses is counted in the sensor's statistics.
     net.run_node(kSensor, [&]() { static_cast<void>(sensor->on_sample(net.node_clock(kSensor), y)); });
   });
+  // The NEES (filters with a covariance: AK, AKx, AKl): the estimate x̂⁻_k of x(t_k) and P⁻_k of
+  // the last computation, against the true state at t_k when command k is applied there (the
+  // plant is at t_k then; a period whose command is late is not taken: the run is not moved).
+  struct Pending {
+    bool set = false;
+    node::SequenceNumber k = 0;
+    Vector<double, kN> xh{};
+    Matrix<double, kN, kN> p{};
+  } pending;
   const HandlerId compute_h = k.add_handler("compute", [&](std::uint64_t) {
     const Estimator before = ctrl->estimator();
     const std::uint32_t runs = ctrl->statistics().computations;
     net.run_node(kController, [&]() { ctrl->on_receive(net.node_clock(kController)); });
     hs.estimate(ctrl->last_k(), ctrl->estimator().estimate());
+    if constexpr (kHasCovariance<Estimator>) {
+      if (ctrl->statistics().computations != runs && hs.opt_faults_empty_) {
+        pending = Pending{true, ctrl->last_k(), ctrl->estimator().estimate(), ctrl->estimator().filter().covariance()};
+      }
+    }
     if (hs.an_ && ctrl->statistics().computations != runs) {
       hs.an_->compute_sync(before, ctrl->estimator(), hs.ctx_.period_us(), hs.ref_.state(ctrl->last_k()),
                            hs.ref_.input(ctrl->last_k()), ctrl->last_command());
@@ -111,7 +135,13 @@ RunResult run_synchronized(Harness& hs, Estimator est, std::int32_t late_us) {
         act->on_timer(static_cast<node::SequenceNumber>(n - act_n0), next);
       }
       InputVec u;
-      if (act->take_output(u)) hs.apply(u);
+      if (act->take_output(u)) {
+        hs.apply(u);
+        if (pending.set && pending.k == n - act_n0) {
+          hs.add_nees(hs.plant_.state(), pending.xh, pending.p);
+          pending.set = false;
+        }
+      }
     });
     const SimTime t_next = k.now() + hs.h_;
     if (t_next < hs.end_) k.schedule(t_next, EventClass::kActuation, *timer_h, n + 1);
@@ -145,10 +175,30 @@ RunResult run_sampling(Harness& hs, Law law, Saturated saturated) {
   engine::Network& net = hs.net_;
   engine::Kernel& k = hs.kernel_;
   std::uint32_t samples = 0;  // the sequence number of the next sample (no restart in analytic runs)
+  // The NEES (the Kalman law of SK, IK): x̂_{k|k}, P_{k|k} of each computation against the true
+  // state at its sample's instant (kh; the sampling job's sample point on a CPU), by sequence number.
+  std::vector<Vector<double, kN>> truth;
+  std::vector<bool> truth_set;
+  const auto note_truth = [&](node::SequenceNumber seq) {
+    if (!kIsKalmanLaw<Law> || !hs.opt_faults_empty_) return;
+    if (truth.size() <= seq) {
+      truth.resize(seq + std::size_t{1});
+      truth_set.resize(seq + std::size_t{1}, false);
+    }
+    truth[seq] = hs.plant_.state();
+    truth_set[seq] = true;
+  };
   const HandlerId compute_h = k.add_handler("compute", [&](std::uint64_t) {
     const Law before = ctrl->law();
+    const std::uint32_t runs = ctrl->statistics().computations;
     net.run_node(controller_at, [&]() { ctrl->on_receive(net.node_clock(controller_at)); });
     if (hs.an_) hs.an_->compute_law(before, samples - 1);
+    if constexpr (kIsKalmanLaw<Law>) {
+      const node::SequenceNumber seq = ctrl->latest().seq;
+      if (ctrl->statistics().computations != runs && seq < truth.size() && truth_set[seq]) {
+        hs.add_nees(truth[seq], ctrl->law().filter().prediction(), ctrl->law().filter().covariance());
+      }
+    }
   });
   net.add_node(sensor_at, "sensor", Duration{0}, nullptr);
   net.add_node(controller_at, "controller", Duration{0},
@@ -188,6 +238,7 @@ RunResult run_sampling(Harness& hs, Law law, Saturated saturated) {
     hs.sensor_cpu_->on_point([&](std::size_t e, std::uint64_t n, engine::cpu::CpuEventKind kind) {
       if (e != hs.sensor_task_ || kind != engine::cpu::CpuEventKind::kSample || n >= jobs.size()) return;
       jobs[n].y = hs.sample();
+      note_truth(jobs[n].seq);
       jobs[n].sampled = true;
       ++samples;
     });
@@ -213,6 +264,7 @@ RunResult run_sampling(Harness& hs, Law law, Saturated saturated) {
     const OutputVec y = hs.sample();
     ++samples;
     const auto seq = static_cast<node::SequenceNumber>(n - sensor_n0);
+    note_truth(seq);
     net.run_node(sensor_at, [&]() { sensor->on_sample(seq, net.node_clock(sensor_at), y); });
     const SimTime t_next = k.now() + hs.h_;
     if (t_next < hs.end_) k.schedule(t_next, EventClass::kSample, *timer_h, n + 1);
@@ -252,7 +304,7 @@ RunResult run_on(Harness& hs, Approach a) {
     return e;
   };
   using Feedback = node::StateFeedbackLaw<double, kN, kM, Ref>;
-  using Kalman = node::PeriodicKalmanLaw<Fmt, Structure, Ref>;
+  using Kalman = KalmanLaw;
   using Compensated = node::DelayCompensatedLaw<double, kN, kM, Ref>;
   switch (a) {
     case Approach::kA:

@@ -26,13 +26,13 @@
 #include <vector>
 
 #include "ncs_model.hpp"
+#include "ncs_reference.hpp"
 #include "oneshot/engine/continuous_plant.hpp"
 #include "oneshot/engine/jump_linear_cost.hpp"
 #include "oneshot/engine/fault_spec.hpp"
 #include "oneshot/engine/frame_faults.hpp"
 #include "oneshot/engine/link.hpp"
 #include "oneshot/engine/network.hpp"
-#include "oneshot/node/square_wave_reference.hpp"
 
 namespace oneshot::ncs {
 
@@ -98,11 +98,15 @@ struct RunResult {
   std::string analytic_refusal;    ///< Analytic runs: why the expected cost is not valid ("" when it is).
   double analytic_mismatch = 0;    ///< Analytic runs: largest |mean − simulated| (relative to max(1, |value|)).
   std::vector<double> counters;    ///< Node counters (ncs_counters.hpp, order of counter_names()).
-  /// One-shot loops: the controller's corrected estimate against the true state at its
-  /// sampling instant, mean of e_kᵀ P_k⁻¹ e_k over the computations whose P_k is regular
-  /// (not at noise scale 0; 0 for the other loops and when none is).
+  /// Loops whose controller runs a Kalman filter (filtered_approach()): the mean of
+  /// e_kᵀ P_k⁻¹ e_k, e_k the true state minus the filter's estimate, P_k its covariance, over
+  /// the computations whose P_k is regular (not at noise scale 0; 0 for the other loops and
+  /// when none is). SK, IK and the one-shot loops: x(kh) (the sample's instant) against
+  /// x̂_{k|k}, P_{k|k} after the corrections of period k; AK, AKx, AKl: x(t_k) against the
+  /// prediction x̂⁻_k, P⁻_k to the actuation instant, over the periods whose command k is
+  /// applied at t_k. Runs with injected faults: none.
   double nees = 0;
-  std::uint32_t nees_steps = 0;    ///< One-shot loops: computations in that mean.
+  std::uint32_t nees_steps = 0;    ///< Computations in that mean.
   std::uint32_t sent = 0;          ///< One-shot loops: samples the sensor sent (of `samples`).
   std::uint32_t sampled = 0;       ///< One-shot loops: samples the sensor took.
   /// Counters of the links the run built, by leg name (order of link_names()).
@@ -123,8 +127,9 @@ struct RunResult {
 
 /// The plant of a run (process noise when `noisy`), shared by the simulation and the live plant.
 engine::ContinuousPlantConfig<kN, kM, kP, 1> plant_config(const Context& ctx, const Scenario& sc, bool noisy);
-/// The set-point square wave of a scenario (x_ref, u_ref per period index).
-node::SquareWaveReference<double, kN, kM> reference(const Context& ctx, const Scenario& sc);
+/// The set-point of a scenario (x_ref, u_ref per period index): its steps
+/// (Scenario::setpoint_changes) or the square wave ±A_r of period T_r.
+SetpointReference reference(const Context& ctx, const Scenario& sc);
 /// Network leg `name` ("as", "sc", "ca"): U[0.5, d] ms in whole µs, FIFO, or the scenario's
 /// leg from a study file (Scenario::legs); none for I, IK.
 engine::LinkConfig leg(const Context& ctx, const Scenario& sc, Approach a, const char* name);

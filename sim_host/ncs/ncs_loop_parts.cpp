@@ -29,14 +29,14 @@ engine::ContinuousPlantConfig<kN, kM, kP, 1> plant_config(const Context& ctx, co
   return c;
 }
 
-node::SquareWaveReference<double, kN, kM> reference(const Context& ctx, const Scenario& sc) {
+SetpointReference reference(const Context& ctx, const Scenario& sc) {
   const std::size_t out = ctx.design().tracked_outputs.empty() ? 0 : ctx.design().tracked_outputs[0];
   Vector<double, kN> nx;
   Vector<double, kM> nu;
   for (std::size_t i = 0; i < kN; ++i) nx[i] = ctx.design().nx(i, out);
   for (std::size_t j = 0; j < kM; ++j) nu[j] = ctx.design().nu(j, out);
-  return node::SquareWaveReference<double, kN, kM>(sc.amplitude_volts,
-                                                   static_cast<std::uint32_t>(half_wave_periods(ctx, sc)), nx, nu);
+  if (sc.setpoint_changes) return SetpointReference(sc.setpoint_r0, sc.setpoint_changes, nx, nu);
+  return SetpointReference(sc.amplitude_volts, static_cast<std::uint32_t>(half_wave_periods(ctx, sc)), nx, nu);
 }
 
 engine::LinkConfig leg(const Context& ctx, const Scenario& sc, Approach a, const char* name) {

@@ -173,6 +173,41 @@ Disc::Model Context::discretizer_model(double s) const {
   return m;
 }
 
+void set_steps(Scenario& sc, std::int64_t h_us, const std::vector<std::pair<double, double>>& steps) {
+  if (h_us <= 0) throw std::invalid_argument("ncs set-point steps: the period h must be positive");
+  const std::int64_t h_ns = h_us * 1000;
+  auto changes = std::make_shared<std::vector<std::pair<std::uint64_t, double>>>();
+  double r0 = 0;
+  double last = 0;  // the set-point of the period before
+  std::uint64_t last_k = 0;
+  for (std::size_t i = 0; i < steps.size(); ++i) {
+    const double t_s = steps[i].first;
+    if (!(t_s >= 0 && t_s <= 1e6)) throw std::invalid_argument("step " + std::to_string(i) + ": t_s must be in [0, 1e6] s");
+    const std::int64_t t_ns = std::llround(t_s * 1e9);
+    const auto k = static_cast<std::uint64_t>((t_ns + h_ns - 1) / h_ns);
+    if (i > 0 && k <= last_k) {
+      throw std::invalid_argument("steps " + std::to_string(i - 1) + " and " + std::to_string(i) + " (t_s " +
+                                  std::to_string(steps[i - 1].first) + " and " + std::to_string(t_s) +
+                                  " s) fall in one period h = " + std::to_string(h_us) + " us (the set-point changes on the kh grid)");
+    }
+    last_k = k;
+    const double v = steps[i].second;
+    if (k == 0) {
+      r0 = v;
+    } else if (v != last) {
+      changes->emplace_back(k, v);
+    }
+    last = v;
+  }
+  sc.setpoint_r0 = r0;
+  sc.setpoint_changes = std::move(changes);
+}
+
+std::uint64_t first_setpoint_change(const Context& ctx, const Scenario& sc) {
+  if (sc.setpoint_changes) return sc.setpoint_changes->empty() ? 0 : sc.setpoint_changes->front().first;
+  return sc.amplitude_volts != 0 ? half_wave_periods(ctx, sc) : 0;
+}
+
 std::uint64_t half_wave_periods(const Context& ctx, const Scenario& sc) {
   const double half = sc.period_s * 0.5e6 / ctx.period_us();
   const auto n = static_cast<std::uint64_t>(std::llround(half));

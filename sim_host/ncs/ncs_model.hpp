@@ -44,6 +44,12 @@ inline constexpr std::array<Approach, 9> kAllApproaches = {Approach::kI,   Appro
 inline constexpr std::array<Approach, 3> kOneShotApproaches = {Approach::kOS, Approach::kOSp, Approach::kOSK};
 /// True for the one-shot loops (OS, OSp, OSK).
 constexpr bool one_shot(Approach a) { return a == Approach::kOS || a == Approach::kOSp || a == Approach::kOSK; }
+/// True for the loops whose controller runs a Kalman filter with a covariance P (AK, AKx,
+/// AKl, SK, IK, OS, OSp, OSK): the ones with a NEES.
+constexpr bool filtered_approach(Approach a) {
+  return a == Approach::kAK || a == Approach::kAKx || a == Approach::kAKl || a == Approach::kSK || a == Approach::kIK ||
+         one_shot(a);
+}
 /// Short name ("I", "S", "A", "AK", "AKx", "AKl", "SK", "S+", "IK", "OS", "OSp", "OSK").
 const char* name(Approach a);
 /// One-line description.
@@ -102,10 +108,30 @@ struct Scenario {
   /// every sample) and its time rule n_t in samples (0: plain send-on-delta), from a study file.
   std::vector<double> sod_delta;
   std::uint32_t sod_time_steps = 0;  ///< n_t of the send-on-delta rule (0: off).
+  /// One-shot loops (OS, OSp): the sensor's MTM rule instead of send-on-delta (node::MtmTrigger:
+  /// send when (ȳ_i − y_i)² > σ y_i² + δ, after k_max silent samples, k_ref,max samples after a
+  /// set-point change); OS then needs σ = 0 (its held value within ±√δ: δy = √δ, n_t = k_max).
+  bool sensor_mtm = false;
+  double mtm_sigma = 0;             ///< σ of the MTM rule.
+  double mtm_delta = 0;             ///< δ of the MTM rule (V²).
+  std::uint32_t mtm_k_max = 0;      ///< k_max of the MTM rule (0: off).
+  std::uint32_t mtm_k_ref_max = 0;  ///< k_ref,max of the MTM rule.
   /// One-shot loops: the controller's timer fires φ after each sampling instant, at kh + φ
   /// (0 < φ < h; std::invalid_argument otherwise).
   std::int64_t controller_phase_us = 0;
+  /// A stepped set-point (a study file's `reference` of kind steps or file) on the kh grid: the
+  /// changes (period k > 0, new value), k strictly increasing, set_steps(); null: the square
+  /// wave ±A_r of period T_r.
+  std::shared_ptr<const std::vector<std::pair<std::uint64_t, double>>> setpoint_changes;
+  double setpoint_r0 = 0;            ///< r_0 of the stepped set-point (before its first change).
+  std::string setpoint_description;  ///< The stepped set-point in one line (the sweep's configuration).
 };
+
+/// Puts the steps (t_s, value) (times strictly increasing, the set-point 0 before the first)
+/// on the kh grid of `sc`: each step from the first period k with kh ≥ t_s (to the ns), r_0
+/// the value at k = 0, a change wherever the value differs from the period before.
+/// std::invalid_argument naming the step's index when two steps fall in one period.
+void set_steps(Scenario& sc, std::int64_t h_us, const std::vector<std::pair<double, double>>& steps);
 
 /// True when the legs come from a study file (point to point or on a bus), not from d.
 inline bool legs_from_file(const Scenario& s) { return !s.legs.empty() || !s.bus_legs.empty(); }
@@ -161,6 +187,10 @@ class Context {
 /// does not set adds 0); std::nullopt when one has no bound (Poisson, lognormal, Pareto) or is
 /// on a CAN bus (its bound is the bus analysis's), that leg's name then in *unbounded_leg when given.
 std::optional<engine::Duration> sc_ca_delay_bound(const Scenario& s, const char** unbounded_leg = nullptr);
+
+/// The first period k > 0 whose set-point differs from the initial one: T_r/2 in periods for
+/// the square wave (0 at amplitude 0), the first change of steps (0 when they never change).
+std::uint64_t first_setpoint_change(const Context& ctx, const Scenario& sc);
 
 /// Periods h in half a set-point period; std::invalid_argument unless whole.
 std::uint64_t half_wave_periods(const Context& ctx, const Scenario& sc);

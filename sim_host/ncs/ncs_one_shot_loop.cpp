@@ -11,8 +11,10 @@
 #include "oneshot/node/controller_node.hpp"
 #include "oneshot/node/held_measurement.hpp"
 #include "oneshot/node/held_measurement_estimator.hpp"
+#include "oneshot/node/mtm_trigger.hpp"
 #include "oneshot/node/send_on_delta_trigger.hpp"
 #include "oneshot/node/sensor_node.hpp"
+#include "oneshot/node/square_wave_reference.hpp"
 
 namespace oneshot::ncs::loop {
 namespace {
@@ -84,6 +86,39 @@ class OneShotLaw {
   std::uint32_t faults_ = 0;
 };
 
+/// The one-shot sensor's rule: send-on-delta (OS, OSp; OSK: every sample through its time
+/// rule) or MTM (Scenario::sensor_mtm), one SensorNode type for both.
+class OneShotTrigger {
+ public:
+  using Sod = node::SendOnDeltaTrigger<double, kP>;
+  using Mtm = node::MtmTrigger<double, kP>;
+  /// Send-on-delta.
+  explicit OneShotTrigger(const Sod& sod) : sod_(sod), mtm_(0, 0, 0, 0), mtm_on_(false) {}
+  /// MTM.
+  explicit OneShotTrigger(const Mtm& mtm) : sod_(Vector<double, kP>{}, 0), mtm_(mtm), mtm_on_(true) {}
+  /// The rule's decision for sample k with value y.
+  node::SendCause evaluate(node::SequenceNumber k, const OutputVec& y) const {
+    return mtm_on_ ? mtm_.evaluate(k, y) : sod_.evaluate(k, y);
+  }
+  /// A send of sample k with value y.
+  void on_sent(node::SequenceNumber k, const OutputVec& y) {
+    if (mtm_on_) {
+      mtm_.on_sent(k, y);
+    } else {
+      sod_.on_sent(k, y);
+    }
+  }
+  /// The set-point changes at sample k (MTM sends k_ref,max samples later; send-on-delta ignores it).
+  void notify_reference_change(node::SequenceNumber k) {
+    if (mtm_on_) mtm_.notify_reference_change(k);
+  }
+
+ private:
+  Sod sod_;
+  Mtm mtm_;
+  bool mtm_on_;
+};
+
 }  // namespace
 
 /// The one-shot loop (ncs_model.hpp kOneShotApproaches): sensor on its timer at kh under
@@ -93,8 +128,7 @@ class OneShotLaw {
 /// With a controller CPU (Scenario::controller_cpu) the timer releases the controller's job
 /// (periodic at h, phase φ) and the command is computed and sent at its finish.
 RunResult run_one_shot(Harness& hs, Approach a) {
-  using Trigger = node::SendOnDeltaTrigger<double, kP>;
-  using Sensor = node::SensorNode<Board, Trigger, double, kP>;
+  using Sensor = node::SensorNode<Board, OneShotTrigger, double, kP>;
   using Ctrl = node::ControllerNode<Board, OneShotLaw, double, kP, kM>;
   using Act = node::ActuatorNode<Board, double, kM>;
   const Scenario& sc = hs.sc_;
@@ -106,7 +140,18 @@ RunResult run_one_shot(Harness& hs, Approach a) {
   Vector<double, kP> delta{};
   std::uint32_t n_t[kP] = {};
   std::uint32_t sensor_n_t = 1;  // OSK: the time rule sends every sample
-  if (a != Approach::kOSK) {
+  const bool mtm = a != Approach::kOSK && sc.sensor_mtm;
+  if (mtm) {
+    // Silent under MTM with σ = 0: |ȳ_i − y_i| ≤ √δ, the held value of send-on-delta at δy = √δ
+    // with the time rule n_t = k_max. With σ > 0 the bound depends on y: OS (held) cannot run.
+    if (a == Approach::kOS && sc.mtm_sigma != 0) {
+      throw std::invalid_argument("ncs one-shot loop: OS under MTM needs sigma = 0 (a held value within +-sqrt(delta))");
+    }
+    for (std::size_t i = 0; i < kP; ++i) {
+      delta[i] = std::sqrt(sc.mtm_delta);
+      n_t[i] = sc.mtm_k_max;
+    }
+  } else if (a != Approach::kOSK) {
     if (sc.sod_delta.size() != kP) throw std::invalid_argument("ncs one-shot loop: OS and OSp need one delta per output");
     for (std::size_t i = 0; i < kP; ++i) {
       delta[i] = sc.sod_delta[i];
@@ -121,7 +166,8 @@ RunResult run_one_shot(Harness& hs, Approach a) {
   OneShotLaw::Estimator est(hs.design_.phi_h, hs.design_.gamma_h, hs.design_.qd_h * sc.noise_scale, hs.design_.c);
   const Vector<double, kN> x0 = hs.ref_.state(0);
   est.reset(x0, hs.design_.p0);
-  Sensor sensor(kController, Trigger(delta, sensor_n_t));
+  Sensor sensor(kController, mtm ? OneShotTrigger(OneShotTrigger::Mtm(sc.mtm_sigma, sc.mtm_delta, sc.mtm_k_max, sc.mtm_k_ref_max))
+                                 : OneShotTrigger(OneShotTrigger::Sod(delta, sensor_n_t)));
   Ctrl ctrl(kActuator, node::ControllerMode::kOnTimer, OneShotLaw(rx, est, hs.design_.l, hs.u_min_, hs.u_max_, hs.ref_));
   ctrl.expect_source(kSensor);
   // A send-on-delta sensor may stay silent for any number of periods: its next sample is not a
@@ -132,8 +178,6 @@ RunResult run_one_shot(Harness& hs, Approach a) {
   engine::Network& net = hs.net_;
   engine::Kernel& k = hs.kernel_;
   std::vector<Vector<double, kN>> truth;  // x(kh) per sample k
-  double nees_sum = 0;
-  std::uint32_t nees_n = 0;
   net.add_node(kSensor, "sensor", Duration{0}, nullptr);
   net.add_node(kController, "controller", Duration{0}, nullptr);  // frames wait for its timer
   net.add_node(kActuator, "actuator", Duration{0}, [&]() { act.on_receive(); });
@@ -147,18 +191,8 @@ RunResult run_one_shot(Harness& hs, Approach a) {
     net.run_node(kController, [&]() { ctrl.on_timer(net.node_clock(kController), kk + 1); });
     if (ctrl.statistics().computations == runs || n >= truth.size()) return;
     const Vector<double, kN>& xh = ctrl.law().corrected();
-    const Matrix<double, kN, kN>& p = ctrl.law().corrected_covariance();
-    const double e0 = truth[n][0] - xh[0];
-    const double e1 = truth[n][1] - xh[1];
-    const double det = p(0, 0) * p(1, 1) - p(0, 1) * p(1, 0);
     hs.estimate(kk, xh);
-    if (!(det > 0)) return;  // a singular P (noise scale 0): no NEES term
-    static_assert(kN == 2, "the NEES below inverts a 2 x 2 covariance in closed form");
-    // eᵀ P⁻¹ e with P⁻¹ = [[p11, −p01], [−p10, p00]] / det
-    const double q = (e0 * e0 * p(1, 1) - e0 * e1 * (p(0, 1) + p(1, 0)) + e1 * e1 * p(0, 0)) / det;
-    if (!std::isfinite(q)) return;
-    nees_sum += q;
-    ++nees_n;
+    hs.add_nees(truth[n], xh, ctrl.law().corrected_covariance());  // x(kh) against x̂_{k|k}, P_{k|k}
   });
   auto ctrl_h = std::make_shared<HandlerId>(0);
   *ctrl_h = k.add_handler("controller timer", [&, ctrl_h](std::uint64_t n) {
@@ -171,6 +205,8 @@ RunResult run_one_shot(Harness& hs, Approach a) {
   *sample_h = k.add_handler("sample", [&, sample_h](std::uint64_t n) {
     const OutputVec y = hs.sample();
     truth.push_back(hs.plant_.state());
+    const auto kk = static_cast<node::SequenceNumber>(n);
+    if (mtm && n > 0 && hs.ref_.setpoint(kk) != hs.ref_.setpoint(kk - 1)) sensor.trigger().notify_reference_change(kk);
     net.run_node(kSensor, [&]() { sensor.on_sample(static_cast<node::SequenceNumber>(n), net.node_clock(kSensor), y); });
     const SimTime t_next = k.now() + hs.h_;
     if (t_next < hs.end_) k.schedule(t_next, EventClass::kSample, *sample_h, n + 1);
@@ -194,8 +230,6 @@ RunResult run_one_shot(Harness& hs, Approach a) {
   r.late = act.statistics().late;
   r.saturated = ctrl.law().saturated();
   r.faults = ctrl.law().faults();
-  r.nees = nees_n > 0 ? nees_sum / nees_n : 0;
-  r.nees_steps = nees_n;
   r.sent = sensor.statistics().sends;
   r.sampled = sensor.statistics().samples;
   r.counters = concat(sampling_controller_counters(ctrl), actuator_counters(act));

@@ -30,7 +30,7 @@ namespace oneshot::ncs {
 namespace {
 
 using Structure = DenseStructure<kN, kM, kP>;
-using Ref = node::SquareWaveReference<double, kN, kM>;
+using Ref = SetpointReference;
 using InputVec = Vector<double, kM>;
 using OutputVec = Vector<double, kP>;
 using Outcome = engine::PeriodOutcome<kZ>;

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <algorithm>
 #include <cstdio>
+#include <map>
 #include <optional>
 #include <sstream>
 
@@ -218,7 +219,14 @@ json resolve_study(const engine::StudyFile& f) {
     }
     // The grid.
     for (const engine::ScenarioSpec& s : f.scenarios) {
-      r["scenarios"].push_back({{"name", s.name}, {"duration_s", s.duration_s.value_or(f.duration_s)}, {"params", s.params}});
+      const engine::ReferenceSpec* ref = s.reference ? &*s.reference : (f.reference ? &*f.reference : nullptr);
+      std::map<std::string, double> params = s.params;
+      if (ref != nullptr) {  // the set-point is the reference's: the square-wave params' defaults do not apply
+        for (const char* key : {"amplitude_volts", "period_s"})
+          if (s.params_given.count(key) == 0) params.erase(key);
+      }
+      r["scenarios"].push_back({{"name", s.name}, {"duration_s", s.duration_s.value_or(f.duration_s)}, {"params", params}});
+      if (ref != nullptr) r["scenarios"].back()["reference"] = ref->describe();
     }
     r["grid"] = {{"approaches", f.approaches.size()}, {"scenarios", f.scenarios.size()},
                  {"runs_per_seed", f.approaches.size() * f.scenarios.size()},

@@ -104,7 +104,8 @@ study::NcsStudy runnable(const Checked& k, const CLI::Option* max_duration, doub
   return s;
 }
 
-/// Each scenario's simulated time as it runs, and whether --max-duration cut it.
+/// Each scenario's simulated time as it runs, and whether --max-duration cut it; with a stepped
+/// set-point (a `reference` of steps or a file), each scenario's set-point.
 std::string simulated_time_text(const study::NcsStudy& s, const CLI::Option* max_duration, double max_duration_s) {
   std::ostringstream t;
   t << "Simulated time per run:";
@@ -112,6 +113,21 @@ std::string simulated_time_text(const study::NcsStudy& s, const CLI::Option* max
     t << (i == 0 ? " " : ", ") << s.scenarios[i].name << " " << s.scenarios[i].duration_s << " s";
   if (max_duration->count() > 0) t << " (capped by --max-duration " << max_duration_s << ")";
   t << ".";
+  bool stepped = false;  // only then: the reports of square-wave files stay as they were
+  for (const ncs::Scenario& x : s.scenarios) stepped = stepped || x.setpoint_changes != nullptr;
+  if (stepped) {
+    t << " Set-point:";
+    for (std::size_t i = 0; i < s.scenarios.size(); ++i) {
+      const ncs::Scenario& x = s.scenarios[i];
+      t << (i == 0 ? " " : ", ") << x.name << " ";
+      if (x.setpoint_changes) {
+        t << x.setpoint_description;
+      } else {
+        t << "square +-" << x.amplitude_volts << " V, T_r " << x.period_s << " s";
+      }
+    }
+    t << ".";
+  }
   return t.str();
 }
 

@@ -6,6 +6,7 @@
 #include <filesystem>
 #include <iterator>
 #include <map>
+#include <optional>
 #include <stdexcept>
 #include <utility>
 #include <vector>
@@ -20,14 +21,20 @@ namespace {
 using engine::InputError;
 
 /// Why approach I, the reference of every ratio, would cost exactly 0 on `sc` ("" when it does
-/// not): it starts on the set-point without delay or noise, so it costs nothing until the first
-/// set-point switch at T_r/2, and nothing at all with amplitude 0. Ratios to it would divide by 0.
+/// not): it starts on the set-point without delay or noise, so it costs nothing until the
+/// set-point first changes (a square wave at T_r/2), and nothing at all when it never does.
+/// Ratios to it would divide by 0.
 std::string zero_reference_cost(const ncs::Context& ctx, const ncs::Scenario& sc) {
-  if (!(sc.amplitude_volts > 0)) return "amplitude 0 keeps the reference approach I at cost 0: no ratio to it";
-  const double first_switch_s = static_cast<double>(ncs::half_wave_periods(ctx, sc)) * static_cast<double>(ctx.period_us()) * 1e-6;
+  const std::uint64_t k = ncs::first_setpoint_change(ctx, sc);
+  if (k == 0) {
+    return sc.setpoint_changes ? "the set-point never changes, so the reference approach I costs 0: no ratio to it"
+                               : "amplitude 0 keeps the reference approach I at cost 0: no ratio to it";
+  }
+  const double first_switch_s = static_cast<double>(k) * static_cast<double>(ctx.period_us()) * 1e-6;
   if (!(sc.duration_s > first_switch_s)) {
-    return "the run ends (" + std::to_string(sc.duration_s) + " s) before the first set-point switch at T_r/2 = " +
-           std::to_string(first_switch_s) + " s, so the reference approach I costs 0: no ratio to it";
+    return "the run ends (" + std::to_string(sc.duration_s) + " s) before the first set-point switch at " +
+           std::string(sc.setpoint_changes ? "" : "T_r/2 = ") + std::to_string(first_switch_s) +
+           " s, so the reference approach I costs 0: no ratio to it";
   }
   return "";
 }
@@ -46,8 +53,9 @@ const engine::StudySchema& ncs_schema() {
     s.study = "ncs";
     for (ncs::Approach a : ncs::kAllApproaches) s.approach_kinds.emplace_back(ncs::name(a));
     for (ncs::Approach a : ncs::kOneShotApproaches) s.approach_kinds.emplace_back(ncs::name(a));
-    s.scenario_params = {{"amplitude_volts", 0, 100, false, true, 0},
-                         {"period_s", 1e-3, 1e6, false, true, 0},
+    // amplitude_volts and period_s: required without a `reference` (map_ncs_study checks).
+    s.scenario_params = {{"amplitude_volts", 0, 100, false, false, 0},
+                         {"period_s", 1e-3, 1e6, false, false, 1},
                          {"noise_scale", 0, 1e6, false, false, 1}};
     return s;
   }();
@@ -87,9 +95,10 @@ NcsStudy map_ncs_study(const engine::StudyFile& file) {
     for (const engine::ApproachSpec& a : file.approaches) {
       for (ncs::Approach k : ncs::kOneShotApproaches) one_shot = one_shot || a.kind == ncs::name(k);
     }
-    std::string sod_field;  // the sensor's send-on-delta trigger ("" when it has none)
+    std::string sod_field;  // the sensor's event trigger, send-on-delta or MTM ("" when it has none)
     std::vector<double> sod_delta;
     std::uint32_t sod_time_steps = 0;
+    std::optional<engine::TriggerSpec> mtm_rule;  // the sensor's MTM trigger (sod_field names it)
     std::int64_t phase_us = 0;
     for (std::size_t i = 0; i < file.nodes.size(); ++i) {
       const engine::NodeSpec& n = file.nodes[i];
@@ -103,7 +112,12 @@ NcsStudy map_ncs_study(const engine::StudyFile& file) {
         refuse(f + ".clock_offset_us", "study ncs runs its nodes on one clock (0 only; the one-shot controller's gives its phase)");
       }
       const bool sod = n.trigger && n.trigger->rule == engine::TriggerSpec::Rule::kSendOnDelta && n.role == "sensor";
-      if (sod) {
+      const bool mtm = n.trigger && n.trigger->rule == engine::TriggerSpec::Rule::kMtm && n.role == "sensor";
+      if (mtm) {
+        if (!one_shot) refuse(f + ".trigger", "MTM runs with the one-shot approaches only (OS, OSp, OSK)");
+        sod_field = f + ".trigger";
+        mtm_rule = *n.trigger;
+      } else if (sod) {
         if (!one_shot) refuse(f + ".trigger", "send-on-delta runs with the one-shot approaches only (OS, OSp, OSK)");
         if (n.trigger->delta.size() != ncs::kP) {
           refuse(f + ".trigger.delta", "one threshold per output: " + std::to_string(ncs::kP) + " values, not " +
@@ -113,7 +127,7 @@ NcsStudy map_ncs_study(const engine::StudyFile& file) {
         sod_delta = n.trigger->delta;
         sod_time_steps = n.trigger->time_steps;
       } else if (n.trigger && !(n.trigger->rule == engine::TriggerSpec::Rule::kPeriodic && n.trigger->every == 1)) {
-        refuse(f + ".trigger", "study ncs samples every period (periodic, every 1, or a sensor's send-on-delta with OS, OSp)");
+        refuse(f + ".trigger", "study ncs samples every period (periodic, every 1, or a sensor's send-on-delta or MTM with OS, OSp)");
       }
       if (timed_controller) {
         if (n.mode != "timer") refuse(f + ".mode", "the one-shot controller (OS, OSp, OSK) runs a timer at h");
@@ -180,11 +194,15 @@ NcsStudy map_ncs_study(const engine::StudyFile& file) {
                             "controller; its other approaches can be I and IK only");
       }
       if (!sod_field.empty() && !ncs::one_shot(ap) && !ncs::delay_free(ap)) {
-        refuse(f + ".kind", a.kind + " cannot use the sensor's send-on-delta rule (" + sod_field + ")");
+        refuse(f + ".kind", a.kind + " cannot use the sensor's event trigger (" + sod_field + ")");
       }
       if (sod_field.empty() && (ap == ncs::Approach::kOS || ap == ncs::Approach::kOSp)) {
-        refuse(f + ".kind", a.kind + " needs a send-on-delta sensor (nodes[].trigger {\"rule\": \"send_on_delta\", ...}); "
-                            "OSK is the one-shot loop with a sensor that sends every sample");
+        refuse(f + ".kind", a.kind + " needs an event-triggered sensor (nodes[].trigger {\"rule\": \"send_on_delta\", ...} or "
+                            "{\"rule\": \"mtm\", ...}); OSK is the one-shot loop with a sensor that sends every sample");
+      }
+      if (mtm_rule && ap == ncs::Approach::kOS && mtm_rule->sigma != 0) {
+        refuse(sod_field + ".sigma", "OS corrects with a silent sensor's held value within +-sqrt(delta): MTM with sigma = 0 "
+                                     "only (sigma > 0 bounds it by y itself; OSp and OSK run with any sigma)");
       }
       if (!first_bus_link.empty() && ncs::one_shot(ap)) {
         refuse(f + ".kind", a.kind + ": the one-shot loops do not run on a CAN bus (" + first_bus_link + ")");
@@ -209,29 +227,63 @@ NcsStudy map_ncs_study(const engine::StudyFile& file) {
     for (std::size_t i = 0; i < file.scenarios.size(); ++i) {
       const engine::ScenarioSpec& s = file.scenarios[i];
       const std::string f = at("scenarios", i);
-      // The schema's checks again (a file parsed without it reaches here too).
-      std::map<std::string, double> params = s.params;
+      // The set-point: the scenario's `reference`, else the file's, else the square wave of the
+      // params amplitude_volts and period_s (required then, refused with a reference).
+      const engine::ReferenceSpec* ref = s.reference ? &*s.reference : (file.reference ? &*file.reference : nullptr);
+      // The schema's checks again, on what the file gave (a file parsed without it reaches here too).
+      std::map<std::string, double> params;
+      for (const auto& [key, v] : s.params) {
+        if (s.params_given.count(key) == 0) continue;  // a schema default
+        const engine::ParamSpec* spec = nullptr;
+        for (const engine::ParamSpec& p : ncs_schema().scenario_params)
+          if (p.name == key) spec = &p;
+        if (spec == nullptr) refuse(f + ".params", "unknown parameter (amplitude_volts, period_s, noise_scale)");
+        if (!(v >= spec->min && v <= spec->max)) refuse(f + ".params." + key, "out of range");
+        params[key] = v;
+      }
       for (const engine::ParamSpec& p : ncs_schema().scenario_params) {
         const std::string g = f + ".params." + p.name;
-        const auto it = params.find(p.name);
-        if (it == params.end()) {
-          if (p.required) refuse(g, "missing");
-          params[p.name] = p.fallback;
-        } else if (!(it->second >= p.min && it->second <= p.max)) {
-          refuse(g, "out of range");
+        const bool wave = p.name == "amplitude_volts" || p.name == "period_s";
+        if (wave && ref != nullptr && params.count(p.name) != 0) {
+          refuse(g, "the set-point comes from '" + ref->field + "' (a square wave there takes amplitude_volts and period_s)");
         }
-      }
-      if (params.size() != ncs_schema().scenario_params.size()) {
-        refuse(f + ".params", "unknown parameter (amplitude_volts, period_s, noise_scale)");
+        if (params.count(p.name) != 0) continue;
+        if (wave && ref == nullptr) refuse(g, "missing (or give the set-point as a 'reference')");
+        params[p.name] = p.fallback;
       }
       ncs::Scenario sc;
       sc.name = s.name;
       sc.amplitude_volts = params.at("amplitude_volts");
       sc.period_s = params.at("period_s");
       sc.noise_scale = params.at("noise_scale");
+      std::string amplitude_field = f + ".params.amplitude_volts";
+      std::string period_field = f + ".params.period_s";
+      if (ref != nullptr && ref->kind == engine::ReferenceSpec::Kind::kSquare) {  // the params' square wave, bit for bit
+        sc.amplitude_volts = ref->amplitude_volts;
+        sc.period_s = ref->period_s;
+        amplitude_field = ref->field + ".amplitude_volts";
+        period_field = ref->field + ".period_s";
+      } else if (ref != nullptr) {
+        sc.amplitude_volts = 0;
+        sc.period_s = 0;
+        amplitude_field = ref->field + (ref->kind == engine::ReferenceSpec::Kind::kFile ? ".path" : ".steps");
+        try {
+          ncs::set_steps(sc, h_us, ref->steps);
+        } catch (const std::invalid_argument& e) {
+          refuse(amplitude_field, e.what());
+        }
+        sc.setpoint_description = ref->describe();
+      }
       sc.duration_s = s.duration_s.value_or(file.duration_s);
       sc.sod_delta = sod_delta;
       sc.sod_time_steps = sod_time_steps;
+      if (mtm_rule) {
+        sc.sensor_mtm = true;
+        sc.mtm_sigma = mtm_rule->sigma;
+        sc.mtm_delta = mtm_rule->mtm_delta;
+        sc.mtm_k_max = mtm_rule->k_max;
+        sc.mtm_k_ref_max = mtm_rule->k_ref_max;
+      }
       sc.controller_phase_us = phase_us;
       for (const engine::LinkSpec& l : file.links) {
         if (l.bus.empty()) {
@@ -252,13 +304,15 @@ NcsStudy map_ncs_study(const engine::StudyFile& file) {
       // takes the legs instead: 0. study run leaves ncs table's by-d keys out and reports each
       // scenario's sc + ca delay bound (study_ncs_sweep.hpp).
       sc.max_delay_ms = 0;
-      try {
-        static_cast<void>(ncs::half_wave_periods(*out.ctx, sc));
-      } catch (const std::exception&) {
-        refuse(f + ".params.period_s", "T_r/2 must be a whole number of periods h = " + std::to_string(h_us) + " us");
+      if (!sc.setpoint_changes) {
+        try {
+          static_cast<void>(ncs::half_wave_periods(*out.ctx, sc));
+        } catch (const std::exception&) {
+          refuse(period_field, "T_r/2 must be a whole number of periods h = " + std::to_string(h_us) + " us");
+        }
       }
       if (!(sc.duration_s * 1e6 >= static_cast<double>(h_us))) refuse(f + ".duration_s", "shorter than one period h");
-      if (!(sc.amplitude_volts > 0)) refuse(f + ".params.amplitude_volts", zero_reference_cost(*out.ctx, sc));
+      if (ncs::first_setpoint_change(*out.ctx, sc) == 0) refuse(amplitude_field, zero_reference_cost(*out.ctx, sc));
       const std::string zero = zero_reference_cost(*out.ctx, sc);
       if (!zero.empty()) refuse(s.duration_s ? f + ".duration_s" : std::string("duration_s"), zero);
       for (ncs::Approach a : out.approaches) {

@@ -9,9 +9,11 @@
 /// the scenarios' link overrides), the scenario parameters are ncs Scenario fields, the
 /// approach kinds are ncs approach names. Legs sc and ca may run on a CAN bus (with the bus's
 /// background traffic) under the sampling loops (I, S, SK, IK): the actuation-synchronized
-/// approaches and S+ are refused then, as is the leg as on a bus. Everything else the schema
-/// accepts (clock offsets, trigger rules other than periodic every sample, other addresses, inline
-/// plants) is refused with the field and the reason.
+/// approaches and S+ are refused then, as is the leg as on a bus. The set-point is the
+/// scenario's or the file's `reference` (square, steps, file), else the params' square wave; the
+/// one-shot loops' sensor may run send-on-delta or MTM. Everything else the schema accepts
+/// (clock offsets, other trigger rules, other addresses, inline plants) is refused with the
+/// field and the reason.
 #pragma once
 
 #include <array>
@@ -44,7 +46,8 @@ inline constexpr NcsLeg kNcsLegs[] = {
 const NcsLeg* find_ncs_leg(const std::string& name);
 
 /// What `study run` accepts from a file with "study": "ncs" (approach kinds: the ncs
-/// approaches; scenario params amplitude_volts, period_s required, noise_scale default 1).
+/// approaches; scenario params amplitude_volts, period_s — required by map_ncs_study() unless a
+/// `reference` gives the set-point —, noise_scale default 1).
 const engine::StudySchema& ncs_schema();
 
 /// A study file resolved onto the ncs loop.
@@ -89,8 +92,8 @@ std::string plant_file_path(const engine::StudyFile& file);
 
 /// Maps a file parsed with ncs_schema() onto the ncs loop; engine::InputError naming the
 /// file and the field for anything the loop cannot run, and for a scenario on which the
-/// reference approach I would cost 0 (amplitude 0, or a run that ends before the first
-/// set-point switch at T_r/2): every ratio to I would divide by 0.
+/// reference approach I would cost 0 (a set-point that never changes, or a run that ends
+/// before its first change): every ratio to I would divide by 0.
 NcsStudy map_ncs_study(const engine::StudyFile& file);
 
 /// Caps the simulated time of every scenario of `s` at `max_s` seconds (`study run

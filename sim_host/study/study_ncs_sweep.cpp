@@ -1,11 +1,12 @@
 /// @file study_ncs_sweep.cpp
-/// @brief The sweep and summary of `oneshot-sim study run` (see study_ncs_sweep.hpp).
+/// @brief The sweep of `oneshot-sim study run` (see study_ncs_sweep.hpp; its summary: study_ncs_summary.cpp).
 #include "study_ncs_sweep.hpp"
 
 #include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <optional>
 #include <utility>
 #include <vector>
@@ -110,6 +111,29 @@ std::array<double, std::size(kCpuMetrics)> cpu_metrics(const ncs::RunResult& r) 
           static_cast<double>(c.other_misses), static_cast<double>(c.busy.count()) * 1e-3};
 }
 
+/// A stepped set-point of scenario `x` for the sweep's configuration: its description, r_0, the
+/// number of changes on the kh grid and an FNV-1a hash of their periods and values (shards of
+/// files with other steps do not merge).
+nlohmann::json setpoint_json(const ncs::Scenario& x) {
+  std::uint64_t hash = 14695981039346656037ULL;
+  const auto mix = [&hash](std::uint64_t v) {
+    for (int b = 0; b < 8; ++b) {
+      hash ^= (v >> (8 * b)) & 0xFFU;
+      hash *= 1099511628211ULL;
+    }
+  };
+  for (const auto& [k, v] : *x.setpoint_changes) {
+    std::uint64_t bits = 0;
+    std::memcpy(&bits, &v, sizeof bits);
+    mix(k);
+    mix(bits);
+  }
+  char hex[17];
+  std::snprintf(hex, sizeof hex, "%016llx", static_cast<unsigned long long>(hash));
+  return {{"description", x.setpoint_description}, {"r0", x.setpoint_r0}, {"changes", x.setpoint_changes->size()},
+          {"changes_fnv1a", hex}};
+}
+
 }  // namespace
 
 nlohmann::json loop_sweep_config(const NcsStudy& s) {
@@ -137,6 +161,7 @@ nlohmann::json loop_sweep_config(const NcsStudy& s) {
                   {"s_plus_mean_tau_io_us", x.bus_legs.empty() ? nlohmann::json(s.ctx->mean_tau_io_us(x)) : nlohmann::json(nullptr)},
                   {"legs", legs}});
     if (!x.bus_legs.empty()) sc.back()["bus_legs"] = bus_legs;
+    if (x.setpoint_changes) sc.back()["reference"] = setpoint_json(x);  // only then: square-wave files' specs stay as they were
   }
   nlohmann::json config = {{"study_file", s.source},
                            {"plant", s.ctx->plant().name},
@@ -195,8 +220,15 @@ engine::SweepResults run_ncs_sweep(const NcsStudy& s, std::size_t seeds, unsigne
   const bool on_cpu = !s.scenarios.empty() && s.scenarios[0].controller_cpu != nullptr;
   if (on_cpu)
     for (const char* c : kCpuMetrics) spec.metrics.push_back(std::string("cpu.") + c);
-  // Only with one-shot approaches: the spec of other files stays as it was.
-  if (one_shot) spec.metrics.insert(spec.metrics.end(), std::begin(kOneShotMetrics), std::end(kOneShotMetrics));
+  // Only with one-shot approaches: their metrics (NEES first); with other filtered approaches
+  // the NEES alone; files without a filter keep their spec.
+  bool filtered = false;
+  for (ncs::Approach a : s.approaches) filtered = filtered || ncs::filtered_approach(a);
+  if (one_shot) {
+    spec.metrics.insert(spec.metrics.end(), std::begin(kOneShotMetrics), std::end(kOneShotMetrics));
+  } else if (filtered) {
+    spec.metrics.insert(spec.metrics.end(), std::begin(kOneShotMetrics), std::begin(kOneShotMetrics) + 2);
+  }
   spec.config = loop_sweep_config(s);
   if (on_cpu) {  // likewise
     const ncs::ControllerCpu& c = *s.scenarios[0].controller_cpu;
@@ -221,6 +253,10 @@ engine::SweepResults run_ncs_sweep(const NcsStudy& s, std::size_t seeds, unsigne
     const ncs::Scenario& x = s.scenarios[0];
     spec.config["one_shot"] = {{"send_on_delta", x.sod_delta}, {"time_steps", x.sod_time_steps},
                                {"controller_phase_us", x.controller_phase_us}};
+    if (x.sensor_mtm) {  // only then: the spec of send-on-delta files stays as it was
+      spec.config["one_shot"]["mtm"] = {{"sigma", x.mtm_sigma}, {"delta", x.mtm_delta}, {"k_max", x.mtm_k_max},
+                                        {"k_ref_max", x.mtm_k_ref_max}};
+    }
   }
   if (analytic) {  // only then, as ncs table: the spec stays as it was without
     spec.config["analytic"] = true;
@@ -237,7 +273,7 @@ engine::SweepResults run_ncs_sweep(const NcsStudy& s, std::size_t seeds, unsigne
   const std::vector<std::string>* bus = &on_bus;
   return engine::run_sweep(
       spec, shard, threads,
-      [study, counter_maps, bus, analytic, on_cpu, one_shot](std::size_t a, std::size_t k, std::uint64_t seed) {
+      [study, counter_maps, bus, analytic, on_cpu, one_shot, filtered](std::size_t a, std::size_t k, std::uint64_t seed) {
         const ncs::Approach ap = study->approaches[a];
         const ncs::RunResult r = ncs::run(*study->ctx, ap, study->scenarios[k], seed, ncs::RunOptions{});
         std::vector<double> v{r.cost, static_cast<double>(r.late), static_cast<double>(r.saturated),
@@ -254,7 +290,11 @@ engine::SweepResults run_ncs_sweep(const NcsStudy& s, std::size_t seeds, unsigne
           const auto c = cpu_metrics(r);
           v.insert(v.end(), c.begin(), c.end());
         }
-        if (one_shot) v.insert(v.end(), {r.nees, static_cast<double>(r.nees_steps), static_cast<double>(r.sampled), static_cast<double>(r.sent)});
+        if (one_shot) {
+          v.insert(v.end(), {r.nees, static_cast<double>(r.nees_steps), static_cast<double>(r.sampled), static_cast<double>(r.sent)});
+        } else if (filtered) {
+          v.insert(v.end(), {r.nees, static_cast<double>(r.nees_steps)});
+        }
         if (analytic) {  // ncs table --analytic's columns: the same run in analytic mode
           const auto x = ncs::analytic_metrics(*study->ctx, ap, study->scenarios[k], seed, ncs::RunOptions{});
           v.insert(v.end(), x.begin(), x.end());
@@ -262,211 +302,6 @@ engine::SweepResults run_ncs_sweep(const NcsStudy& s, std::size_t seeds, unsigne
         return v;
       },
       "study run");
-}
-
-namespace {
-
-/// Adds "bus_delays" (per approach, per leg on a bus: observed delays over every run beside
-/// the analysis's worst-case response time) and its table to the markdown.
-void add_bus_delays(nlohmann::json& j, const engine::SweepResults& results) {
-  const engine::SweepSpec& spec = results.spec;
-  std::string md = "\n| approach | leg | messages | min delay (us) | mean delay (us) | max delay (us) | worst-case response (us) |\n"
-                   "|---|---|---:|---:|---:|---:|---:|\n";
-  for (std::size_t a = 0; a < spec.approaches.size(); ++a) {
-    for (const auto& l : spec.config.at("bus_links")) {
-      const std::string leg = l.get<std::string>();
-      const std::size_t mm = results.metric(leg + ".bus_messages");
-      const std::size_t mn = results.metric(leg + ".bus_delay_min_us");
-      const std::size_t mx = results.metric(leg + ".bus_delay_max_us");
-      const std::size_t ms = results.metric(leg + ".bus_delay_sum_us");
-      nlohmann::json e = nlohmann::json::object();
-      double n_all = 0, sum_all = 0, min_all = 0, max_all = 0;
-      nlohmann::json wcrt_all = 0.0;
-      for (std::size_t s = 0; s < spec.scenarios.size(); ++s) {
-        double n = 0, sum = 0, lo = 0, hi = 0;
-        for (std::size_t k = 0; k < spec.seeds; ++k) {
-          const double c = results.at(a, s, k, mm);
-          if (c <= 0) continue;
-          lo = n == 0 ? results.at(a, s, k, mn) : std::fmin(lo, results.at(a, s, k, mn));
-          hi = std::fmax(hi, results.at(a, s, k, mx));
-          n += c;
-          sum += results.at(a, s, k, ms);
-        }
-        const nlohmann::json& w = spec.config.at("scenarios")[s].at("bus_legs").at(leg).at("worst_response_us");
-        if (w.is_null() || wcrt_all.is_null()) {
-          wcrt_all = nullptr;
-        } else {
-          wcrt_all = std::fmax(wcrt_all.get<double>(), w.get<double>());
-        }
-        nlohmann::json x = {{"messages", n}, {"worst_response_us", w}};
-        x["min_us"] = n > 0 ? nlohmann::json(lo) : nlohmann::json(nullptr);
-        x["mean_us"] = n > 0 ? nlohmann::json(sum / n) : nlohmann::json(nullptr);
-        x["max_us"] = n > 0 ? nlohmann::json(hi) : nlohmann::json(nullptr);
-        e["per_scenario"][spec.scenarios[s]] = x;
-        if (n > 0) {
-          min_all = n_all == 0 ? lo : std::fmin(min_all, lo);
-          max_all = std::fmax(max_all, hi);
-          n_all += n;
-          sum_all += sum;
-        }
-      }
-      e["messages"] = n_all;
-      e["min_us"] = n_all > 0 ? nlohmann::json(min_all) : nlohmann::json(nullptr);
-      e["mean_us"] = n_all > 0 ? nlohmann::json(sum_all / n_all) : nlohmann::json(nullptr);
-      e["max_us"] = n_all > 0 ? nlohmann::json(max_all) : nlohmann::json(nullptr);
-      e["worst_response_us"] = wcrt_all;
-      e["within_bound"] = n_all == 0 || (!wcrt_all.is_null() && max_all <= wcrt_all.get<double>());
-      j["bus_delays"][spec.approaches[a]][leg] = e;
-      if (n_all == 0) continue;  // I and IK: delay-free links, nothing on the bus
-      char row[256];
-      std::snprintf(row, sizeof row, "| %s | %s | %.0f | %.3f | %.3f | %.3f | %s |\n", spec.approaches[a].c_str(), leg.c_str(), n_all,
-                    min_all, sum_all / n_all, max_all, wcrt_all.is_null() ? "unbounded" : wcrt_all.dump().c_str());
-      md += row;
-    }
-  }
-  j["markdown"] = j.at("markdown").get<std::string>() + md;
-}
-
-/// Adds "cpu" (per approach: the controller job's observed response times over every run
-/// beside the analysis's bounds, misses, measured utilization) and its table to the markdown.
-void add_cpu_stats(nlohmann::json& j, const engine::SweepResults& results) {
-  const engine::SweepSpec& spec = results.spec;
-  const nlohmann::json& cfg = spec.config.at("controller_cpu");
-  const double wcrt = cfg.at("wcrt_us").get<double>(), bcrt = cfg.at("bcrt_us").get<double>();
-  std::size_t m[std::size(kCpuMetrics)];
-  for (std::size_t i = 0; i < std::size(kCpuMetrics); ++i) m[i] = results.metric(std::string("cpu.") + kCpuMetrics[i]);
-  std::string md = "\n| approach | controller jobs | min tau_c (us) | mean tau_c (us) | max tau_c (us) | BCRT (us) | WCRT (us) | "
-                   "within | deadline misses | other misses | utilization |\n|---|---:|---:|---:|---:|---:|---:|---|---:|---:|---:|\n";
-  for (std::size_t a = 0; a < spec.approaches.size(); ++a) {
-    double n = 0, lo = 0, hi = 0, sum = 0, miss = 0, other = 0, busy = 0, time_us = 0;
-    for (std::size_t s = 0; s < spec.scenarios.size(); ++s) {
-      const double dur_us = spec.config.at("scenarios")[s].at("duration_s").get<double>() * 1e6;
-      for (std::size_t k = 0; k < spec.seeds; ++k) {
-        const double c = results.at(a, s, k, m[0]);
-        time_us += dur_us;
-        busy += results.at(a, s, k, m[6]);
-        other += results.at(a, s, k, m[5]);
-        if (c <= 0) continue;
-        lo = n == 0 ? results.at(a, s, k, m[1]) : std::fmin(lo, results.at(a, s, k, m[1]));
-        hi = std::fmax(hi, results.at(a, s, k, m[2]));
-        n += c;
-        sum += results.at(a, s, k, m[3]);
-        miss += results.at(a, s, k, m[4]);
-      }
-    }
-    nlohmann::json e = {{"jobs", n}, {"wcrt_us", wcrt}, {"bcrt_us", bcrt}, {"deadline_misses", miss}, {"other_misses", other},
-                        {"utilization_measured", time_us > 0 ? busy / time_us : 0.0}};
-    e["min_us"] = n > 0 ? nlohmann::json(lo) : nlohmann::json(nullptr);
-    e["mean_us"] = n > 0 ? nlohmann::json(sum / n) : nlohmann::json(nullptr);
-    e["max_us"] = n > 0 ? nlohmann::json(hi) : nlohmann::json(nullptr);
-    e["within_bounds"] = n == 0 || (lo >= bcrt && hi <= wcrt);
-    j["cpu"][spec.approaches[a]] = e;
-    if (n == 0) continue;  // I and IK: delay-free, not on the CPU
-    char row[320];
-    std::snprintf(row, sizeof row, "| %s | %.0f | %.1f | %.1f | %.1f | %.1f | %.1f | %s | %.0f | %.0f | %.4f |\n", spec.approaches[a].c_str(), n,
-                  lo, sum / n, hi, bcrt, wcrt, e.at("within_bounds").get<bool>() ? "yes" : "no", miss, other,
-                  e.at("utilization_measured").get<double>());
-    md += row;
-  }
-  j["markdown"] = j.at("markdown").get<std::string>() + md;
-  j["markdown_cpu"] = md;
-}
-
-/// Adds "one_shot" (per one-shot approach: the filter's NEES, mean and 95 % interval over
-/// seeds of the scenario mean, and the sensor's send rate, overall and per scenario) and its
-/// table to the markdown.
-void add_one_shot(nlohmann::json& j, const engine::SweepResults& results) {
-  const engine::SweepSpec& spec = results.spec;
-  const std::size_t nees_i = results.metric("nees");
-  const std::size_t steps_i = results.metric("nees_steps");
-  const std::size_t sampled = results.metric("sensor.samples");
-  const std::size_t sent = results.metric("sensor.sent");
-  // A run without a regular P (noise scale 0) has no NEES: left out, never counted as 0. Per seed
-  // the mean over the scenarios that have one, then the mean and interval over the seeds.
-  const auto summary = [](const std::vector<double>& v) {
-    if (v.empty()) return nlohmann::json::array({nullptr, nullptr});
-    const util::Summary m = util::summarize(v);
-    return nlohmann::json::array({m.mean, m.ci95});
-  };
-  std::string md = "\n| approach | NEES (n = " + std::to_string(ncs::kN) +
-                   ") | 95 % CI | samples sent |\n|---|---:|---:|---:|\n";
-  for (std::size_t a = 0; a < spec.approaches.size(); ++a) {
-    if (!ncs::one_shot(ncs::parse_any_approach(spec.approaches[a]))) continue;
-    std::vector<double> per_seed;
-    for (std::size_t k = 0; k < spec.seeds; ++k) {
-      double sum = 0;
-      std::size_t count = 0;
-      for (std::size_t x = 0; x < spec.scenarios.size(); ++x) {
-        if (results.at(a, x, k, steps_i) > 0) {
-          sum += results.at(a, x, k, nees_i);
-          ++count;
-        }
-      }
-      if (count > 0) per_seed.push_back(sum / static_cast<double>(count));
-    }
-    const nlohmann::json overall = summary(per_seed);
-    nlohmann::json e = {{"nees_mean", overall[0]}, {"nees_ci95", overall[1]}};
-    double n_all = 0, s_all = 0;
-    for (std::size_t x = 0; x < spec.scenarios.size(); ++x) {
-      double n = 0, sn = 0;
-      std::vector<double> nees;
-      for (std::size_t k = 0; k < spec.seeds; ++k) {
-        n += results.at(a, x, k, sampled);
-        sn += results.at(a, x, k, sent);
-        if (results.at(a, x, k, steps_i) > 0) nees.push_back(results.at(a, x, k, nees_i));
-      }
-      const nlohmann::json m = summary(nees);
-      e["per_scenario"][spec.scenarios[x]] = {{"nees_mean", m[0]}, {"nees_ci95", m[1]},
-                                              {"samples", n}, {"sent", sn}, {"send_rate", n > 0 ? sn / n : 0.0}};
-      n_all += n;
-      s_all += sn;
-    }
-    e["samples"] = n_all;
-    e["sent"] = s_all;
-    e["send_rate"] = n_all > 0 ? s_all / n_all : 0.0;
-    j["one_shot"][spec.approaches[a]] = e;
-    char row[200];
-    if (overall[0].is_null()) {
-      std::snprintf(row, sizeof row, "| %s | — | — | %.4f |\n", spec.approaches[a].c_str(), e["send_rate"].get<double>());
-    } else {
-      std::snprintf(row, sizeof row, "| %s | %.4f | ± %.4f | %.4f |\n", spec.approaches[a].c_str(), overall[0].get<double>(),
-                    overall[1].get<double>(), e["send_rate"].get<double>());
-    }
-    md += row;
-  }
-  j["markdown"] = j.at("markdown").get<std::string>() + md;
-}
-
-}  // namespace
-
-nlohmann::json run_outputs(const engine::SweepResults& results, const std::string& out_dir, bool plots) {
-  if (results.spec.config.contains("loops")) return loops_outputs(results, out_dir, plots);  // study_loops_sweep.cpp
-  nlohmann::json j = ncs::table_outputs(results, out_dir, plots);
-  const engine::SweepSpec& spec = results.spec;
-  j["experiment"] = "study run";
-  j["study_file"] = spec.config.at("study_file");
-  // ncs table keys S's ratio by study ncs's d, which the file's legs do not have: left out.
-  j.erase("S_ratio_to_I_by_delay_ms");
-  j.erase("S_ratio_increases_with_delay");
-  for (const auto& x : spec.config.at("scenarios")) j["delay_bound_sc_ca_ms"][x.at("name").get<std::string>()] = x.at("delay_bound_sc_ca_ms");
-  for (std::size_t a = 0; a < spec.approaches.size(); ++a) {
-    for (const auto& l : spec.config.at("links")) {
-      const std::string link = l.get<std::string>();
-      nlohmann::json e = nlohmann::json::object();
-      for (const char* c : kLinkCounters) {
-        const std::size_t m = results.metric(link + "." + c);
-        double total = 0;
-        for (std::size_t s = 0; s < spec.scenarios.size(); ++s)
-          for (std::size_t k = 0; k < spec.seeds; ++k) total += results.at(a, s, k, m);
-        e[c] = total;
-      }
-      j["links"][spec.approaches[a]][link] = e;
-    }
-  }
-  if (spec.config.contains("bus_links")) add_bus_delays(j, results);
-  if (spec.config.contains("controller_cpu")) add_cpu_stats(j, results);
-  if (std::find(spec.metrics.begin(), spec.metrics.end(), "nees") != spec.metrics.end()) add_one_shot(j, results);
-  return j;
 }
 
 }  // namespace oneshot::study

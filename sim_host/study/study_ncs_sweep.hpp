@@ -32,8 +32,9 @@ inline constexpr const char* kBusDelayMetrics[] = {"bus_messages", "bus_delay_mi
 inline constexpr const char* kCpuMetrics[] = {"jobs", "response_min_us", "response_max_us", "response_sum_us",
                                               "deadline_misses", "other_misses", "busy_us"};
 /// Metrics of the one-shot approaches (only in sweeps that run one): the filter's NEES (mean of
-/// e_kᵀ P_k⁻¹ e_k over the run's computations, 0 for the other approaches), its computations,
-/// the sensor's samples and the samples it sent.
+/// e_kᵀ P_k⁻¹ e_k over the run's computations, 0 for the approaches without a filter), its
+/// computations, the sensor's samples and the samples it sent. Sweeps with filtered approaches
+/// (ncs::filtered_approach()) but no one-shot one have the first two only.
 inline constexpr const char* kOneShotMetrics[] = {"nees", "nees_steps", "sensor.samples", "sensor.sent"};
 
 /// Position of the counter `name` in kLinkCounters (its size when there is none).
@@ -108,6 +109,9 @@ engine::SweepResults run_ncs_sweep(const NcsStudy& s, std::size_t seeds, unsigne
 /// CPU's other tasks and ISRs) and the measured utilization (busy time / simulated time;
 /// I and IK do not use the CPU: 0 jobs); its table is appended to "markdown" and is
 /// "markdown_cpu".
+/// With approaches that run a Kalman filter (ncs::filtered_approach()), "nees": per such
+/// approach nees_mean, nees_ci95 (over seeds of the scenario mean), steps (the filter
+/// computations averaged) and per_scenario nees_mean, nees_ci95 (table appended to "markdown").
 /// With one-shot approaches, "one_shot": per
 /// such approach nees_mean, nees_ci95 (over seeds), samples, sent, send_rate and per_scenario
 /// the same (table appended to "markdown").

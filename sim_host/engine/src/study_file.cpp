@@ -172,7 +172,7 @@ StudyFile parse_study(const std::string& text, const std::string& source, const 
   const json root = parse_json_strict(text, source);
   try {
     require_keys(root, "study file", {"schema", "study", "description", "plant", "loops", "duration_s", "seeds", "nodes",
-                                      "links", "buses", "cpus", "approaches", "scenarios"});
+                                      "links", "buses", "cpus", "approaches", "scenarios", "reference"});
     StudyFile s;
     s.source = source;
     if (string_of(root, "study file", "schema") != kStudySchemaVersion) {
@@ -343,16 +343,21 @@ StudyFile parse_study(const std::string& text, const std::string& source, const 
     }
     unique_names(s.approaches, "approaches");
 
+    if (root.contains("reference")) s.reference = parse_reference(root["reference"], "reference", base_dir);
     const json& scenarios = array_of(root, "study file", "scenarios", false);
     if (scenarios.empty()) throw InputError("field 'scenarios': must not be empty");
     for (std::size_t i = 0; i < scenarios.size(); ++i) {
       const std::string f = at("scenarios", i);
       const json& sc = scenarios[i];
-      require_keys(sc, f, {"name", "duration_s", "params", "links"});
+      require_keys(sc, f, {"name", "duration_s", "params", "links", "reference"});
       ScenarioSpec x;
       x.name = string_of(sc, f, "name");
       if (sc.contains("duration_s")) x.duration_s = number_in(sc, f, "duration_s", 1e-6, 1e6);
       x.params = parse_params(sc, f, schema != nullptr ? &schema->scenario_params : nullptr);
+      if (sc.contains("params")) {
+        for (const auto& item : sc["params"].items()) x.params_given.insert(item.key());
+      }
+      if (sc.contains("reference")) x.reference = parse_reference(sc["reference"], f + ".reference", base_dir);
       if (sc.contains("links")) {
         const json& over = sc["links"];
         if (!over.is_object()) throw InputError("field '" + f + ".links': must be an object of link overrides");

@@ -6,6 +6,8 @@
 
 #include <fstream>
 #include <functional>
+#include <set>
+#include <utility>
 #include <sstream>
 
 #include "oneshot/engine/study_file.hpp"
@@ -166,6 +168,45 @@ TEST(StudyFile, SeveralLoopsEachHaveTheirPlantAndNodes) {
       ADD_FAILURE() << "accepted; expected an error naming " << c.expected;
     } catch (const InputError& e) {
       EXPECT_NE(std::string(e.what()).find(c.expected), std::string::npos) << e.what();
+TEST(StudyFile, ReferencesParseStrictlyAtTheTopAndPerScenario) {
+  const StudySchema schema = example_schema();
+  const StudyFile f = parse_study(
+      edited("\"scenarios\": [", "\"reference\": {\"kind\": \"steps\", \"steps\": [[0, 0.1], [1.5, -0.2]]}, \"scenarios\": ["),
+      "f.json", &schema);
+  ASSERT_TRUE(f.reference.has_value());
+  EXPECT_EQ(f.reference->kind, ReferenceSpec::Kind::kSteps);
+  ASSERT_EQ(f.reference->steps.size(), 2U);
+  EXPECT_EQ(f.reference->steps[1], std::make_pair(1.5, -0.2));
+  EXPECT_EQ(f.reference->field, "reference");
+  EXPECT_EQ(f.reference->describe(), "steps (2)");
+  EXPECT_EQ(f.scenarios[0].params_given, std::set<std::string>{"amplitude"});  // period_s: the schema's default
+  const StudyFile g = parse_study(
+      edited("{\"amplitude\": 0.2}", "{\"amplitude\": 0.2}, \"reference\": {\"kind\": \"square\", \"amplitude_volts\": 0.3, \"period_s\": 2}"),
+      "f.json", &schema);
+  ASSERT_TRUE(g.scenarios[0].reference.has_value());
+  EXPECT_EQ(g.scenarios[0].reference->field, "scenarios[0].reference");
+  EXPECT_EQ(g.scenarios[0].reference->amplitude_volts, 0.3);
+  EXPECT_FALSE(g.reference.has_value());
+  // The CSV form, line by line.
+  const auto steps = parse_reference_csv("t_s,value_volts\r\n# c\n\n0, 1\n2.5,-1e-3\n", "reference.path", "x.csv");
+  ASSERT_EQ(steps.size(), 2U);
+  EXPECT_EQ(steps[1], std::make_pair(2.5, -1e-3));
+  const std::pair<const char*, const char*> bad[] = {
+      {"", "x.csv line 1"},
+      {"t_s;value_volts\n0,1\n", "x.csv line 1"},
+      {"t_s,value_volts\n0,1\n0,2\n", "x.csv line 3: times must increase strictly"},
+      {"t_s,value_volts\n0,inf\n", "x.csv line 2: expected two finite numbers"},
+      {"t_s,value_volts\n1e400,0\n", "x.csv line 2: expected two finite numbers"},
+      {"t_s,value_volts\n0\n", "x.csv line 2"},
+      {"t_s,value_volts\n2e6,0\n", "x.csv line 2: t_s must be finite in [0, 1e6] s"},
+      {"t_s,value_volts\n", "x.csv: no steps"},
+  };
+  for (const auto& [text, expect] : bad) {
+    try {
+      static_cast<void>(parse_reference_csv(text, "reference.path", "x.csv"));
+      ADD_FAILURE() << "accepted: " << text;
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find(std::string("field 'reference.path': ") + expect), std::string::npos) << e.what();
     }
   }
 }

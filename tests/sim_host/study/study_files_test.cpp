@@ -3,14 +3,17 @@
 ///        (the file's legs against the table's built-in ones), with --analytic the same
 ///        figures as `ncs table --analytic` and refused approaches reported with the reason,
 ///        per-link counters, shards merged to the same bytes as one run (with and without
-///        --analytic), and the refusals of what the loop cannot run.
+///        --analytic), the refusals of what the loop cannot run, and the NEES of every filter
+///        (the well-tuned AKx consistent, SK's not, IK's free of the noise scale).
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <functional>
 
 #include "ncs_experiments.hpp"
+#include "ncs_loop.hpp"
 #include "oneshot/engine/study_file.hpp"
 #include "study_ncs_runner.hpp"
 #include "study_ncs_sweep.hpp"
@@ -291,6 +294,57 @@ TEST(StudyFiles, WhatTheLoopCannotRunIsRefusedNamingTheField) {
   // The schema refuses unknown kinds and parameters (parse_study).
   EXPECT_THROW(parse_edited([](nlohmann::json& j) { j["approaches"][1]["kind"] = "Z"; }), engine::InputError);
   EXPECT_THROW(parse_edited([](nlohmann::json& j) { j["scenarios"][0]["params"]["d"] = 3; }), engine::InputError);
+}
+
+TEST(StudyFiles, NeesOfEveryFilterAndTheWellTunedOneIsConsistent) {
+  // Every approach whose controller runs a Kalman filter reports its NEES (n = 2): e = x − x̂ against
+  // the filter's own P. AKx (the half Kalman filter with the exact Q_d(τ) of each interval) is the
+  // loop's model: its mean NEES over seeds lies within three 95 % intervals of n (plus 1 % for the
+  // first steps from P0 = 10 R). IK, delay-free, is scale-free: at noise scale s the error grows
+  // as √s and P as s, so with the same normalized draws its NEES is the same in every scenario.
+  // SK's filter takes the input as applied at the sample (it is applied τ later): its NEES is far
+  // above n. A has no filter, no NEES.
+  NcsStudy s = map_ncs_study(engine::load_study(example_path(), &ncs_schema()));
+  s.approaches = {ncs::Approach::kI, ncs::Approach::kA, ncs::Approach::kAKx, ncs::Approach::kSK, ncs::Approach::kIK};
+  s.scenarios = {s.scenarios[0], s.scenarios[3]};  // s = 1, d = 4 ms; s = 4, d = 14 ms
+  const nlohmann::json j = run_outputs(run_ncs_sweep(s, 20, 2, engine::Shard{}), temp_dir("nees"), false);
+  const nlohmann::json& nees = j.at("nees");
+  EXPECT_FALSE(nees.contains("A"));
+  EXPECT_FALSE(nees.contains("I"));
+  const double akx = nees.at("AKx").at("nees_mean").get<double>();
+  const double akx_ci = nees.at("AKx").at("nees_ci95").get<double>();
+  EXPECT_LT(std::fabs(akx - 2.0), 3 * akx_ci + 0.02) << akx << " +- " << akx_ci;
+  EXPECT_LT(akx_ci, 0.3);
+  const double sk = nees.at("SK").at("nees_mean").get<double>();
+  EXPECT_GT(sk - 3 * nees.at("SK").at("nees_ci95").get<double>(), 2.0) << sk;
+  const nlohmann::json& ik = nees.at("IK").at("per_scenario");
+  const double ik0 = ik.at(s.scenarios[0].name).at("nees_mean").get<double>();
+  EXPECT_NEAR(ik.at(s.scenarios[1].name).at("nees_mean").get<double>(), ik0, 1e-9 * ik0);
+  EXPECT_EQ(nees.at("IK").at("steps").get<double>(), 20 * 2 * 400);  // one per sample: 20 s at h = 50 ms
+  EXPECT_NE(j.at("markdown").get<std::string>().find("| AKx | "), std::string::npos);
+}
+
+TEST(StudyFiles, NeesOfTheFirstFilterStepIsChiSquareOverSeeds) {
+  // IK's first computation, at t = 0: the filter starts on the true state x0 with P0 = 10 R and
+  // corrects with y0 = x0 + v0 (C = I, R diagonal): K = 10/11 I, e = −K v0, P = 10/11 R, so its
+  // NEES is 10/11 v0ᵀ R⁻¹ v0 = 10/11 χ²(2). Over M seeds 11/10 Σ NEES is χ²(2M): within the
+  // two-sided 99.9 % interval (Wilson–Hilferty), one NEES term per run of one period.
+  NcsStudy s = map_ncs_study(engine::load_study(example_path(), &ncs_schema()));
+  ncs::Scenario x = s.scenarios[0];
+  x.duration_s = static_cast<double>(s.ctx->period_us()) * 1e-6;
+  const int m = 400;
+  double sum = 0;
+  for (int seed = 1; seed <= m; ++seed) {
+    const ncs::RunResult r = ncs::run(*s.ctx, ncs::Approach::kIK, x, static_cast<std::uint64_t>(seed), ncs::RunOptions{});
+    ASSERT_EQ(r.nees_steps, 1U);
+    sum += r.nees * 11.0 / 10.0;
+  }
+  const double k = 2.0 * m;
+  const auto quantile = [k](double z) { return k * std::pow(1 - 2 / (9 * k) + z * std::sqrt(2 / (9 * k)), 3); };
+  std::printf("IK first-step NEES: 11/10 sum over %d seeds %.1f, chi2(%.0f) 99.9 %% interval [%.1f, %.1f]\n", m, sum, k,
+              quantile(-3.29), quantile(3.29));
+  EXPECT_GT(sum, quantile(-3.29)) << sum;
+  EXPECT_LT(sum, quantile(3.29)) << sum;
 }
 
 TEST(StudyFiles, OtherStudiesAreRefusedNamingTheStudyField) {

@@ -8,6 +8,8 @@
 ///        controller's job on a CPU (examples/ncs_cpu_one_shot.json): every τ_c within the
 ///        analysed [BCRT, WCRT], a lone constant job equal to the loop with that constant τ_c,
 ///        the timer job analysed as periodic at h, the same bytes on 1 and 2 threads, refusals.
+///        The sensor under MTM: at σ = δ = 0, k_max = 1 the periodic loop bit for bit, its
+///        reference sends (one per set-point change), refusals, the same bytes on 1 and 2 threads.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -196,6 +198,74 @@ TEST(StudyOneShot, WhatTheLoopCannotRunIsRefusedNamingTheField) {
   } catch (const engine::InputError& e) {
     EXPECT_NE(std::string(e.what()).find("field '--analytic'"), std::string::npos) << e.what();
   }
+}
+
+/// The sensor under MTM {σ, δ, k_max, k_ref_max}, no loss on sc.
+std::function<void(nlohmann::json&)> lossless_mtm(double sigma, double delta, int k_max, int k_ref_max) {
+  return [=](nlohmann::json& j) {
+    j["nodes"][0]["trigger"] = {{"rule", "mtm"}, {"sigma", sigma}, {"delta", delta}, {"k_max", k_max}, {"k_ref_max", k_ref_max}};
+    j["links"][0].erase("loss");
+  };
+}
+
+TEST(StudyOneShotMtm, AtZeroThresholdsAndKMaxOneItIsPeriodicSending) {
+  // σ = 0, δ = 0, k_max = 1: every sample is sent, so OS and OSp under MTM are OSK bit for bit
+  // (OS's held value never serves: a sample arrives for every period the chain fits in).
+  const NcsStudy s = kOs.study(lossless_mtm(0, 0, 1, 0), 4);
+  for (std::size_t x = 0; x < s.scenarios.size(); ++x) {
+    for (std::uint64_t seed = 1; seed <= 3; ++seed) {
+      const ncs::RunResult osk = ncs::run(*s.ctx, ncs::Approach::kOSK, s.scenarios[x], seed, ncs::RunOptions{});
+      for (const ncs::Approach a : {ncs::Approach::kOS, ncs::Approach::kOSp}) {
+        const ncs::RunResult r = ncs::run(*s.ctx, a, s.scenarios[x], seed, ncs::RunOptions{});
+        EXPECT_EQ(r.sent, r.sampled) << ncs::name(a);
+        EXPECT_EQ(r.cost, osk.cost) << ncs::name(a) << " " << x << " " << seed;
+        EXPECT_EQ(r.nees, osk.nees) << ncs::name(a);
+        EXPECT_EQ(r.late, osk.late) << ncs::name(a);
+      }
+    }
+  }
+}
+
+TEST(StudyOneShotMtm, ASilentSensorSendsItsFirstSampleAndOnePerSetPointChange) {
+  // δ far above any move, no safety rule: the sensor sends its first sample and, k_ref,max samples
+  // after each set-point change, one more. 4 s: the square waves switch at 1, 2, 3 s (T_r 2 s) and
+  // at 2 s (T_r 4 s); with k_ref,max = 3 the send 0.15 s after the change at 3 s is still in the run.
+  const NcsStudy s = kOs.study(lossless_mtm(0, 1e6, 0, 3), 4);
+  const std::uint32_t changes[] = {3, 1};
+  for (std::size_t x = 0; x < s.scenarios.size(); ++x) {
+    for (const ncs::Approach a : {ncs::Approach::kOS, ncs::Approach::kOSp}) {
+      const ncs::RunResult r = ncs::run(*s.ctx, a, s.scenarios[x], 1, ncs::RunOptions{});
+      EXPECT_EQ(r.sent, 1 + changes[x]) << ncs::name(a) << " " << x;
+      EXPECT_EQ(r.sampled, 80U);
+    }
+  }
+  // A relative term σ > 0 widens the threshold (σ y² + δ): fewer sends than δ alone; OS cannot
+  // run with it (its held value's bound depends on y), OSp and OSK can.
+  const auto sent = [](const NcsStudy& st) {
+    std::uint32_t n = 0;
+    for (const ncs::Scenario& x : st.scenarios) n += ncs::run(*st.ctx, ncs::Approach::kOSp, x, 2, ncs::RunOptions{}).sent;
+    return n;
+  };
+  const auto osp_only = [](double sigma) {
+    return [sigma](nlohmann::json& j) {
+      lossless_mtm(sigma, 1e-4, 10, 0)(j);
+      j["approaches"] = nlohmann::json::parse(R"([{"name": "I", "kind": "I"}, {"name": "OSp", "kind": "OSp"}])");
+    };
+  };
+  EXPECT_LT(sent(kOs.study(osp_only(0.5), 4)), sent(kOs.study(osp_only(0), 4)));
+  kOs.expect_refused(lossless_mtm(0.1, 1e-4, 10, 0), "field 'nodes[0].trigger.sigma'");
+  kOs.expect_refused(
+      [](nlohmann::json& j) {
+        lossless_mtm(0, 1e-4, 10, 0)(j);
+        j["approaches"] = nlohmann::json::parse(R"([{"name": "I", "kind": "I"}, {"name": "IK", "kind": "IK"}])");
+      },
+      "field 'nodes[0].trigger'");
+  // The same bytes on 1 and 2 threads, the rule in the sweep's configuration.
+  const NcsStudy m = kOs.study(lossless_mtm(0, 4e-4, 10, 2), 3);
+  const std::string one = run_outputs(run_ncs_sweep(m, 3, 1, engine::Shard{}), temp_dir("mtm_one"), false).dump();
+  const std::string two = run_outputs(run_ncs_sweep(m, 3, 2, engine::Shard{}), temp_dir("mtm_two"), false).dump();
+  EXPECT_EQ(one, two);
+  EXPECT_EQ(run_ncs_sweep(m, 2, 1, engine::Shard{}).spec.config.at("one_shot").at("mtm").at("k_ref_max"), 2);
 }
 
 // ---- The one-shot controller's job on a CPU (examples/ncs_cpu_one_shot.json): its timer at

@@ -16,7 +16,9 @@
 #include <cstdint>
 #include <map>
 #include <optional>
+#include <set>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "oneshot/engine/can_analysis.hpp"
@@ -110,6 +112,27 @@ struct BusSpec {
   std::vector<Duration> offsets;      ///< First release of each background stream.
 };
 
+/// A set-point signal (the file's "reference", overridable per scenario): a square wave, steps
+/// given inline, or steps from a CSV file (two columns t_s,value_volts).
+struct ReferenceSpec {
+  /// Form of the signal.
+  enum class Kind : std::uint8_t { kSquare, kSteps, kFile };
+  Kind kind = Kind::kSquare;   ///< Form.
+  double amplitude_volts = 0;  ///< kSquare: ±A_r (V, [0, 100]).
+  double period_s = 0;         ///< kSquare: T_r (s, [0.001, 10⁶]).
+  /// kSteps, kFile: (t_s, value_volts) pairs, times strictly increasing in [0, 10⁶] s, values
+  /// finite within ±100 V; the set-point is 0 before the first time, then the value of the last
+  /// time reached.
+  std::vector<std::pair<double, double>> steps;
+  std::string path;            ///< kFile: the CSV file (resolved against the study file's folder).
+  std::string field;           ///< Where the file gives it ("reference", "scenarios[i].reference").
+  /// One line: "square ±0.2 V, T_r 2 s", "steps (4)", "file x.csv (4 steps)".
+  std::string describe() const;
+};
+
+/// Most steps a reference may hold (inline or from its file).
+inline constexpr std::size_t kMaxReferenceSteps = 100'000;
+
 /// An approach: a name, a study-defined kind, numeric parameters.
 struct ApproachSpec {
   std::string name;                       ///< Unique name (table column).
@@ -122,6 +145,8 @@ struct ScenarioSpec {
   std::string name;                          ///< Unique name.
   std::optional<double> duration_s;          ///< Overrides the study's duration.
   std::map<std::string, double> params;      ///< Parameters (schema defaults filled in).
+  std::set<std::string> params_given;        ///< Keys of `params` the file gave (the rest are defaults).
+  std::optional<ReferenceSpec> reference;    ///< Its own set-point (overrides the file's `reference`).
   std::map<std::string, DelayModel> delays;  ///< Link name → delay override.
   std::map<std::string, LossModel> losses;   ///< Link name → loss override.
 };
@@ -155,12 +180,24 @@ struct StudyFile {
   std::vector<cpu::TaskSet> cpus;
   std::vector<ApproachSpec> approaches; ///< Approaches.
   std::vector<ScenarioSpec> scenarios;  ///< Scenarios.
+  std::optional<ReferenceSpec> reference;  ///< The set-point of every scenario without its own.
 
   /// The node called `name` (InputError otherwise).
   const NodeSpec& node(const std::string& name) const;
   /// The link called `name`, with scenario `s`'s overrides applied (InputError otherwise).
   LinkConfig link_config(const std::string& name, const ScenarioSpec* s = nullptr) const;
 };
+
+/// Parses a "reference" object at field `f` (kind square, steps or file; a file's path relative
+/// to `base_dir`); InputError naming the field (and the file's line) otherwise.
+ReferenceSpec parse_reference(const nlohmann::json& j, const std::string& f, const std::string& base_dir);
+
+/// The steps of a reference CSV file's text: the header "t_s,value_volts", then one
+/// "t_s,value_volts" pair per line (blank lines and lines starting with '#' skipped); InputError
+/// "field '<field>': <source> line <n>: <reason>" for anything else, non-finite or out-of-range
+/// numbers, times not strictly increasing, no steps, more than kMaxReferenceSteps.
+std::vector<std::pair<double, double>> parse_reference_csv(const std::string& text, const std::string& field,
+                                                           const std::string& source);
 
 /// Parses and validates a study file's text; `schema` may be null (any kinds and params).
 StudyFile parse_study(const std::string& text, const std::string& source, const StudySchema* schema,
