@@ -52,8 +52,8 @@ const char* description(Approach a) {
     case Approach::kSK: return "sampling-synchronized, periodic Kalman";
     case Approach::kSPlus: return "sampling-synchronized, LQR on eq. 8 for the mean delay";
     case Approach::kIK: return "no delay, noise, periodic Kalman";
-    case Approach::kOS: return "one-shot, send-on-delta sensor, held value with inflated R";
-    case Approach::kOSp: return "one-shot, send-on-delta sensor, predict-only when silent";
+    case Approach::kOS: return "one-shot, event-triggered sensor, held value with inflated R";
+    case Approach::kOSp: return "one-shot, event-triggered sensor, predict-only when silent";
     case Approach::kOSK: return "one-shot, sensor every sample, predict-only when missing";
   }
   return "?";

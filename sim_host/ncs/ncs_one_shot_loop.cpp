@@ -14,7 +14,6 @@
 #include "oneshot/node/mtm_trigger.hpp"
 #include "oneshot/node/send_on_delta_trigger.hpp"
 #include "oneshot/node/sensor_node.hpp"
-#include "oneshot/node/square_wave_reference.hpp"
 
 namespace oneshot::ncs::loop {
 namespace {

@@ -167,6 +167,8 @@ StationaryRow stationary_row(const Context& ctx, const Scenario& sc, Approach a,
                                 std::to_string(pmf.tau_us.back()) + " µs, not below the period (late commands)");
   Scenario flat = sc;  // the noise-driven part: set-point zero
   flat.amplitude_volts = 0;
+  flat.setpoint_changes.reset();  // a stepped set-point too
+  flat.setpoint_r0 = 0;
   const Design d = ctx.controller_design(sc.noise_scale);
   const Disc disc(ctx.discretizer_model(sc.noise_scale));
   const Ref ref = reference(ctx, flat);

@@ -123,52 +123,68 @@ void add_cpu_stats(nlohmann::json& j, const engine::SweepResults& results) {
   j["markdown_cpu"] = md;
 }
 
-/// Adds "one_shot" (per one-shot approach: the filter's NEES, mean and 95 % interval over
-/// seeds of the scenario mean, and the sensor's send rate, overall and per scenario) and its
-/// table to the markdown.
-void add_one_shot(nlohmann::json& j, const engine::SweepResults& results) {
+/// The NEES of approach index `a` (a filtered approach): {"nees_mean", "nees_ci95"} over seeds
+/// of the per-seed mean over the scenarios with a NEES (a run without a regular P, e.g. noise
+/// scale 0, has none: left out, never counted as 0), "steps" the computations averaged, and per
+/// scenario {"nees_mean", "nees_ci95"} over seeds.
+nlohmann::json nees_of(const engine::SweepResults& results, std::size_t a) {
   const engine::SweepSpec& spec = results.spec;
   const std::size_t nees_i = results.metric("nees");
   const std::size_t steps_i = results.metric("nees_steps");
-  const std::size_t sampled = results.metric("sensor.samples");
-  const std::size_t sent = results.metric("sensor.sent");
-  // A run without a regular P (noise scale 0) has no NEES: left out, never counted as 0. Per seed
-  // the mean over the scenarios that have one, then the mean and interval over the seeds.
   const auto summary = [](const std::vector<double>& v) {
     if (v.empty()) return nlohmann::json::array({nullptr, nullptr});
     const util::Summary m = util::summarize(v);
     return nlohmann::json::array({m.mean, m.ci95});
   };
-  std::string md = "\n| approach | NEES (n = " + std::to_string(ncs::kN) +
-                   ") | 95 % CI | samples sent |\n|---|---:|---:|---:|\n";
+  std::vector<double> per_seed;
+  double steps = 0;
+  for (std::size_t k = 0; k < spec.seeds; ++k) {
+    double sum = 0;
+    std::size_t count = 0;
+    for (std::size_t x = 0; x < spec.scenarios.size(); ++x) {
+      steps += results.at(a, x, k, steps_i);
+      if (results.at(a, x, k, steps_i) > 0) {
+        sum += results.at(a, x, k, nees_i);
+        ++count;
+      }
+    }
+    if (count > 0) per_seed.push_back(sum / static_cast<double>(count));
+  }
+  const nlohmann::json overall = summary(per_seed);
+  nlohmann::json e = {{"nees_mean", overall[0]}, {"nees_ci95", overall[1]}, {"steps", steps}};
+  for (std::size_t x = 0; x < spec.scenarios.size(); ++x) {
+    std::vector<double> nees;
+    for (std::size_t k = 0; k < spec.seeds; ++k)
+      if (results.at(a, x, k, steps_i) > 0) nees.push_back(results.at(a, x, k, nees_i));
+    const nlohmann::json m = summary(nees);
+    e["per_scenario"][spec.scenarios[x]] = {{"nees_mean", m[0]}, {"nees_ci95", m[1]}};
+  }
+  return e;
+}
+
+/// Adds "one_shot" (per one-shot approach: the filter's NEES as nees_of(), and the sensor's
+/// send rate, overall and per scenario) and the send rates' table to the markdown (the NEES is
+/// in add_nees()'s table).
+void add_one_shot(nlohmann::json& j, const engine::SweepResults& results) {
+  const engine::SweepSpec& spec = results.spec;
+  const std::size_t sampled = results.metric("sensor.samples");
+  const std::size_t sent = results.metric("sensor.sent");
+  std::string md = "\n| approach | samples sent |\n|---|---:|\n";
   for (std::size_t a = 0; a < spec.approaches.size(); ++a) {
     if (!ncs::one_shot(ncs::parse_any_approach(spec.approaches[a]))) continue;
-    std::vector<double> per_seed;
-    for (std::size_t k = 0; k < spec.seeds; ++k) {
-      double sum = 0;
-      std::size_t count = 0;
-      for (std::size_t x = 0; x < spec.scenarios.size(); ++x) {
-        if (results.at(a, x, k, steps_i) > 0) {
-          sum += results.at(a, x, k, nees_i);
-          ++count;
-        }
-      }
-      if (count > 0) per_seed.push_back(sum / static_cast<double>(count));
-    }
-    const nlohmann::json overall = summary(per_seed);
-    nlohmann::json e = {{"nees_mean", overall[0]}, {"nees_ci95", overall[1]}};
+    nlohmann::json e = nees_of(results, a);
+    e.erase("steps");
     double n_all = 0, s_all = 0;
     for (std::size_t x = 0; x < spec.scenarios.size(); ++x) {
       double n = 0, sn = 0;
-      std::vector<double> nees;
       for (std::size_t k = 0; k < spec.seeds; ++k) {
         n += results.at(a, x, k, sampled);
         sn += results.at(a, x, k, sent);
-        if (results.at(a, x, k, steps_i) > 0) nees.push_back(results.at(a, x, k, nees_i));
       }
-      const nlohmann::json m = summary(nees);
-      e["per_scenario"][spec.scenarios[x]] = {{"nees_mean", m[0]}, {"nees_ci95", m[1]},
-                                              {"samples", n}, {"sent", sn}, {"send_rate", n > 0 ? sn / n : 0.0}};
+      nlohmann::json& p = e["per_scenario"][spec.scenarios[x]];
+      p["samples"] = n;
+      p["sent"] = sn;
+      p["send_rate"] = n > 0 ? sn / n : 0.0;
       n_all += n;
       s_all += sn;
     }
@@ -176,64 +192,29 @@ void add_one_shot(nlohmann::json& j, const engine::SweepResults& results) {
     e["sent"] = s_all;
     e["send_rate"] = n_all > 0 ? s_all / n_all : 0.0;
     j["one_shot"][spec.approaches[a]] = e;
-    char row[200];
-    if (overall[0].is_null()) {
-      std::snprintf(row, sizeof row, "| %s | — | — | %.4f |\n", spec.approaches[a].c_str(), e["send_rate"].get<double>());
-    } else {
-      std::snprintf(row, sizeof row, "| %s | %.4f | ± %.4f | %.4f |\n", spec.approaches[a].c_str(), overall[0].get<double>(),
-                    overall[1].get<double>(), e["send_rate"].get<double>());
-    }
+    char row[120];
+    std::snprintf(row, sizeof row, "| %s | %.4f |\n", spec.approaches[a].c_str(), e["send_rate"].get<double>());
     md += row;
   }
   j["markdown"] = j.at("markdown").get<std::string>() + md;
 }
 
-/// Adds "nees" (per approach whose controller runs a Kalman filter: the NEES, mean and 95 %
-/// interval over seeds of the scenario mean, the computations it averages, and per scenario
-/// the same) and its table to the markdown.
+/// Adds "nees" (per approach whose controller runs a Kalman filter: nees_of()) and its table to
+/// the markdown.
 void add_nees(nlohmann::json& j, const engine::SweepResults& results) {
   const engine::SweepSpec& spec = results.spec;
-  const std::size_t nees_i = results.metric("nees");
-  const std::size_t steps_i = results.metric("nees_steps");
-  const auto summary = [](const std::vector<double>& v) {
-    if (v.empty()) return nlohmann::json::array({nullptr, nullptr});
-    const util::Summary m = util::summarize(v);
-    return nlohmann::json::array({m.mean, m.ci95});
-  };
   std::string md = "\n| approach | NEES (n = " + std::to_string(ncs::kN) + ") | 95 % CI | filter steps |\n|---|---:|---:|---:|\n";
   for (std::size_t a = 0; a < spec.approaches.size(); ++a) {
     if (!ncs::filtered_approach(ncs::parse_any_approach(spec.approaches[a]))) continue;
-    // Per seed the mean over the scenarios with a NEES (a singular P has none: left out, never 0).
-    std::vector<double> per_seed;
-    double steps = 0;
-    for (std::size_t k = 0; k < spec.seeds; ++k) {
-      double sum = 0;
-      std::size_t count = 0;
-      for (std::size_t x = 0; x < spec.scenarios.size(); ++x) {
-        steps += results.at(a, x, k, steps_i);
-        if (results.at(a, x, k, steps_i) > 0) {
-          sum += results.at(a, x, k, nees_i);
-          ++count;
-        }
-      }
-      if (count > 0) per_seed.push_back(sum / static_cast<double>(count));
-    }
-    const nlohmann::json overall = summary(per_seed);
-    nlohmann::json e = {{"nees_mean", overall[0]}, {"nees_ci95", overall[1]}, {"steps", steps}};
-    for (std::size_t x = 0; x < spec.scenarios.size(); ++x) {
-      std::vector<double> nees;
-      for (std::size_t k = 0; k < spec.seeds; ++k)
-        if (results.at(a, x, k, steps_i) > 0) nees.push_back(results.at(a, x, k, nees_i));
-      const nlohmann::json m = summary(nees);
-      e["per_scenario"][spec.scenarios[x]] = {{"nees_mean", m[0]}, {"nees_ci95", m[1]}};
-    }
+    const nlohmann::json e = nees_of(results, a);
     j["nees"][spec.approaches[a]] = e;
+    const double steps = e.at("steps").get<double>();
     char row[200];
-    if (overall[0].is_null()) {
+    if (e.at("nees_mean").is_null()) {
       std::snprintf(row, sizeof row, "| %s | — | — | %.0f |\n", spec.approaches[a].c_str(), steps);
     } else {
-      std::snprintf(row, sizeof row, "| %s | %.4f | ± %.4f | %.0f |\n", spec.approaches[a].c_str(), overall[0].get<double>(),
-                    overall[1].get<double>(), steps);
+      std::snprintf(row, sizeof row, "| %s | %.4f | ± %.4f | %.0f |\n", spec.approaches[a].c_str(),
+                    e.at("nees_mean").get<double>(), e.at("nees_ci95").get<double>(), steps);
     }
     md += row;
   }

@@ -227,7 +227,7 @@ engine::SweepResults run_ncs_sweep(const NcsStudy& s, std::size_t seeds, unsigne
   if (one_shot) {
     spec.metrics.insert(spec.metrics.end(), std::begin(kOneShotMetrics), std::end(kOneShotMetrics));
   } else if (filtered) {
-    spec.metrics.insert(spec.metrics.end(), std::begin(kOneShotMetrics), std::begin(kOneShotMetrics) + 2);
+    spec.metrics.insert(spec.metrics.end(), std::begin(kOneShotMetrics), std::begin(kOneShotMetrics) + kNeesMetricCount);
   }
   spec.config = loop_sweep_config(s);
   if (on_cpu) {  // likewise

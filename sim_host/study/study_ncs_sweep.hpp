@@ -36,6 +36,8 @@ inline constexpr const char* kCpuMetrics[] = {"jobs", "response_min_us", "respon
 /// computations, the sensor's samples and the samples it sent. Sweeps with filtered approaches
 /// (ncs::filtered_approach()) but no one-shot one have the first two only.
 inline constexpr const char* kOneShotMetrics[] = {"nees", "nees_steps", "sensor.samples", "sensor.sent"};
+/// The leading NEES metrics of kOneShotMetrics: what every other filtered approach reports.
+inline constexpr std::size_t kNeesMetricCount = 2;
 
 /// Position of the counter `name` in kLinkCounters (its size when there is none).
 constexpr std::size_t link_counter_index(std::string_view name) {

@@ -68,6 +68,7 @@ std::vector<std::pair<double, double>> parse_reference_csv(const std::string& te
   };
   if (!std::getline(in, line)) fail(1, "expected the header 't_s,value_volts'");
   if (!line.empty() && line.back() == '\r') line.pop_back();
+  if (line.rfind("\xEF\xBB\xBF", 0) == 0) line.erase(0, 3);  // a UTF-8 byte-order mark (spreadsheets write one)
   if (line != "t_s,value_volts") fail(1, "expected the header 't_s,value_volts'");
   std::vector<std::pair<double, double>> out;
   for (int n = 2; std::getline(in, line); ++n) {

@@ -168,6 +168,10 @@ TEST(StudyFile, SeveralLoopsEachHaveTheirPlantAndNodes) {
       ADD_FAILURE() << "accepted; expected an error naming " << c.expected;
     } catch (const InputError& e) {
       EXPECT_NE(std::string(e.what()).find(c.expected), std::string::npos) << e.what();
+    }
+  }
+}
+
 TEST(StudyFile, ReferencesParseStrictlyAtTheTopAndPerScenario) {
   const StudySchema schema = example_schema();
   const StudyFile f = parse_study(
@@ -191,6 +195,8 @@ TEST(StudyFile, ReferencesParseStrictlyAtTheTopAndPerScenario) {
   const auto steps = parse_reference_csv("t_s,value_volts\r\n# c\n\n0, 1\n2.5,-1e-3\n", "reference.path", "x.csv");
   ASSERT_EQ(steps.size(), 2U);
   EXPECT_EQ(steps[1], std::make_pair(2.5, -1e-3));
+  // A UTF-8 byte-order mark before the header (what spreadsheets write) is not part of it.
+  EXPECT_EQ(parse_reference_csv("\xEF\xBB\xBFt_s,value_volts\n0,1\n", "reference.path", "x.csv").size(), 1U);
   const std::pair<const char*, const char*> bad[] = {
       {"", "x.csv line 1"},
       {"t_s;value_volts\n0,1\n", "x.csv line 1"},

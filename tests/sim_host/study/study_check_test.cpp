@@ -16,6 +16,7 @@
 #include "oneshot/engine/random_stream.hpp"
 #include "oneshot/engine/study_file.hpp"
 #include "study_check.hpp"
+#include "study_ncs_runner.hpp"
 #include "support/run_command.hpp"
 #include "support/temp_files.hpp"
 
@@ -243,6 +244,24 @@ TEST(StudyCheck, FuzzCorpusFilesResolveOrAreRefusedNamingAField) {
   }
   EXPECT_GE(files, 4U);
   EXPECT_GE(mapped, 1U);  // the ncs seed maps onto the loop
+}
+
+/// Every shipped example (its relative plant, reference and CSV paths against its own folder)
+/// parses, resolves to finite figures and maps onto the ncs loop: `study run` runs each.
+TEST(StudyCheck, EveryShippedExampleResolvesAndMaps) {
+  std::size_t files = 0;
+  for (const auto& entry : std::filesystem::directory_iterator(ONESHOT_STUDY_EXAMPLES_DIR)) {
+    if (entry.path().extension() != ".json") continue;
+    std::ifstream in(entry.path());
+    std::stringstream text;
+    text << in.rdbuf();
+    const std::string name = entry.path().filename().string();
+    const engine::StudyFile f = engine::parse_study(text.str(), entry.path().string(), &ncs_schema(), ONESHOT_STUDY_EXAMPLES_DIR);
+    expect_finite(resolve_study(f), name);
+    EXPECT_NO_THROW(static_cast<void>(map_ncs_study(f))) << name;
+    ++files;
+  }
+  EXPECT_GE(files, 8U);  // ncs, ncs_can, three on CPUs, sod_ge_oneshot, two_loops_can, mtm_file_oneshot
 }
 
 TEST(StudyCheck, CommandLine) {

@@ -41,13 +41,15 @@ class StudyExample {
   }
 
   /// The file after `edit`, mapped onto the loop (with the check's bus bounds when it has a
-  /// bus), every scenario `duration_s` long.
+  /// bus), every scenario (of every loop) `duration_s` long.
   NcsStudy study(const Edit& edit, double duration_s) const {
     nlohmann::json j = json();
     edit(j);
     const engine::StudyFile f = parse(j);
     NcsStudy s = map_ncs_study(f);
     for (ncs::Scenario& x : s.scenarios) x.duration_s = duration_s;
+    for (NcsStudy& loop : s.loops)  // a file with several loops: every loop's scenarios
+      for (ncs::Scenario& x : loop.scenarios) x.duration_s = duration_s;
     if (!f.buses.empty()) attach_bus_bounds(s, resolve_study(f));
     return s;
   }
