@@ -23,7 +23,7 @@ namespace {
 
 const test_support::StudyExample kCan("ncs_can.json");
 
-std::string temp_dir(const char* name) { return test::fresh_dir("oneshot_study_can_test", name); }
+std::string can_temp_dir(const char* name) { return test::fresh_dir("oneshot_study_can_test", name); }
 
 /// Bits of a standard CAN data frame with s payload bytes under worst-case stuffing (Davis et
 /// al. 2007, eq. 1): 34 + 8s stuffable bits, ⌊(34 + 8s − 1)/4⌋ stuff bits, 13 unstuffed.
@@ -38,7 +38,7 @@ double message_us(std::int64_t bytes, std::int64_t bit_rate) {
 
 TEST(StudyCan, WithoutBackgroundEveryDelayIsTheTransmissionTime) {
   const NcsStudy s = kCan.study([](nlohmann::json& j) { j["buses"][0].erase("background"); }, 4);
-  const nlohmann::json j = run_outputs(run_ncs_sweep(s, 3, 2, engine::Shard{}), temp_dir("quiet"), false);
+  const nlohmann::json j = run_outputs(run_ncs_sweep(s, 3, 2, engine::Shard{}), can_temp_dir("quiet"), false);
   // The loop's messages: header (sequence, stamp: 8 bytes) + p = 2 doubles (sc), + m = 1 double (ca).
   const double sc_us = message_us(8 + 2 * 8, 125'000);
   const double ca_us = message_us(8 + 1 * 8, 125'000);
@@ -90,7 +90,7 @@ double mean_delay_checked(double scale, const char* leg, std::size_t seeds) {
         for (auto& b : j["buses"][0]["background"]) b["period_us"] = std::llround(b["period_us"].get<double>() * scale);
       },
       4);
-  const nlohmann::json j = run_outputs(run_ncs_sweep(s, seeds, 2, engine::Shard{}), temp_dir("load"), false);
+  const nlohmann::json j = run_outputs(run_ncs_sweep(s, seeds, 2, engine::Shard{}), can_temp_dir("load"), false);
   for (const char* a : {"S", "SK"}) {
     for (const char* l : {"sc", "ca"}) {
       const nlohmann::json& e = j.at("bus_delays").at(a).at(l);
@@ -123,15 +123,15 @@ TEST(StudyCan, WithBackgroundDelaysStayWithinTheBoundAndTheMeanGrowsWithTheLoad)
 
 TEST(StudyCan, SameBytesOnOneAndTwoThreadsAndFromMergedShards) {
   const NcsStudy s = kCan.study([](nlohmann::json&) {}, 2.5);
-  const std::string one = run_outputs(run_ncs_sweep(s, 4, 1, engine::Shard{}), temp_dir("one"), false).dump();
-  const std::string two = run_outputs(run_ncs_sweep(s, 4, 2, engine::Shard{}), temp_dir("two"), false).dump();
+  const std::string one = run_outputs(run_ncs_sweep(s, 4, 1, engine::Shard{}), can_temp_dir("one"), false).dump();
+  const std::string two = run_outputs(run_ncs_sweep(s, 4, 2, engine::Shard{}), can_temp_dir("two"), false).dump();
   EXPECT_EQ(one, two);
   std::vector<engine::SweepResults> parts;
   for (std::size_t i = 0; i < 3; ++i) {
     const engine::SweepResults p = run_ncs_sweep(s, 4, 1, engine::Shard{i, 3});
     parts.push_back(engine::shard_from_json(nlohmann::json::parse(engine::shard_to_json(p).dump())));
   }
-  EXPECT_EQ(run_outputs(engine::merge_shards(parts), temp_dir("merged"), false).dump(), two);
+  EXPECT_EQ(run_outputs(engine::merge_shards(parts), can_temp_dir("merged"), false).dump(), two);
   EXPECT_TRUE(nlohmann::json::parse(two).contains("bus_delays"));
 }
 

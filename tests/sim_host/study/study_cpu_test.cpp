@@ -33,7 +33,7 @@ namespace {
 const test_support::StudyExample kCpu("ncs_cpu.json");
 const test_support::StudyExample kSensorCpu("ncs_cpu_sensor.json");
 
-std::string temp_dir(const char* name) { return test::fresh_dir("oneshot_study_cpu_test", name); }
+std::string cpu_temp_dir(const char* name) { return test::fresh_dir("oneshot_study_cpu_test", name); }
 
 /// Keeps the approaches named in `keep` (I first).
 void only(nlohmann::json& j, std::initializer_list<const char*> keep) {
@@ -50,7 +50,7 @@ TEST(StudyCpu, EveryControllerResponseIsWithinTheAnalysedBounds) {
           only(j, {"I", "S", "A", "AKl"});
         },
         2);
-    const nlohmann::json j = run_outputs(run_ncs_sweep(s, 30, 2, engine::Shard{}), temp_dir(scheduler), false);
+    const nlohmann::json j = run_outputs(run_ncs_sweep(s, 30, 2, engine::Shard{}), cpu_temp_dir(scheduler), false);
     // One job per period (30 seeds x 2 scenarios x 40 periods), nothing lost.
     test_support::expect_controller_jobs_within_bounds(j, *s.scenarios[0].controller_cpu, {"S", "A", "AKl"}, 30 * 2 * 40,
                                                        scheduler);
@@ -101,7 +101,7 @@ std::pair<double, double> load_point(double scale, const char* approach) {
         only(j, {"I", approach});
       },
       4);
-  const nlohmann::json j = run_outputs(run_ncs_sweep(s, 20, 2, engine::Shard{}), temp_dir("load"), false);
+  const nlohmann::json j = run_outputs(run_ncs_sweep(s, 20, 2, engine::Shard{}), cpu_temp_dir("load"), false);
   const double mean = j.at("cpu").at(approach).at("mean_us").get<double>();
   const double cost = j.at("approaches").at(approach).at("cost_mean").get<double>();
   std::printf("background periods x %.2f: %s mean tau_c %.1f us (WCRT %.1f), J %.6f\n", scale, approach, mean,
@@ -129,15 +129,15 @@ TEST(StudyCpu, AHeavierBackgroundRaisesTheMeanResponseAndTheCost) {
 
 TEST(StudyCpu, SameBytesOnOneAndTwoThreadsAndFromMergedShards) {
   const NcsStudy s = kCpu.study([](nlohmann::json&) {}, 1.5);
-  const std::string one = run_outputs(run_ncs_sweep(s, 3, 1, engine::Shard{}), temp_dir("one"), false).dump();
-  const std::string two = run_outputs(run_ncs_sweep(s, 3, 2, engine::Shard{}), temp_dir("two"), false).dump();
+  const std::string one = run_outputs(run_ncs_sweep(s, 3, 1, engine::Shard{}), cpu_temp_dir("one"), false).dump();
+  const std::string two = run_outputs(run_ncs_sweep(s, 3, 2, engine::Shard{}), cpu_temp_dir("two"), false).dump();
   EXPECT_EQ(one, two);
   std::vector<engine::SweepResults> parts;
   for (std::size_t i = 0; i < 3; ++i) {
     const engine::SweepResults p = run_ncs_sweep(s, 3, 1, engine::Shard{i, 3});
     parts.push_back(engine::shard_from_json(nlohmann::json::parse(engine::shard_to_json(p).dump())));
   }
-  EXPECT_EQ(run_outputs(engine::merge_shards(parts), temp_dir("merged"), false).dump(), two);
+  EXPECT_EQ(run_outputs(engine::merge_shards(parts), cpu_temp_dir("merged"), false).dump(), two);
   EXPECT_TRUE(nlohmann::json::parse(two).contains("cpu"));
 }
 
@@ -319,8 +319,8 @@ TEST(StudyCpuSensor, ALoneConstantJobIsTheLoopWithItsFrameLaterByC) {
 
 TEST(StudyCpuSensor, SameBytesOnOneAndTwoThreadsAndWhatTheLoopCannotRunIsRefused) {
   const NcsStudy s = sensor_study(kSensorCpu.json(), 1.5);
-  const std::string one = run_outputs(run_ncs_sweep(s, 3, 1, engine::Shard{}), temp_dir("sensor_one"), false).dump();
-  const std::string two = run_outputs(run_ncs_sweep(s, 3, 2, engine::Shard{}), temp_dir("sensor_two"), false).dump();
+  const std::string one = run_outputs(run_ncs_sweep(s, 3, 1, engine::Shard{}), cpu_temp_dir("sensor_one"), false).dump();
+  const std::string two = run_outputs(run_ncs_sweep(s, 3, 2, engine::Shard{}), cpu_temp_dir("sensor_two"), false).dump();
   EXPECT_EQ(one, two);
   try {
     static_cast<void>(run_ncs_sweep(s, 1, 1, engine::Shard{}, true));
