@@ -10,7 +10,7 @@
 # namespace`) must then be unique within its group. ONESHOT_UNITY=OFF compiles every source alone.
 option(ONESHOT_UNITY "Compile the host libraries' and the tests' sources in unity groups" ON)
 set(ONESHOT_UNITY_GROUP_SIZE 4 CACHE STRING "Sources per unity group of the host libraries")
-set(ONESHOT_TEST_UNITY_GROUP_SIZE 4 CACHE STRING "Sources per unity group of a test executable")
+set(ONESHOT_TEST_UNITY_GROUP_SIZE 6 CACHE STRING "Sources per unity group of a test executable")
 
 # oneshot_unity_groups(<target> <prefix> [SIZE <n>] <source>...): the sources, in order, into the
 # target's unity groups <prefix>_0, <prefix>_1, ... of <n> sources each (default

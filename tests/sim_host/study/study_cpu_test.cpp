@@ -142,29 +142,29 @@ TEST(StudyCpu, SameBytesOnOneAndTwoThreadsAndFromMergedShards) {
 }
 
 /// Parsing, checking and mapping the edited file is refused, the message containing `expect`.
-void expect_refused(const test_support::Edit& edit, const std::string& expect) { kCpu.expect_refused(edit, expect, true); }
+void expect_cpu_refused(const test_support::Edit& edit, const std::string& expect) { kCpu.expect_refused(edit, expect, true); }
 
 TEST(StudyCpu, BadCpusAreRefusedNamingTheField) {
-  expect_refused([](nlohmann::json& j) { j["nodes"][1]["cpu"] = "arm"; }, "field 'nodes[1].cpu'");  // dangling
-  expect_refused([](nlohmann::json& j) { j["cpus"][0]["tasks"][0]["wcet_us"] = 6000; }, "field 'cpus[0].tasks[0].wcet_us'");  // > period
-  expect_refused([](nlohmann::json& j) { j["cpus"][0]["tasks"][0]["bcet_us"] = 700; }, "field 'cpus[0].tasks[0].bcet_us'");
-  expect_refused([](nlohmann::json& j) { j["cpus"][0]["tasks"][1]["name"] = "comm"; }, "field 'cpus[0].tasks[1].name'");  // duplicate
-  expect_refused([](nlohmann::json& j) { j["cpus"].push_back(j["cpus"][0]); }, "field 'cpus[1].name'");  // duplicate CPU
-  expect_refused([](nlohmann::json& j) { j["cpus"][0]["tasks"][0]["name"] = "controller"; }, "field 'nodes[1].name'");
-  expect_refused([](nlohmann::json& j) { j["cpus"][0]["scheduler"] = "round_robin"; }, "field 'cpus[0].scheduler'");
-  expect_refused([](nlohmann::json& j) { j["cpus"][0]["tasks"][2]["wcet_us"] = 12000; }, "field 'cpus[0].tasks[2]'");  // unschedulable
-  expect_refused([](nlohmann::json& j) { j["nodes"][1]["job"]["deadline_us"] = 3500; }, "field 'nodes[1].job'");  // it misses
-  expect_refused([](nlohmann::json& j) { j["nodes"][1].erase("job"); }, "field 'nodes[1].job'");
-  expect_refused([](nlohmann::json& j) { j["nodes"][1].erase("cpu"); }, "field 'nodes[1].job'");
-  expect_refused([](nlohmann::json& j) { j["nodes"][1]["job"]["period_us"] = 50000; }, "field 'nodes[1].job.period_us'");
-  expect_refused([](nlohmann::json& j) { j["nodes"][1]["job"]["sample_at"] = "end"; }, "field 'nodes[1].job.sample_at'");
-  expect_refused([](nlohmann::json& j) { j["nodes"][1]["job"] = {{"wcet_us", 45000}, {"priority", 3}}; }, "field 'nodes[1].job.wcet_us'");  // > h - J
-  expect_refused([](nlohmann::json& j) { j["nodes"][1]["job"]["exec"]["instructions_max"] = 2'000'000; }, "field 'nodes[1].job.exec'");
-  expect_refused([](nlohmann::json& j) { j["nodes"][0]["cpu"] = "dspic"; j["nodes"][0]["job"] = {{"wcet_us", 100}, {"priority", 5}}; },
+  expect_cpu_refused([](nlohmann::json& j) { j["nodes"][1]["cpu"] = "arm"; }, "field 'nodes[1].cpu'");  // dangling
+  expect_cpu_refused([](nlohmann::json& j) { j["cpus"][0]["tasks"][0]["wcet_us"] = 6000; }, "field 'cpus[0].tasks[0].wcet_us'");  // > period
+  expect_cpu_refused([](nlohmann::json& j) { j["cpus"][0]["tasks"][0]["bcet_us"] = 700; }, "field 'cpus[0].tasks[0].bcet_us'");
+  expect_cpu_refused([](nlohmann::json& j) { j["cpus"][0]["tasks"][1]["name"] = "comm"; }, "field 'cpus[0].tasks[1].name'");  // duplicate
+  expect_cpu_refused([](nlohmann::json& j) { j["cpus"].push_back(j["cpus"][0]); }, "field 'cpus[1].name'");  // duplicate CPU
+  expect_cpu_refused([](nlohmann::json& j) { j["cpus"][0]["tasks"][0]["name"] = "controller"; }, "field 'nodes[1].name'");
+  expect_cpu_refused([](nlohmann::json& j) { j["cpus"][0]["scheduler"] = "round_robin"; }, "field 'cpus[0].scheduler'");
+  expect_cpu_refused([](nlohmann::json& j) { j["cpus"][0]["tasks"][2]["wcet_us"] = 12000; }, "field 'cpus[0].tasks[2]'");  // unschedulable
+  expect_cpu_refused([](nlohmann::json& j) { j["nodes"][1]["job"]["deadline_us"] = 3500; }, "field 'nodes[1].job'");  // it misses
+  expect_cpu_refused([](nlohmann::json& j) { j["nodes"][1].erase("job"); }, "field 'nodes[1].job'");
+  expect_cpu_refused([](nlohmann::json& j) { j["nodes"][1].erase("cpu"); }, "field 'nodes[1].job'");
+  expect_cpu_refused([](nlohmann::json& j) { j["nodes"][1]["job"]["period_us"] = 50000; }, "field 'nodes[1].job.period_us'");
+  expect_cpu_refused([](nlohmann::json& j) { j["nodes"][1]["job"]["sample_at"] = "end"; }, "field 'nodes[1].job.sample_at'");
+  expect_cpu_refused([](nlohmann::json& j) { j["nodes"][1]["job"] = {{"wcet_us", 45000}, {"priority", 3}}; }, "field 'nodes[1].job.wcet_us'");  // > h - J
+  expect_cpu_refused([](nlohmann::json& j) { j["nodes"][1]["job"]["exec"]["instructions_max"] = 2'000'000; }, "field 'nodes[1].job.exec'");
+  expect_cpu_refused([](nlohmann::json& j) { j["nodes"][0]["cpu"] = "dspic"; j["nodes"][0]["job"] = {{"wcet_us", 100}, {"priority", 5}}; },
                  "field 'nodes[0].cpu'");  // the sensor runs on its timer
-  expect_refused([](nlohmann::json& j) { j["cpus"].push_back({{"name", "spare"}, {"scheduler", "edf"}}); }, "field 'cpus[1]'");
-  expect_refused([](nlohmann::json& j) { j["approaches"].push_back({{"name", "S+"}, {"kind", "S+"}}); }, "field 'approaches[7].kind'");
-  expect_refused([](nlohmann::json& j) { j["links"][1]["delay"] = {{"model", "poisson_periods"}, {"mean_periods", 1}, {"period_us", 1000}}; },
+  expect_cpu_refused([](nlohmann::json& j) { j["cpus"].push_back({{"name", "spare"}, {"scheduler", "edf"}}); }, "field 'cpus[1]'");
+  expect_cpu_refused([](nlohmann::json& j) { j["approaches"].push_back({{"name", "S+"}, {"kind", "S+"}}); }, "field 'approaches[7].kind'");
+  expect_cpu_refused([](nlohmann::json& j) { j["links"][1]["delay"] = {{"model", "poisson_periods"}, {"mean_periods", 1}, {"period_us", 1000}}; },
                  "field 'nodes[1].cpu'");  // no bound on the input's arrival
 }
 
