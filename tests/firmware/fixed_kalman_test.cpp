@@ -77,7 +77,7 @@ TEST(FixedDiscretizer, GenericRoutineMatchesDouble) {
 
 using Variant = test::FilterVariant;
 
-struct Deviation {
+struct FixedDeviation {
   double state_lsb = 0;
   double gain = 0;
   double cov_rel = 0;
@@ -85,7 +85,7 @@ struct Deviation {
 
 /// Fixed and double filters on the same jobs (closed loop on the double estimate).
 template <typename FixedDisc, typename DoubleDisc>
-Deviation run_pair(Variant v, NoiseModel noise_model, const FixedDisc& fq, const DoubleDisc& fd, int jobs,
+FixedDeviation run_pair(Variant v, NoiseModel noise_model, const FixedDisc& fq, const DoubleDisc& fd, int jobs,
                    std::uint64_t seed) {
   HalfKalman<FixedFormat, PlantStructure, FixedDisc> hq(KQ::kDesign, fq, noise_model);
   HalfKalman<F64, PlantStructure, DoubleDisc> hd(KD::kDesign, fd, noise_model);
@@ -100,7 +100,7 @@ Deviation run_pair(Variant v, NoiseModel noise_model, const FixedDisc& fq, const
   const test::MatX b = test::to_eigen(design::reference_plant().b);
   double r = 0;
   double u = 0;
-  Deviation dev;
+  FixedDeviation dev;
   clear_saturation_flag();
   for (int k = 0; k < jobs; ++k) {
     const std::int32_t t = tau(rng);
@@ -167,7 +167,7 @@ TEST_P(FixedVsDouble, StateWithinOneAdcLsbOverLongIrregularSequences) {
   const GenericDiscretizer<F64, 2, 1> gd(KD::kModel);
   const FixedTable tq(KQ::kTable);
   const FixedGeneric gq(KQ::kModel);
-  const Deviation d = c.table ? run_pair(c.variant, c.noise, tq, td, 20'000, 21)
+  const FixedDeviation d = c.table ? run_pair(c.variant, c.noise, tq, td, 20'000, 21)
                               : run_pair(c.variant, c.noise, gq, gd, 20'000, 21);
   std::cout << "[ measured ] fixed " << c.name << ": max state error " << d.state_lsb << " ADC LSB, max |dK| " << d.gain
             << ", P rel " << d.cov_rel << "\n";

@@ -13,7 +13,7 @@ namespace {
 
 using Q1_14 = Fixed<std::int16_t, 14>;
 using Q3_28 = Fixed<std::int32_t, 28>;
-using T = ScalarTraits<Q15>;
+using Q15Traits = ScalarTraits<Q15>;
 
 static_assert(!std::is_same_v<Q15, Q1_14>, "Q formats are distinct types");
 static_assert(!std::is_convertible_v<int, Q15>, "no implicit conversion from raw integers");
@@ -38,17 +38,17 @@ TEST_F(FixedPoint, RoundsToNearestTiesUpward) {
   // Integer codes round as std::lround does: halves away from zero.
   EXPECT_EQ(ScalarTraits<Half>::round_to_int(Half::from_raw(-3)), -2);
   EXPECT_EQ(ScalarTraits<Half>::round_to_int(Half::from_raw(3)), 2);
-  EXPECT_EQ(mul<Q15>(T::from_double(0.5), T::from_double(0.5)).raw(), 8192);
+  EXPECT_EQ(mul<Q15>(Q15Traits::from_double(0.5), Q15Traits::from_double(0.5)).raw(), 8192);
   EXPECT_FALSE(saturation_flag());
 }
 
 TEST_F(FixedPoint, SaturatesAndRaisesTheStickyFlag) {
-  const Q15 big = T::from_double(0.9);
+  const Q15 big = Q15Traits::from_double(0.9);
   const Q15 sum = big + big;
   EXPECT_EQ(sum.raw(), 32767);
   EXPECT_TRUE(saturation_flag());
-  const Q15 fine = T::from_double(0.1) + T::from_double(0.1);  // later exact operations keep it raised
-  EXPECT_NEAR(T::to_double(fine), 0.2, 1e-4);
+  const Q15 fine = Q15Traits::from_double(0.1) + Q15Traits::from_double(0.1);  // later exact operations keep it raised
+  EXPECT_NEAR(Q15Traits::to_double(fine), 0.2, 1e-4);
   EXPECT_TRUE(saturation_flag());
   clear_saturation_flag();
   EXPECT_FALSE(saturation_flag());
@@ -91,10 +91,10 @@ TEST_F(FixedPoint, AccumulatorRoundsOnceAtTheEnd) {
     Accumulator<Q1_14> acc;
     double exact = 0;
     for (int k = 0; k < 8; ++k) {
-      const Q15 a = T::from_double(u(rng) * 0.5);
-      const Q15 b = T::from_double(u(rng) * 0.5);
+      const Q15 a = Q15Traits::from_double(u(rng) * 0.5);
+      const Q15 b = Q15Traits::from_double(u(rng) * 0.5);
       acc.add_product(a, b);
-      exact += T::to_double(a) * T::to_double(b);
+      exact += Q15Traits::to_double(a) * Q15Traits::to_double(b);
     }
     // The 16 guard bits make the sum exact before the final rounding.
     EXPECT_LE(std::fabs(ScalarTraits<Q1_14>::to_double(acc.value()) - exact), 0.5 * Q1_14::resolution() + 1e-12);

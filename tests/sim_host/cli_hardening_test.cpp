@@ -21,10 +21,10 @@ namespace {
 namespace fs = std::filesystem;
 using test::run_command;
 
-std::string sim() { return ONESHOT_SIM_PATH; }
+std::string oneshot_sim() { return ONESHOT_SIM_PATH; }
 
 /// A fresh empty folder `name` (any characters) for one test.
-std::string fresh_dir(const std::string& name) { return test::made_dir("oneshot_hard", name); }
+std::string hardening_dir(const std::string& name) { return test::made_dir("oneshot_hard", name); }
 
 /// A scenario file whose only scenario is called `name` (1 s, default jitter).
 std::string scenario_named(const std::string& file, const std::string& name) {
@@ -34,14 +34,14 @@ std::string scenario_named(const std::string& file, const std::string& name) {
 
 TEST(CliHardening, AScenarioNameIsDataInTheGnuplotScript) {
   if (util::find_program("gnuplot").empty()) GTEST_SKIP() << "gnuplot not installed";
-  const std::string dir = fresh_dir("gp_name");
+  const std::string dir = hardening_dir("gp_name");
   // gnuplot's command-running function, spelt in two pieces (tests/no_shell.cmake).
   const std::string run = std::string("sys") + "tem";
   // gnuplot runs in the output folder dir/out: ../pwnedN would land in dir.
   const std::string name =
       "x' . " + run + "('touch ../pwned1') . '`touch ../pwned2`\" . " + run + "(\"touch ../pwned3\") . \"";
   const std::string file = scenario_named("hostile_name.json", name);
-  const auto r = run_command({sim(), "run", "--scenarios", file, "--scenario", name, "--out", dir + "/out"});
+  const auto r = run_command({oneshot_sim(), "run", "--scenarios", file, "--scenario", name, "--out", dir + "/out"});
   ASSERT_EQ(r.exit_code, 0) << r.output;
   EXPECT_TRUE(fs::exists(dir + "/out/run.png"));
   for (const char* f : {"/pwned1", "/pwned2", "/pwned3"}) EXPECT_FALSE(fs::exists(dir + f)) << f;
@@ -50,9 +50,9 @@ TEST(CliHardening, AScenarioNameIsDataInTheGnuplotScript) {
 
 TEST(CliHardening, AnOutputFolderWithAnApostropheOrShellSyntaxPlots) {
   if (util::find_program("gnuplot").empty()) GTEST_SKIP() << "gnuplot not installed";
-  const std::string base = fresh_dir("gp_folder");
+  const std::string base = hardening_dir("gp_folder");
   const std::string out = base + "/it's $(touch " + base + "/pwned) 'x'; touch " + base + "/pwned2";
-  const auto r = run_command({sim(), "noise", "--duration", "0.5", "--out", out});
+  const auto r = run_command({oneshot_sim(), "noise", "--duration", "0.5", "--out", out});
   ASSERT_EQ(r.exit_code, 0) << r.output;
   EXPECT_TRUE(fs::exists(out + "/noise.png"));
   EXPECT_FALSE(fs::exists(base + "/pwned"));
@@ -64,9 +64,9 @@ TEST(CliHardening, AnOutputFolderIsNotACommandForValgrind) {
   GTEST_SKIP() << "valgrind cannot run an AddressSanitizer build of oneshot-sim";
 #endif
   if (util::find_program("valgrind").empty()) GTEST_SKIP() << "valgrind not installed";
-  const std::string base = fresh_dir("vg_folder");
+  const std::string base = hardening_dir("vg_folder");
   const std::string out = base + "/a'; touch " + base + "/pwned; echo '%p";
-  const auto r = run_command({sim(), "exectime", "--no-plots", "--json", "-", "--out", out});
+  const auto r = run_command({oneshot_sim(), "exectime", "--no-plots", "--json", "-", "--out", out});
   ASSERT_EQ(r.exit_code, 0) << r.output;
   EXPECT_FALSE(fs::exists(base + "/pwned"));
   EXPECT_TRUE(fs::exists(out + "/callgrind.half_table.out"));  // '%p' kept literally, not the pid
@@ -98,8 +98,8 @@ TEST(CliHardening, NonsenseOptionsAreRefusedWithTheReason) {
       {{"run", "--scenarios", "/dev/zero"}, "longer than"},
   };
   for (const Refusal& c : cases) {
-    const std::string out = fresh_dir("refused");
-    std::vector<std::string> argv = {sim()};
+    const std::string out = hardening_dir("refused");
+    std::vector<std::string> argv = {oneshot_sim()};
     argv.insert(argv.end(), c.args.begin(), c.args.end());
     argv.insert(argv.end(), {"--no-plots", "--out", out + "/o"});
     const auto r = run_command(argv);
@@ -110,7 +110,7 @@ TEST(CliHardening, NonsenseOptionsAreRefusedWithTheReason) {
 }
 
 TEST(CliHardening, AmbiguousOrMalformedInputFilesAreRefusedByName) {
-  const std::string dir = fresh_dir("input_files");
+  const std::string dir = hardening_dir("input_files");
   const std::string dup_key =
       test::write_temp_file("hard_dup_key.json", R"({"scenarios": [{"name": "a", "duration_s": 20, "duration_s": 1}]})");
   const std::string dup_name =
@@ -126,7 +126,7 @@ TEST(CliHardening, AmbiguousOrMalformedInputFilesAreRefusedByName) {
       {{"run", "--scenarios", trace_dir, "--scenario", "a"}, "is a directory, not a jitter trace"},
   };
   for (const Refusal& c : cases) {
-    std::vector<std::string> argv = {sim()};
+    std::vector<std::string> argv = {oneshot_sim()};
     argv.insert(argv.end(), c.args.begin(), c.args.end());
     argv.insert(argv.end(), {"--duration", "0.5", "--no-plots", "--out", dir + "/o"});
     const auto r = run_command(argv);
@@ -138,8 +138,8 @@ TEST(CliHardening, AmbiguousOrMalformedInputFilesAreRefusedByName) {
 
 TEST(CliHardening, JitterTraceAloneSelectsTheTraceModel) {
   const std::string trace = test::write_temp_file("hard_trace2.csv", "release_us,exec_us\n1000,300\n2000,300\n");
-  const auto r = run_command({sim(), "run", "--duration", "0.5", "--jitter-trace", trace, "--no-plots", "--json", "-",
-                              "--out", fresh_dir("trace_run")});
+  const auto r = run_command({oneshot_sim(), "run", "--duration", "0.5", "--jitter-trace", trace, "--no-plots", "--json", "-",
+                              "--out", hardening_dir("trace_run")});
   ASSERT_EQ(r.exit_code, 0) << r.output;
   const auto j = nlohmann::json::parse(r.output);
   EXPECT_NE(j["jitter"].get<std::string>().find("trace " + trace), std::string::npos) << j["jitter"];
@@ -149,11 +149,11 @@ TEST(CliHardening, ARefusedRunCreatesNoOutputFolder) {
   const std::string overrun = test::write_temp_file(
       "hard_overrun.json",
       R"({"scenarios": [{"name": "late", "jitter": {"model": "uniform", "release_max_us": 49900, "exec_min_us": 300}}]})");
-  const std::string base = fresh_dir("refused_run");
+  const std::string base = hardening_dir("refused_run");
   for (const std::vector<std::string>& args :
        {std::vector<std::string>{"table1", "--seeds", "2", "--scenarios", overrun},
         std::vector<std::string>{"run", "--scenarios", overrun, "--scenario", "late"}}) {
-    std::vector<std::string> argv = {sim()};
+    std::vector<std::string> argv = {oneshot_sim()};
     argv.insert(argv.end(), args.begin(), args.end());
     argv.insert(argv.end(), {"--no-plots", "--out", base + "/" + args[0]});
     const auto r = run_command(argv);
@@ -166,8 +166,8 @@ TEST(CliHardening, ARefusedRunCreatesNoOutputFolder) {
 TEST(CliHardening, AFailedWriteIsAnError) {
   for (const std::vector<std::string>& args :
        {std::vector<std::string>{"design", "--json", "/dev/full"},
-        std::vector<std::string>{"run", "--duration", "0.5", "--no-plots", "--json", "/dev/full", "--out", fresh_dir("full")}}) {
-    std::vector<std::string> argv = {sim()};
+        std::vector<std::string>{"run", "--duration", "0.5", "--no-plots", "--json", "/dev/full", "--out", hardening_dir("full")}}) {
+    std::vector<std::string> argv = {oneshot_sim()};
     argv.insert(argv.end(), args.begin(), args.end());
     const auto r = run_command(argv);
     EXPECT_NE(r.exit_code, 0) << args[0];
@@ -177,7 +177,7 @@ TEST(CliHardening, AFailedWriteIsAnError) {
   test::CommandOptions full;
   full.stdout_path = "/dev/full";
   for (const std::vector<std::string>& argv :
-       {std::vector<std::string>{sim(), "design", "--json", "-"}, std::vector<std::string>{sim(), "design"}}) {
+       {std::vector<std::string>{oneshot_sim(), "design", "--json", "-"}, std::vector<std::string>{oneshot_sim(), "design"}}) {
     const auto r = run_command(argv, full);
     EXPECT_NE(r.exit_code, 0) << argv.back();
     EXPECT_NE(r.output.find("standard output: write failed"), std::string::npos) << r.output;
@@ -188,10 +188,10 @@ TEST(CliHardening, AFullDiskAtTheLastFlushIsAnErrorAndLeavesNoPartialFile) {
   // A file size limit makes the disk "full" after 300 bytes. The jobs CSV of a short run
   // (about 2 KB) used to sit in the stream buffer, fail at the final flush unchecked, and
   // leave a truncated file with exit status 0.
-  const std::string dir = fresh_dir("fsize");
+  const std::string dir = hardening_dir("fsize");
   test::CommandOptions limited;
   limited.file_size_limit_bytes = 300;
-  const std::vector<std::string> run = {sim(), "run", "--duration", "0.5", "--trace-step-us", "0", "--no-plots",
+  const std::vector<std::string> run = {oneshot_sim(), "run", "--duration", "0.5", "--trace-step-us", "0", "--no-plots",
                                         "--out", dir + "/o"};
   const auto r = run_command(run, limited);
   EXPECT_NE(r.exit_code, 0) << r.output;
@@ -216,24 +216,24 @@ TEST(CliHardening, ANonFiniteResultIsAnErrorNotNull) {
   j["board"]["adc_min_volts"] = {-1e308};
   j["board"]["adc_max_volts"] = {1e308};
   const std::string file = test::write_temp_file("hard_span.json", j.dump());
-  const auto r = run_command({sim(), "run", "--plant", file, "--duration", "0.5", "--no-plots", "--json", "-", "--out",
-                              fresh_dir("span")});
+  const auto r = run_command({oneshot_sim(), "run", "--plant", file, "--duration", "0.5", "--no-plots", "--json", "-", "--out",
+                              hardening_dir("span")});
   EXPECT_NE(r.exit_code, 0) << r.output;
   EXPECT_EQ(r.output.find("null"), std::string::npos) << r.output;
   EXPECT_NE(r.output.find("board.pwm_low_volts[0]"), std::string::npos) << r.output;
 }
 
 TEST(CliHardening, ReportWritesWhereOutSays) {
-  const std::string cwd = fresh_dir("report_cwd");
-  const std::string out = fresh_dir("report_out") + "/r";
+  const std::string cwd = hardening_dir("report_cwd");
+  const std::string out = hardening_dir("report_out") + "/r";
   // Both forms given and different: refused.
-  const auto both = run_command({sim(), "report", out, "--out", out + "2"});
+  const auto both = run_command({oneshot_sim(), "report", out, "--out", out + "2"});
   EXPECT_NE(both.exit_code, 0);
   EXPECT_NE(both.output.find("two output folders given"), std::string::npos) << both.output;
   // --out alone: the first experiment's files appear there, nothing in ./out.
   test::CommandOptions in_cwd;
   in_cwd.working_dir = cwd;
-  test::BackgroundCommand report({sim(), "report", "--out", out, "--no-mcu", "--no-plots", "--seeds", "2"}, in_cwd);
+  test::BackgroundCommand report({oneshot_sim(), "report", "--out", out, "--no-mcu", "--no-plots", "--seeds", "2"}, in_cwd);
   EXPECT_TRUE(test::eventually([&] { return fs::exists(out + "/noise_trace.csv"); }, 60'000));
   ::kill(report.pid(), SIGTERM);
   const auto r = report.wait(10'000);
@@ -242,10 +242,10 @@ TEST(CliHardening, ReportWritesWhereOutSays) {
 }
 
 TEST(CliHardening, AShardFileIsReadStrictlyAndBounded) {
-  const std::string dir = fresh_dir("shards");
+  const std::string dir = hardening_dir("shards");
   // A valid shard of a two-seed table1, then the same file with a key given twice.
   const std::string one = scenario_named("hard_shard_scenario.json", "short");
-  const auto made = run_command({sim(), "table1", "--seeds", "2", "--scenarios", one, "--shard", "0/2", "--no-plots",
+  const auto made = run_command({oneshot_sim(), "table1", "--seeds", "2", "--scenarios", one, "--shard", "0/2", "--no-plots",
                                  "--out", dir});
   ASSERT_EQ(made.exit_code, 0) << made.output;
   const std::string shard = dir + "/table1.shard-0-of-2.json";
@@ -254,7 +254,7 @@ TEST(CliHardening, AShardFileIsReadStrictlyAndBounded) {
   text.insert(1, "\"format\": \"x\",");
   const std::string twice = test::write_temp_file("hard_shard_twice.json", text);
   for (const std::string& bad : {twice, dir}) {
-    const auto r = run_command({sim(), "merge", bad, "--no-plots", "--out", dir + "/merged"});
+    const auto r = run_command({oneshot_sim(), "merge", bad, "--no-plots", "--out", dir + "/merged"});
     EXPECT_NE(r.exit_code, 0) << bad;
     EXPECT_NE(r.output.find(bad == dir ? "is a directory" : "duplicate key"), std::string::npos) << r.output;
   }

@@ -24,7 +24,7 @@ using V1 = Vector<double, 1>;
 constexpr std::uint8_t kSensor = 1;
 constexpr std::uint8_t kController = 2;
 constexpr std::uint8_t kActuator = 3;
-constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+constexpr double kNaNInput = std::numeric_limits<double>::quiet_NaN();
 
 using test::v1;
 
@@ -56,7 +56,7 @@ TEST(ActuatorValidation, TimerModeHoldsTheLastGoodCommand) {
   act.set_command_range(v1(-1), v1(1));
   const host::ScopedHostNetwork cur(net);
   deliver(net, 1, 0.5);
-  deliver(net, 2, kNaN);
+  deliver(net, 2, kNaNInput);
   deliver(net, 3, 7.0);   // outside [−1, 1]
   deliver(net, 4, -0.25);
   act.on_receive();
@@ -103,7 +103,7 @@ TEST(ActuatorValidation, OnArrivalModeRefusesNanAndFollowsARestartedController) 
     deliver(net, k, 0.01 * k);
     act.on_receive();
   }
-  deliver(net, 100, kNaN);
+  deliver(net, 100, kNaNInput);
   deliver(net, 101, -std::numeric_limits<double>::infinity());
   deliver(net, 102, 0.5, kSensor);  // not the controller
   act.on_receive();
@@ -137,7 +137,7 @@ TEST(ControllerValidation, RestartedSensorReacquiredAndNanRefused) {
   };
   for (SequenceNumber k = 0; k < 500; ++k) sample(k, 0.001 * k);
   ASSERT_EQ(net.outbox.size(), 500U);
-  sample(500, kNaN);
+  sample(500, kNaNInput);
   sample(501U + (1U << 31) - (1U << 16), 1.0);
   EXPECT_EQ(net.outbox.size(), 500U);
   EXPECT_EQ(ctrl.latest().seq, 499U);

@@ -20,7 +20,7 @@ namespace {
 
 using namespace sync_test;  // NOLINT(google-build-using-namespace): the shared test loop
 using Report = SampleReport<double, 1, 1>;
-constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+constexpr double kNaNMeasurement = std::numeric_limits<double>::quiet_NaN();
 
 /// A controller on the generated reference plant, its interface, and a report sender.
 struct Loop {
@@ -66,7 +66,7 @@ TEST(SyncControllerValidation, NanSamplesNeverReachTheEstimate) {
   Loop l;
   for (SequenceNumber k = 1; k <= 20; ++k) l.report(k, genuine_y(k));
   ASSERT_EQ(l.commands(), 20U);
-  for (SequenceNumber k = 21; k <= 80; ++k) l.report(k, kNaN);
+  for (SequenceNumber k = 21; k <= 80; ++k) l.report(k, kNaNMeasurement);
   // THEN the estimate and the command stay finite, and the loop goes on commanding
   EXPECT_TRUE(l.estimate_finite());
   for (SequenceNumber k = 81; k <= 100; ++k) l.report(k, genuine_y(k));
@@ -75,7 +75,7 @@ TEST(SyncControllerValidation, NanSamplesNeverReachTheEstimate) {
   EXPECT_EQ(l.last_command_k(), 100U);
   EXPECT_EQ(l.ctrl.statistics().refused_non_finite, 60U);
   // A NaN echo is refused the same way.
-  l.report(101, genuine_y(101), kNaN);
+  l.report(101, genuine_y(101), kNaNMeasurement);
   EXPECT_TRUE(l.estimate_finite());
   EXPECT_EQ(l.ctrl.statistics().refused_non_finite, 61U);
 }
@@ -190,7 +190,7 @@ TEST(SyncSensorValidation, ForgedAndRestartedRequests) {
   };
   for (SequenceNumber k = 1; k <= 30; ++k) ASSERT_TRUE(request(k, k * 50'000U, 0.1));
   EXPECT_FALSE(request(31U + (1U << 31) - (1U << 16), 31 * 50'000U, 0.1));  // forged k
-  EXPECT_FALSE(request(31, 31 * 50'000U, kNaN));                          // NaN echo
+  EXPECT_FALSE(request(31, 31 * 50'000U, kNaNMeasurement));                          // NaN echo
   EXPECT_FALSE(request(31, 31 * 50'000U, 0.1, kController));              // not the actuator
   EXPECT_TRUE(request(31, 31 * 50'000U, 0.1));                            // genuine
   // t_k 35 min ahead of the sensor's clock: refused (it would stall late sampling).

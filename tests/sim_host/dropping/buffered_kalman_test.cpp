@@ -14,6 +14,7 @@
 #include "oneshot/standard_kalman.hpp"
 #include "support/eigen_reference.hpp"
 #include "support/measured_text.hpp"
+#include "study_plant.hpp"
 
 // Step indices are signed here (n = k − T_hold is negative at first); they index vectors.
 #pragma GCC diagnostic ignored "-Wsign-conversion"
@@ -27,32 +28,27 @@ using Structure = DenseStructure<kN, kM, kP>;
 using test::MatX;
 using test::VecX;
 
-const DroppingPlant& plant() {
-  static const DroppingPlant p = load_dropping_plant("");
-  return p;
-}
-
 node::BufferedKalmanModel<Fmt, kN, kM, kP> model() {
   node::BufferedKalmanModel<Fmt, kN, kM, kP> m;
-  m.step.phi = plant().phi;
-  m.step.gamma = plant().gamma;
-  m.q = plant().q;
-  m.c = plant().c;
-  m.r = plant().r;
+  m.step.phi = study_plant().phi;
+  m.step.gamma = study_plant().gamma;
+  m.q = study_plant().q;
+  m.c = study_plant().c;
+  m.r = study_plant().r;
   return m;
 }
 
 template <std::size_t kHold>
 void all_in_time_matches_standard(std::uint32_t seed) {
   const auto m = model();
-  node::BufferedKalman<Fmt, Structure, kHold> f(m, Vector<double, kN>{}, plant().p0);
+  node::BufferedKalman<Fmt, Structure, kHold> f(m, Vector<double, kN>{}, study_plant().p0);
   ControllerDesign<Fmt, kN, kM, kP> d{};
-  d.phi_h = plant().phi;
-  d.gamma_h = plant().gamma;
-  d.q_constant = plant().q;
-  d.c = plant().c;
-  d.r = plant().r;
-  d.p0 = plant().p0;
+  d.phi_h = study_plant().phi;
+  d.gamma_h = study_plant().gamma;
+  d.q_constant = study_plant().q;
+  d.c = study_plant().c;
+  d.r = study_plant().r;
+  d.p0 = study_plant().p0;
   StandardKalman<Fmt, Structure> s(d, NoiseModel::kConstant);
   std::mt19937_64 rng(seed);
   std::normal_distribution<double> nd(0, 3);
@@ -106,9 +102,9 @@ struct Reference {
 };
 Reference eigen_intermittent(const std::vector<bool>& present, const std::vector<double>& y,
                              const std::vector<double>& u, int k) {
-  const MatX phi = test::to_eigen(plant().phi), gam = test::to_eigen(plant().gamma), c = test::to_eigen(plant().c);
-  const MatX q = test::to_eigen(plant().q), r = test::to_eigen(plant().r);
-  Reference ref{VecX::Zero(kN), test::to_eigen(plant().p0)};
+  const MatX phi = test::to_eigen(study_plant().phi), gam = test::to_eigen(study_plant().gamma), c = test::to_eigen(study_plant().c);
+  const MatX q = test::to_eigen(study_plant().q), r = test::to_eigen(study_plant().r);
+  Reference ref{VecX::Zero(kN), test::to_eigen(study_plant().p0)};
   for (int j = 0; j < k; ++j) {
     if (present[j]) {
       const MatX s = c * ref.p * c.transpose() + r;
@@ -149,7 +145,7 @@ double random_patterns(int patterns, std::mt19937_64& rng, int& over_delayed, in
       first_arrival[j] = a;
       if (uni(rng) < 0.2) arrivals[a + tau(rng)].push_back(j);
     }
-    node::BufferedKalman<Fmt, Structure, kHold> f(m, Vector<double, kN>{}, plant().p0);
+    node::BufferedKalman<Fmt, Structure, kHold> f(m, Vector<double, kN>{}, study_plant().p0);
     for (int k = 0; k < steps; ++k) {
       std::shuffle(arrivals[k].begin(), arrivals[k].end(), rng);
       for (int j : arrivals[k]) {
@@ -199,25 +195,25 @@ void noise_free_invariants(std::uint64_t seed, double& worst_exact, double& wors
   std::uniform_real_distribution<double> uni(0, 1);
   Vector<double, kN> x0;
   for (std::size_t i = 0; i < kN; ++i) x0[i] = 5 * nd(rng);
-  node::BufferedKalman<Fmt, Structure, kHold> f(m, x0, plant().p0);
+  node::BufferedKalman<Fmt, Structure, kHold> f(m, x0, study_plant().p0);
   const int steps = 200;
   std::vector<Vector<double, kN>> xs;
   Vector<double, kN> x = x0;
   std::vector<std::vector<std::pair<int, double>>> arrivals(steps + 12);
   for (int k = 0; k < steps; ++k) {
     xs.push_back(x);
-    const double yk = (plant().c * x)[0];
+    const double yk = (study_plant().c * x)[0];
     if (uni(rng) > 0.3) arrivals[k + 1 + static_cast<int>(uni(rng) * (kHold + 2))].push_back({k, yk});
     for (const auto& [j, v] : arrivals[k]) static_cast<void>(f.receive(static_cast<std::uint32_t>(j), Vector<double, 1>{{v}}));
     ASSERT_EQ(f.step(), Status::kOk);
-    Vector<double, 1> u = -(plant().l * f.estimate());
+    Vector<double, 1> u = -(study_plant().l * f.estimate());
     u[0] += (k / 50) % 2 == 0 ? 1.0 : -1.0;
     f.set_applied_input(u);
     const double scale = std::max(1.0, test::to_eigen(x).cwiseAbs().maxCoeff());
     worst_exact = std::max(worst_exact, (test::to_eigen(f.estimate()) - test::to_eigen(x)).cwiseAbs().maxCoeff() / scale);
     if (f.anchor_started())
       worst_exact = std::max(worst_exact, (test::to_eigen(f.anchor()) - test::to_eigen(xs[f.anchor_index()])).cwiseAbs().maxCoeff() / scale);
-    x = plant().phi * x + plant().gamma * u;
+    x = study_plant().phi * x + study_plant().gamma * u;
   }
   // Error independence of u: same arrivals and noise, two different open-loop inputs.
   std::vector<double> noise(steps), w(steps * kN), ua(steps), ub(steps);
@@ -230,23 +226,23 @@ void noise_free_invariants(std::uint64_t seed, double& worst_exact, double& wors
   std::vector<std::vector<double>> err(2);
   for (int which = 0; which < 2; ++which) {
     const std::vector<double>& uu = which == 0 ? ua : ub;
-    node::BufferedKalman<Fmt, Structure, kHold> g(m, Vector<double, kN>{}, plant().p0);
+    node::BufferedKalman<Fmt, Structure, kHold> g(m, Vector<double, kN>{}, study_plant().p0);
     Vector<double, kN> xx = x0;
     std::vector<std::vector<std::pair<int, double>>> arr(steps + 12);
     std::mt19937_64 arng(seed + 7);
     for (int k = 0; k < steps; ++k) {
-      const double yk = (plant().c * xx)[0] + noise[k];
+      const double yk = (study_plant().c * xx)[0] + noise[k];
       if (uni(arng) > 0.3) arr[k + 1 + static_cast<int>(uni(arng) * (kHold + 2))].push_back({k, yk});
       for (const auto& [j, v] : arr[k]) static_cast<void>(g.receive(static_cast<std::uint32_t>(j), Vector<double, 1>{{v}}));
       ASSERT_EQ(g.step(), Status::kOk);
       // Closed loop (keeps x bounded) with a different reference per pass: u differs, is known.
-      Vector<double, 1> u = -(plant().l * g.estimate());
+      Vector<double, 1> u = -(study_plant().l * g.estimate());
       u[0] += uu[k];
       g.set_applied_input(u);
       for (std::size_t i = 0; i < kN; ++i) err[which].push_back(xx[i] - g.estimate()[i]);
       Vector<double, kN> wk;
       for (std::size_t i = 0; i < kN; ++i) wk[i] = w[k * kN + i];
-      xx = plant().phi * xx + plant().gamma * u + wk;
+      xx = study_plant().phi * xx + study_plant().gamma * u + wk;
     }
   }
   for (std::size_t i = 0; i < err[0].size(); ++i)

@@ -14,16 +14,12 @@
 #include "closed_loop.hpp"
 #include "oneshot/engine/fault_spec.hpp"
 #include "oneshot/engine/json_fields.hpp"
+#include "study_plant.hpp"
 
 namespace {
 
 using namespace oneshot::dropping;
 using oneshot::engine::parse_fault_spec;
-
-const DroppingPlant& plant() {
-  static const DroppingPlant p = load_dropping_plant("");
-  return p;
-}
 
 RunConfig config(EstimatorKind e, const char* spec) {
   RunConfig c;
@@ -53,9 +49,9 @@ struct Pair {
 
 Pair run(EstimatorKind e, const char* spec, std::uint64_t seed = 11) {
   RunConfig c = config(e, spec);
-  Pair p{run_closed_loop(plant(), c, seed), {}};
+  Pair p{run_closed_loop(study_plant(), c, seed), {}};
   c.faults = {};
-  p.clean = run_closed_loop(plant(), c, seed);
+  p.clean = run_closed_loop(study_plant(), c, seed);
   return p;
 }
 
@@ -79,7 +75,7 @@ TEST(DroppingFaults, EmptySpecIsTheCleanRunBitForBit) {
       with.channel = ch;
       RunConfig without = with;
       without.faults = {};
-      EXPECT_EQ(bits(run_closed_loop(plant(), with, 5)), bits(run_closed_loop(plant(), without, 5)));
+      EXPECT_EQ(bits(run_closed_loop(study_plant(), with, 5)), bits(run_closed_loop(study_plant(), without, 5)));
     }
 }
 
@@ -133,7 +129,7 @@ TEST(DroppingFaults, RestartsAreRefusedNamingTheNode) {
     const std::string spec = std::string("restart:node=") + node + ",at_s=1";
     RunConfig c = config(EstimatorKind::kBuffered, spec.c_str());
     try {
-      static_cast<void>(run_closed_loop(plant(), c, 1));
+      static_cast<void>(run_closed_loop(study_plant(), c, 1));
       ADD_FAILURE() << spec << " was accepted";
     } catch (const oneshot::engine::InputError& e) {
       EXPECT_NE(std::string(e.what()).find(std::string("node '") + node + "' cannot restart"), std::string::npos) << e.what();

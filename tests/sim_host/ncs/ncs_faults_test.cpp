@@ -18,7 +18,7 @@
 namespace oneshot::ncs {
 namespace {
 
-Scenario short_scenario() {
+Scenario faults_scenario() {
   Scenario s = default_scenarios()[1];  // d = 14 ms
   s.duration_s = 4;
   return s;
@@ -27,13 +27,13 @@ Scenario short_scenario() {
 RunResult run_with(const Context& ctx, Approach a, const std::string& spec, std::uint64_t seed = 5) {
   RunOptions o;
   o.faults = engine::parse_fault_spec(spec);
-  return run(ctx, a, short_scenario(), seed, o);
+  return run(ctx, a, faults_scenario(), seed, o);
 }
 
 TEST(NcsFaults, EmptySpecAndFaultsAfterTheEndAreBitIdenticalToTheCleanRun) {
   const auto ctx = Context::load("");
   for (Approach a : {Approach::kAK, Approach::kS, Approach::kA, Approach::kI}) {
-    const RunResult clean = run(*ctx, a, short_scenario(), 5, RunOptions{});
+    const RunResult clean = run(*ctx, a, faults_scenario(), 5, RunOptions{});
     for (const char* spec : {"", "nan:at_s=100;flip:rate=0,at_s=100;dup:link=sc,at_s=100;replay:at_s=100;"
                                  "forge_seq:at_s=100;restart:node=sensor,at_s=100;restart:node=actuator,at_s=100"}) {
       const RunResult r = run_with(*ctx, a, spec);
@@ -68,7 +68,7 @@ TEST(NcsFaults, FaultedRunsAreReproducibleAndCounted) {
   t.seeds = 3;
   t.threads = 1;
   t.approaches = {Approach::kI, Approach::kAK};
-  t.scenarios = {short_scenario()};
+  t.scenarios = {faults_scenario()};
   t.faults = engine::parse_fault_spec(spec);
   const auto one = table_sweep(*ctx, t, engine::Shard{});
   t.threads = 2;
@@ -81,7 +81,7 @@ TEST(NcsFaults, FaultedRunsAreReproducibleAndCounted) {
 TEST(NcsFaults, FaultTableCoversEveryCaseReproducibly) {
   const auto ctx = Context::load("");
   FaultTableOptions o;
-  o.scenario = short_scenario();
+  o.scenario = faults_scenario();
   o.scenario.duration_s = 3;  // the forged sequences and restarts come at 2 s
   o.seeds = 3;
   o.threads = 1;
@@ -106,7 +106,7 @@ TEST(NcsFaults, FaultTableCoversEveryCaseReproducibly) {
 // estimate; the forged report makes every later one stale).
 TEST(NcsFaults, NanAndForgedSequenceAreAbsorbed) {
   const auto ctx = Context::load("");
-  const RunResult clean = run(*ctx, Approach::kAK, short_scenario(), 5, RunOptions{});
+  const RunResult clean = run(*ctx, Approach::kAK, faults_scenario(), 5, RunOptions{});
   for (const char* spec : {"nan:link=sc,rate=0.05", "nan:link=ca,rate=0.05", "nan:link=as,rate=0.05",
                            "forge_seq:link=sc,at_s=1", "forge_seq:link=as,at_s=1", "restart:node=actuator,at_s=1"}) {
     const RunResult r = run_with(*ctx, Approach::kAK, spec);

@@ -22,7 +22,7 @@
 namespace oneshot::sim {
 namespace {
 
-RunOptions options(Approach a) {
+RunOptions double_options(Approach a) {
   RunOptions o;
   o.approach = a;
   o.format = NumberFormat::kDouble;
@@ -49,7 +49,7 @@ TEST(LinearBoard, NoiseFreeAnalyticEqualsSimulatedOnEveryApproach) {
   for (Approach a : kAllApproaches) {
     if (!approach_available(*ctx, a)) continue;
     for (std::uint64_t seed : {3U, 11U}) {
-      const LinearRunResult r = run_linear_board(*ctx, sc, seed, options(a), LinearOptions{false, true});
+      const LinearRunResult r = run_linear_board(*ctx, sc, seed, double_options(a), LinearOptions{false, true});
       EXPECT_EQ(r.refusal, "") << info(a).letter;
       EXPECT_EQ(r.jobs, 120U);
       EXPECT_LT(r.mismatch, 1e-9);
@@ -57,7 +57,7 @@ TEST(LinearBoard, NoiseFreeAnalyticEqualsSimulatedOnEveryApproach) {
       EXPECT_NEAR(r.analytic.total(), r.cost, 1e-9 * r.cost) << info(a).letter << " seed " << seed;
       EXPECT_EQ(r.analytic.covariance, 0.0);
       // The same run without the tracker gives the same trajectory.
-      const LinearRunResult s = run_linear_board(*ctx, sc, seed, options(a), LinearOptions{false, false});
+      const LinearRunResult s = run_linear_board(*ctx, sc, seed, double_options(a), LinearOptions{false, false});
       EXPECT_EQ(s.cost, r.cost);
     }
   }
@@ -69,7 +69,7 @@ TEST(LinearBoard, SameTimingDrawsAsTheEmulatedBoard) {
   const auto ctx = SimContext::reference();
   const Scenario sc = uniform_scenario("t", 20'000, 0.5, 1.0, 4.0);
   for (Approach a : {Approach::kA, Approach::kB}) {
-    RunOptions o = options(a);
+    RunOptions o = double_options(a);
     o.record_jobs = true;
     const RunResult board = simulate(*ctx, sc, 5, o);
     const LinearRunResult lin = run_linear_board(*ctx, sc, 5, o, LinearOptions{true, false, true});
@@ -101,9 +101,9 @@ TEST(LinearBoard, AnalyticMeanAgreesWithTheMonteCarloOfTheSameModelPairedPerSeed
       if (!approach_available(*ctx, a)) continue;
       std::vector<double> d;
       for (std::uint64_t seed = 1; seed <= seeds; ++seed) {
-        const LinearRunResult r = run_linear_board(*ctx, sc, seed, options(a), LinearOptions{true, true});
+        const LinearRunResult r = run_linear_board(*ctx, sc, seed, double_options(a), LinearOptions{true, true});
         ASSERT_EQ(r.refusal, "") << sc.name << " " << info(a).letter;
-        d.push_back(run_linear_board(*ctx, sc, seed, options(a), LinearOptions{true, false}).cost - r.analytic.total());
+        d.push_back(run_linear_board(*ctx, sc, seed, double_options(a), LinearOptions{true, false}).cost - r.analytic.total());
       }
       double mean = 0;
       for (double x : d) mean += x;
@@ -173,9 +173,9 @@ TEST(LinearBoard, PeriodicZeroDelayLoopEqualsTheStationaryLqgCostRate) {
   ASSERT_GT(st.cost_rate, 0);
 
   Scenario sc = uniform_scenario("still", 0, 0.0, 1000.0, 200.0);
-  const LinearRunResult full = run_linear_board(*ctx, sc, 1, options(Approach::kA), LinearOptions{true, true});
+  const LinearRunResult full = run_linear_board(*ctx, sc, 1, double_options(Approach::kA), LinearOptions{true, true});
   sc.duration_s = 100.0;
-  const LinearRunResult half = run_linear_board(*ctx, sc, 1, options(Approach::kA), LinearOptions{true, true});
+  const LinearRunResult half = run_linear_board(*ctx, sc, 1, double_options(Approach::kA), LinearOptions{true, true});
   ASSERT_EQ(full.refusal, "");
   ASSERT_EQ(half.refusal, "");
   const double rate = (full.analytic.total() - half.analytic.total()) / 100.0;
@@ -189,8 +189,8 @@ TEST(LinearBoard, NoRunOfTheLargestStepsLeavesTheActuatorRange) {
   const Scenario sc = uniform_scenario("big", 20'000, 1.6, 0.5, 4.0);
   for (Approach a : kAllApproaches) {
     for (std::uint64_t seed = 1; seed <= 5; ++seed) {
-      const LinearRunResult r = run_linear_board(*ctx, sc, seed, options(a), LinearOptions{true, true});
-      const LinearRunResult s = run_linear_board(*ctx, sc, seed, options(a), LinearOptions{false, false});
+      const LinearRunResult r = run_linear_board(*ctx, sc, seed, double_options(a), LinearOptions{true, true});
+      const LinearRunResult s = run_linear_board(*ctx, sc, seed, double_options(a), LinearOptions{false, false});
       EXPECT_EQ(s.out_of_range, 0U) << info(a).letter << seed;
       EXPECT_EQ(r.refusal, "") << info(a).letter << seed;
     }

@@ -21,9 +21,9 @@ namespace {
 using oneshot::test::sci;
 
 using namespace oneshot::sim::petc;
-using Law = oneshot::node::InterlacedController<double, 1, 2>;
+using InterlacedLaw = oneshot::node::InterlacedController<double, 1, 2>;
 
-Law make(const MrciDesign& d, bool at_update = false) {
+InterlacedLaw make(const MrciDesign& d, bool at_update = false) {
   oneshot::node::InterlacedConfig<double, 1, 2> cfg;
   cfg.feedthrough = d.feedthrough;
   cfg.ratio = static_cast<std::uint32_t>(d.ratio);
@@ -35,7 +35,7 @@ Law make(const MrciDesign& d, bool at_update = false) {
     else
       cfg.fast[f++] = {m.residue, m.pole};
   }
-  return Law(cfg);
+  return InterlacedLaw(cfg);
 }
 
 std::vector<double> errors(std::size_t n) {
@@ -85,7 +85,7 @@ TEST(Mrci, RatioOneEqualsUndividedDifferenceEquation) {
   // Force two slow modes at m = 1 (the split rule would call 0.8496 fast at m = 1).
   d.modes[1].slow = true;
   d.modes[2].slow = false;
-  Law law = make(d);
+  InterlacedLaw law = make(d);
   const double z1 = 0.9813, z2 = 0.9681, z3 = -1.0, p1 = 1.0, p2 = 0.8496, p3 = 0.6137, g = 1.0882;
   const double b[4] = {g, -g * (z1 + z2 + z3), g * (z1 * z2 + z1 * z3 + z2 * z3), -g * z1 * z2 * z3};
   const double a[4] = {1, -(p1 + p2 + p3), p1 * p2 + p1 * p3 + p2 * p3, -p1 * p2 * p3};
@@ -109,7 +109,7 @@ TEST(Mrci, RatioOneEqualsUndividedDifferenceEquation) {
 // mode x⁺ = p_i x + ē driven by the held error ē_t = e_{m⌊t/m⌋}.
 TEST(Mrci, InterlacedEqualsUndividedOnItsSchedule) {
   const MrciDesign d = brief_mrci(2);
-  Law law = make(d);
+  InterlacedLaw law = make(d);
   const std::size_t m = d.ratio;
   const std::vector<double> e = errors(400);
   std::vector<std::vector<double>> xund(d.modes.size(), std::vector<double>(e.size() + 1, 0.0));
@@ -137,10 +137,10 @@ TEST(Mrci, InterlacedEqualsUndividedOnItsSchedule) {
   RecordProperty("rel_err", sci(worst / scale));
   EXPECT_LT(worst / scale, 1e-14);  // measured 1.4e-16
   // The schedule matters: the interlaced law is not C_D on the same errors.
-  Law again = make(d);
+  InterlacedLaw again = make(d);
   MrciDesign d1 = d;
   d1.ratio = 1;
-  Law undivided = make(d1);
+  InterlacedLaw undivided = make(d1);
   double diff = 0;
   for (std::size_t k = 0; k < e.size(); ++k) diff = std::max(diff, std::abs(again.step(k, e[k]) - undivided.step(k, e[k])));
   EXPECT_GT(diff, 1e-3 * scale);

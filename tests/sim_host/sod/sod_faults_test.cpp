@@ -11,16 +11,12 @@
 #include "oneshot/engine/json_fields.hpp"
 #include "sod_model.hpp"
 #include "sod_sim.hpp"
+#include "study_model.hpp"
 
 namespace {
 
 using namespace oneshot::sod;
 using oneshot::engine::parse_fault_spec;
-
-const SodModel& model() {
-  static const SodModel m = load_sod_model(default_sod_plant_path());
-  return m;
-}
 
 RunConfig config(const char* spec) {
   RunConfig c;
@@ -34,13 +30,13 @@ RunConfig config(const char* spec) {
 TEST(SodFaults, EmptySpecIsTheCleanRunBitForBit) {
   RunConfig clean = config("");
   clean.loss = 0.1;
-  const RunResult a = simulate_run(model(), clean, 7);
+  const RunResult a = simulate_run(study_model(), clean, 7);
   RunConfig none;
   none.sender = clean.sender;
   none.n_t[0] = none.n_t[1] = 50;
   none.steps = clean.steps;
   none.loss = clean.loss;
-  const RunResult b = simulate_run(model(), none, 7);
+  const RunResult b = simulate_run(study_model(), none, 7);
   for (std::size_t i = 0; i < kNodes; ++i) {
     EXPECT_EQ(a.e[i], b.e[i]);
     EXPECT_EQ(a.sends[i], b.sends[i]);
@@ -52,7 +48,7 @@ TEST(SodFaults, EmptySpecIsTheCleanRunBitForBit) {
 }
 
 TEST(SodFaults, FaultedFramesAreRefusedCountedAndTheEstimateStaysFinite) {
-  const RunResult clean = simulate_run(model(), config(""), 3);
+  const RunResult clean = simulate_run(study_model(), config(""), 3);
   struct Case {
     const char* spec;
     bool nan_refused;  // every NaN frame refused as non-finite (no loss: none is lost)
@@ -60,7 +56,7 @@ TEST(SodFaults, FaultedFramesAreRefusedCountedAndTheEstimateStaysFinite) {
   };
   for (const Case& c : {Case{"nan:link=node1,rate=0.05", true, false}, Case{"replay:age_ms=100,rate=0.05", false, true},
                         Case{"forge_seq:link=node2,at_s=5", false, true}, Case{"dup:rate=0.05", false, false}}) {
-    const RunResult r = simulate_run(model(), config(c.spec), 3);
+    const RunResult r = simulate_run(study_model(), config(c.spec), 3);
     EXPECT_GT(r.injected.injected(), 0u) << c.spec;
     for (std::size_t i = 0; i < kNodes; ++i) {
       EXPECT_TRUE(std::isfinite(r.e[i])) << c.spec;
@@ -81,8 +77,8 @@ TEST(SodFaults, FaultedFramesAreRefusedCountedAndTheEstimateStaysFinite) {
 }
 
 TEST(SodFaults, NodeRestartsAndUnknownLinksAreRefused) {
-  EXPECT_THROW(simulate_run(model(), config("restart:node=node1,at_s=1"), 1), oneshot::engine::InputError);
-  EXPECT_THROW(simulate_run(model(), config("nan:link=sc,rate=0.1"), 1), oneshot::engine::InputError);
+  EXPECT_THROW(simulate_run(study_model(), config("restart:node=node1,at_s=1"), 1), oneshot::engine::InputError);
+  EXPECT_THROW(simulate_run(study_model(), config("nan:link=sc,rate=0.1"), 1), oneshot::engine::InputError);
 }
 
 }  // namespace

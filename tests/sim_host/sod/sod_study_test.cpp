@@ -13,20 +13,16 @@
 #include "sod_design.hpp"
 #include "sod_model.hpp"
 #include "sod_sim.hpp"
+#include "study_model.hpp"
 
 namespace {
 
 using namespace oneshot::sod;
 
-const SodModel& model() {
-  static const SodModel m = load_sod_model(default_sod_plant_path());
-  return m;
-}
-
 /// Steady-state prior and posterior of the periodic filter by iterating the Riccati map (Eigen).
 std::pair<Eigen::MatrixXd, Eigen::MatrixXd> riccati_fixed_point(const Eigen::MatrixXd& rbar) {
-  const Eigen::MatrixXd a = oneshot::test::to_eigen(model().a_d), q = oneshot::test::to_eigen(model().q_d),
-                        c = oneshot::test::to_eigen(model().c);
+  const Eigen::MatrixXd a = oneshot::test::to_eigen(study_model().a_d), q = oneshot::test::to_eigen(study_model().q_d),
+                        c = oneshot::test::to_eigen(study_model().c);
   Eigen::MatrixXd p = Eigen::MatrixXd::Identity(2, 2);
   Eigen::MatrixXd post = p;
   for (int it = 0; it < 200000; ++it) {
@@ -46,7 +42,7 @@ TEST(SodStudy, PlainSodSendsTheSamePacketsAtEveryLossRate) {
     double sends[2] = {-1, -1}, lost_prev[2] = {0, 0};
     for (double xi : {0.0, 0.05, 0.1, 0.2}) {
       cfg.loss = xi;
-      const RunResult r = simulate_run(model(), cfg, seed);
+      const RunResult r = simulate_run(study_model(), cfg, seed);
       for (int i = 0; i < 2; ++i) {
         if (sends[i] < 0) sends[i] = r.sends[i];
         EXPECT_EQ(r.sends[i], sends[i]) << "seed " << seed << " xi " << xi;
@@ -68,15 +64,15 @@ TEST(SodStudy, DeltaYZeroLosslessIsThePeriodicFilterAtSteadyState) {
   periodic.sender = SenderKind::kPeriodic;
   periodic.filter = FilterKind::kPredictOnly;
   Eigen::MatrixXd r = Eigen::MatrixXd::Zero(2, 2);
-  r(0, 0) = model().r_diag[0];
-  r(1, 1) = model().r_diag[1];
+  r(0, 0) = study_model().r_diag[0];
+  r(1, 1) = study_model().r_diag[1];
   const Eigen::MatrixXd post = riccati_fixed_point(r).second;
   const int seeds = 20;
   double e[2] = {0, 0};
   for (int s = 1; s <= seeds; ++s) {
     RunTrace tr;
-    const RunResult a = simulate_run(model(), sod, static_cast<std::uint64_t>(s), &tr);
-    const RunResult b = simulate_run(model(), periodic, static_cast<std::uint64_t>(s));
+    const RunResult a = simulate_run(study_model(), sod, static_cast<std::uint64_t>(s), &tr);
+    const RunResult b = simulate_run(study_model(), periodic, static_cast<std::uint64_t>(s));
     for (std::size_t i = 0; i < 2; ++i) {
       const auto ei = static_cast<Eigen::Index>(i);
       EXPECT_EQ(a.sends[i], static_cast<double>(sod.steps + 1));  // δy = 0: every sample is sent
@@ -101,7 +97,7 @@ TEST(SodStudy, PeriodicFilterNeesIsTwo) {
   c.steps = 5000;
   c.loss = 0.2;
   double nees = 0;
-  for (int s = 1; s <= 10; ++s) nees += simulate_run(model(), c, static_cast<std::uint64_t>(s)).nees / 10;
+  for (int s = 1; s <= 10; ++s) nees += simulate_run(study_model(), c, static_cast<std::uint64_t>(s)).nees / 10;
   std::printf("periodic filter at xi = 0.2: mean NEES over 10 runs = %.4f\n", nees);
   EXPECT_NEAR(nees, 2.0, 0.1);
 }
@@ -118,13 +114,13 @@ TEST(SodStudy, NoiseFreeInvariants) {
     c.n_t[0] = c.n_t[1] = 300;
     c.steps = 5000;
     RunTrace tr;
-    simulate_run(model(), c, 5, &tr);
+    simulate_run(study_model(), c, 5, &tr);
     double x[2] = {0, 0};
     std::size_t since[2] = {0, 0}, held = 0;
     for (std::size_t k = 0; k < tr.t_s.size(); ++k) {
       if (k > 0) {
-        const double x0 = model().a_d(0, 0) * x[0] + model().a_d(0, 1) * x[1] + model().b_d(0, 0) * c.amplitude;
-        const double x1 = model().a_d(1, 0) * x[0] + model().a_d(1, 1) * x[1] + model().b_d(1, 0) * c.amplitude;
+        const double x0 = study_model().a_d(0, 0) * x[0] + study_model().a_d(0, 1) * x[1] + study_model().b_d(0, 0) * c.amplitude;
+        const double x1 = study_model().a_d(1, 0) * x[0] + study_model().a_d(1, 1) * x[1] + study_model().b_d(1, 0) * c.amplitude;
         x[0] = x0;
         x[1] = x1;
       }
@@ -157,7 +153,7 @@ TEST(SodDesign, DeltaTTimesLossIsConstantAndTheOptimumIsChecked) {
   DeltaTDesign d;
   for (double xi : {0.05, 0.1, 0.15, 0.2}) {
     in.loss[0] = in.loss[1] = xi;
-    d = design_delta_t(model(), in);
+    d = design_delta_t(study_model(), in);
     EXPECT_TRUE(d.grid_check_passed) << d.packets_per_s << " vs grid " << d.grid_best_packets_per_s;
     EXPECT_FALSE(d.active.empty());
     for (std::size_t i = 0; i < 2; ++i) {
@@ -171,7 +167,7 @@ TEST(SodDesign, DeltaTTimesLossIsConstantAndTheOptimumIsChecked) {
   Eigen::MatrixXd rb = Eigen::MatrixXd::Zero(2, 2);
   for (std::size_t i = 0; i < 2; ++i) {
     const auto e = static_cast<Eigen::Index>(i);
-    rb(e, e) = model().r_diag[i] + in.delta_y[i] * in.delta_y[i] / 3;
+    rb(e, e) = study_model().r_diag[i] + in.delta_y[i] * in.delta_y[i] / 3;
   }
   const Eigen::MatrixXd prior = riccati_fixed_point(rb).first;
   for (std::size_t i = 0; i < 2; ++i) {
@@ -184,7 +180,7 @@ TEST(SodDesign, UnboundedDeltaTIsReportedWithItsReason) {
   DesignInputs in;
   in.mean_gap_s[0] = in.mean_gap_s[1] = 1;
   in.mu = 1e6;  // no measurement at all still meets the bound
-  const DeltaTDesign d = design_delta_t(model(), in);
+  const DeltaTDesign d = design_delta_t(study_model(), in);
   for (std::size_t i = 0; i < 2; ++i) {
     EXPECT_FALSE(d.node[i].bounded);
     EXPECT_NE(d.node[i].reason.find("rule (2b) off"), std::string::npos);
@@ -192,11 +188,11 @@ TEST(SodDesign, UnboundedDeltaTIsReportedWithItsReason) {
   EXPECT_TRUE(d.active.empty());
   in.loss[0] = in.loss[1] = 0;
   in.mu = 5;
-  const DeltaTDesign z = design_delta_t(model(), in);
+  const DeltaTDesign z = design_delta_t(study_model(), in);
   EXPECT_FALSE(z.node[0].bounded);
   EXPECT_NE(z.node[0].reason.find("loss rate 0"), std::string::npos);
   in.mu = 1;
-  EXPECT_THROW(design_delta_t(model(), in), std::invalid_argument);
+  EXPECT_THROW(design_delta_t(study_model(), in), std::invalid_argument);
 }
 
 }  // namespace

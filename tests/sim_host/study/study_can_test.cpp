@@ -33,7 +33,7 @@ namespace {
 
 const test_support::StudyExample kCan("ncs_can.json");
 
-std::string temp_dir(const char* name) { return test::fresh_dir("oneshot_study_can_test", name); }
+std::string can_temp_dir(const char* name) { return test::fresh_dir("oneshot_study_can_test", name); }
 
 /// Bits of a standard CAN data frame with s payload bytes under worst-case stuffing (Davis et
 /// al. 2007, eq. 1): 34 + 8s stuffable bits, ⌊(34 + 8s − 1)/4⌋ stuff bits, 13 unstuffed.
@@ -48,7 +48,7 @@ double message_us(std::int64_t bytes, std::int64_t bit_rate) {
 
 TEST(StudyCan, WithoutBackgroundEveryDelayIsTheTransmissionTime) {
   const NcsStudy s = kCan.study([](nlohmann::json& j) { j["buses"][0].erase("background"); }, 4);
-  const nlohmann::json j = run_outputs(run_ncs_sweep(s, 3, 2, engine::Shard{}), temp_dir("quiet"), false);
+  const nlohmann::json j = run_outputs(run_ncs_sweep(s, 3, 2, engine::Shard{}), can_temp_dir("quiet"), false);
   // The loop's messages: header (sequence, stamp: 8 bytes) + p = 2 doubles (sc), + m = 1 double (ca).
   const double sc_us = message_us(8 + 2 * 8, 125'000);
   const double ca_us = message_us(8 + 1 * 8, 125'000);
@@ -100,7 +100,7 @@ double mean_delay_checked(double scale, const char* leg, std::size_t seeds) {
         for (auto& b : j["buses"][0]["background"]) b["period_us"] = std::llround(b["period_us"].get<double>() * scale);
       },
       4);
-  const nlohmann::json j = run_outputs(run_ncs_sweep(s, seeds, 2, engine::Shard{}), temp_dir("load"), false);
+  const nlohmann::json j = run_outputs(run_ncs_sweep(s, seeds, 2, engine::Shard{}), can_temp_dir("load"), false);
   for (const char* a : {"S", "SK"}) {
     for (const char* l : {"sc", "ca"}) {
       const nlohmann::json& e = j.at("bus_delays").at(a).at(l);
@@ -195,7 +195,7 @@ TEST(StudyLoops, ApartInTimeEachLoopCostsWhatItCostsAlone) {
       for (std::size_t x = 0; x < r.spec.scenarios.size(); ++x)
         for (std::size_t k = 0; k < r.spec.seeds; ++k) EXPECT_EQ(r.at(a, x, k, shared), r.at(a, x, k, alone)) << loop << " " << a;
   }
-  const nlohmann::json j = run_outputs(r, temp_dir("apart"), false);
+  const nlohmann::json j = run_outputs(r, can_temp_dir("apart"), false);
   for (const auto& [loop, leg, c_us] : {std::tuple<const char*, const char*, double>{"board", "sc", message_us(24, 250'000)},
                                         {"servo", "ca", message_us(16, 250'000)}}) {
     for (const char* a : {"S", "SK"}) {
@@ -218,7 +218,7 @@ TEST(StudyLoops, ApartInTimeEachLoopCostsWhatItCostsAlone) {
 TEST(StudyLoops, TogetherEveryDelayIsWithinTheBoundCountingBothLoopsAndTheServoDelaysTheBoard) {
   const std::size_t seeds = test::sanitized_length<std::size_t>(10, 3);
   const NcsStudy s = loops_study([](nlohmann::json&) {}, 4);
-  const nlohmann::json j = run_outputs(run_ncs_sweep(s, seeds, 2, engine::Shard{}), temp_dir("together"), false);
+  const nlohmann::json j = run_outputs(run_ncs_sweep(s, seeds, 2, engine::Shard{}), can_temp_dir("together"), false);
   for (const char* loop : {"board", "servo"}) {
     for (const char* a : {"S", "SK"}) {
       for (const auto& [leg, d] : j.at("interference").at(loop).at(a).at("bus_delays").items()) {
@@ -256,17 +256,8 @@ TEST(StudyLoops, TogetherEveryDelayIsWithinTheBoundCountingBothLoopsAndTheServoD
 }
 
 TEST(StudyLoops, SameBytesOnOneAndTwoThreadsAndFromMergedShards) {
-  const NcsStudy s = loops_study([](nlohmann::json&) {}, 2.5);
-  const std::string one = run_outputs(run_ncs_sweep(s, 3, 1, engine::Shard{}), temp_dir("loops_one"), false).dump();
-  const std::string two = run_outputs(run_ncs_sweep(s, 3, 2, engine::Shard{}), temp_dir("loops_two"), false).dump();
-  EXPECT_EQ(one, two);
-  std::vector<engine::SweepResults> parts;
-  for (std::size_t i = 0; i < 2; ++i) {
-    const engine::SweepResults p = run_ncs_sweep(s, 3, 1, engine::Shard{i, 2});
-    parts.push_back(engine::shard_from_json(nlohmann::json::parse(engine::shard_to_json(p).dump())));
-  }
-  EXPECT_EQ(run_outputs(engine::merge_shards(parts), temp_dir("loops_merged"), false).dump(), two);
-  EXPECT_TRUE(nlohmann::json::parse(two).at("loops").contains("servo"));
+  test_support::expect_same_bytes_on_threads_and_shards(loops_study([](nlohmann::json&) {}, 2.5), 3,
+                                                        "oneshot_study_loops_test", "loops");
 }
 
 TEST(StudyLoops, RefusalsNameTheField) {

@@ -34,7 +34,7 @@ namespace {
 const test_support::StudyExample kCpu("ncs_cpu.json");
 const test_support::StudyExample kSensorCpu("ncs_cpu_sensor.json");
 
-std::string temp_dir(const char* name) { return test::fresh_dir("oneshot_study_cpu_test", name); }
+std::string cpu_temp_dir(const char* name) { return test::fresh_dir("oneshot_study_cpu_test", name); }
 
 /// Keeps the approaches named in `keep` (I first).
 void only(nlohmann::json& j, std::initializer_list<const char*> keep) {
@@ -51,7 +51,7 @@ TEST(StudyCpu, EveryControllerResponseIsWithinTheAnalysedBounds) {
           only(j, {"I", "S", "A", "AKl"});
         },
         2);
-    const nlohmann::json j = run_outputs(run_ncs_sweep(s, 30, 2, engine::Shard{}), temp_dir(scheduler), false);
+    const nlohmann::json j = run_outputs(run_ncs_sweep(s, 30, 2, engine::Shard{}), cpu_temp_dir(scheduler), false);
     // One job per period (30 seeds x 2 scenarios x 40 periods), nothing lost.
     test_support::expect_controller_jobs_within_bounds(j, *s.scenarios[0].controller_cpu, {"S", "A", "AKl"}, 30 * 2 * 40,
                                                        scheduler);
@@ -102,7 +102,7 @@ std::pair<double, double> load_point(double scale, const char* approach) {
         only(j, {"I", approach});
       },
       4);
-  const nlohmann::json j = run_outputs(run_ncs_sweep(s, 20, 2, engine::Shard{}), temp_dir("load"), false);
+  const nlohmann::json j = run_outputs(run_ncs_sweep(s, 20, 2, engine::Shard{}), cpu_temp_dir("load"), false);
   const double mean = j.at("cpu").at(approach).at("mean_us").get<double>();
   const double cost = j.at("approaches").at(approach).at("cost_mean").get<double>();
   std::printf("background periods x %.2f: %s mean tau_c %.1f us (WCRT %.1f), J %.6f\n", scale, approach, mean,
@@ -134,29 +134,29 @@ TEST(StudyCpu, SameBytesOnOneAndTwoThreadsAndFromMergedShards) {
 }
 
 /// Parsing, checking and mapping the edited file is refused, the message containing `expect`.
-void expect_refused(const test_support::Edit& edit, const std::string& expect) { kCpu.expect_refused(edit, expect, true); }
+void expect_cpu_refused(const test_support::Edit& edit, const std::string& expect) { kCpu.expect_refused(edit, expect, true); }
 
 TEST(StudyCpu, BadCpusAreRefusedNamingTheField) {
-  expect_refused([](nlohmann::json& j) { j["nodes"][1]["cpu"] = "arm"; }, "field 'nodes[1].cpu'");  // dangling
-  expect_refused([](nlohmann::json& j) { j["cpus"][0]["tasks"][0]["wcet_us"] = 6000; }, "field 'cpus[0].tasks[0].wcet_us'");  // > period
-  expect_refused([](nlohmann::json& j) { j["cpus"][0]["tasks"][0]["bcet_us"] = 700; }, "field 'cpus[0].tasks[0].bcet_us'");
-  expect_refused([](nlohmann::json& j) { j["cpus"][0]["tasks"][1]["name"] = "comm"; }, "field 'cpus[0].tasks[1].name'");  // duplicate
-  expect_refused([](nlohmann::json& j) { j["cpus"].push_back(j["cpus"][0]); }, "field 'cpus[1].name'");  // duplicate CPU
-  expect_refused([](nlohmann::json& j) { j["cpus"][0]["tasks"][0]["name"] = "controller"; }, "field 'nodes[1].name'");
-  expect_refused([](nlohmann::json& j) { j["cpus"][0]["scheduler"] = "round_robin"; }, "field 'cpus[0].scheduler'");
-  expect_refused([](nlohmann::json& j) { j["cpus"][0]["tasks"][2]["wcet_us"] = 12000; }, "field 'cpus[0].tasks[2]'");  // unschedulable
-  expect_refused([](nlohmann::json& j) { j["nodes"][1]["job"]["deadline_us"] = 3500; }, "field 'nodes[1].job'");  // it misses
-  expect_refused([](nlohmann::json& j) { j["nodes"][1].erase("job"); }, "field 'nodes[1].job'");
-  expect_refused([](nlohmann::json& j) { j["nodes"][1].erase("cpu"); }, "field 'nodes[1].job'");
-  expect_refused([](nlohmann::json& j) { j["nodes"][1]["job"]["period_us"] = 50000; }, "field 'nodes[1].job.period_us'");
-  expect_refused([](nlohmann::json& j) { j["nodes"][1]["job"]["sample_at"] = "end"; }, "field 'nodes[1].job.sample_at'");
-  expect_refused([](nlohmann::json& j) { j["nodes"][1]["job"] = {{"wcet_us", 45000}, {"priority", 3}}; }, "field 'nodes[1].job.wcet_us'");  // > h - J
-  expect_refused([](nlohmann::json& j) { j["nodes"][1]["job"]["exec"]["instructions_max"] = 2'000'000; }, "field 'nodes[1].job.exec'");
-  expect_refused([](nlohmann::json& j) { j["nodes"][0]["cpu"] = "dspic"; j["nodes"][0]["job"] = {{"wcet_us", 100}, {"priority", 5}}; },
+  expect_cpu_refused([](nlohmann::json& j) { j["nodes"][1]["cpu"] = "arm"; }, "field 'nodes[1].cpu'");  // dangling
+  expect_cpu_refused([](nlohmann::json& j) { j["cpus"][0]["tasks"][0]["wcet_us"] = 6000; }, "field 'cpus[0].tasks[0].wcet_us'");  // > period
+  expect_cpu_refused([](nlohmann::json& j) { j["cpus"][0]["tasks"][0]["bcet_us"] = 700; }, "field 'cpus[0].tasks[0].bcet_us'");
+  expect_cpu_refused([](nlohmann::json& j) { j["cpus"][0]["tasks"][1]["name"] = "comm"; }, "field 'cpus[0].tasks[1].name'");  // duplicate
+  expect_cpu_refused([](nlohmann::json& j) { j["cpus"].push_back(j["cpus"][0]); }, "field 'cpus[1].name'");  // duplicate CPU
+  expect_cpu_refused([](nlohmann::json& j) { j["cpus"][0]["tasks"][0]["name"] = "controller"; }, "field 'nodes[1].name'");
+  expect_cpu_refused([](nlohmann::json& j) { j["cpus"][0]["scheduler"] = "round_robin"; }, "field 'cpus[0].scheduler'");
+  expect_cpu_refused([](nlohmann::json& j) { j["cpus"][0]["tasks"][2]["wcet_us"] = 12000; }, "field 'cpus[0].tasks[2]'");  // unschedulable
+  expect_cpu_refused([](nlohmann::json& j) { j["nodes"][1]["job"]["deadline_us"] = 3500; }, "field 'nodes[1].job'");  // it misses
+  expect_cpu_refused([](nlohmann::json& j) { j["nodes"][1].erase("job"); }, "field 'nodes[1].job'");
+  expect_cpu_refused([](nlohmann::json& j) { j["nodes"][1].erase("cpu"); }, "field 'nodes[1].job'");
+  expect_cpu_refused([](nlohmann::json& j) { j["nodes"][1]["job"]["period_us"] = 50000; }, "field 'nodes[1].job.period_us'");
+  expect_cpu_refused([](nlohmann::json& j) { j["nodes"][1]["job"]["sample_at"] = "end"; }, "field 'nodes[1].job.sample_at'");
+  expect_cpu_refused([](nlohmann::json& j) { j["nodes"][1]["job"] = {{"wcet_us", 45000}, {"priority", 3}}; }, "field 'nodes[1].job.wcet_us'");  // > h - J
+  expect_cpu_refused([](nlohmann::json& j) { j["nodes"][1]["job"]["exec"]["instructions_max"] = 2'000'000; }, "field 'nodes[1].job.exec'");
+  expect_cpu_refused([](nlohmann::json& j) { j["nodes"][0]["cpu"] = "dspic"; j["nodes"][0]["job"] = {{"wcet_us", 100}, {"priority", 5}}; },
                  "field 'nodes[0].cpu'");  // the sensor runs on its timer
-  expect_refused([](nlohmann::json& j) { j["cpus"].push_back({{"name", "spare"}, {"scheduler", "edf"}}); }, "field 'cpus[1]'");
-  expect_refused([](nlohmann::json& j) { j["approaches"].push_back({{"name", "S+"}, {"kind", "S+"}}); }, "field 'approaches[7].kind'");
-  expect_refused([](nlohmann::json& j) { j["links"][1]["delay"] = {{"model", "poisson_periods"}, {"mean_periods", 1}, {"period_us", 1000}}; },
+  expect_cpu_refused([](nlohmann::json& j) { j["cpus"].push_back({{"name", "spare"}, {"scheduler", "edf"}}); }, "field 'cpus[1]'");
+  expect_cpu_refused([](nlohmann::json& j) { j["approaches"].push_back({{"name", "S+"}, {"kind", "S+"}}); }, "field 'approaches[7].kind'");
+  expect_cpu_refused([](nlohmann::json& j) { j["links"][1]["delay"] = {{"model", "poisson_periods"}, {"mean_periods", 1}, {"period_us", 1000}}; },
                  "field 'nodes[1].cpu'");  // no bound on the input's arrival
 }
 
@@ -311,8 +311,8 @@ TEST(StudyCpuSensor, ALoneConstantJobIsTheLoopWithItsFrameLaterByC) {
 
 TEST(StudyCpuSensor, SameBytesOnOneAndTwoThreadsAndWhatTheLoopCannotRunIsRefused) {
   const NcsStudy s = sensor_study(kSensorCpu.json(), 1.5);
-  const std::string one = run_outputs(run_ncs_sweep(s, 3, 1, engine::Shard{}), temp_dir("sensor_one"), false).dump();
-  const std::string two = run_outputs(run_ncs_sweep(s, 3, 2, engine::Shard{}), temp_dir("sensor_two"), false).dump();
+  const std::string one = run_outputs(run_ncs_sweep(s, 3, 1, engine::Shard{}), cpu_temp_dir("sensor_one"), false).dump();
+  const std::string two = run_outputs(run_ncs_sweep(s, 3, 2, engine::Shard{}), cpu_temp_dir("sensor_two"), false).dump();
   EXPECT_EQ(one, two);
   try {
     static_cast<void>(run_ncs_sweep(s, 1, 1, engine::Shard{}, true));

@@ -32,7 +32,7 @@ namespace {
 const test_support::StudyExample kOs("sod_ge_oneshot.json");
 const test_support::StudyExample kOsCpu("ncs_cpu_one_shot.json");
 
-std::string temp_dir(const char* name) { return test::fresh_dir("oneshot_study_os_test", name); }
+std::string oneshot_temp_dir(const char* name) { return test::fresh_dir("oneshot_study_os_test", name); }
 
 /// The sensor's thresholds δy (both outputs) and no loss on sc.
 std::function<void(nlohmann::json&)> lossless_delta(double delta) {
@@ -131,7 +131,7 @@ TEST(StudyOneShot, OnTheLossyLegDeliveredAndLostAddUpToSent) {
     }
   }
   EXPECT_GT(lost_all, 0);
-  const nlohmann::json j = run_outputs(r, temp_dir("lossy"), false);
+  const nlohmann::json j = run_outputs(r, oneshot_temp_dir("lossy"), false);
   for (const char* a : {"OS", "OSp", "OSK"}) {
     const nlohmann::json& c = j.at("links").at(a).at("sc");
     EXPECT_EQ(c.at("delivered").get<double>() + c.at("lost").get<double>(), c.at("sent").get<double>()) << a;
@@ -147,7 +147,7 @@ TEST(StudyOneShot, NeesIsNearTheStateDimensionWhenTheFilterIsConsistent) {
   const NcsStudy s = kOs.study(lossless_delta(0.02), 100);
   NcsStudy osk = s;
   osk.approaches = {ncs::Approach::kI, ncs::Approach::kOSK};
-  const nlohmann::json j = run_outputs(run_ncs_sweep(osk, 20, 2, engine::Shard{}), temp_dir("nees"), false);
+  const nlohmann::json j = run_outputs(run_ncs_sweep(osk, 20, 2, engine::Shard{}), oneshot_temp_dir("nees"), false);
   const double nees = j.at("one_shot").at("OSK").at("nees_mean").get<double>();
   const double ci = j.at("one_shot").at("OSK").at("nees_ci95").get<double>();
   // Measured 1.949 ± 0.057 (20 seeds × 2000 steps; the first ~20 steps from P0 = 10 R pull it
@@ -158,8 +158,8 @@ TEST(StudyOneShot, NeesIsNearTheStateDimensionWhenTheFilterIsConsistent) {
 
 TEST(StudyOneShot, SameBytesOnOneAndTwoThreads) {
   const NcsStudy s = kOs.study([](nlohmann::json&) {}, 3);
-  const std::string one = run_outputs(run_ncs_sweep(s, 3, 1, engine::Shard{}), temp_dir("one"), false).dump();
-  const std::string two = run_outputs(run_ncs_sweep(s, 3, 2, engine::Shard{}), temp_dir("two"), false).dump();
+  const std::string one = run_outputs(run_ncs_sweep(s, 3, 1, engine::Shard{}), oneshot_temp_dir("one"), false).dump();
+  const std::string two = run_outputs(run_ncs_sweep(s, 3, 2, engine::Shard{}), oneshot_temp_dir("two"), false).dump();
   EXPECT_EQ(one, two);
   EXPECT_TRUE(nlohmann::json::parse(two).contains("one_shot"));
 }
@@ -274,7 +274,7 @@ TEST(StudyOneShotMtm, ASilentSensorSendsItsFirstSampleAndOnePerSetPointChange) {
 TEST(StudyCpuOneShot, EveryControllerResponseIsWithinTheAnalysedBounds) {
   for (const char* scheduler : {"fixed_priority", "fixed_priority_nonpreemptive", "edf"}) {
     const NcsStudy s = kOsCpu.study([&](nlohmann::json& j) { j["cpus"][0]["scheduler"] = scheduler; }, 2);
-    const nlohmann::json j = run_outputs(run_ncs_sweep(s, 20, 2, engine::Shard{}), temp_dir(scheduler), false);
+    const nlohmann::json j = run_outputs(run_ncs_sweep(s, 20, 2, engine::Shard{}), oneshot_temp_dir(scheduler), false);
     const ncs::ControllerCpu& c = *s.scenarios[0].controller_cpu;
     EXPECT_GT(c.wcrt, c.bcrt);
     // One job per timer (20 seeds x 2 scenarios x 40 periods), nothing lost.
@@ -306,8 +306,8 @@ TEST(StudyCpuOneShot, CheckAnalysesTheTimerJobAsPeriodicAtItsPhase) {
 
 TEST(StudyCpuOneShot, SameBytesOnOneAndTwoThreadsAndBadJobsRefused) {
   const NcsStudy s = kOsCpu.study([](nlohmann::json&) {}, 1.5);
-  const std::string one = run_outputs(run_ncs_sweep(s, 3, 1, engine::Shard{}), temp_dir("os_one"), false).dump();
-  const std::string two = run_outputs(run_ncs_sweep(s, 3, 2, engine::Shard{}), temp_dir("os_two"), false).dump();
+  const std::string one = run_outputs(run_ncs_sweep(s, 3, 1, engine::Shard{}), oneshot_temp_dir("os_one"), false).dump();
+  const std::string two = run_outputs(run_ncs_sweep(s, 3, 2, engine::Shard{}), oneshot_temp_dir("os_two"), false).dump();
   EXPECT_EQ(one, two);
   EXPECT_TRUE(nlohmann::json::parse(two).contains("cpu"));
   const auto refused = [](const std::function<void(nlohmann::json&)>& edit, const std::string& expect) {

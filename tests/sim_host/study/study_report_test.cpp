@@ -28,7 +28,7 @@ namespace {
 
 const std::string kExample = std::string(ONESHOT_STUDY_EXAMPLES_DIR) + "/ncs.json";
 
-nlohmann::json read_json(const std::string& path) { return nlohmann::json::parse(test::read_file(path)); }
+nlohmann::json read_report_json(const std::string& path) { return nlohmann::json::parse(test::read_file(path)); }
 
 /// The cells of a markdown table row "| a | b | … |" (trimmed), empty when `line` is not one.
 std::vector<std::string> cells(const std::string& line) {
@@ -81,7 +81,7 @@ TEST(StudyReport, NamesEveryApproachWithTheCostsOfStudyRun) {
   const test::CommandResult rep =
       test::run_command({ONESHOT_SIM_PATH, "study", "report", kExample, out, "--seeds", "2", "--threads", "2", "--trace", "AK"});
   ASSERT_EQ(rep.exit_code, 0) << rep.output;
-  const nlohmann::json j = read_json(run_json);
+  const nlohmann::json j = read_report_json(run_json);
   const std::string md = test::read_file(out + "/report.md");
   ASSERT_FALSE(md.empty());
   EXPECT_NE(md.find("`ncs.json`"), std::string::npos) << md;
@@ -120,7 +120,7 @@ TEST(StudyReport, NamesEveryApproachWithTheCostsOfStudyRun) {
     EXPECT_NEAR(number(pairs.at(pair)[2]), d.at("ci95").get<double>(), 5.1e-7) << pair;
   }
   // report.json holds the run's figures, bit for bit (same seeds, same runs).
-  const nlohmann::json rj = read_json(out + "/report.json");
+  const nlohmann::json rj = read_report_json(out + "/report.json");
   for (const auto& [name, a] : j.at("approaches").items())
     EXPECT_EQ(rj.at("approaches").at(name).at("cost_mean").get<double>(), a.at("cost_mean").get<double>()) << name;
   // The plot the report links is there.
@@ -130,7 +130,7 @@ TEST(StudyReport, NamesEveryApproachWithTheCostsOfStudyRun) {
 }
 
 TEST(StudyReport, BadInputWritesNothing) {
-  nlohmann::json bad = read_json(kExample);
+  nlohmann::json bad = read_report_json(kExample);
   bad["scenarios"][0]["params"]["amplitude_volts"] = 1000;  // range [0, 100]
   bad["plant"]["file"] = std::string(ONESHOT_STUDY_EXAMPLES_DIR) + "/" + bad["plant"]["file"].get<std::string>();
   const std::string dir = test::made_dir("oneshot_study_report", "bad");
@@ -184,7 +184,7 @@ TEST(StudyReport, MaxDurationCutsEveryScenario) {
   const test::CommandResult r = test::run_command(
       {ONESHOT_SIM_PATH, "study", "run", kExample, "--seeds", "2", "--max-duration", "2.5", "--no-plots", "--out", out, "--json", out + "/run.json"});
   ASSERT_EQ(r.exit_code, 0) << r.output;
-  const nlohmann::json capped_run = read_json(out + "/run.json");  // kept alive: the loop reads inside it
+  const nlohmann::json capped_run = read_report_json(out + "/run.json");  // kept alive: the loop reads inside it
   for (const auto& x : capped_run.at("scenarios")) EXPECT_EQ(x.at("duration_s").get<double>(), 2.5);
   // The report says its runs were cut; an explicit 0 is a cap below one period, refused.
   const std::string rep = test::fresh_dir("oneshot_study_report", "capped_report");
@@ -262,7 +262,7 @@ TEST(StudyReport, TracesHaveTheirColumnsAndTheRunsMessages) {
   const test::CommandResult r = test::run_command({ONESHOT_SIM_PATH, "study", "report", file, out, "--seeds", "2", "--threads", "2",
                                                    "--max-duration", "3", "--trace", "OSK,I"});
   ASSERT_EQ(r.exit_code, 0) << r.output;
-  const nlohmann::json rep = read_json(out + "/report.json");
+  const nlohmann::json rep = read_report_json(out + "/report.json");
   ASSERT_EQ(rep.at("traces").size(), 2U);
   NcsStudy s = map_ncs_study(engine::load_study(file, &ncs_schema()));
   cap_duration(s, 3, "--max-duration");
@@ -333,7 +333,7 @@ TEST(StudyReport, NoPlotsWritesTheTracesCsvOnly) {
     csv += f.path().filename().string().rfind("trace_", 0) == 0 && f.path().extension() == ".csv";
   }
   EXPECT_EQ(csv, 5U);  // S: states, messages; AK: states, estimates, messages
-  EXPECT_EQ(read_json(out + "/report.json").at("traces").size(), 2U);
+  EXPECT_EQ(read_report_json(out + "/report.json").at("traces").size(), 2U);
 }
 
 TEST(StudyReport, BenchCountsTheSweepsKernelEvents) {
@@ -343,7 +343,7 @@ TEST(StudyReport, BenchCountsTheSweepsKernelEvents) {
   const test::CommandResult r = test::run_command({ONESHOT_SIM_PATH, "study", "bench", file, "--seeds", "2", "--threads", "2",
                                                    "--max-duration", "2.5", "--json", dir + "/bench.json"});
   ASSERT_EQ(r.exit_code, 0) << r.output;
-  const nlohmann::json j = read_json(dir + "/bench.json");
+  const nlohmann::json j = read_report_json(dir + "/bench.json");
   NcsStudy s = map_ncs_study(engine::load_study(file, &ncs_schema()));
   cap_duration(s, 2.5, "--max-duration");
   double total = 0;
