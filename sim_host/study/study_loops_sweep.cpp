@@ -2,17 +2,19 @@
 /// @brief The sweep and summary of a study file with several loops on one engine (see
 ///        study_ncs_sweep.hpp: run_loops_sweep(), loop_results(), loops_outputs()).
 #include <cmath>
-#include <cstdio>
 #include <iterator>
 #include <string>
 #include <utility>
 #include <vector>
 
 #include "ncs_loop.hpp"
+#include "oneshot/util/number_text.hpp"
 #include "oneshot/util/statistics.hpp"
 #include "study_ncs_sweep.hpp"
 
 namespace oneshot::study {
+
+using util::format_f;
 namespace {
 
 /// The legs of loop `s` on a CAN bus (the same in every scenario).
@@ -56,13 +58,6 @@ LegDelays leg_delays(const engine::SweepResults& r, std::size_t a, const std::st
   for (std::size_t s = 0; s < r.spec.scenarios.size(); ++s)
     for (std::size_t k = 0; k < r.spec.seeds; ++k) d.add(r.at(a, s, k, mm), r.at(a, s, k, mn), r.at(a, s, k, mx), r.at(a, s, k, ms));
   return d;
-}
-
-/// "%.6f" of `v`.
-std::string fixed(double v, const char* format = "%.6f") {
-  char buf[64];
-  std::snprintf(buf, sizeof buf, format, v);
-  return buf;
 }
 
 }  // namespace
@@ -194,9 +189,9 @@ nlohmann::json loops_outputs(const engine::SweepResults& results, const std::str
                           {"cost_alone_ci95", al.ci95}, {"shared_minus_alone_mean", df.mean},
                           {"shared_minus_alone_ci95", df.ci95}, {"ratio_shared_to_alone_mean", rt.mean},
                           {"ratio_shared_to_alone_ci95", rt.ci95}};
-      cost_md += "| " + spec.approaches[a] + " | " + fixed(sh.mean) + " ± " + fixed(sh.ci95) + " | " + fixed(al.mean) + " ± " +
-                 fixed(al.ci95) + " | " + fixed(df.mean, "%+.6f") + " ± " + fixed(df.ci95) + " | " + fixed(rt.mean, "%.4f") +
-                 " ± " + fixed(rt.ci95, "%.4f") + " |\n";
+      cost_md += "| " + spec.approaches[a] + " | " + format_f(sh.mean, 6) + " ± " + format_f(sh.ci95, 6) + " | " + format_f(al.mean, 6) + " ± " +
+                 format_f(al.ci95, 6) + " | " + format_f(df.mean, 6, true) + " ± " + format_f(df.ci95, 6) + " | " + format_f(rt.mean, 4) +
+                 " ± " + format_f(rt.ci95, 4) + " |\n";
       if (loops[i].contains("bus_links")) {
         for (const auto& l : loops[i].at("bus_links")) {
           const std::string leg = l.get<std::string>();
@@ -206,9 +201,9 @@ nlohmann::json loops_outputs(const engine::SweepResults& results, const std::str
           const bool within = sd.messages == 0 || (!w.is_null() && sd.max_us <= w.get<double>());
           e["bus_delays"][leg] = {{"shared", sd.json()}, {"alone", ad.json()}, {"worst_response_us", w}, {"within_bound", within}};
           if (sd.messages == 0) continue;  // I and IK: nothing on the bus
-          delay_md += "| " + spec.approaches[a] + " | " + leg + " | " + fixed(sd.messages, "%.0f") + " | " + fixed(ad.min_us, "%.1f") +
-                      " / " + fixed(ad.sum_us / ad.messages, "%.1f") + " / " + fixed(ad.max_us, "%.1f") + " | " +
-                      fixed(sd.min_us, "%.1f") + " / " + fixed(sd.sum_us / sd.messages, "%.1f") + " / " + fixed(sd.max_us, "%.1f") +
+          delay_md += "| " + spec.approaches[a] + " | " + leg + " | " + format_f(sd.messages, 0) + " | " + format_f(ad.min_us, 1) +
+                      " / " + format_f(ad.sum_us / ad.messages, 1) + " / " + format_f(ad.max_us, 1) + " | " +
+                      format_f(sd.min_us, 1) + " / " + format_f(sd.sum_us / sd.messages, 1) + " / " + format_f(sd.max_us, 1) +
                       " | " + (w.is_null() ? std::string("unbounded") : w.dump()) + " | " + (within ? "yes" : "no") + " |\n";
         }
       }

@@ -232,11 +232,23 @@ TEST(StudyOneShotMtm, ASilentSensorSendsItsFirstSampleAndOnePerSetPointChange) {
   // at 2 s (T_r 4 s); with k_ref,max = 3 the send 0.15 s after the change at 3 s is still in the run.
   const NcsStudy s = kOs.study(lossless_mtm(0, 1e6, 0, 3), 4);
   const std::uint32_t changes[] = {3, 1};
+  const double h_s = s.ctx->period_us() * 1e-6;
+  ncs::RunOptions record;
+  record.record_messages = true;
   for (std::size_t x = 0; x < s.scenarios.size(); ++x) {
+    // When: the first sample at 0, then k_ref,max = 3 periods after each switch (T_r/2, T_r, ...).
+    std::vector<double> expected_s = {0};
+    const double half_s = s.scenarios[x].period_s / 2;
+    for (int i = 1; i * half_s < 4; ++i) expected_s.push_back(i * half_s + 3 * h_s);
     for (const ncs::Approach a : {ncs::Approach::kOS, ncs::Approach::kOSp}) {
-      const ncs::RunResult r = ncs::run(*s.ctx, a, s.scenarios[x], 1, ncs::RunOptions{});
+      const ncs::RunResult r = ncs::run(*s.ctx, a, s.scenarios[x], 1, record);
       EXPECT_EQ(r.sent, 1 + changes[x]) << ncs::name(a) << " " << x;
       EXPECT_EQ(r.sampled, 80U);
+      std::vector<double> sent_s;
+      for (const ncs::MessageEvent& m : r.messages)
+        if (m.leg == "sc") sent_s.push_back(m.sent_s);
+      ASSERT_EQ(sent_s.size(), expected_s.size()) << ncs::name(a) << " " << x;
+      for (std::size_t i = 0; i < sent_s.size(); ++i) EXPECT_NEAR(sent_s[i], expected_s[i], 1e-9) << ncs::name(a) << " " << i;
     }
   }
   // A relative term σ > 0 widens the threshold (σ y² + δ): fewer sends than δ alone; OS cannot

@@ -14,10 +14,10 @@ inline std::string format_g(double v, int significant = 6) {
   return b;
 }
 
-/// `v` fixed-point with `decimals` decimals (printf "%.*f").
-inline std::string format_f(double v, int decimals) {
+/// `v` fixed-point with `decimals` decimals (printf "%.*f"; with `sign`, "%+.*f": a difference).
+inline std::string format_f(double v, int decimals, bool sign = false) {
   char b[48];
-  std::snprintf(b, sizeof b, "%.*f", decimals, v);
+  std::snprintf(b, sizeof b, sign ? "%+.*f" : "%.*f", decimals, v);
   return b;
 }
 
