@@ -4,9 +4,11 @@
 ///        timing streams, the controller's CPU) and the loops' type aliases and addresses.
 #pragma once
 
+#include <algorithm>
 #include <cmath>
 #include <functional>
 #include <memory>
+#include <stdexcept>
 #include <string>
 #include <utility>
 #include <vector>
@@ -51,6 +53,7 @@ struct World {
   engine::Network net;     ///< Nodes, links, buses.
   std::vector<std::pair<std::string, engine::CanBus*>> buses;   ///< Buses by name (built on first use).
   std::vector<std::unique_ptr<engine::CanTraffic>> traffic;     ///< Their background streams.
+  SimTime end{0};  ///< The run's end: the latest loop's (the kernel and the background traffic run to it).
 };
 
 /// What every loop shares: kernel, plant, network, set-point, noise and timing streams.
@@ -77,7 +80,12 @@ class Harness {
         ref_(reference(ctx, sc)),
         noisy_(noisy(a, opt)),
         h_(engine::from_us(ctx.period_us())),
-        end_(engine::from_seconds(sc.duration_s, "ncs scenario duration")) {
+        offset_(engine::from_us(on != nullptr ? on->clock_offset_us : 0)),
+        end_(offset_ + engine::from_seconds(sc.duration_s, "ncs scenario duration")) {
+    if (offset_ < Duration{0} || offset_ >= h_) {
+      throw std::invalid_argument("ncs: a loop's clock offset is in [0, h) (" + std::to_string(offset_.count() / 1000) + " us)");
+    }
+    if (own_world_ || end_ > world_.end) world_.end = end_;
     if (on != nullptr) {
       sensor_at_ = on->sensor;
       controller_at_ = on->controller;
@@ -107,9 +115,9 @@ class Harness {
       plant_.set_reference(ref_.state(kk), ref_.input(kk));
       if (an_) an_->set_reference(ref_.state(kk), ref_.input(kk));
     });
-    const auto k_end = static_cast<std::uint64_t>((end_.count() + h_.count() - 1) / h_.count());
+    const auto k_end = static_cast<std::uint64_t>(((end_ - offset_).count() + h_.count() - 1) / h_.count());
     for (std::uint64_t k : ref_.switches(k_end)) {
-      kernel_.schedule(SimTime{h_ * static_cast<std::int64_t>(k)}, EventClass::kEnvironment, sw, k);
+      kernel_.schedule(SimTime{offset_ + h_ * static_cast<std::int64_t>(k)}, EventClass::kEnvironment, sw, k);
     }
     if (sc.controller_cpu && !delay_free(a)) {  // τ_c from the schedule (ncs_cpu.hpp)
       cpu_ = std::make_unique<engine::cpu::Cpu>(kernel_, sc.controller_cpu->set);
@@ -144,10 +152,12 @@ class Harness {
   /// Whether a run of `a` under `opt` draws process and measurement noise.
   static bool noisy(Approach a, const RunOptions& opt) { return !opt.noise_free && !opt.analytic && a != Approach::kI; }
 
-  /// The plant (and the analytic tracker) at now.
+  /// The plant (and the analytic tracker) at now: on the plant's time, the loop's (now − φ,
+  /// the loop's clock offset), held at the loop's end in a run that goes on for a later loop.
   void advance() {
-    plant_.advance_to(kernel_.now());
-    if (an_) an_->flow_to(kernel_.now());
+    const SimTime t = std::min(std::max(kernel_.now(), offset_), end_);
+    plant_.advance_to(t - offset_);
+    if (an_) an_->flow_to(t);
   }
 
   /// Leg `name`'s link of this scenario and approach.
@@ -184,7 +194,7 @@ class Harness {
     engine::CanBus& b = net_.add_can_bus(leg.bus);
     world_.buses.emplace_back(leg.bus.name, &b);
     if (!leg.background.empty()) {
-      world_.traffic.push_back(std::make_unique<engine::CanTraffic>(kernel_, b, leg.background, leg.offsets, end_));
+      world_.traffic.push_back(std::make_unique<engine::CanTraffic>(kernel_, b, leg.background, leg.offsets, world_.end));
     }
     return b;
   }
@@ -264,7 +274,7 @@ class Harness {
     if (inner_) {
       inner_();  // the next loop of a shared run: it runs the kernel
     } else {
-      kernel_.run_until(end_);
+      kernel_.run_until(world_.end);
     }
     result_.events = kernel_.events_run();
     result_.injected = net_.fault_counters();
@@ -332,7 +342,8 @@ class Harness {
   bool noisy_;
   bool opt_faults_empty_ = true;
   Duration h_;
-  SimTime end_;
+  Duration offset_;  ///< The loop's clock offset φ (LoopOnBus::clock_offset_us): its timer at kh + φ.
+  SimTime end_;      ///< The loop's end: φ + the scenario's duration.
   double r_chol_[3] = {};
   InputVec u_min_;
   InputVec u_max_;

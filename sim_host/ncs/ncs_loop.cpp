@@ -269,7 +269,7 @@ RunResult run_sampling(Harness& hs, Law law, Saturated saturated) {
     const SimTime t_next = k.now() + hs.h_;
     if (t_next < hs.end_) k.schedule(t_next, EventClass::kSample, *timer_h, n + 1);
   });
-  k.schedule(SimTime{0}, EventClass::kSample, *timer_h, 0);
+  k.schedule(SimTime{hs.offset_}, EventClass::kSample, *timer_h, 0);  // at kh + φ (φ = 0 but in a run of several loops)
   RunResult r = hs.finish();
   r.saturated = saturated(ctrl->law());
   r.counters = concat(sampling_controller_counters(*ctrl), actuator_counters(*act));
@@ -351,6 +351,10 @@ std::vector<RunResult> run_loops(const std::vector<LoopOnBus>& loops, Approach a
     throw std::invalid_argument(std::string("ncs: several loops in one run take I, S, SK, IK, not ") + name(a));
   }
   World world(seed);
+  for (const LoopOnBus& l : loops) {  // the run's end before any loop builds a bus: the background runs to it
+    const SimTime end = engine::from_us(l.clock_offset_us) + engine::from_seconds(l.scenario->duration_s, "ncs scenario duration");
+    if (end > world.end) world.end = end;
+  }
   std::vector<RunResult> out(loops.size());
   // Loop i's nodes and timers are set up, then loop i + 1's inside its finish(); the last runs
   // the kernel, and each collects its results as the calls return.

@@ -158,10 +158,17 @@ struct LoopOnBus {
   std::uint8_t sensor = 0;             ///< Its sensor's address (unique in the run).
   std::uint8_t controller = 0;         ///< Its controller's.
   std::uint8_t actuator = 0;           ///< Its actuator's.
+  /// The phase φ of its timer (its sensor's, I, S, SK, IK), whole µs, 0 ≤ φ < h: the loop
+  /// runs on [φ, φ + duration] of the run's time, its samples at kh + φ, its set-point
+  /// switches at kh + φ, its plant's time and cost from φ (the loop's own time shifted by φ;
+  /// the plants are separate, so only the bus and its other traffic see the shift).
+  std::int64_t clock_offset_us = 0;
 };
 
 /// Runs the sampling loop `a` (I, S, SK, IK; std::invalid_argument otherwise) of every loop
-/// of `loops` together in one engine run with `seed`: one kernel, one network, their bus legs
+/// of `loops` together in one engine run with `seed` until the latest loop's end (its
+/// clock_offset_us + duration; std::invalid_argument for an offset outside [0, h)): one
+/// kernel, one network, their bus legs
 /// on the same buses (arbitration by identifier with each other and the background traffic,
 /// stream "can/<bus>/jitter"), each loop's streams named per loop. One result per loop, in order.
 std::vector<RunResult> run_loops(const std::vector<LoopOnBus>& loops, Approach a, std::uint64_t seed);

@@ -134,29 +134,33 @@ std::string simulated_time_text(const study::NcsStudy& s, const CLI::Option* max
 /// `study bench`: the file's sweep (approaches x scenarios x seeds, ncs::run with the sweep's
 /// seeds) timed, each run's kernel events counted (an event: one pop of the engine's event
 /// queue, whatever its handler: sampling, timers, computations, deliveries, set-point
-/// switches, CAN frames and background traffic).
+/// switches, CAN frames and background traffic); per approach the mean cost over its runs
+/// (`cost_mean`; a file with several loops: one run of them all, `loops.<loop>.cost_mean`).
 nlohmann::json bench(const study::NcsStudy& s, std::size_t seeds, unsigned threads) {
-  engine::SweepSpec spec;
-  spec.study = "study";
-  spec.experiment = "bench";
-  for (ncs::Approach a : s.approaches) spec.approaches.emplace_back(ncs::name(a));
-  for (const ncs::Scenario& x : s.scenarios) spec.scenarios.push_back(x.name);
-  spec.first_seed = s.first_seed;
-  spec.seeds = seeds == 0 ? s.seeds : seeds;
-  spec.metrics = {"cost", "events", "simulated_s", "run_s"};
+  engine::SweepSpec spec = study::study_sweep_spec(s, seeds, "bench");
+  // Several loops: each loop's cost "<loop>/cost" (the loops of one shared run), then the run's figures.
+  for (const study::NcsStudy& l : s.loops) spec.metrics.push_back(l.loop + "/cost");
+  if (s.loops.empty()) spec.metrics.emplace_back("cost");
+  std::int64_t last_offset_us = 0;  // the shared run goes on to the latest loop's end
+  for (const study::NcsStudy& l : s.loops) last_offset_us = std::max(last_offset_us, l.clock_offset_us);
+  for (const char* m : {"events", "simulated_s", "run_s"}) spec.metrics.emplace_back(m);
   spec.config = {{"study_file", s.source}};
   const unsigned used = threads == 0 ? std::max(1U, std::thread::hardware_concurrency()) : threads;
   const std::clock_t cpu0 = std::clock();
   const auto start = std::chrono::steady_clock::now();
   const engine::SweepResults r = engine::run_sweep(
       spec, engine::Shard{}, used,
-      [&s](std::size_t a, std::size_t k, std::uint64_t seed) {
+      [&s, last_offset_us](std::size_t a, std::size_t k, std::uint64_t seed) {
         const auto t0 = std::chrono::steady_clock::now();
-        // Several loops: one run of them all on the shared engine (its events; the first loop's cost).
-        const ncs::RunResult x = s.loops.empty() ? ncs::run(*s.ctx, s.approaches[a], s.scenarios[k], seed, ncs::RunOptions{})
-                                                 : ncs::run_loops(study::loops_on_bus(s, k), s.approaches[a], seed)[0];
+        // Several loops: one run of them all on the shared engine (its events, every loop's cost).
+        const std::vector<ncs::RunResult> x =
+            s.loops.empty() ? std::vector<ncs::RunResult>{ncs::run(*s.ctx, s.approaches[a], s.scenarios[k], seed, ncs::RunOptions{})}
+                            : ncs::run_loops(study::loops_on_bus(s, k), s.approaches[a], seed);
         const double run_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-        return std::vector<double>{x.cost, static_cast<double>(x.events), s.scenarios[k].duration_s, run_s};
+        std::vector<double> v;
+        for (const ncs::RunResult& l : x) v.push_back(l.cost);
+        v.insert(v.end(), {static_cast<double>(x[0].events), s.scenarios[k].duration_s + 1e-6 * static_cast<double>(last_offset_us), run_s});
+        return v;
       },
       "study bench");
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
@@ -178,6 +182,16 @@ nlohmann::json bench(const study::NcsStudy& s, std::size_t seeds, unsigned threa
       }
     events += ea;
     per[spec.approaches[a]] = {{"events", ea}, {"run_s", ta}, {"events_per_run_s", ta > 0 ? ea / ta : 0.0}};
+    // The mean cost over the approach's runs: the loop's, or per loop of a file with several.
+    const auto cost_mean = [&](const std::string& metric) {
+      const std::size_t m = r.metric(metric);
+      double sum = 0;
+      for (std::size_t x = 0; x < spec.scenarios.size(); ++x)
+        for (std::size_t k = 0; k < spec.seeds; ++k) sum += r.at(a, x, k, m);
+      return sum / static_cast<double>(spec.scenarios.size() * spec.seeds);
+    };
+    if (s.loops.empty()) per[spec.approaches[a]]["cost_mean"] = cost_mean("cost");
+    for (const study::NcsStudy& l : s.loops) per[spec.approaches[a]]["loops"][l.loop]["cost_mean"] = cost_mean(l.loop + "/cost");
   }
   return {{"per_approach", per}, {"study_file", s.source}, {"runs", spec.runs()}, {"seeds", spec.seeds}, {"threads", used},
           {"events", events}, {"simulated_s", simulated}, {"wall_s", wall}, {"cpu_s", cpu},

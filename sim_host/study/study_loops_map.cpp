@@ -91,6 +91,21 @@ NcsStudy map_ncs_loops(const engine::StudyFile& file) {
       for (const engine::LinkSpec& l : v.links) used = used || l.bus == b.config.name;
       if (used) v.buses.push_back(b);
     }
+    // The loop's phase: its sensor's clock offset (the timer of I, S, SK, IK); the controller
+    // and the actuator act on arrival, their offsets stay 0. The view runs on one clock.
+    engine::Duration offset{0};
+    std::size_t offset_node = 0;  // the sensor's index in the file
+    for (std::size_t p = 0; p < v.nodes.size(); ++p) {
+      engine::NodeSpec& n = v.nodes[p];
+      if (n.clock_offset.count() == 0) continue;
+      if (n.role != "sensor") {
+        refuse(at("nodes", node_index[p]) + ".clock_offset_us",
+               "a loop's phase is its sensor's clock offset (the timer of I, S, SK, IK); the " + n.role + " acts on arrival: 0 only");
+      }
+      offset = n.clock_offset;
+      offset_node = node_index[p];
+      n.clock_offset = engine::Duration{0};
+    }
     NcsStudy part;
     try {
       part = map_ncs_study(v);
@@ -108,6 +123,12 @@ NcsStudy map_ncs_loops(const engine::StudyFile& file) {
       if (what.rfind("field 'links':", 0) == 0) what.replace(0, 14, "field '" + at("loops", i) + "': its links:");
       throw InputError(what);
     }
+    const std::int64_t h_us = part.ctx->period_us();
+    if (offset.count() < 0 || offset.count() % 1000 != 0 || offset.count() / 1000 >= h_us) {
+      refuse(at("nodes", offset_node) + ".clock_offset_us", "the loop's phase: its sensor's timer fires at kh + clock_offset_us, "
+                                                            "0 <= it < h = " + std::to_string(h_us) + " us (whole us)");
+    }
+    part.clock_offset_us = offset.count() / 1000;
     part.loop = loop.name;
     part.addresses = addresses;
     for (const auto& [nm, leg] : leg_of) part.link_names[leg] = nm;

@@ -17,15 +17,6 @@ namespace oneshot::study {
 using util::format_f;
 namespace {
 
-/// The legs of loop `s` on a CAN bus (the same in every scenario).
-std::vector<std::string> loop_bus_legs(const NcsStudy& s) {
-  std::vector<std::string> out;
-  if (s.scenarios.empty()) return out;
-  for (const std::string& l : s.links)
-    if (s.scenarios[0].bus_legs.count(l) != 0) out.push_back(l);
-  return out;
-}
-
 /// Observed delays of one leg over a set of runs.
 struct LegDelays {
   double messages = 0;  ///< Messages over every run.
@@ -65,43 +56,46 @@ LegDelays leg_delays(const engine::SweepResults& r, std::size_t a, const std::st
 engine::SweepResults run_loops_sweep(const NcsStudy& s, std::size_t seeds, unsigned threads, const engine::Shard& shard,
                                      bool analytic) {
   if (analytic) throw engine::InputError("field '--analytic': no analytic cost for a file with several loops (loops[])");
-  engine::SweepSpec spec;
-  spec.study = "study";
-  spec.experiment = "run";
-  for (ncs::Approach a : s.approaches) spec.approaches.emplace_back(ncs::name(a));
-  for (const ncs::Scenario& x : s.scenarios) spec.scenarios.push_back(x.name);
-  spec.first_seed = s.first_seed;
-  spec.seeds = seeds == 0 ? s.seeds : seeds;
+  engine::SweepSpec spec = study_sweep_spec(s, seeds, "run");
+  bool filtered = false;  // SK or IK: each loop's NEES
+  for (ncs::Approach a : s.approaches) filtered = filtered || ncs::filtered_approach(a);
   spec.config = {{"study_file", s.source}, {"loops", nlohmann::json::array()}};
   for (const NcsStudy& l : s.loops) {
     nlohmann::json c = loop_sweep_config(l);
     c["name"] = l.loop;
     c["addresses"] = l.addresses;
     c["file_links"] = l.link_names;
+    if (l.clock_offset_us != 0) c["clock_offset_us"] = l.clock_offset_us;  // only then: the spec of files without stays as it was
     spec.config["loops"].push_back(c);
     for (const std::string& m : loop_sweep_metrics(l)) spec.metrics.push_back(l.loop + "/" + m);
+    if (filtered)  // as a file of one loop: the filter's NEES (only then: files without SK, IK keep their spec)
+      for (std::size_t m = 0; m < kNeesMetricCount; ++m) spec.metrics.push_back(l.loop + "/" + kOneShotMetrics[m]);
   }
+  std::vector<std::vector<std::string>> bus_legs;  // per loop its legs on a CAN bus (the same in every run)
   for (const NcsStudy& l : s.loops) {
+    bus_legs.push_back(bus_links(l));
     spec.metrics.push_back(l.loop + "/alone.cost");
-    for (const std::string& leg : loop_bus_legs(l))
+    for (const std::string& leg : bus_legs.back())
       for (const char* c : kBusDelayMetrics) spec.metrics.push_back(l.loop + "/alone." + leg + "." + c);
   }
   const NcsStudy* study = &s;
+  const std::vector<std::vector<std::string>>* legs_on_bus = &bus_legs;
   return engine::run_sweep(
       spec, shard, threads,
-      [study](std::size_t a, std::size_t k, std::uint64_t seed) {
+      [study, legs_on_bus, filtered](std::size_t a, std::size_t k, std::uint64_t seed) {
         const ncs::Approach ap = study->approaches[a];
         const std::vector<ncs::LoopOnBus> loops = loops_on_bus(*study, k);
         const std::vector<ncs::RunResult> shared = ncs::run_loops(loops, ap, seed);
         std::vector<double> v;
         for (std::size_t i = 0; i < loops.size(); ++i) {
-          const std::vector<double> x = loop_sweep_values(study->loops[i], a, shared[i]);
+          const std::vector<double> x = loop_sweep_values(study->loops[i], a, shared[i], (*legs_on_bus)[i]);
           v.insert(v.end(), x.begin(), x.end());
+          if (filtered) v.insert(v.end(), {shared[i].nees, static_cast<double>(shared[i].nees_steps)});
         }
         for (std::size_t i = 0; i < loops.size(); ++i) {  // the loop alone on the engine: the same seed and streams
           const ncs::RunResult alone = ncs::run_loops({loops[i]}, ap, seed)[0];
           v.push_back(alone.cost);
-          for (const std::string& leg : loop_bus_legs(study->loops[i])) {
+          for (const std::string& leg : (*legs_on_bus)[i]) {
             double d[std::size(kBusDelayMetrics)] = {};
             for (const auto& [nm, st] : alone.bus_legs) {
               if (nm != leg) continue;
@@ -121,7 +115,8 @@ engine::SweepResults run_loops_sweep(const NcsStudy& s, std::size_t seeds, unsig
 std::vector<ncs::LoopOnBus> loops_on_bus(const NcsStudy& s, std::size_t scenario) {
   std::vector<ncs::LoopOnBus> loops;
   for (const NcsStudy& l : s.loops) {
-    loops.push_back({l.ctx.get(), &l.scenarios.at(scenario), l.loop, l.addresses[0], l.addresses[1], l.addresses[2]});
+    loops.push_back({l.ctx.get(), &l.scenarios.at(scenario), l.loop, l.addresses[0], l.addresses[1], l.addresses[2],
+                     l.clock_offset_us});
   }
   return loops;
 }

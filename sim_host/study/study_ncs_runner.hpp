@@ -68,6 +68,9 @@ struct NcsStudy {
   std::string loop;
   /// Its nodes' addresses in the run: sensor, controller, actuator.
   std::array<std::uint8_t, 3> addresses{ncs::kLiveSensor, ncs::kLiveController, ncs::kLiveActuator};
+  /// A file with several loops: this loop's phase φ, its sensor's `clock_offset_us` (its timer
+  /// at kh + φ, 0 ≤ φ < h; ncs::LoopOnBus::clock_offset_us); 0 without `loops`.
+  std::int64_t clock_offset_us = 0;
   /// Leg name ("sc", "ca", "as") → the file's link name (the same name without `loops`).
   std::map<std::string, std::string> link_names;
   /// A file with several loops: every loop mapped (file order; this study's own fields are the

@@ -80,15 +80,6 @@ nlohmann::json sc_ca_delay_bound_ms(const ncs::Scenario& x) {
   return static_cast<double>(ub->count()) * 1e-6;
 }
 
-/// The legs of `s` on a CAN bus (the same in every scenario: overrides cannot move a leg).
-std::vector<std::string> bus_links(const NcsStudy& s) {
-  std::vector<std::string> out;
-  if (s.scenarios.empty()) return out;
-  for (const std::string& l : s.links)
-    if (s.scenarios[0].bus_legs.count(l) != 0) out.push_back(l);
-  return out;
-}
-
 /// The delay metrics of `leg` in run `r`, in the order of kBusDelayMetrics (0 when the run
 /// sent nothing over the bus: I and IK keep their delay-free links).
 std::array<double, std::size(kBusDelayMetrics)> bus_delays(const ncs::RunResult& r, const std::string& leg) {
@@ -135,6 +126,25 @@ nlohmann::json setpoint_json(const ncs::Scenario& x) {
 }
 
 }  // namespace
+
+std::vector<std::string> bus_links(const NcsStudy& s) {
+  std::vector<std::string> out;
+  if (s.scenarios.empty()) return out;
+  for (const std::string& l : s.links)
+    if (s.scenarios[0].bus_legs.count(l) != 0) out.push_back(l);
+  return out;
+}
+
+engine::SweepSpec study_sweep_spec(const NcsStudy& s, std::size_t seeds, const char* experiment) {
+  engine::SweepSpec spec;
+  spec.study = "study";
+  spec.experiment = experiment;
+  for (ncs::Approach a : s.approaches) spec.approaches.emplace_back(ncs::name(a));
+  for (const ncs::Scenario& x : s.scenarios) spec.scenarios.push_back(x.name);
+  spec.first_seed = s.first_seed;
+  spec.seeds = seeds == 0 ? s.seeds : seeds;
+  return spec;
+}
 
 nlohmann::json loop_sweep_config(const NcsStudy& s) {
   nlohmann::json sc = nlohmann::json::array();
@@ -183,13 +193,13 @@ std::vector<std::string> loop_sweep_metrics(const NcsStudy& s) {
   return metrics;
 }
 
-std::vector<double> loop_sweep_values(const NcsStudy& s, std::size_t a, const ncs::RunResult& r) {
+std::vector<double> loop_sweep_values(const NcsStudy& s, std::size_t a, const ncs::RunResult& r, const std::vector<std::string>& on_bus) {
   std::vector<double> v{r.cost, static_cast<double>(r.late), static_cast<double>(r.saturated), static_cast<double>(r.faults)};
   for (const std::string& l : s.links) {
     const auto c = link_counts(r, link_counter_map(s.approaches[a], l), l);
     v.insert(v.end(), c.begin(), c.end());
   }
-  for (const std::string& l : bus_links(s)) {
+  for (const std::string& l : on_bus) {
     const auto d = bus_delays(r, l);
     v.insert(v.end(), d.begin(), d.end());
   }
@@ -208,14 +218,8 @@ engine::SweepResults run_ncs_sweep(const NcsStudy& s, std::size_t seeds, unsigne
   if (analytic && sensor_on_cpu) {
     throw engine::InputError("field '--analytic': no analytic cost with the sensor on a CPU (its samples lag kh by the schedule)");
   }
-  engine::SweepSpec spec;
-  spec.study = "study";
-  spec.experiment = "run";
-  for (ncs::Approach a : s.approaches) spec.approaches.emplace_back(ncs::name(a));
-  for (const ncs::Scenario& x : s.scenarios) spec.scenarios.push_back(x.name);
+  engine::SweepSpec spec = study_sweep_spec(s, seeds, "run");
   const std::vector<std::string> on_bus = bus_links(s);
-  spec.first_seed = s.first_seed;
-  spec.seeds = seeds == 0 ? s.seeds : seeds;
   spec.metrics = loop_sweep_metrics(s);
   const bool on_cpu = !s.scenarios.empty() && s.scenarios[0].controller_cpu != nullptr;
   if (on_cpu)

@@ -46,14 +46,23 @@ constexpr std::size_t link_counter_index(std::string_view name) {
   return i;
 }
 
+/// The legs of the one loop `s` on a CAN bus, in the order of s.links (the same in every
+/// scenario: overrides cannot move a leg).
+std::vector<std::string> bus_links(const NcsStudy& s);
+
+/// The header of a sweep of `s`: study "study", `experiment`, the file's approaches and
+/// scenarios by name, its first seed, `seeds` replications (0: the file's count); no metrics.
+engine::SweepSpec study_sweep_spec(const NcsStudy& s, std::size_t seeds, const char* experiment);
+
 /// The sweep configuration of the one loop `s` (spec.config of a file without `loops`:
 /// study_file, plant, links, compute_us, scenarios with their legs and bus legs, bus_links).
 nlohmann::json loop_sweep_config(const NcsStudy& s);
 /// The per-run metrics of the one loop `s`: cost, late, saturated, faults, per link the
 /// kLinkCounters, per leg on a bus the kBusDelayMetrics.
 std::vector<std::string> loop_sweep_metrics(const NcsStudy& s);
-/// Run `r` of approach index `a` of `s` as the values of loop_sweep_metrics().
-std::vector<double> loop_sweep_values(const NcsStudy& s, std::size_t a, const ncs::RunResult& r);
+/// Run `r` of approach index `a` of `s` as the values of loop_sweep_metrics(); `on_bus` is
+/// bus_links() of `s` (computed once per sweep).
+std::vector<double> loop_sweep_values(const NcsStudy& s, std::size_t a, const ncs::RunResult& r, const std::vector<std::string>& on_bus);
 
 /// The sweep of a file with several loops (s.loops; study_loops_sweep.cpp): each run is
 /// ncs::run_loops() of every loop on the shared engine, and each loop once more alone on it

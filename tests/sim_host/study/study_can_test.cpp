@@ -7,8 +7,10 @@
 ///        bus (examples/two_loops_can.json): apart in time each loop costs what it costs alone,
 ///        bit for bit (and a loop without a stream prefix what ncs::run gives); together every
 ///        delay within the check's bound that counts both loops' frames, the second loop's
-///        frames delaying the first's; the same bytes on 1 and 2 threads and from shards; the
-///        loops' refusals naming the field.
+///        frames delaying the first's; a loop's clock offset shifts the whole loop (alone, the
+///        same cost bit for bit) and, between the loops, moves the board's delays within the
+///        bound; each loop's NEES that of its runs; the same bytes on 1 and 2 threads and from
+///        shards; the loops' refusals naming the field.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -255,6 +257,95 @@ TEST(StudyLoops, TogetherEveryDelayIsWithinTheBoundCountingBothLoopsAndTheServoD
   EXPECT_GE(with - without, message_us(24, 250'000));  // at least one servo report ahead of it
 }
 
+TEST(StudyLoops, AClockOffsetShiftsTheWholeLoopAloneItCostsTheSame) {
+  // No background: a loop alone on the bus with its timer, set-point and plant time shifted by
+  // φ runs the same arithmetic as at φ = 0 (the plant's intervals are the same integers).
+  const NcsStudy s = loops_study([](nlohmann::json& j) { j["buses"][0].erase("background"); }, 4);
+  for (std::size_t i = 0; i < s.loops.size(); ++i) {
+    for (std::size_t x = 0; x < s.scenarios.size(); ++x) {
+      const ncs::LoopOnBus at0 = loops_on_bus(s, x)[i];
+      ncs::LoopOnBus shifted = at0;
+      shifted.clock_offset_us = i == 0 ? 12'345 : 19'999;  // 0 <= phi < h (50 ms, 20 ms)
+      for (ncs::Approach a : s.approaches) {
+        const ncs::RunResult r0 = ncs::run_loops({at0}, a, 5)[0], r1 = ncs::run_loops({shifted}, a, 5)[0];
+        EXPECT_EQ(r1.cost, r0.cost) << i << " " << x << " " << ncs::name(a);
+        EXPECT_EQ(r1.nees, r0.nees) << i << " " << x << " " << ncs::name(a);
+        EXPECT_EQ(r1.commands, r0.commands);
+        EXPECT_EQ(r1.samples.size(), r0.samples.size());
+        ASSERT_FALSE(r1.samples.empty());
+        EXPECT_NEAR(r1.samples[0].t_s - r0.samples[0].t_s, 1e-6 * static_cast<double>(shifted.clock_offset_us), 1e-12);  // at kh + phi
+        for (std::size_t b = 0; b < r0.bus_legs.size(); ++b) EXPECT_EQ(r1.bus_legs[b].second.max_delay, r0.bus_legs[b].second.max_delay);
+      }
+    }
+  }
+  // An offset outside [0, h) is refused by the run.
+  ncs::LoopOnBus bad = loops_on_bus(s, 0)[1];
+  bad.clock_offset_us = 20'000;
+  EXPECT_THROW(static_cast<void>(ncs::run_loops({bad}, ncs::Approach::kS, 1)), std::invalid_argument);
+}
+
+const test_support::StudyExample kLoopsPhase("two_loops_can_phase.json");
+
+TEST(StudyLoops, APhaseBetweenTheTimersMovesTheBoardsDelaysWithinTheBound) {
+  // two_loops_can_phase.json: the servo's timer at 20k + 5 ms never meets the board's at 50k ms,
+  // so the board's report no longer waits behind the servo's; every delay stays within the
+  // check's bound (an analysis of every stream released at once: a bound whatever the phases).
+  const std::size_t seeds = test::sanitized_length<std::size_t>(6, 2);
+  NcsStudy phased = map_ncs_study(kLoopsPhase.parse(kLoopsPhase.json()));
+  ASSERT_EQ(phased.loops.size(), 2U);
+  EXPECT_EQ(phased.loops[0].clock_offset_us, 0);
+  EXPECT_EQ(phased.loops[1].clock_offset_us, 5000);
+  cap_duration(phased, 4, "test");
+  attach_bus_bounds(phased, resolve_study(kLoopsPhase.parse(kLoopsPhase.json())));
+  const engine::SweepResults rp = run_ncs_sweep(phased, seeds, 2, engine::Shard{});
+  EXPECT_EQ(rp.spec.config.at("loops")[1].at("clock_offset_us").get<std::int64_t>(), 5000);
+  EXPECT_FALSE(rp.spec.config.at("loops")[0].contains("clock_offset_us"));
+  const nlohmann::json jp = run_outputs(rp, can_temp_dir("phase"), false);
+  const nlohmann::json j0 = run_outputs(run_ncs_sweep(loops_study([](nlohmann::json&) {}, 4), seeds, 2, engine::Shard{}),
+                                        can_temp_dir("phase0"), false);
+  for (const char* loop : {"board", "servo"})
+    for (const char* a : {"S", "SK"})
+      for (const auto& [leg, d] : jp.at("interference").at(loop).at(a).at("bus_delays").items()) {
+        EXPECT_LE(d.at("shared").at("max_us").get<double>(), d.at("worst_response_us").get<double>()) << loop << " " << leg;
+        EXPECT_TRUE(d.at("within_bound").get<bool>()) << loop << " " << leg;
+      }
+  const auto board_sc = [](const nlohmann::json& j, const char* what) {
+    return j.at("interference").at("board").at("S").at("bus_delays").at("sc").at("shared").at(what).get<double>();
+  };
+  EXPECT_LT(board_sc(jp, "mean_us"), board_sc(j0, "mean_us"));
+  EXPECT_LT(board_sc(jp, "max_us"), board_sc(j0, "max_us"));
+  // The servo's I and IK use no bus: its offset leaves their cost as it is, bit for bit.
+  for (const char* a : {"I", "IK"})
+    EXPECT_EQ(jp.at("interference").at("servo").at(a).at("cost_shared_mean"), j0.at("interference").at("servo").at(a).at("cost_shared_mean"));
+}
+
+TEST(StudyLoops, EachLoopsNeesIsItsFiltersAsInAFileOfOneLoop) {
+  const NcsStudy s = loops_study([](nlohmann::json&) {}, 4);
+  const engine::SweepResults r = run_ncs_sweep(s, 2, 2, engine::Shard{});
+  const nlohmann::json j = run_outputs(r, can_temp_dir("nees"), false);
+  for (std::size_t i = 0; i < s.loops.size(); ++i) {
+    const std::string loop = s.loops[i].loop;
+    const nlohmann::json& nees = j.at("loops").at(loop).at("nees");
+    EXPECT_FALSE(nees.contains("S"));  // no filter
+    for (const char* an : {"SK", "IK"}) {
+      const ncs::Approach a = ncs::parse_any_approach(an);
+      std::size_t ai = 0;
+      while (s.approaches[ai] != a) ++ai;
+      double sum = 0;  // the oracle: the runs' own NEES, scenario mean per seed, mean over seeds
+      for (std::size_t k = 0; k < 2; ++k)
+        for (std::size_t x = 0; x < s.scenarios.size(); ++x) {
+          const ncs::RunResult run = ncs::run_loops(loops_on_bus(s, x), a, r.spec.first_seed + k)[i];
+          EXPECT_EQ(r.at(ai, x, k, r.metric(loop + "/nees")), run.nees) << loop << " " << an;
+          EXPECT_GT(run.nees_steps, 0U);
+          sum += run.nees;
+        }
+      EXPECT_NEAR(nees.at(an).at("nees_mean").get<double>(), sum / 4, 1e-12 * sum) << loop << " " << an;
+    }
+    EXPECT_GT(nees.at("SK").at("nees_mean").get<double>(), nees.at("IK").at("nees_mean").get<double>());  // SK's input lags its model
+  }
+  EXPECT_NE(j.at("markdown").get<std::string>().find("NEES"), std::string::npos);
+}
+
 TEST(StudyLoops, SameBytesOnOneAndTwoThreadsAndFromMergedShards) {
   test_support::expect_same_bytes_on_threads_and_shards(loops_study([](nlohmann::json&) {}, 2.5), 3,
                                                         "oneshot_study_loops_test", "loops");
@@ -287,6 +378,10 @@ TEST(StudyLoops, RefusalsNameTheField) {
       [](nlohmann::json& j) { j["links"][2] = {{"name", "servo_x"}, {"from", "servo_sensor"}, {"to", "servo_actuator"}, {"bus", "can0"}, {"id", 200}}; },
       "field 'links[2]'");  // not a leg of the loop
   e.expect_refused([](nlohmann::json& j) { j["links"].erase(3); }, "field 'loops[1]'");  // the servo without its ca
+  e.expect_refused([](nlohmann::json& j) { j["nodes"][1]["clock_offset_us"] = 100; }, "field 'nodes[1].clock_offset_us'");  // controller
+  e.expect_refused([](nlohmann::json& j) { j["nodes"][5]["clock_offset_us"] = 100; }, "field 'nodes[5].clock_offset_us'");  // actuator
+  e.expect_refused([](nlohmann::json& j) { j["nodes"][3]["clock_offset_us"] = 20000; }, "field 'nodes[3].clock_offset_us'");  // = h
+  e.expect_refused([](nlohmann::json& j) { j["nodes"][0]["clock_offset_us"] = -1; }, "field 'nodes[0].clock_offset_us'");
   // The run's options.
   const NcsStudy s = loops_study([](nlohmann::json&) {}, 2.5);
   try {

@@ -363,5 +363,31 @@ TEST(StudyReport, BenchCountsTheSweepsKernelEvents) {
   EXPECT_NEAR(j.at("events_per_s_per_thread").get<double>(), total / j.at("wall_s").get<double>() / 2, 1e-9 * total);
 }
 
+TEST(StudyReport, BenchGivesEveryLoopsCost) {
+  // A file with several loops: per approach every loop's mean cost over its shared runs.
+  const std::string file = std::string(ONESHOT_STUDY_EXAMPLES_DIR) + "/two_loops_can_phase.json";
+  const std::string dir = test::made_dir("oneshot_study_report", "bench_loops");
+  const test::CommandResult r = test::run_command({ONESHOT_SIM_PATH, "study", "bench", file, "--seeds", "2", "--threads", "2",
+                                                   "--max-duration", "2.5", "--json", dir + "/bench.json"});
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const nlohmann::json j = read_report_json(dir + "/bench.json");
+  NcsStudy s = map_ncs_study(engine::load_study(file, &ncs_schema()));
+  cap_duration(s, 2.5, "--max-duration");
+  for (ncs::Approach a : s.approaches) {
+    std::vector<double> sum(s.loops.size(), 0.0);
+    for (std::size_t x = 0; x < s.scenarios.size(); ++x)
+      for (std::uint64_t seed = s.first_seed; seed < s.first_seed + 2; ++seed) {
+        const std::vector<ncs::RunResult> runs = ncs::run_loops(loops_on_bus(s, x), a, seed);
+        for (std::size_t i = 0; i < runs.size(); ++i) sum[i] += runs[i].cost;
+      }
+    for (std::size_t i = 0; i < s.loops.size(); ++i) {
+      const double mean = sum[i] / static_cast<double>(2 * s.scenarios.size());
+      EXPECT_NEAR(j.at("per_approach").at(ncs::name(a)).at("loops").at(s.loops[i].loop).at("cost_mean").get<double>(), mean,
+                  1e-12 * mean)
+          << ncs::name(a) << " " << s.loops[i].loop;
+    }
+  }
+}
+
 }  // namespace
 }  // namespace oneshot::study
