@@ -67,8 +67,10 @@ std::vector<double> loop_sweep_values(const NcsStudy& s, std::size_t a, const nc
 /// The sweep of a file with several loops (s.loops; study_loops_sweep.cpp): each run is
 /// ncs::run_loops() of every loop on the shared engine, and each loop once more alone on it
 /// (the same seed: common random numbers), metrics "<loop>/<metric>" (loop_sweep_metrics())
-/// and "<loop>/alone.cost", "<loop>/alone.<leg>.<bus delay metric>"; the configuration
-/// {"study_file", "loops": [loop_sweep_config() + "name", ...]}. `analytic` is refused
+/// (with SK or IK among the approaches also "<loop>/nees", "<loop>/nees_steps": the loop's
+/// filter as in a file of one loop) and "<loop>/alone.cost", "<loop>/alone.<leg>.<bus delay
+/// metric>"; the configuration {"study_file", "loops": [loop_sweep_config() + "name",
+/// "addresses", "file_links", "clock_offset_us" when not 0, ...]}. `analytic` is refused
 /// (engine::InputError naming `--analytic`).
 engine::SweepResults run_loops_sweep(const NcsStudy& s, std::size_t seeds, unsigned threads, const engine::Shard& shard,
                                      bool analytic);

@@ -261,7 +261,7 @@ TEST(StudyCheck, EveryShippedExampleResolvesAndMaps) {
     EXPECT_NO_THROW(static_cast<void>(map_ncs_study(f))) << name;
     ++files;
   }
-  EXPECT_GE(files, 8U);  // ncs, ncs_can, three on CPUs, sod_ge_oneshot, two_loops_can, mtm_file_oneshot
+  EXPECT_GE(files, 9U);  // ncs, ncs_can, three on CPUs, sod_ge_oneshot, two_loops_can, two_loops_can_phase, mtm_file_oneshot
 }
 
 TEST(StudyCheck, CommandLine) {
