@@ -130,6 +130,8 @@ json resolve_study(const engine::StudyFile& f) {
       const engine::LoopSpec& l = f.loops[i];
       r["loops"].push_back({{"name", l.name}, {"sensor", l.sensor}, {"controller", l.controller}, {"actuator", l.actuator},
                             {"plant", ri.at("plant")}, {"approaches", ri.at("approaches")}});
+      const engine::Duration phase = f.node(l.sensor).clock_offset;  // the loop's phase (only then: the rest stays as it was)
+      if (phase.count() != 0) r["loops"].back()["clock_offset_us"] = static_cast<double>(phase.count()) * 1e-3;
     }
     try {
       r["links"] = json::array();
@@ -294,7 +296,9 @@ std::string describe_resolution(const json& r) {
   if (r.contains("loops")) {  // several loops: each with its plant and designs
     for (const json& l : r.at("loops")) {
       o << "loop " << l.at("name").get<std::string>() << ": sensor " << l.at("sensor").get<std::string>() << ", controller "
-        << l.at("controller").get<std::string>() << ", actuator " << l.at("actuator").get<std::string>() << "\n  ";
+        << l.at("controller").get<std::string>() << ", actuator " << l.at("actuator").get<std::string>();
+      if (l.contains("clock_offset_us")) o << "; phase " << l.at("clock_offset_us").dump() << " us (its timer at kh + phase)";
+      o << "\n  ";
       plant_line(l.at("plant"));
       approach_lines(l.at("approaches"), "  ");
     }

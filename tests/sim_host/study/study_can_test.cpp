@@ -296,7 +296,10 @@ TEST(StudyLoops, APhaseBetweenTheTimersMovesTheBoardsDelaysWithinTheBound) {
   EXPECT_EQ(phased.loops[0].clock_offset_us, 0);
   EXPECT_EQ(phased.loops[1].clock_offset_us, 5000);
   cap_duration(phased, 4, "test");
-  attach_bus_bounds(phased, resolve_study(kLoopsPhase.parse(kLoopsPhase.json())));
+  const nlohmann::json resolved = resolve_study(kLoopsPhase.parse(kLoopsPhase.json()));
+  attach_bus_bounds(phased, resolved);
+  EXPECT_FALSE(resolved.at("loops")[0].contains("clock_offset_us"));
+  EXPECT_EQ(resolved.at("loops")[1].at("clock_offset_us").get<double>(), 5000);  // study check's phase
   const engine::SweepResults rp = run_ncs_sweep(phased, seeds, 2, engine::Shard{});
   EXPECT_EQ(rp.spec.config.at("loops")[1].at("clock_offset_us").get<std::int64_t>(), 5000);
   EXPECT_FALSE(rp.spec.config.at("loops")[0].contains("clock_offset_us"));
