@@ -4,7 +4,7 @@
 ///        bit (every cost and metric, plant_source aside), for a few seeds, and the same study
 ///        check; so does the board loop of two_loops_can.json written inline beside the servo's
 ///        plant file; what the loop cannot run (other shapes, C not the identity, missing design
-///        keys, an unstabilizable plant, a discrete plant) and bad design keys (R not symmetric
+///        keys, an unstabilizable or undetectable plant, a discrete plant) and bad design keys (R not symmetric
 ///        or not positive definite, period 0, unknown keys and outputs, non-finite entries) are
 ///        refused naming the field.
 #include <gtest/gtest.h>
@@ -127,8 +127,19 @@ TEST(StudyInlinePlant, WhatTheLoopCannotRunIsRefusedNamingTheKey) {
     c.erase("board");
     c["actuator"] = {{"u_min", {-1}}, {"u_max", {1}}};
   }, "field 'plant.continuous.board'");
-  // Unstabilizable: the unstable first state is not reachable from u (C = I: always detectable).
-  expect([](nlohmann::json& c) { c["A"] = {{1, 0}, {0, 0}}; c["B"] = {{0}, {1}}; }, "field 'plant.continuous");
+  // Unstabilizable: the unstable first state is not reachable from u.
+  expect([](nlohmann::json& c) { c["A"] = {{1, 0}, {0, 0}}; c["B"] = {{0}, {1}}; }, "field 'plant.continuous': design: LQR");
+  // Undetectable (p = 1: the check designs it before the loop refuses the shape): the unstable
+  // second state is invisible in the one output.
+  expect([](nlohmann::json& c) {
+    c["A"] = {{0, 0}, {0, 1}};
+    c["B"] = {{1}, {1}};
+    c["C"] = {{1, 0}};
+    c["outputs"] = {"v1"};
+    c["measurement_covariance"] = {{8e-5}};
+    c["board"]["adc_min_volts"] = {-1.65};
+    c["board"]["adc_max_volts"] = {1.65};
+  }, "field 'plant.continuous': design: Kalman filter");
   // A discrete plant: the delays fall between samples.
   kInlineNcs.expect_refused([](nlohmann::json& j) {
     j["plant"] = {{"discrete", {{"Phi", {{1, 0.1}, {0, 1}}}, {"Gamma", {{0}, {0.1}}}, {"C", {{1, 0}, {0, 1}}},
