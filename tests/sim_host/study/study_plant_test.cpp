@@ -177,9 +177,15 @@ TEST(StudyInlinePlant, BadDesignKeysAreRefusedNamingTheKey) {
   std::string text = j.dump();
   text.replace(text.find("\"INF\""), 5, "1e999");
   EXPECT_THROW(engine::parse_study(text, kInlineNcs.path(), &ncs_schema(), ONESHOT_STUDY_EXAMPLES_DIR), engine::InputError);
-  std::string twice = kInlineNcs.json().dump();
-  twice.replace(twice.find("\"plant\":{"), 9, "\"plant\":{\"continuous\":{\"period_us\":1,\"period_us\":2},");
-  EXPECT_THROW(engine::parse_study(twice, kInlineNcs.path(), &ncs_schema(), ONESHOT_STUDY_EXAMPLES_DIR), engine::InputError);
+  j["plant"]["continuous"]["measurement_covariance"][0][0] = 8e-5;
+  std::string twice = j.dump();
+  twice.replace(twice.find("\"period_us\":50000", twice.find("\"continuous\"")), 17, "\"period_us\":50000,\"period_us\":40000");
+  try {
+    static_cast<void>(engine::parse_study(twice, kInlineNcs.path(), &ncs_schema(), ONESHOT_STUDY_EXAMPLES_DIR));
+    ADD_FAILURE() << "a duplicate key accepted";
+  } catch (const engine::InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("duplicate key 'period_us'"), std::string::npos) << e.what();
+  }
 }
 
 }  // namespace
