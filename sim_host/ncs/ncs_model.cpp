@@ -141,8 +141,12 @@ std::string describe(const Scenario& s) {
 }
 
 std::shared_ptr<const Context> Context::load(const std::string& plant_path) {
+  return from(design::load_plant_file(plant_path.empty() ? std::string(ONESHOT_STUDY_PLANT_FILE) : plant_path));
+}
+
+std::shared_ptr<const Context> Context::from(design::PlantDescription plant) {
   auto ctx = std::make_shared<Context>();
-  ctx->plant_ = design::load_plant_file(plant_path.empty() ? std::string(ONESHOT_STUDY_PLANT_FILE) : plant_path);
+  ctx->plant_ = std::move(plant);
   const design::PlantDescription& p = ctx->plant_;
   if (!p.continuous() || p.a.rows != kN || p.b.cols != kM || p.c.rows != kP || !p.b_w.values.empty()) {
     throw std::invalid_argument(p.source + ": study 'ncs' needs a continuous plant with n = 2, m = 1, p = 2 and no B_w");

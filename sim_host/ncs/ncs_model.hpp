@@ -160,6 +160,8 @@ class Context {
   /// and runs the design step; std::invalid_argument when the plant is not 2 states,
   /// 1 input, 2 outputs with a board, or has no LQR gain or feed-forward.
   static std::shared_ptr<const Context> load(const std::string& plant_path);
+  /// The same from a plant description already parsed (a study file's inline plant).
+  static std::shared_ptr<const Context> from(design::PlantDescription plant);
 
   const design::PlantDescription& plant() const { return plant_; }  ///< The plant file.
   const design::DesignResult& design() const { return design_; }    ///< The design step's result.

@@ -71,36 +71,52 @@ bool ncs_kind(const std::string& kind) {
 
 json plant_section(const engine::StudyFile& f, json& designs) {
   json j;
+  std::string field = "plant";  // what a design error names
+  design::PlantDescription p;
   switch (f.plant.kind) {
     case engine::PlantSpec::Kind::kContinuous:
-      j = {{"kind", "continuous"}, {"n", f.plant.continuous.a.rows}, {"m", f.plant.continuous.b.cols},
-           {"p", f.plant.continuous.c.rows}, {"designed", false},
-           {"why_not_designed", "an inline plant carries no measurement covariance: give a plant file"}};
-      return j;
+      if (!f.plant.design) {
+        j = {{"kind", "continuous"}, {"n", f.plant.continuous.a.rows}, {"m", f.plant.continuous.b.cols},
+             {"p", f.plant.continuous.c.rows}, {"designed", false},
+             {"why_not_designed", "no design keys: give period_us and measurement_covariance (and Q1c, Q2c, actuator or board)"}};
+        return j;
+      }
+      p = *f.plant.design;
+      field = "plant.continuous";
+      if (p.cost_form == design::CostForm::kNone) {
+        throw InputError("field 'plant.continuous.Q1c': missing: no LQR gain without Q1c and Q2c");
+      }
+      break;
     case engine::PlantSpec::Kind::kDiscrete:
       j = {{"kind", "discrete"}, {"n", f.plant.discrete.phi.rows}, {"m", f.plant.discrete.gamma.cols},
            {"p", f.plant.discrete.c.rows}, {"period_us", to_us(f.plant.discrete.period)}, {"designed", false},
-           {"why_not_designed", "an inline plant carries no measurement covariance: give a plant file"}};
+           {"why_not_designed", f.study == "ncs" ? std::string(kDiscretePlantRefusal)
+                                                  : std::string("an inline discrete plant carries no measurement covariance")}};
       return j;
-    case engine::PlantSpec::Kind::kFile:
+    case engine::PlantSpec::Kind::kFile: {
+      const std::string path = plant_file_path(f);
+      try {
+        p = design::load_plant_file(path);
+      } catch (const std::exception& e) {
+        throw InputError("field 'plant.file': " + std::string(e.what()));
+      }
       break;
-  }
-  const std::string path = plant_file_path(f);
-  design::PlantDescription p;
-  try {
-    p = design::load_plant_file(path);
-  } catch (const std::exception& e) {
-    throw InputError("field 'plant.file': " + std::string(e.what()));
+    }
   }
   design::DesignResult d;
   try {
     d = design::synthesize(p);
   } catch (const std::exception& e) {
-    throw InputError("field 'plant': " + std::string(e.what()));
+    throw InputError("field '" + field + "': " + std::string(e.what()));
   }
-  if (!d.lqr_available) throw InputError("field 'plant': no LQR gain: " + d.lqr_unavailable_reason);
-  j = {{"kind", "file"}, {"file", path}, {"name", p.name}, {"form", design::to_string(p.form)},
-       {"n", p.n()}, {"m", p.m()}, {"p", p.p()}, {"period_us", p.period_us}, {"designed", true}};
+  if (!d.lqr_available) throw InputError("field '" + field + "': no LQR gain: " + d.lqr_unavailable_reason);
+  if (f.plant.kind == engine::PlantSpec::Kind::kFile) {
+    j = {{"kind", "file"}, {"file", p.source}};
+  } else {
+    j = {{"kind", "continuous"}};
+  }
+  j.update({{"name", p.name}, {"form", design::to_string(p.form)}, {"n", p.n()}, {"m", p.m()}, {"p", p.p()},
+            {"period_us", p.period_us}, {"designed", true}});
   designs["lqr_gain"] = rows(d.l);
   designs["closed_loop_spectral_radius"] = d.closed_loop_radius;
   designs["kalman_gain"] = rows(d.kalman_gain);

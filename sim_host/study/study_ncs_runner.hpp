@@ -4,7 +4,8 @@
 ///        approaches and scenarios of its sweep.
 ///
 /// The ncs loop has three firmware nodes (sensor, controller, actuator), three point-to-point
-/// legs "as" (actuator → sensor), "sc", "ca" and the plant of a plant file. A file maps onto
+/// legs "as" (actuator → sensor), "sc", "ca" and the plant of a plant file, or the same plant
+/// written inline (plant.continuous with the plant file's design keys). A file maps onto
 /// it when it declares exactly that: the legs' delay, loss and order come from the file (and
 /// the scenarios' link overrides), the scenario parameters are ncs Scenario fields, the
 /// approach kinds are ncs approach names. Legs sc and ca may run on a CAN bus (with the bus's
@@ -12,8 +13,8 @@
 /// approaches and S+ are refused then, as is the leg as on a bus. The set-point is the
 /// scenario's or the file's `reference` (square, steps, file), else the params' square wave; the
 /// one-shot loops' sensor may run send-on-delta or MTM. Everything else the schema accepts
-/// (clock offsets, other trigger rules, other addresses, inline plants) is refused with the
-/// field and the reason.
+/// (clock offsets, other trigger rules, other addresses, other plant shapes, discrete plants) is
+/// refused with the field and the reason.
 #pragma once
 
 #include <array>
@@ -50,10 +51,16 @@ const NcsLeg* find_ncs_leg(const std::string& name);
 /// `reference` gives the set-point —, noise_scale default 1).
 const engine::StudySchema& ncs_schema();
 
+/// Why a discrete inline plant (plant.discrete) does not run: one line.
+inline constexpr const char* kDiscretePlantRefusal =
+    "the ncs loop integrates the continuous model between the delays, which fall between samples; a discrete "
+    "plant would run only with every delay 0 or a whole number of periods, which the loop does not model: give "
+    "plant.continuous (or a plant file)";
+
 /// A study file resolved onto the ncs loop.
 struct NcsStudy {
   std::string source;                         ///< The study file.
-  std::string plant_path;                     ///< The plant file (resolved against the study file's folder).
+  std::string plant_path;                     ///< The plant file (resolved against the study file's folder; "" inline).
   std::shared_ptr<const ncs::Context> ctx;    ///< Plant and design.
   std::vector<ncs::Approach> approaches;      ///< In file order (I first).
   std::vector<ncs::Scenario> scenarios;       ///< In file order, legs from the file.

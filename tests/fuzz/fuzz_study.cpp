@@ -36,6 +36,7 @@
 
 #include "fuzz_oracle.hpp"
 #include "study_fuzz_support.hpp"
+#include "oneshot/design/plant_description.hpp"
 #include "oneshot/engine/can_analysis.hpp"
 #include "oneshot/engine/random_stream.hpp"
 #include "oneshot/engine/study_file.hpp"
@@ -83,6 +84,15 @@ void check_plant(const e::PlantSpec& p) {
     require_psd(m.qc, "plant.continuous.Q_c");
     require_psd(m.q1c, "plant.continuous.Q1c");
     require_psd(m.q2c, "plant.continuous.Q2c");
+    if (p.design) {  // the design keys: the plant file's description of the same matrices
+      const oneshot::design::PlantDescription& d = *p.design;
+      require(d.period_us > 0, "plant.continuous.period_us: accepted, not positive");
+      require(d.n() == m.a.rows && d.m() == m.b.cols && d.p() == m.c.rows, "plant.continuous: design of another shape");
+      require(d.a.values == m.a.values && d.c.values == m.c.values, "plant.continuous: design of other matrices");
+      require_psd(d.measurement_covariance, "plant.continuous.measurement_covariance");
+      for (std::size_t i = 0; i < d.p(); ++i)
+        require(d.measurement_covariance(i, i) > 0, "plant.continuous.measurement_covariance: accepted, not positive definite");
+    }
   } else if (p.kind == e::PlantSpec::Kind::kDiscrete) {
     const e::DiscreteModel& m = p.discrete;
     require(finite_matrix(m.phi) && finite_matrix(m.gamma) && finite_matrix(m.c) && finite_matrix(m.gamma_w),

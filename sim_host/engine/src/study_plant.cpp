@@ -4,6 +4,7 @@
 #include <cmath>
 #include <vector>
 
+#include "oneshot/design/plant_description.hpp"
 #include "oneshot/dimension_limits.hpp"
 #include "study_parse_detail.hpp"
 
@@ -102,6 +103,58 @@ void linear_model(const json& c, const std::string& g, const std::array<const ch
   psd(*out[6], in.cols, field(6));
 }
 
+/// The plant-file field a design error names, as the inline key (noise.* and cost.* are flat inline).
+std::string inline_key(const std::string& plant_file_field) {
+  if (plant_file_field == "noise.process_intensity") return "Q_c";
+  if (plant_file_field.rfind("noise.", 0) == 0 || plant_file_field.rfind("cost.", 0) == 0) {
+    return plant_file_field.substr(plant_file_field.find('.') + 1);
+  }
+  return plant_file_field;
+}
+
+/// The keys an inline continuous plant carries for the design step, with the plant file's names and units.
+constexpr std::array<const char*, 9> kDesignKeys = {"period_us", "measurement_covariance", "name",    "states", "inputs",
+                                                  "outputs",   "tracked_outputs",        "actuator", "board"};
+
+/// The plant-file description of an inline continuous plant `c` at field `g` (already read into
+/// `m`): the same JSON a plant file would hold (A, B, C, period_us, names, tracked_outputs,
+/// cost {Q1c, Q2c}, noise {process_intensity = Q_c, measurement_covariance}, actuator or board),
+/// parsed by the plant-file parser, its errors naming the inline key.
+std::shared_ptr<const design::PlantDescription> inline_design(const json& c, const std::string& g, const ContinuousModel& m) {
+  for (const char* k : {"period_us", "measurement_covariance"}) {
+    if (!c.contains(k)) {
+      throw InputError("field '" + g + "." + k + "': missing (an inline plant with design keys needs period_us and "
+                       "measurement_covariance)");
+    }
+  }
+  if (m.bw.rows != 0) {
+    throw InputError("field '" + g + ".B_w': the design step takes no disturbance input in an inline plant (give a plant "
+                     "file with its disturbance noise)");
+  }
+  static_cast<void>(integer_in(c, g, "period_us", 1, 60'000'000));
+  const DenseMatrix r = matrix(c, g, "measurement_covariance", false);
+  psd(r, m.c.rows, g + ".measurement_covariance");
+  json f = json::object();
+  f["name"] = c.contains("name") ? c["name"] : json("inline");
+  f["form"] = "continuous";
+  for (const char* k : {"A", "B", "C", "period_us", "states", "inputs", "outputs", "tracked_outputs", "actuator", "board"})
+    if (c.contains(k)) f[k] = c[k];
+  for (const char* k : {"Q1c", "Q2c"})
+    if (c.contains(k)) f["cost"][k] = c[k];
+  f["noise"] = {{"process_intensity", c["Q_c"]}, {"measurement_covariance", c["measurement_covariance"]}};
+  try {
+    return std::make_shared<const design::PlantDescription>(design::parse_plant(f.dump(), g));
+  } catch (const design::PlantError& e) {
+    const std::string what = e.what();
+    const std::string open = "field '";
+    const std::size_t a = what.find(open);
+    const std::size_t b = a == std::string::npos ? a : what.find('\'', a + open.size());
+    if (b == std::string::npos) throw InputError("field '" + g + "': " + what);
+    const std::string field = what.substr(a + open.size(), b - a - open.size());
+    throw InputError("field '" + g + "." + inline_key(field) + "'" + what.substr(b + 1));
+  }
+}
+
 }  // namespace
 
 PlantSpec parse_plant(const json& j, const std::string& f) {
@@ -115,10 +168,15 @@ PlantSpec parse_plant(const json& j, const std::string& f) {
   }
   if (j.contains("continuous")) {
     const std::string g = f + ".continuous";
-    require_keys(j["continuous"], g, {"A", "B", "B_w", "C", "Q_c", "Q1c", "Q2c"});
+    const json& c = j["continuous"];
+    require_keys(c, g, {"A", "B", "B_w", "C", "Q_c", "Q1c", "Q2c", "period_us", "measurement_covariance", "name", "states",
+                        "inputs", "outputs", "tracked_outputs", "actuator", "board"});
     p.kind = PlantSpec::Kind::kContinuous;
     ContinuousModel& m = p.continuous;
-    linear_model(j["continuous"], g, {"A", "B", "B_w", "C", "Q_c", "Q1c", "Q2c"}, {&m.a, &m.b, &m.bw, &m.c, &m.qc, &m.q1c, &m.q2c});
+    linear_model(c, g, {"A", "B", "B_w", "C", "Q_c", "Q1c", "Q2c"}, {&m.a, &m.b, &m.bw, &m.c, &m.qc, &m.q1c, &m.q2c});
+    bool designed = false;
+    for (const char* k : kDesignKeys) designed = designed || c.contains(k);
+    if (designed) p.design = inline_design(c, g, m);
     return p;
   }
   const std::string g = f + ".discrete";

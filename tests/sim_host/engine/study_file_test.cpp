@@ -1,6 +1,7 @@
 /// @file study_file_test.cpp
 /// @brief The study file: the documented example parses to what it says, a study's
-///        schema is enforced, every malformed input is refused with its field named, and a
+///        schema is enforced, every malformed input is refused with its field named, an inline
+///        plant with the design keys is the plant-file description of its matrices, and a
 ///        file with several loops (loops[]) gives each its plant and nodes.
 #include <gtest/gtest.h>
 
@@ -10,6 +11,7 @@
 #include <utility>
 #include <sstream>
 
+#include "oneshot/design/plant_description.hpp"
 #include "oneshot/engine/study_file.hpp"
 #include "support/expect_error.hpp"
 
@@ -67,6 +69,31 @@ std::string edited(const std::string& from, const std::string& to) {
   return s.replace(at, from.size(), to);
 }
 
+TEST(StudyFile, AnInlinePlantWithDesignKeysIsThePlantFilesDescription) {
+  const StudyFile bare = parse_study(example_text(), "example_study.json", nullptr);
+  EXPECT_EQ(bare.plant.design, nullptr);  // no design keys: not designed
+  const StudyFile f = parse_study(
+      edited("\"Q1c\"", "\"period_us\": 50000, \"measurement_covariance\": [[8e-5, 0], [0, 8e-5]], \"outputs\": [\"v1\", \"v2\"], "
+                         "\"tracked_outputs\": [\"v1\"], \"actuator\": {\"u_min\": [-1.65], \"u_max\": [1.65]}, \"Q1c\""),
+      "example_study.json", nullptr);
+  ASSERT_NE(f.plant.design, nullptr);
+  const design::PlantDescription& d = *f.plant.design;
+  EXPECT_TRUE(d.continuous());
+  EXPECT_EQ(d.period_us, 50000);
+  EXPECT_EQ(d.name, "inline");
+  EXPECT_EQ(d.a.values, f.plant.continuous.a.values);
+  EXPECT_EQ(d.b.values, f.plant.continuous.b.values);
+  EXPECT_EQ(d.c.values, f.plant.continuous.c.values);
+  EXPECT_EQ(d.process_intensity.values, f.plant.continuous.qc.values);
+  EXPECT_EQ(d.q1c.values, f.plant.continuous.q1c.values);
+  EXPECT_EQ(d.q2c.values, f.plant.continuous.q2c.values);
+  EXPECT_EQ(d.measurement_covariance(1, 1), 8e-5);
+  ASSERT_EQ(d.tracked_outputs.size(), 1U);
+  EXPECT_EQ(d.tracked_outputs[0], 0U);
+  EXPECT_TRUE(d.has_actuator_range);
+  EXPECT_EQ(d.u_max[0], 1.65);
+}
+
 TEST(StudyFile, MalformedFilesNameTheField) {
   const StudySchema schema = example_schema();
   struct Case {
@@ -84,6 +111,14 @@ TEST(StudyFile, MalformedFilesNameTheField) {
       {edited("\"C\": [[1, 0], [0, 1]]", "\"C\": [[1, 0, 0]]"), "plant.continuous.C"},
       {edited("\"Q_c\": [[4e-6, 0], [0, 4e-6]]", "\"Q_c\": [[4e-6, 1], [1, 4e-6]]"), "plant.continuous.Q_c"},
       {edited("\"Q_c\": [[4e-6, 0], [0, 4e-6]]", "\"Q_c\": [[4e-6, 0], [1, 4e-6]]"), "not symmetric"},
+      {edited("\"Q1c\"", "\"measurement_covariance\": [[1, 0], [0, 1]], \"Q1c\""), "plant.continuous.period_us': missing"},
+      {edited("\"Q1c\"", "\"period_us\": 0, \"measurement_covariance\": [[1, 0], [0, 1]], \"Q1c\""), "plant.continuous.period_us"},
+      {edited("\"Q1c\"", "\"period_us\": 1000, \"measurement_covariance\": [[1, 1], [0, 1]], \"Q1c\""),
+       "plant.continuous.measurement_covariance': not symmetric"},
+      {edited("\"Q1c\"", "\"period_us\": 1000, \"measurement_covariance\": [[1, 0], [0, 0]], \"Q1c\""),
+       "plant.continuous.measurement_covariance': must be positive definite"},
+      {edited("\"Q1c\"", "\"period_us\": 1000, \"measurement_covariance\": [[1, 0], [0, 1]], \"tracked_outputs\": [\"z\"], \"Q1c\""),
+       "plant.continuous.tracked_outputs[0]"},
       {edited("\"address\": 2", "\"address\": 1"), "nodes[1].address"},
       {edited("\"address\": 3", "\"address\": 300"), "nodes[2].address"},
       {edited("\"role\": \"actuator\"", "\"role\": \"relay\""), "nodes[2].role"},

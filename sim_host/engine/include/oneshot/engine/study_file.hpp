@@ -15,6 +15,7 @@
 
 #include <cstdint>
 #include <map>
+#include <memory>
 #include <optional>
 #include <set>
 #include <string>
@@ -29,6 +30,10 @@
 #include "oneshot/engine/link.hpp"
 #include "oneshot/engine/loss_model.hpp"
 #include "oneshot/engine/plant_model.hpp"
+
+namespace oneshot::design {
+struct PlantDescription;
+}  // namespace oneshot::design
 
 namespace oneshot::engine {
 
@@ -61,6 +66,9 @@ struct PlantSpec {
   std::string file;            ///< kFile: a plant description file (lut_gen's format).
   ContinuousModel continuous;  ///< kContinuous: the matrices.
   DiscreteModel discrete;      ///< kDiscrete: the matrices and period.
+  /// kContinuous with the design keys (period_us, measurement_covariance, ...): the same
+  /// description a plant file with these keys gives (design::parse_plant), else null.
+  std::shared_ptr<const design::PlantDescription> design;
 };
 
 /// A node's trigger rule.
