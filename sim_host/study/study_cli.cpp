@@ -148,12 +148,15 @@ nlohmann::json bench(const study::NcsStudy& s, std::size_t seeds, unsigned threa
   const unsigned used = threads == 0 ? std::max(1U, std::thread::hardware_concurrency()) : threads;
   const std::clock_t cpu0 = std::clock();
   const auto start = std::chrono::steady_clock::now();
+  engine::PlantCachePool<ncs::kN, ncs::kM + 1> pool;  // as study run's sweep
+  ncs::RunOptions options;
+  options.caches = &pool;
   const engine::SweepResults r = engine::run_sweep(
       spec, engine::Shard{}, used,
-      [&s](std::size_t a, std::size_t k, std::uint64_t seed) {
+      [&s, &options](std::size_t a, std::size_t k, std::uint64_t seed) {
         const auto t0 = std::chrono::steady_clock::now();
         // Several loops: one run of them all on the shared engine (its events; the first loop's cost).
-        const ncs::RunResult x = s.loops.empty() ? ncs::run(*s.ctx, s.approaches[a], s.scenarios[k], seed, ncs::RunOptions{})
+        const ncs::RunResult x = s.loops.empty() ? ncs::run(*s.ctx, s.approaches[a], s.scenarios[k], seed, options)
                                                  : ncs::run_loops(study::loops_on_bus(s, k), s.approaches[a], seed)[0];
         const double run_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
         return std::vector<double>{x.cost, static_cast<double>(x.events), s.scenarios[k].duration_s, run_s};
