@@ -221,7 +221,7 @@ TEST(PlantCachePool, AHitReturnsTheSameBytesAndDifferentPlantsNeverShare) {
     ak(1, 0) = -4.0 - k;
     pool.take(ak, b, cfg.qc, cfg.q1c);
   }
-  EXPECT_LE(pool.size(), 4 * PlantCachePool<3, 2>::kPlantsPerThread);  // two threads, two kinds
+  EXPECT_LE(pool.size(), (4 * PlantCachePool<3, 2>::kPlantsPerThread));  // two threads, two kinds
   EXPECT_TRUE(same_bytes(c1.segments->get(1'000).phi, own.get(1'000).phi));
 }
 
