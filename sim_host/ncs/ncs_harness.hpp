@@ -73,7 +73,7 @@ class Harness {
         world_(world == nullptr ? *own_world_ : *world),
         kernel_(world_.kernel),
         plant_(plant_config(ctx, sc, noisy(a, opt)),
-               engine::RandomStream(opt.noise_seed != 0 ? opt.noise_seed : seed, prefix_ + "process")),
+               engine::RandomStream(opt.noise_seed != 0 ? opt.noise_seed : seed, prefix_ + "process"), opt.caches),
         net_(world_.net),
         measurement_(opt.noise_seed != 0 ? opt.noise_seed : seed, prefix_ + "measurement"),
         compute_(kernel_.stream(prefix_ + "compute")),

@@ -53,6 +53,9 @@ struct RunOptions {
   double analytic_mark_s = 0;
   /// Log every message of the legs in RunResult::messages (observes only: the run is unchanged).
   bool record_messages = false;
+  /// The plant's interval maps and noise terms from these caches shared by a sweep's runs
+  /// (plant_cache_pool.hpp; nullptr: the run's own). The same run, bit for bit.
+  engine::PlantCachePool<kN, kM + 1>* caches = nullptr;
 };
 
 /// One row of a recorded sample or estimate.

@@ -177,7 +177,9 @@ Disc::Model Context::discretizer_model(double s) const {
   return m;
 }
 
-void set_steps(Scenario& sc, std::int64_t h_us, const std::vector<std::pair<double, double>>& steps) {
+void set_steps(Scenario& sc, std::int64_t h_us, const std::vector<std::pair<double, double>>& steps,
+               const std::vector<std::size_t>& lines, const std::string& source) {
+  const bool by_line = lines.size() == steps.size();
   if (h_us <= 0) throw std::invalid_argument("ncs set-point steps: the period h must be positive");
   const std::int64_t h_ns = h_us * 1000;
   auto changes = std::make_shared<std::vector<std::pair<std::uint64_t, double>>>();
@@ -190,7 +192,9 @@ void set_steps(Scenario& sc, std::int64_t h_us, const std::vector<std::pair<doub
     const std::int64_t t_ns = std::llround(t_s * 1e9);
     const auto k = static_cast<std::uint64_t>((t_ns + h_ns - 1) / h_ns);
     if (i > 0 && k <= last_k) {
-      throw std::invalid_argument("steps " + std::to_string(i - 1) + " and " + std::to_string(i) + " (t_s " +
+      const std::string which = by_line ? source + " lines " + std::to_string(lines[i - 1]) + " and " + std::to_string(lines[i])
+                                        : "steps " + std::to_string(i - 1) + " and " + std::to_string(i);
+      throw std::invalid_argument(which + " (t_s " +
                                   std::to_string(steps[i - 1].first) + " and " + std::to_string(t_s) +
                                   " s) fall in one period h = " + std::to_string(h_us) + " us (the set-point changes on the kh grid)");
     }

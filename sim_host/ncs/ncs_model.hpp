@@ -130,8 +130,10 @@ struct Scenario {
 /// Puts the steps (t_s, value) (times strictly increasing, the set-point 0 before the first)
 /// on the kh grid of `sc`: each step from the first period k with kh ≥ t_s (to the ns), r_0
 /// the value at k = 0, a change wherever the value differs from the period before.
-/// std::invalid_argument naming the step's index when two steps fall in one period.
-void set_steps(Scenario& sc, std::int64_t h_us, const std::vector<std::pair<double, double>>& steps);
+/// std::invalid_argument naming the steps' indices when two steps fall in one period, or,
+/// when `lines` gives each step's line in the file `source`, the file and its lines.
+void set_steps(Scenario& sc, std::int64_t h_us, const std::vector<std::pair<double, double>>& steps,
+               const std::vector<std::size_t>& lines = {}, const std::string& source = "");
 
 /// True when the legs come from a study file (point to point or on a bus), not from d.
 inline bool legs_from_file(const Scenario& s) { return !s.legs.empty() || !s.bus_legs.empty(); }

@@ -1,6 +1,6 @@
 /// @file ncs_reference.hpp
 /// @brief The set-point of a study `ncs` run on the control grid: the brief's square wave ±A_r
-///        (node::SquareWaveReference's law, bit for bit) or steps from a study file's
+///        (a node::SquareWaveReference: the firmware's own law) or steps from a study file's
 ///        `reference` (steps inline or from a CSV file), as the reference pair
 ///        (x_ref, u_ref) = (N_x r_k, N_u r_k) the controllers and the cost take.
 #pragma once
@@ -15,6 +15,7 @@
 #include "ncs_model.hpp"
 #include "oneshot/matrix.hpp"
 #include "oneshot/node/message.hpp"
+#include "oneshot/node/square_wave_reference.hpp"
 
 namespace oneshot::ncs {
 
@@ -28,25 +29,26 @@ class SetpointReference {
   /// The square wave ±`amplitude`, `half_wave_periods` (≥ 1) periods per half wave.
   SetpointReference(double amplitude, std::uint32_t half_wave_periods, const Vector<double, kN>& nx,
                     const Vector<double, kM>& nu)
-      : amplitude_(amplitude), half_(half_wave_periods == 0 ? 1 : half_wave_periods), nx_(nx), nu_(nu) {}
+      : amplitude_(amplitude), half_(half_wave_periods == 0 ? 1 : half_wave_periods),
+        wave_(amplitude, half_wave_periods, nx, nu), nx_(nx), nu_(nu) {}
 
   /// Steps: r_0 = `r0`, then each change (k, value) from period k on.
   SetpointReference(double r0, std::shared_ptr<const Changes> changes, const Vector<double, kN>& nx,
                     const Vector<double, kM>& nu)
-      : amplitude_(r0), half_(0), changes_(std::move(changes)), nx_(nx), nu_(nu) {}
+      : amplitude_(r0), half_(0), wave_(r0, 1, nx, nu), changes_(std::move(changes)), nx_(nx), nu_(nu) {}
 
   /// r_k.
   double setpoint(node::SequenceNumber k) const {
-    if (half_ != 0) return ((k / half_) % 2U) == 0U ? amplitude_ : -amplitude_;
+    if (half_ != 0) return wave_.setpoint(k);
     const Changes& c = *changes_;
     const auto it = std::upper_bound(c.begin(), c.end(), std::uint64_t{k},
                                      [](std::uint64_t kk, const std::pair<std::uint64_t, double>& e) { return kk < e.first; });
     return it == c.begin() ? amplitude_ : std::prev(it)->second;
   }
   /// x_ref,k = N_x r_k.
-  Vector<double, kN> state(node::SequenceNumber k) const { return nx_ * setpoint(k); }
+  Vector<double, kN> state(node::SequenceNumber k) const { return half_ != 0 ? wave_.state(k) : nx_ * setpoint(k); }
   /// u_ref,k = N_u r_k.
-  Vector<double, kM> input(node::SequenceNumber k) const { return nu_ * setpoint(k); }
+  Vector<double, kM> input(node::SequenceNumber k) const { return half_ != 0 ? wave_.input(k) : nu_ * setpoint(k); }
 
   /// The periods k, 0 < k < `k_end`, at whose instant kh the set-point is switched (the square
   /// wave: every half wave, whatever its amplitude; steps: where the value changes).
@@ -63,7 +65,8 @@ class SetpointReference {
 
  private:
   double amplitude_;  // A_r, or r_0 of steps
-  std::uint32_t half_;  // periods per half wave; 0: steps
+  std::uint32_t half_;  // periods per half wave (the switch instants); 0: steps
+  node::SquareWaveReference<double, kN, kM> wave_;  // the square wave's law (unused for steps)
   std::shared_ptr<const Changes> changes_;
   Vector<double, kN> nx_;
   Vector<double, kM> nu_;

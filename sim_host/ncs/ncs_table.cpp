@@ -73,9 +73,11 @@ engine::SweepResults table_sweep(const Context& ctx, const TableOptions& opt, co
     spec.metrics.insert(spec.metrics.end(), std::begin(kAnalyticMetrics), std::end(kAnalyticMetrics));
   }
   const std::vector<Approach> approaches = opt.approaches;
+  engine::PlantCachePool<kN, kM + 1> pool;  // the sweep's: per thread, bounded (plant_cache_pool.hpp)
   RunOptions ro;
   ro.noise_free = opt.noise_free;
   ro.faults = opt.faults;
+  ro.caches = &pool;
   const bool analytic = opt.analytic;
   return engine::run_sweep(
       spec, shard, opt.threads,

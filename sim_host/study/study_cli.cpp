@@ -148,13 +148,16 @@ nlohmann::json bench(const study::NcsStudy& s, std::size_t seeds, unsigned threa
   const unsigned used = threads == 0 ? std::max(1U, std::thread::hardware_concurrency()) : threads;
   const std::clock_t cpu0 = std::clock();
   const auto start = std::chrono::steady_clock::now();
+  engine::PlantCachePool<ncs::kN, ncs::kM + 1> pool;  // as study run's sweep
+  ncs::RunOptions options;
+  options.caches = &pool;
   const engine::SweepResults r = engine::run_sweep(
       spec, engine::Shard{}, used,
-      [&s, last_offset_us](std::size_t a, std::size_t k, std::uint64_t seed) {
+      [&s, &options, last_offset_us](std::size_t a, std::size_t k, std::uint64_t seed) {
         const auto t0 = std::chrono::steady_clock::now();
         // Several loops: one run of them all on the shared engine (its events, every loop's cost).
         const std::vector<ncs::RunResult> x =
-            s.loops.empty() ? std::vector<ncs::RunResult>{ncs::run(*s.ctx, s.approaches[a], s.scenarios[k], seed, ncs::RunOptions{})}
+            s.loops.empty() ? std::vector<ncs::RunResult>{ncs::run(*s.ctx, s.approaches[a], s.scenarios[k], seed, options)}
                             : ncs::run_loops(study::loops_on_bus(s, k), s.approaches[a], seed);
         const double run_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
         std::vector<double> v;

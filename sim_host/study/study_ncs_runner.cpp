@@ -305,7 +305,7 @@ NcsStudy map_ncs_study(const engine::StudyFile& file) {
         sc.period_s = 0;
         amplitude_field = ref->field + (ref->kind == engine::ReferenceSpec::Kind::kFile ? ".path" : ".steps");
         try {
-          ncs::set_steps(sc, h_us, ref->steps);
+          ncs::set_steps(sc, h_us, ref->steps, ref->lines, ref->path);
         } catch (const std::invalid_argument& e) {
           refuse(amplitude_field, e.what());
         }

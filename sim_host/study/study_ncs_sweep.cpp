@@ -207,7 +207,7 @@ std::vector<double> loop_sweep_values(const NcsStudy& s, std::size_t a, const nc
 }
 
 engine::SweepResults run_ncs_sweep(const NcsStudy& s, std::size_t seeds, unsigned threads, const engine::Shard& shard,
-                                   bool analytic) {
+                                   bool analytic, bool share_caches) {
   if (!s.loops.empty()) return run_loops_sweep(s, seeds, threads, shard, analytic);  // study_loops_sweep.cpp
   bool one_shot = false;
   for (ncs::Approach a : s.approaches) one_shot = one_shot || ncs::one_shot(a);
@@ -275,11 +275,14 @@ engine::SweepResults run_ncs_sweep(const NcsStudy& s, std::size_t seeds, unsigne
   const NcsStudy* study = &s;
   const std::vector<std::vector<LinkCounterMap>>* counter_maps = &maps;
   const std::vector<std::string>* bus = &on_bus;
+  engine::PlantCachePool<ncs::kN, ncs::kM + 1> pool;  // the sweep's: per thread, bounded (plant_cache_pool.hpp)
+  ncs::RunOptions options;
+  if (share_caches) options.caches = &pool;
   return engine::run_sweep(
       spec, shard, threads,
-      [study, counter_maps, bus, analytic, on_cpu, one_shot, filtered](std::size_t a, std::size_t k, std::uint64_t seed) {
+      [study, counter_maps, bus, analytic, on_cpu, one_shot, filtered, &options](std::size_t a, std::size_t k, std::uint64_t seed) {
         const ncs::Approach ap = study->approaches[a];
-        const ncs::RunResult r = ncs::run(*study->ctx, ap, study->scenarios[k], seed, ncs::RunOptions{});
+        const ncs::RunResult r = ncs::run(*study->ctx, ap, study->scenarios[k], seed, options);
         std::vector<double> v{r.cost, static_cast<double>(r.late), static_cast<double>(r.saturated),
                               static_cast<double>(r.faults)};
         for (std::size_t l = 0; l < study->links.size(); ++l) {
@@ -300,7 +303,7 @@ engine::SweepResults run_ncs_sweep(const NcsStudy& s, std::size_t seeds, unsigne
           v.insert(v.end(), {r.nees, static_cast<double>(r.nees_steps)});
         }
         if (analytic) {  // ncs table --analytic's columns: the same run in analytic mode
-          const auto x = ncs::analytic_metrics(*study->ctx, ap, study->scenarios[k], seed, ncs::RunOptions{});
+          const auto x = ncs::analytic_metrics(*study->ctx, ap, study->scenarios[k], seed, options);
           v.insert(v.end(), x.begin(), x.end());
         }
         return v;

@@ -98,9 +98,11 @@ nlohmann::json loops_outputs(const engine::SweepResults& results, const std::str
 /// same run in ncs::RunOptions::analytic mode, its exact E[J] over the noise for the run's
 /// timing in the metrics "analytic", "analytic_refused" (the refusal's code, 0 when valid) and
 /// "analytic_mismatch", and "analytic": true in the configuration (only then: the sweep's
-/// spec, and its shards, stay as they are without).
+/// spec, and its shards, stay as they are without). With `share_caches` the runs of each
+/// thread take the plant's interval maps and noise terms from one pool for the sweep
+/// (ncs::RunOptions::caches); without, each run its own: the same bytes either way.
 engine::SweepResults run_ncs_sweep(const NcsStudy& s, std::size_t seeds, unsigned threads, const engine::Shard& shard,
-                                   bool analytic = false);
+                                   bool analytic = false, bool share_caches = true);
 
 /// The summary of a complete sweep: ncs::table_outputs() (cost_mean, cost_ci95, ratio_to_I,
 /// ratio_scenario_weighted, paired differences, per scenario; with an analytic sweep the

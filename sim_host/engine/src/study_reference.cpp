@@ -60,7 +60,8 @@ std::string ReferenceSpec::describe() const {
 }
 
 std::vector<std::pair<double, double>> parse_reference_csv(const std::string& text, const std::string& field,
-                                                           const std::string& source) {
+                                                           const std::string& source, std::vector<std::size_t>* lines) {
+  if (lines != nullptr) lines->clear();
   std::istringstream in(text);
   std::string line;
   const auto fail = [&](int n, const std::string& why) {
@@ -83,6 +84,7 @@ std::vector<std::pair<double, double>> parse_reference_csv(const std::string& te
     const std::string why = step_error(out, t, v);
     if (!why.empty()) fail(n, why);
     out.emplace_back(t, v);
+    if (lines != nullptr) lines->push_back(static_cast<std::size_t>(n));
   }
   if (out.empty()) throw InputError("field '" + field + "': " + source + ": no steps after the header");
   return out;
@@ -126,7 +128,7 @@ ReferenceSpec parse_reference(const nlohmann::json& j, const std::string& f, con
     }
     const std::string text =
         util::read_text_file_as<InputError>(r.path, "reference file", "field '" + f + ".path': ", kMaxReferenceFileBytes);
-    r.steps = parse_reference_csv(text, f + ".path", r.path);
+    r.steps = parse_reference_csv(text, f + ".path", r.path, &r.lines);
   } else {
     throw InputError("field '" + f + ".kind': unknown kind '" + kind + "' (square, steps, file)");
   }

@@ -4,9 +4,13 @@
 ///        alone, the discrete latch/step order, and the dimension check of plain-matrix models.
 #include <gtest/gtest.h>
 
+#include <cstring>
+#include <thread>
+
 
 #include "oneshot/engine/continuous_plant.hpp"
 #include "oneshot/engine/discrete_plant.hpp"
+#include "oneshot/engine/plant_cache_pool.hpp"
 #include "oneshot/engine/plant_model.hpp"
 #include "support/eigen_reference.hpp"
 #include "support/expect_error.hpp"
@@ -127,6 +131,98 @@ TEST(ContinuousPlant, NoiseHasTheExactCovarianceAndTracesDoNotChangeTheRun) {
     EXPECT_NEAR(mid(i, i), qd_half(i, i), 0.05 * qd_half(i, i)) << i;  // unconditional law of a bridge point
   }
   EXPECT_NEAR(end(0, 1), qd(0, 1), 0.1 * std::sqrt(qd(0, 0) * qd(1, 1)));
+}
+
+/// Bytes of a matrix.
+template <std::size_t R, std::size_t C>
+bool same_bytes(const Matrix<double, R, C>& x, const Matrix<double, R, C>& y) {
+  for (std::size_t i = 0; i < R; ++i)
+    for (std::size_t j = 0; j < C; ++j)
+      if (std::memcmp(&x(i, j), &y(i, j), sizeof(double)) != 0) return false;
+  return true;
+}
+
+/// A run of 300 random intervals (whole µs up to 50 ms, often repeated), inputs and a trace.
+struct PlantRun {
+  Vector<double, 3> x;
+  double cost = 0;
+  double trace_x0 = 0;
+};
+PlantRun run_plant(const ContinuousPlantConfig<3, 1, 1, 1>& cfg, std::uint64_t seed, PlantCachePool<3, 2>* pool) {
+  ContinuousPlant<3, 1, 1, 1> plant(cfg, RandomStream(seed, "p"), pool);
+  plant.record_trace(Duration{7'000'000}, RandomStream(seed, "trace"));
+  RandomStream rng(seed, "events");
+  SimTime t{0};
+  for (int k = 0; k < 300; ++k) {
+    t += Duration{1000 * rng.uniform_int(1, 400)};
+    plant.advance_to(t);
+    Vector<double, 1> u;
+    u[0] = rng.uniform(-1, 1);
+    plant.set_input(u);
+  }
+  return {plant.state(), plant.cost().total(), plant.trace().back().x[0]};
+}
+
+TEST(PlantCachePool, RunsWithThePoolAreTheRunsWithTheirOwnCachesBitForBit) {
+  PlantCachePool<3, 2> pool;
+  for (bool noise : {true, false})
+    for (std::uint64_t seed = 1; seed <= 3; ++seed) {  // later seeds hit what earlier ones computed
+      const PlantRun own = run_plant(oscillator(noise), seed, nullptr);
+      const PlantRun shared = run_plant(oscillator(noise), seed, &pool);
+      EXPECT_TRUE(same_bytes(own.x, shared.x)) << seed;
+      EXPECT_EQ(std::memcmp(&own.cost, &shared.cost, sizeof(double)), 0) << seed;
+      EXPECT_EQ(std::memcmp(&own.trace_x0, &shared.trace_x0, sizeof(double)), 0) << seed;
+    }
+}
+
+TEST(PlantCachePool, AHitReturnsTheSameBytesAndDifferentPlantsNeverShare) {
+  PlantCachePool<3, 2> pool;
+  const auto cfg = oscillator(true);
+  Matrix<double, 3, 2> b;
+  b.set_block<0, 0>(cfg.b);
+  b.set_block<0, 1>(cfg.bw);
+  const auto c1 = pool.take(cfg.a, b, cfg.qc, cfg.q1c);
+  const auto c2 = pool.take(cfg.a, b, cfg.qc, cfg.q1c);
+  EXPECT_EQ(c1.segments, c2.segments);
+  EXPECT_EQ(c1.noise, c2.noise);
+  ExactSegmentCache<3, 2> own(cfg.a, b, cfg.q1c);
+  ProcessNoise<3> own_noise(cfg.a, cfg.qc, cfg.q1c);
+  for (std::int64_t d : {1'000, 2'345'000, 50'000'000}) {
+    const auto miss = c1.segments->get(d);  // a copy: the first call computes it
+    const auto& hit = c2.segments->get(d);
+    const auto& mine = own.get(d);
+    EXPECT_TRUE(same_bytes(miss.phi, hit.phi) && same_bytes(miss.gamma, hit.gamma) && same_bytes(miss.g, hit.g)) << d;
+    EXPECT_TRUE(same_bytes(mine.phi, hit.phi) && same_bytes(mine.gamma, hit.gamma) && same_bytes(mine.g, hit.g)) << d;
+    EXPECT_TRUE(same_bytes(own_noise.interval_covariance(Duration{d}), c2.noise->interval_covariance(Duration{d}))) << d;
+  }
+  // Another noise scale: the same interval maps, other noise terms; another A, B or Q1c: others.
+  const auto scaled = pool.take(cfg.a, b, cfg.qc * 4.0, cfg.q1c);
+  EXPECT_EQ(scaled.segments, c1.segments);
+  EXPECT_NE(scaled.noise, c1.noise);
+  Matrix<double, 3, 3> a2 = cfg.a;
+  a2(1, 1) = -0.5;
+  const auto other_a = pool.take(a2, b, cfg.qc, cfg.q1c);
+  EXPECT_NE(other_a.segments, c1.segments);
+  EXPECT_NE(other_a.noise, c1.noise);
+  Matrix<double, 3, 2> b2 = b;
+  b2(2, 1) = 0.3;
+  EXPECT_NE(pool.take(cfg.a, b2, cfg.qc, cfg.q1c).segments, c1.segments);
+  EXPECT_NE(pool.take(cfg.a, b, cfg.qc, cfg.q1c * 2.0).segments, c1.segments);
+  Matrix<double, 3, 3> a_negative_zero = cfg.a;
+  a_negative_zero(0, 0) = -0.0;  // the same value, other bytes: kept apart
+  EXPECT_NE(pool.take(a_negative_zero, b, cfg.qc, cfg.q1c).segments, c1.segments);
+  // Another thread has its own caches of the same plant.
+  std::shared_ptr<ExactSegmentCache<3, 2>> there;
+  std::thread([&] { there = pool.take(cfg.a, b, cfg.qc, cfg.q1c).segments; }).join();
+  EXPECT_NE(there, c1.segments);
+  // Bounded: at most kPlantsPerThread of each kind per thread; one taken before stays usable.
+  for (int k = 0; k < 10; ++k) {
+    Matrix<double, 3, 3> ak = cfg.a;
+    ak(1, 0) = -4.0 - k;
+    pool.take(ak, b, cfg.qc, cfg.q1c);
+  }
+  EXPECT_LE(pool.size(), (4 * PlantCachePool<3, 2>::kPlantsPerThread));  // two threads, two kinds
+  EXPECT_TRUE(same_bytes(c1.segments->get(1'000).phi, own.get(1'000).phi));
 }
 
 TEST(DiscretePlant, InputsLatchAtTheEndOfTheInstantAndStepsRunFirst) {

@@ -9,6 +9,7 @@
 #include <cstring>
 #include <random>
 
+#include "ncs_reference.hpp"
 #include "ncs_test_support.hpp"
 #include "oneshot/host/host_network.hpp"
 #include "oneshot/node/sync_actuator_node.hpp"
@@ -299,6 +300,28 @@ TEST(NcsNodes, LateCommandIsHeldCountedAndItsEchoUsed) {
   ASSERT_TRUE(is_exact(with_own.update(r.tau_us, r.y)));
   EXPECT_EQ(ctrl.estimator().estimate()[1], with_echo.prediction()[1]);
   EXPECT_NE(ctrl.estimator().estimate()[1], with_own.prediction()[1]);
+}
+
+TEST(NcsReference, TheSquareWaveIsTheFirmwaresBitForBit) {
+  Vector<double, kN> nx;
+  nx[0] = 1.3;
+  nx[1] = -0.7;
+  Vector<double, kM> nu;
+  nu[0] = 0.45;
+  for (const std::uint32_t half : {1U, 7U, 20U}) {
+    const Ref firmware(0.37, half, nx, nu);
+    const SetpointReference mine(0.37, half, nx, nu);
+    for (node::SequenceNumber k = 0; k < 200; ++k) {
+      const double a = firmware.setpoint(k);
+      const double b = mine.setpoint(k);
+      ASSERT_EQ(std::memcmp(&a, &b, sizeof a), 0) << half << " " << k;
+      for (std::size_t i = 0; i < kN; ++i) ASSERT_EQ(firmware.state(k)[i], mine.state(k)[i]) << k;
+      for (std::size_t j = 0; j < kM; ++j) ASSERT_EQ(firmware.input(k)[j], mine.input(k)[j]) << k;
+    }
+    const std::vector<std::uint64_t> sw = mine.switches(60);  // every half wave, where the sign flips
+    for (std::uint64_t k : sw) EXPECT_NE(firmware.setpoint(static_cast<node::SequenceNumber>(k)), firmware.setpoint(static_cast<node::SequenceNumber>(k - 1)));
+    EXPECT_EQ(sw.size(), (60 - 1) / half);
+  }
 }
 
 }  // namespace

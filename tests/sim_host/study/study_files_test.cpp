@@ -243,6 +243,18 @@ TEST(StudyFiles, MergedShardsGiveTheSameBytesAsOneRun) {
   }
 }
 
+TEST(StudyFiles, SharedIntervalCachesGiveTheSameBytesAsEachRunItsOwn) {
+  NcsStudy s = small_study(2);  // A, AK, S+: plant events at ever different offsets; I on a fixed grid
+  s.approaches = {ncs::Approach::kI, ncs::Approach::kA, ncs::Approach::kAK, ncs::Approach::kSPlus};
+  const auto outputs = [&](unsigned threads, bool shared, const char* dir) {
+    const engine::SweepResults r = run_ncs_sweep(s, 3, threads, engine::Shard{}, false, shared);
+    return engine::shard_to_json(r).dump() + run_outputs(r, temp_dir(dir), false).dump();
+  };
+  const std::string own = outputs(1, false, "own");
+  EXPECT_EQ(outputs(1, true, "shared1"), own);
+  EXPECT_EQ(outputs(2, true, "shared2"), own);
+}
+
 /// A refusal names the field; `expect` is a fragment of the message.
 void expect_refused(const std::function<void(nlohmann::json&)>& edit, const std::string& expect) {
   try {

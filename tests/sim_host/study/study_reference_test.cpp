@@ -166,6 +166,9 @@ TEST(StudyReference, BadReferencesAreRefusedNamingTheFieldAndLine) {
   kOs.expect_refused(file("r.csv", "t_s,value_volts\n0,1\n1,1e5\n"), "line 3: value_volts must be finite");
   kOs.expect_refused(file("e.csv", "t_s,value_volts\n# nothing\n"), "no steps after the header");
   kOs.expect_refused(file("x.csv", "t_s,value_volts\n0,0.5x\n"), "field 'reference.path'");
+  // Two steps in one period (the loop's check): the file's lines, comments and blank lines counted.
+  kOs.expect_refused(file("p.csv", "t_s,value_volts\n0,0.2\n# next\n\n1.01,-0.2\n1.02,0.2\n"),
+                     "field 'reference.path': " + dir + "/p.csv lines 5 and 6 (t_s");
 }
 
 }  // namespace

@@ -24,6 +24,7 @@
 #include "oneshot/assert_handler.hpp"
 #include "oneshot/engine/cost.hpp"
 #include "oneshot/engine/exact_segment.hpp"
+#include "oneshot/engine/plant_cache_pool.hpp"
 #include "oneshot/engine/process_noise.hpp"
 #include "oneshot/engine/random_stream.hpp"
 #include "oneshot/engine/sim_time.hpp"
@@ -65,6 +66,14 @@ class ContinuousPlant {
   ContinuousPlant(const ContinuousPlantConfig<N, M, P, W>& config, RandomStream noise)
       : cfg_(config), noise_rng_(std::move(noise)), noise_(config.a, config.qc, config.q1c),
         segments_(config.a, held_input_matrix(config), config.q1c) {}
+
+  /// The same, with the interval maps and noise terms taken from (and added to) `pool`'s caches
+  /// for this plant (nullptr: its own). The values per interval length do not depend on the
+  /// cache: the same run, bit for bit.
+  ContinuousPlant(const ContinuousPlantConfig<N, M, P, W>& config, RandomStream noise, PlantCachePool<N, M + W>* pool)
+      : ContinuousPlant(config, std::move(noise)) {
+    if (pool != nullptr) shared_ = pool->take(config.a, held_input_matrix(config), config.qc, config.q1c);
+  }
 
   /// Current time.
   SimTime now() const { return now_; }
@@ -127,10 +136,10 @@ class ContinuousPlant {
     const Input du = u_ - u_ref_;
     const std::size_t first_new = trace_.size();
     while (trace_step_.count() > 0 && trace_next_ <= t1) {
-      trace_.push_back(Sample{trace_next_, propagated(segments_.get((trace_next_ - start).count()), e0, du), x_ref_c(), u_});
+      trace_.push_back(Sample{trace_next_, propagated(segments().get((trace_next_ - start).count()), e0, du), x_ref_c(), u_});
       trace_next_ += trace_step_;
     }
-    const Segment& seg = segments_.get(delta.count());
+    const Segment& seg = segments().get(delta.count());
     Vector<double, kK> z;
     z.template set_block<0, 0>(e0);
     z.template set_block<N, 0>(du);
@@ -143,16 +152,21 @@ class ContinuousPlant {
     x_ = propagated(seg, e0, du);
     now_ = t1;
     if (!cfg_.process_noise) return;
-    const State n_end = noise_.draw(delta, noise_rng_);
+    ProcessNoise<N>& terms = noise();
+    const State n_end = terms.draw(delta, noise_rng_);
     x_ = x_ + n_end;
-    cost_.noise += noise_.interval_cost(delta);
-    bridge_trace_noise(trace_, first_new, start, t1, n_end, noise_, trace_rng_);
+    cost_.noise += terms.interval_cost(delta);
+    bridge_trace_noise(trace_, first_new, start, t1, n_end, terms, trace_rng_);
   }
 
   /// Q_d(Δ) of the process noise.
   Matrix<double, N, N> process_covariance(Duration delta) const { return noise_.covariance(delta); }
 
  private:
+  /// The interval maps in use (the pool's or the plant's own).
+  ExactSegmentCache<N, M + W>& segments() { return shared_.segments ? *shared_.segments : segments_; }
+  /// The noise terms in use.
+  ProcessNoise<N>& noise() { return shared_.noise ? *shared_.noise : noise_; }
   Output x_ref_c() const { return cfg_.c * x_ref_; }
   using Segment = ExactSegment<N, M + W>;
   /// [B, B_w]: the columns held over an interval.
@@ -180,6 +194,7 @@ class ContinuousPlant {
   Input u_ref_{};
   CostBreakdown cost_{};
   ExactSegmentCache<N, M + W> segments_;
+  SharedPlantCaches<N, M + W> shared_;
   Duration trace_step_{0};
   SimTime trace_next_{0};
   RandomStream trace_rng_{0, "trace"};

@@ -33,15 +33,18 @@ struct ExactSegment {
 };
 
 /// Exact interval maps of ẋ = A x + B v, cached by interval length in ns (the cache is
-/// cleared when it passes 8192 entries, so irregular timing cannot grow it without bound).
+/// cleared when it passes `capacity` entries, so irregular timing cannot grow it without bound).
 template <std::size_t N, std::size_t U>
 class ExactSegmentCache {
  public:
   static constexpr std::size_t kK = N + U;  ///< Size of z = [e; v].
   using Segment = ExactSegment<N, U>;
 
-  /// A (1/s), B (all held input columns) and the state cost weight Q1c.
-  ExactSegmentCache(const Matrix<double, N, N>& a, const Matrix<double, N, U>& b, const Matrix<double, N, N>& q1c) {
+  /// A (1/s), B (all held input columns) and the state cost weight Q1c; at most about
+  /// `capacity` interval lengths kept.
+  ExactSegmentCache(const Matrix<double, N, N>& a, const Matrix<double, N, U>& b, const Matrix<double, N, N>& q1c,
+                    std::size_t capacity = 8192)
+      : capacity_(capacity) {
     f_.template set_block<0, 0>(a);
     f_.template set_block<0, N>(b);
     w_.template set_block<0, 0>(q1c);
@@ -51,7 +54,7 @@ class ExactSegmentCache {
   const Segment& get(std::int64_t delta_ns) {
     const auto it = segments_.find(delta_ns);
     if (it != segments_.end()) return it->second;
-    if (segments_.size() > 8192) segments_.clear();
+    if (segments_.size() > capacity_) segments_.clear();
     const double d = static_cast<double>(delta_ns) * 1e-9;
     Matrix<double, 2 * kK, 2 * kK> v;
     v.template set_block<0, 0>(-(f_.transposed() * d));
@@ -71,6 +74,7 @@ class ExactSegmentCache {
  private:
   Matrix<double, kK, kK> f_;
   Matrix<double, kK, kK> w_;
+  std::size_t capacity_;
   std::unordered_map<std::int64_t, Segment> segments_;
 };
 

@@ -34,9 +34,11 @@ namespace oneshot::engine {
 template <std::size_t N>
 class ProcessNoise {
  public:
-  /// Noise of intensity `qc` (state coordinates) on dynamics `a`; cost weight `q1c`.
-  ProcessNoise(const Matrix<double, N, N>& a, const Matrix<double, N, N>& qc, const Matrix<double, N, N>& q1c)
-      : a_(a), qc_(qc) {
+  /// Noise of intensity `qc` (state coordinates) on dynamics `a`; cost weight `q1c`; the cache
+  /// per interval length is cleared when it passes `capacity` entries.
+  ProcessNoise(const Matrix<double, N, N>& a, const Matrix<double, N, N>& qc, const Matrix<double, N, N>& q1c,
+               std::size_t capacity = 4096)
+      : a_(a), qc_(qc), capacity_(capacity) {
     Matrix<double, N, N> mk = qc;
     for (std::size_t k = 0; k < kTerms; ++k) {
       double tr = 0;
@@ -142,7 +144,7 @@ class ProcessNoise {
   const Entry& entry(Duration delta) {
     const auto it = cache_.find(delta.count());
     if (it != cache_.end()) return it->second;
-    if (cache_.size() > 4096) cache_.clear();
+    if (cache_.size() > capacity_) cache_.clear();
     Entry e;
     e.qd = covariance(delta);
     e.chol = psd_cholesky(e.qd);
@@ -155,6 +157,7 @@ class ProcessNoise {
   Matrix<double, N, N> q1c_;
   double coeff_[kTerms] = {};
   double a_norm_ = 0;
+  std::size_t capacity_;
   std::unordered_map<std::int64_t, Entry> cache_;
 };
 

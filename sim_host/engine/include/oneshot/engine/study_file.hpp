@@ -132,6 +132,7 @@ struct ReferenceSpec {
   /// finite within ±100 V; the set-point is 0 before the first time, then the value of the last
   /// time reached.
   std::vector<std::pair<double, double>> steps;
+  std::vector<std::size_t> lines;  ///< kFile: the file's line of each step (empty otherwise).
   std::string path;            ///< kFile: the CSV file (resolved against the study file's folder).
   std::string field;           ///< Where the file gives it ("reference", "scenarios[i].reference").
   /// One line: "square ±0.2 V, T_r 2 s", "steps (4)", "file x.csv (4 steps)".
@@ -203,9 +204,11 @@ ReferenceSpec parse_reference(const nlohmann::json& j, const std::string& f, con
 /// The steps of a reference CSV file's text: the header "t_s,value_volts", then one
 /// "t_s,value_volts" pair per line (blank lines and lines starting with '#' skipped); InputError
 /// "field '<field>': <source> line <n>: <reason>" for anything else, non-finite or out-of-range
-/// numbers, times not strictly increasing, no steps, more than kMaxReferenceSteps.
+/// numbers, times not strictly increasing, no steps, more than kMaxReferenceSteps. `lines`
+/// (when given) receives the line of each step.
 std::vector<std::pair<double, double>> parse_reference_csv(const std::string& text, const std::string& field,
-                                                           const std::string& source);
+                                                           const std::string& source,
+                                                           std::vector<std::size_t>* lines = nullptr);
 
 /// Parses and validates a study file's text; `schema` may be null (any kinds and params).
 StudyFile parse_study(const std::string& text, const std::string& source, const StudySchema* schema,
