@@ -95,7 +95,9 @@ TEST(NcsFaults, EveryFlippedFrameIsRefusedAsCorrupt) {
       for (std::size_t i = 0; i < names.size(); ++i) {
         const std::string& n = names[i];
         if (n.size() > 8 && n.compare(n.size() - 8, 8, ".corrupt") == 0) corrupt += r.counters[i];
-        if (n.find(".refused_") != std::string::npos) EXPECT_EQ(r.counters[i], clean.counters[i]) << name(a) << " " << spec << " " << n;
+        if (n.find(".refused_") != std::string::npos) {
+          EXPECT_EQ(r.counters[i], clean.counters[i]) << name(a) << " " << spec << " " << n;
+        }
       }
       const double flipped = static_cast<double>(r.injected.flip);
       EXPECT_GT(flipped, 50) << name(a) << " " << spec;
