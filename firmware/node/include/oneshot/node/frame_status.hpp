@@ -18,7 +18,7 @@ namespace oneshot::node {
 
 /// Outcome of one received frame (values ordered by severity, see the file comment).
 enum class [[nodiscard]] FrameStatus : std::uint8_t {
-  kOk = 0,             ///< Decoded and accepted (decode(): the size fits).
+  kOk = 0,             ///< Decoded and accepted (decode(): the size fits, the CRC matches).
   kReacquired,         ///< Accepted as the new sequence base of a restarted peer.
   kStale,              ///< Not newer than the last accepted one: dropped.
   kRefusedSequence,    ///< Sequence jump beyond the window, or stamp outside its window.
