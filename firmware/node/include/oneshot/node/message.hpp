@@ -7,8 +7,10 @@
 /// its 8 bytes, a Fixed its raw integer. crc is the CRC-16/CCITT-FALSE (poly 0x1021, init
 /// 0xFFFF, oneshot/crc16.hpp) of every byte before it, sent low byte first: an end-to-end
 /// check (AUTOSAR E2E style, with the sequence number) that a gateway, a driver or a link
-/// without its own check cannot alter a frame unnoticed; every 1- and 2-bit error is caught. Sequence numbers wrap; seq_newer() compares them in serial
-/// arithmetic (RFC 1982), right while the two are less than 2^31 apart.
+/// without its own check cannot alter a frame unnoticed: every error of 1 to 3 bits, and
+/// every burst of ≤ 16 bits, is caught (decode() gives kCorrupt). Sequence numbers wrap;
+/// seq_newer() compares them in serial arithmetic (RFC 1982), right while the two are less
+/// than 2^31 apart.
 #pragma once
 
 #include <cstddef>
