@@ -13,17 +13,17 @@
 namespace oneshot::ncs {
 
 /// `names` followed by the refusal causes every decoding node counts (node::FrameRefusals)
-/// after `node.`: non-finite payload, value outside the design's range, unexpected source,
+/// after `node.`: CRC mismatch (bits altered on the way), non-finite payload, value outside the design's range, unexpected source,
 /// sequence/stamp outside the window, re-acquisitions of a restarted peer.
 inline std::vector<std::string> with_refusal_names(std::vector<std::string> names, const std::string& node) {
-  for (const char* c : {".refused_non_finite", ".refused_out_of_range", ".refused_source", ".refused_sequence", ".reacquired"})
+  for (const char* c : {".corrupt", ".refused_non_finite", ".refused_out_of_range", ".refused_source", ".refused_sequence", ".reacquired"})
     names.push_back(node + c);
   return names;
 }
 /// `values` followed by the refusal counters of `s`, in the order of with_refusal_names().
 template <typename Stats>
 std::vector<double> with_refusals(std::vector<double> values, const Stats& s) {
-  values.insert(values.end(), {double(s.refused_non_finite), double(s.refused_out_of_range), double(s.refused_source),
+  values.insert(values.end(), {double(s.corrupt), double(s.refused_non_finite), double(s.refused_out_of_range), double(s.refused_source),
                                double(s.refused_sequence), double(s.reacquired)});
   return values;
 }

@@ -43,9 +43,9 @@ engine::LinkConfig leg(const Context& ctx, const Scenario& sc, Approach a, const
   engine::LinkConfig c;
   c.name = name;
   c.fifo = true;
-  // Frames: k (4) | instant (4) | [τ (4)] | doubles (actuation_sync_messages.hpp, message.hpp).
+  // Frames: k (4) | instant (4) | [τ (4)] | doubles | crc (2) (actuation_sync_messages.hpp, message.hpp).
   const bool report = std::string(name) == "sc" && actuation_synchronized(a);
-  c.frame = engine::FrameLayout{0, 4, report ? node::kHeaderBytes + 4 : node::kHeaderBytes, 8};
+  c.frame = engine::FrameLayout{0, 4, report ? node::kHeaderBytes + 4 : node::kHeaderBytes, 8, node::kCrcBytes};
   if (delay_free(a)) return c;  // constant 0
   const auto given = sc.legs.find(name);
   if (given != sc.legs.end()) {  // from a study file

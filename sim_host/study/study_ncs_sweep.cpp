@@ -39,7 +39,7 @@ using LinkCounterMap = std::vector<std::pair<std::size_t, std::size_t>>;
 /// The map of `link` under approach `a`: the receiving node's stale counter to kLate (frames
 /// dropped as stale: not newer than what the node holds, or their period past; the actuator's
 /// "late" counts periods without a command, not frames: the approach's late_commands), its
-/// malformed and refused_* counters to kRefused (empty when `link` is not a leg of the loop).
+/// malformed, corrupt and refused_* counters to kRefused (empty when `link` is not a leg of the loop).
 LinkCounterMap link_counter_map(ncs::Approach a, const std::string& link) {
   LinkCounterMap m;
   const NcsLeg* leg = find_ncs_leg(link);
@@ -51,7 +51,7 @@ LinkCounterMap link_counter_map(ncs::Approach a, const std::string& link) {
     if (c.rfind(node + ".", 0) != 0) continue;
     const std::string what = c.substr(node.size() + 1);
     if (what == "stale") m.emplace_back(i, kLate);
-    if (what == "malformed" || what.rfind("refused_", 0) == 0) m.emplace_back(i, kRefused);
+    if (what == "malformed" || what == "corrupt" || what.rfind("refused_", 0) == 0) m.emplace_back(i, kRefused);
   }
   return m;
 }

@@ -2,11 +2,13 @@
 /// @brief libFuzzer harness of the network-facing nodes (firmware/node): sequences of raw
 ///        frames from any source into each node, decode and state machine together.
 ///
-/// Input: records [op (1) | source (1) | length (1) | bytes (length)]; op picks the node:
+/// Input: records [op (1) | source (1) | length (1) | bytes (length)]; op & 0x7F picks the node:
 ///   0 sync controller (report)      1 sync sensor (request)     2 sync actuator (command)
 ///   3 sync actuator timer tick      4 controller node (sample)  5 on-arrival actuator
 ///   6 PETC arrival (k 4, y 8)       7 threshold buffer (stamp 4, y 8) and a step
 ///   8 send-on-delta receiver + estimator (node 1, k 4, y 8) and a step
+/// The frames of ops 0, 1, 2, 4, 5 get their CRC-16 appended (message.hpp), so the fuzzer
+/// reaches the checks behind it; with op bit 7 set they go as given (the CRC check fuzzed).
 /// Oracles after every record: no estimate, covariance, command or held value is ever NaN
 /// or ±∞, and actuators only apply commands within [u_min, u_max]. After the records, valid
 /// traffic resumes (a new epoch from the last bytes): the controllers must command, and
@@ -80,6 +82,8 @@ struct Nodes {
   HeldMeasurementReceiver<double, 2> rx;
   HeldMeasurementEstimator<double, 2, 1, 2> sod;
   SequenceNumber timer_k = 0, step_k = 0;
+  bool seal_ = true;                                ///< Append the CRC to the next frame.
+  std::uint8_t sealed_[256 + kCrcBytes] = {};        ///< The frame with its CRC.
 
   static Est estimator(const Disc& d) {
     Est e(K::kDesign, d, NoiseModel::kExact);
@@ -146,15 +150,20 @@ struct Nodes {
 
   /// Delivers the frame (src, b[0..n)) to `net` and runs `on_frame` as the node behind it.
   template <typename F>
-  static void receive(host::HostNetworkState& net, std::uint8_t src, const std::uint8_t* b, std::size_t n,
-                      F&& on_frame) {
-    deliver(net, src, b, n);
+  void receive(host::HostNetworkState& net, std::uint8_t src, const std::uint8_t* b, std::size_t n, F&& on_frame) {
+    if (seal_ && n + kCrcBytes <= sizeof sealed_) {
+      std::memcpy(sealed_, b, n);
+      deliver(net, src, sealed_, node::detail::seal(sealed_, n));
+    } else {
+      deliver(net, src, b, n);
+    }
     const host::ScopedHostNetwork cur(net);
     on_frame();
   }
 
   void run(std::uint8_t op, std::uint8_t src, const std::uint8_t* b, std::size_t n) {
-    switch (op % 9) {
+    seal_ = (op & 0x80U) == 0;
+    switch ((op & 0x7FU) % 9) {
       case 0:
         receive(c_net, src, b, n, [&] {
           ctrl_clock_us += 50'000U;  // one period per invocation: any stamp may open a gap

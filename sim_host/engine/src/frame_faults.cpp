@@ -4,9 +4,23 @@
 
 #include <algorithm>
 
+#include "oneshot/crc16.hpp"
+
 #include "oneshot/engine/json_fields.hpp"
 
 namespace oneshot::engine {
+
+namespace {
+/// Rewrites the CRC that ends `bytes` (when the layout has one) after a fault that models a
+/// wrong sender rather than a corrupted transfer.
+void reseal(const FrameLayout& layout, std::vector<std::uint8_t>& bytes) {
+  if (layout.crc_bytes != 2 || bytes.size() < 2) return;
+  const std::size_t n = bytes.size() - 2;
+  const std::uint16_t crc = crc16_ccitt_false(bytes.data(), n);
+  bytes[n] = static_cast<std::uint8_t>(crc & 0xFFU);
+  bytes[n + 1] = static_cast<std::uint8_t>(crc >> 8);
+}
+}  // namespace
 
 FaultCounters& FaultCounters::operator+=(const FaultCounters& o) {
   nan += o.nan;
@@ -67,14 +81,16 @@ bool LinkFaults::act(Active& a, SimTime sent, std::vector<std::uint8_t>& bytes, 
   switch (c.kind) {
     case FaultClause::Kind::kNan: {
       const std::size_t w = layout_.value_bytes;
-      if ((w != 4 && w != 8) || bytes.size() < layout_.value_offset + w) return false;
-      const std::size_t slots = (bytes.size() - layout_.value_offset) / w;
+      const std::size_t end = bytes.size() - std::min(bytes.size(), layout_.crc_bytes);
+      if ((w != 4 && w != 8) || end < layout_.value_offset + w) return false;
+      const std::size_t slots = (end - layout_.value_offset) / w;
       const auto slot = static_cast<std::size_t>(a.pick.uniform_int(0, static_cast<std::int64_t>(slots) - 1));
       // Quiet NaN, little-endian: 0x7FF8000000000000 (binary64) or 0x7FC00000 (binary32).
       std::uint8_t* p = bytes.data() + layout_.value_offset + slot * w;
       std::fill(p, p + w, std::uint8_t{0});
       p[w - 1] = 0x7F;
       p[w - 2] = w == 8 ? 0xF8 : 0xC0;
+      reseal(layout_, bytes);  // a NaN its sender computed: a valid frame, the receiver's finite check
       return true;
     }
     case FaultClause::Kind::kFlip: {
@@ -97,6 +113,7 @@ bool LinkFaults::act(Active& a, SimTime sent, std::vector<std::uint8_t>& bytes, 
       for (std::size_t i = 0; i < w; ++i) seq |= std::uint64_t{p[i]} << (8 * i);
       seq += c.jump;  // modulo 2^(8w): the bytes below keep the low ones
       for (std::size_t i = 0; i < w; ++i) p[i] = static_cast<std::uint8_t>(seq >> (8 * i));
+      reseal(layout_, bytes);  // a forger writes a valid frame: the sequence window catches it
       return true;
     }
     case FaultClause::Kind::kDup:

@@ -111,6 +111,9 @@ TEST(FrameChecks, StatusOrderedBySeverityAndCountedPerCause) {
   EXPECT_EQ(then_check(FrameStatus::kOk, [] { return FrameStatus::kStale; }), FrameStatus::kStale);
   EXPECT_EQ(worst_of(FrameStatus::kStale, FrameStatus::kReacquired), FrameStatus::kStale);
   EXPECT_EQ(worst_of(FrameStatus::kRefusedOutOfRange, FrameStatus::kMalformed), FrameStatus::kMalformed);
+  EXPECT_EQ(worst_of(FrameStatus::kCorrupt, FrameStatus::kRefusedSource), FrameStatus::kCorrupt);
+  EXPECT_EQ(worst_of(FrameStatus::kCorrupt, FrameStatus::kMalformed), FrameStatus::kMalformed);
+  EXPECT_FALSE(accepted(FrameStatus::kCorrupt));
   EXPECT_TRUE(accepted(FrameStatus::kReacquired));
   EXPECT_FALSE(accepted(FrameStatus::kStale));
   EXPECT_EQ(frame_status(SequenceVerdict::kJump), FrameStatus::kRefusedSequence);
@@ -118,12 +121,13 @@ TEST(FrameChecks, StatusOrderedBySeverityAndCountedPerCause) {
   FrameRefusals r;
   for (const FrameStatus s : {FrameStatus::kOk, FrameStatus::kReacquired, FrameStatus::kStale, FrameStatus::kRefusedSequence,
                               FrameStatus::kRefusedOutOfRange, FrameStatus::kRefusedNonFinite, FrameStatus::kRefusedSource,
-                              FrameStatus::kMalformed})
+                              FrameStatus::kCorrupt, FrameStatus::kMalformed})
     EXPECT_EQ(count_frame(s, r), s) << to_string(s);
   EXPECT_EQ(r.reacquired + r.stale + r.refused_sequence + r.refused_out_of_range + r.refused_non_finite + r.refused_source +
-                r.malformed,
-            7U);
+                r.corrupt + r.malformed,
+            8U);
   EXPECT_EQ(r.malformed, 1U);
+  EXPECT_EQ(r.corrupt, 1U);
   EXPECT_EQ(r.stale, 1U);
 }
 

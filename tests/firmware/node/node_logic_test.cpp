@@ -1,10 +1,12 @@
 /// @file node_logic_test.cpp
-/// @brief The node logic of firmware/node: wire form, serial sequence numbers, the trigger
+/// @brief The node logic of firmware/node: wire form and its CRC, serial sequence numbers, the trigger
 ///        rules' equations, the command buffer, and the nodes' bookkeeping on the host port.
 #include <gtest/gtest.h>
 
+#include "oneshot/crc16.hpp"
 #include "oneshot/fixed_point.hpp"
 #include "oneshot/host/host_network.hpp"
+#include "oneshot/node/actuation_sync_messages.hpp"
 #include "oneshot/node/actuator_node.hpp"
 #include "oneshot/node/command_buffer.hpp"
 #include "oneshot/node/controller_node.hpp"
@@ -54,6 +56,87 @@ TEST(Message, RoundTripsEveryScalarExactly) {
   q[0] = Q::from_raw(-123456789);
   q[1] = Q::from_raw(2147483647);
   round_trip(q);
+}
+
+TEST(Crc16, GivesTheCcittFalseCheckValue) {
+  // The catalogue's check value of CRC-16/CCITT-FALSE: CRC("123456789") = 0x29B1.
+  static constexpr std::uint8_t kCheck[] = {'1', '2', '3', '4', '5', '6', '7', '8', '9'};
+  static_assert(crc16_ccitt_false(kCheck, sizeof kCheck) == 0x29B1, "CRC-16/CCITT-FALSE check value");
+  EXPECT_EQ(crc16_ccitt_false(kCheck, sizeof kCheck), 0x29B1);
+  EXPECT_EQ(crc16_ccitt_false(kCheck, 0), kCrc16Init);
+}
+
+/// Encodes `m`; checks the trailer is the CRC of the bytes before it (low byte first), then
+/// that every frame with `flips` (1 or 2) distinct bits inverted decodes as kCorrupt and
+/// leaves the message untouched. Returns the frames tried.
+template <typename Msg>
+std::size_t expect_flips_corrupt(const Msg& m, int flips) {
+  std::uint8_t bytes[kMaxMessageBytes];
+  const std::size_t n = encode(m, bytes);
+  const std::uint16_t crc = crc16_ccitt_false(bytes, n - kCrcBytes);
+  EXPECT_EQ(bytes[n - 2], crc & 0xFFU);
+  EXPECT_EQ(bytes[n - 1], crc >> 8);
+  Msg back{};
+  EXPECT_EQ(decode(bytes, n, back), FrameStatus::kOk);
+  std::size_t tried = 0;
+  std::size_t wrong = 0;
+  const std::size_t bits = 8 * n;
+  for (std::size_t a = 0; a < bits; ++a) {
+    for (std::size_t b = flips == 2 ? a + 1 : a; b < (flips == 2 ? bits : a + 1); ++b) {
+      std::uint8_t f[kMaxMessageBytes];
+      for (std::size_t i = 0; i < n; ++i) f[i] = bytes[i];
+      f[a / 8] = static_cast<std::uint8_t>(f[a / 8] ^ (1U << (a % 8)));
+      if (flips == 2) f[b / 8] = static_cast<std::uint8_t>(f[b / 8] ^ (1U << (b % 8)));
+      Msg got{};
+      if (decode(f, n, got) != FrameStatus::kCorrupt) ++wrong;
+      ++tried;
+    }
+  }
+  EXPECT_EQ(wrong, 0U) << wrong << " of " << tried << " frames with " << flips << " flipped bits not refused as corrupt";
+  return tried;
+}
+
+TEST(Message, EverySingleBitFlipOfEveryMessageTypeIsRefusedAsCorrupt) {
+  Message<VectorPayload<double, 2>> md;
+  md.seq = 77;
+  md.stamp = McuInstant(123456U);
+  md.payload.value[0] = 0.25;
+  md.payload.value[1] = -3.0;
+  EXPECT_EQ(expect_flips_corrupt(md, 1), (8 * encoded_size<double, 2>()));
+  Message<VectorPayload<float, 3>> mf;
+  mf.seq = 0xFFFFFFFFU;
+  mf.payload.value[1] = 1.5F;
+  EXPECT_EQ(expect_flips_corrupt(mf, 1), (8 * encoded_size<float, 3>()));
+  using Q = Fixed<std::int32_t, 29>;
+  Message<VectorPayload<Q, 1>> mq;
+  mq.seq = 5;
+  mq.payload.value[0] = Q::from_raw(-42);
+  EXPECT_EQ(expect_flips_corrupt(mq, 1), (8 * encoded_size<Q, 1>()));
+  ActuationRequest<double, 1> req;
+  req.k = 9;
+  req.t_k = McuInstant(1000U);
+  req.u_applied[0] = 0.5;
+  EXPECT_EQ(expect_flips_corrupt(req, 1), (8 * request_size<double, 1>()));
+  SampleReport<double, 2, 1> rep;
+  rep.k = 9;
+  rep.t_s = McuInstant(990U);
+  rep.tau_us = -10;
+  rep.y[0] = 1.0;
+  rep.y[1] = -2.0;
+  rep.u_applied[0] = 0.5;
+  EXPECT_EQ(expect_flips_corrupt(rep, 1), (8 * report_size<double, 2, 1>()));
+}
+
+TEST(Message, EveryDoubleBitFlipOfAReportIsRefusedAsCorrupt) {
+  SampleReport<double, 2, 1> rep;  // the longest frame of the loops: 38 bytes, 304 bits
+  rep.k = 123;
+  rep.t_s = McuInstant(0xDEADBEEFU);
+  rep.tau_us = 1500;
+  rep.y[0] = 0.125;
+  rep.y[1] = -7.5;
+  rep.u_applied[0] = 2.0;
+  const std::size_t bits = 8 * report_size<double, 2, 1>();
+  EXPECT_EQ(expect_flips_corrupt(rep, 2), bits * (bits - 1) / 2);
 }
 
 TEST(Message, SequenceNumbersCompareAcrossTheWrap) {

@@ -4,12 +4,14 @@
 ///        duplicate and the replayed frame, hits at the rate (binomial, |z| < 3.29), the same
 ///        bytes for the same seed, clauses that never move one another; on the network:
 ///        the extra frames arrive right after theirs, restarts run their hook at their
-///        instant, and unknown targets are refused.
+///        instant, and unknown targets are refused; with a CRC in the layout, nan and
+///        forge_seq rewrite it and flip does not.
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <cstring>
 
+#include "oneshot/crc16.hpp"
 #include "oneshot/engine/frame_faults.hpp"
 #include "oneshot/engine/json_fields.hpp"
 #include "oneshot/engine/kernel.hpp"
@@ -49,6 +51,37 @@ std::vector<Bytes> stream(LinkFaults& f, std::uint32_t n) {
     for (auto& e : extra) out.push_back(e);
   }
   return out;
+}
+
+/// True when the last two bytes of `b` are the CRC-16/CCITT-FALSE of the bytes before them.
+bool crc_ok(const Bytes& b) {
+  const std::uint16_t c = crc16_ccitt_false(b.data(), b.size() - 2);
+  return b[b.size() - 2] == (c & 0xFFU) && b[b.size() - 1] == (c >> 8);
+}
+
+TEST(FrameFaults, WithACrcNanAndForgedSequenceAreResealedAndFlipsAreNot) {
+  const FrameLayout crc_layout{0, 4, 8, 8, 2};
+  for (const char* spec : {"nan:rate=1", "forge_seq:rate=1", "flip:rate=1", "flip:bits=2,rate=1", "dup:rate=1"}) {
+    LinkFaults f(parse_fault_spec(spec), "sc", crc_layout, 3);
+    const bool flip = std::string(spec).rfind("flip", 0) == 0;
+    for (std::uint32_t k = 0; k < 50; ++k) {
+      Bytes b = frame(k);
+      b.resize(26);
+      const std::uint16_t c = crc16_ccitt_false(b.data(), 24);
+      b[24] = static_cast<std::uint8_t>(c & 0xFFU);
+      b[25] = static_cast<std::uint8_t>(c >> 8);
+      const Bytes sent = b;
+      std::vector<Bytes> extra;
+      f.apply(SimTime{std::int64_t{k} * 10'000'000}, b, extra);
+      EXPECT_EQ(crc_ok(b), !flip) << spec << " frame " << k;  // a transfer error breaks it, a wrong sender seals it
+      if (std::string(spec) == "nan:rate=1") {
+        EXPECT_TRUE(std::isnan(value(b, 0)) || std::isnan(value(b, 1))) << k;  // never the CRC's bytes
+      }
+      if (std::string(spec) == "dup:rate=1") {
+        EXPECT_EQ(b, sent);
+      }
+    }
+  }
 }
 
 TEST(FrameFaults, NanOnceTurnsOneValueOfOneFrameNaN) {

@@ -171,9 +171,10 @@ TEST(NetworkedLoop, ConstantDelaysEqualTheDirectLoopBitForBit) {
 }
 
 TEST(NetworkedLoop, OnACanBusTheDelayIsTheFrameTimes) {
-  // A 16-byte command (8-byte header, one double) is two 8-byte frames: 2 × 135 bits at 500 kbit/s.
+  // An 18-byte command (8-byte header, one double, 2-byte CRC) is two 8-byte frames and a
+  // 2-byte one: 2 × 135 + 75 bits (34 + 8s + 13 + ⌊(33 + 8s)/4⌋ for s bytes) at 500 kbit/s.
   const Outcome o = networked(4, constant(1000), LinkConfig{}, true);
-  EXPECT_EQ(o.cost, direct(4, from_us(1000 + 540)));
+  EXPECT_EQ(o.cost, direct(4, from_us(1000 + 690)));
 }
 
 TEST(NetworkedLoop, LossesAreCountedConsistentlyAndStampsCarryTheClockOffset) {

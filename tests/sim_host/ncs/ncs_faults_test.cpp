@@ -2,7 +2,8 @@
 /// @brief Faults in study `ncs` on the engine: an empty spec, or faults that never fire
 ///        within the run, leave the run bit-identical to a clean one; a fault spec gives
 ///        the same run every time and any thread count; duplicates are counted stale one
-///        for one; the fault table command covers every case and is reproducible. The
+///        for one; every bit-flipped frame is refused as corrupt (the frames' CRC-16), none
+///        used; the fault table command covers every case and is reproducible. The
 ///        NaN and forged-sequence oracles of issue 24 are kept disabled until the nodes
 ///        refuse such frames (branch h24nodes): they fail on today's nodes.
 #include <gtest/gtest.h>
@@ -76,6 +77,41 @@ TEST(NcsFaults, FaultedRunsAreReproducibleAndCounted) {
   // Names are checked against the study's links and nodes.
   t.faults = engine::parse_fault_spec("dup:link=xy,rate=0.1");
   EXPECT_THROW(table_sweep(*ctx, t, engine::Shard{}), engine::InputError);
+}
+
+// The injector counts the frames it flipped; the receivers' CRC check must refuse every one
+// of them (`*.corrupt`), and nothing else may change: no flipped frame is used, so the
+// refusal counters of the other causes stay those of the clean run and the cost stays
+// finite (5 % of the frames of every leg refused is a lossy loop: its cost is that of the
+// loss; the fault table measures the 2 % one-leg case: no loop lost). The legs lose nothing; a flipped frame
+// still in flight when the run ends (at most one per leg: the delay is below the period) is
+// the only one not counted.
+TEST(NcsFaults, EveryFlippedFrameIsRefusedAsCorrupt) {
+  const auto ctx = Context::load("");
+  for (Approach a : {Approach::kAK, Approach::kS}) {
+    const auto names = counter_names(a);
+    for (const char* spec : {"flip:rate=0.05", "flip:bits=2,rate=0.05", "flip:bits=3,rate=0.05"}) {
+      double flipped = 0;
+      for (std::uint64_t seed = 1; seed <= 6; ++seed) {
+        const RunResult clean = run(*ctx, a, faults_scenario(), seed, RunOptions{});
+        const RunResult r = run_with(*ctx, a, spec, seed);
+        double corrupt = 0;
+        for (std::size_t i = 0; i < names.size(); ++i) {
+          const std::string& n = names[i];
+          if (n.size() > 8 && n.compare(n.size() - 8, 8, ".corrupt") == 0) corrupt += r.counters[i];
+          if (n.find(".refused_") != std::string::npos) {
+            EXPECT_EQ(r.counters[i], clean.counters[i]) << name(a) << " " << spec << " " << n;
+          }
+        }
+        const auto f = static_cast<double>(r.injected.flip);
+        flipped += f;
+        EXPECT_LE(corrupt, f) << name(a) << " " << spec << " seed " << seed;
+        EXPECT_GE(corrupt, f - 3) << name(a) << " " << spec << " seed " << seed;  // zero silent corruption accepted
+        EXPECT_TRUE(std::isfinite(r.cost)) << name(a) << " " << spec << " seed " << seed;
+      }
+      EXPECT_GT(flipped, 40) << name(a) << " " << spec;
+    }
+  }
 }
 
 TEST(NcsFaults, FaultTableCoversEveryCaseReproducibly) {

@@ -253,7 +253,7 @@ RelayFaults redraw_relay_faults(const LiveOptions& o) {
   const engine::FaultSpec spec = engine::parse_fault_spec(o.inject);
   std::map<int, std::unique_ptr<engine::LinkFaults>> faults;
   const char* names[4] = {"", "sc", "ca", "as"};  // by source address
-  const std::size_t sizes[4] = {0, node::report_size<double, kP, kM>(), node::kHeaderBytes + 8 * kM,
+  const std::size_t sizes[4] = {0, node::report_size<double, kP, kM>(), node::encoded_size<double, kM>(),
                                 node::request_size<double, kM>()};
   for (int src : {1, 2, 3}) {
     const engine::LinkConfig cfg = leg(*ctx, o.scenario, o.approach, names[src]);

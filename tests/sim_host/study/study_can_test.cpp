@@ -51,10 +51,11 @@ double message_us(std::int64_t bytes, std::int64_t bit_rate) {
 TEST(StudyCan, WithoutBackgroundEveryDelayIsTheTransmissionTime) {
   const NcsStudy s = kCan.study([](nlohmann::json& j) { j["buses"][0].erase("background"); }, 4);
   const nlohmann::json j = run_outputs(run_ncs_sweep(s, 3, 2, engine::Shard{}), can_temp_dir("quiet"), false);
-  // The loop's messages: header (sequence, stamp: 8 bytes) + p = 2 doubles (sc), + m = 1 double (ca).
-  const double sc_us = message_us(8 + 2 * 8, 125'000);
-  const double ca_us = message_us(8 + 1 * 8, 125'000);
-  EXPECT_EQ(sc_us, 3 * 135 * 8.0);  // three 8-byte frames of 135 bits, 8 us each
+  // The loop's messages: header (sequence, stamp: 8 bytes) + p = 2 doubles (sc), + m = 1
+  // double (ca), + the CRC-16 (2 bytes).
+  const double sc_us = message_us(8 + 2 * 8 + 2, 125'000);
+  const double ca_us = message_us(8 + 1 * 8 + 2, 125'000);
+  EXPECT_EQ(sc_us, (3 * 135 + 75) * 8.0);  // three 8-byte frames of 135 bits and a 2-byte one of 75, 8 us each
   for (const char* a : {"S", "SK"}) {
     for (const auto& [leg, c] : {std::pair<const char*, double>{"sc", sc_us}, {"ca", ca_us}}) {
       const nlohmann::json& e = j.at("bus_delays").at(a).at(leg);
@@ -78,20 +79,21 @@ TEST(StudyCan, CheckAnalysesTheLoopMessagesInFramesWithTheirChainedJitter) {
   const nlohmann::json& sc = m[0];
   const nlohmann::json& ca = m[1];
   ASSERT_EQ(sc.at("name"), "sc");
-  // 125 kbit/s: 8 us a bit, an 8-byte frame 135 bits = 1080 us. sc: 24 bytes, 3 frames,
-  // C = 3240 us; ca: 16 bytes, 2 frames, C = 2160 us, and the higher priority (id 240 < 256).
-  EXPECT_EQ(sc.at("frames"), 3);
-  EXPECT_EQ(sc.at("transmission_us").get<double>(), 3240);
-  EXPECT_EQ(ca.at("transmission_us").get<double>(), 2160);
-  // sc (timer, J = 0, nothing below it: B = 0): its first two frames, one ca message between
-  // frames, its last frame: R = (3240 − 1080) + 2160 + 1080 = 5400 us.
+  // 125 kbit/s: 8 us a bit, an 8-byte frame 135 bits = 1080 us, a 2-byte one 75 bits =
+  // 600 us. sc: 26 bytes, 4 frames, C = 3 × 1080 + 600 = 3840 us; ca: 18 bytes, 3 frames,
+  // C = 2 × 1080 + 600 = 2760 us, and the higher priority (id 240 < 256).
+  EXPECT_EQ(sc.at("frames"), 4);
+  EXPECT_EQ(sc.at("transmission_us").get<double>(), 3840);
+  EXPECT_EQ(ca.at("transmission_us").get<double>(), 2760);
+  // sc (timer, J = 0, nothing below it: B = 0): its first three frames, one ca message
+  // between frames, its last frame: R = (3840 − 600) + 2760 + 600 = 6600 us.
   EXPECT_EQ(sc.at("jitter_us").get<double>(), 0);
-  EXPECT_EQ(sc.at("worst_response_us").get<double>(), 5400);
-  // ca is sent τ_c ∈ [1, 5] ms after sc arrives, sc's delay in [C, R] = [3240, 5400] us:
-  // J = (5400 + 5000) − (3240 + 1000) = 6160 us. Blocked by one sc frame (1080 us), then its
-  // first frame and its last: R = J + 1080 + 1080 + 1080 = 9400 us.
-  EXPECT_EQ(ca.at("jitter_us").get<double>(), 6160);
-  EXPECT_EQ(ca.at("worst_response_us").get<double>(), 9400);
+  EXPECT_EQ(sc.at("worst_response_us").get<double>(), 6600);
+  // ca is sent τ_c ∈ [1, 5] ms after sc arrives, sc's delay in [C, R] = [3840, 6600] us:
+  // J = (6600 + 5000) − (3840 + 1000) = 6760 us. Blocked by one sc frame (1080 us), then its
+  // frames: R = J + 1080 + 2760 = 10600 us.
+  EXPECT_EQ(ca.at("jitter_us").get<double>(), 6760);
+  EXPECT_EQ(ca.at("worst_response_us").get<double>(), 10600);
 }
 
 /// Mean delay of leg `leg` under S with the background periods multiplied by `scale`, after
@@ -198,8 +200,8 @@ TEST(StudyLoops, ApartInTimeEachLoopCostsWhatItCostsAlone) {
         for (std::size_t k = 0; k < r.spec.seeds; ++k) EXPECT_EQ(r.at(a, x, k, shared), r.at(a, x, k, alone)) << loop << " " << a;
   }
   const nlohmann::json j = run_outputs(r, can_temp_dir("apart"), false);
-  for (const auto& [loop, leg, c_us] : {std::tuple<const char*, const char*, double>{"board", "sc", message_us(24, 250'000)},
-                                        {"servo", "ca", message_us(16, 250'000)}}) {
+  for (const auto& [loop, leg, c_us] : {std::tuple<const char*, const char*, double>{"board", "sc", message_us(26, 250'000)},
+                                        {"servo", "ca", message_us(18, 250'000)}}) {  // with the CRC-16
     for (const char* a : {"S", "SK"}) {
       const nlohmann::json& d = j.at("interference").at(loop).at(a).at("bus_delays").at(leg);
       EXPECT_EQ(d.at("shared").at("min_us").get<double>(), c_us) << loop << " " << a;  // the transmission, no queueing
@@ -254,7 +256,7 @@ TEST(StudyLoops, TogetherEveryDelayIsWithinTheBoundCountingBothLoopsAndTheServoD
   const double with = board_sc_wcrt(resolve_study(kLoops.parse(kLoops.json())));
   const double without = board_sc_wcrt(resolve_study(kLoops.parse(off)));
   EXPECT_GT(with, without);
-  EXPECT_GE(with - without, message_us(24, 250'000));  // at least one servo report ahead of it
+  EXPECT_GE(with - without, message_us(26, 250'000));  // at least one servo report ahead of it
 }
 
 TEST(StudyLoops, AClockOffsetShiftsTheWholeLoopAloneItCostsTheSame) {

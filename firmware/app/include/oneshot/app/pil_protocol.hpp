@@ -13,6 +13,8 @@
 #include <cstddef>
 #include <cstdint>
 
+#include "oneshot/crc16.hpp"
+
 namespace oneshot::app::pil {
 
 inline constexpr std::uint8_t kFlag = 0x7E;     ///< Frame delimiter.
@@ -33,15 +35,8 @@ enum class Type : std::uint8_t {
   kFault = 0xFF,      ///< Firmware → host: an invariant failed (payload: line, file).
 };
 
-/// CRC-16/CCITT-FALSE update.
-constexpr std::uint16_t crc16(std::uint16_t crc, std::uint8_t byte) {
-  crc = static_cast<std::uint16_t>(crc ^ (static_cast<std::uint16_t>(byte) << 8));
-  for (int i = 0; i < 8; ++i) {
-    const unsigned shifted = static_cast<unsigned>(crc) << 1U;
-    crc = static_cast<std::uint16_t>((crc & 0x8000U) != 0U ? shifted ^ 0x1021U : shifted);
-  }
-  return crc;
-}
+/// CRC-16/CCITT-FALSE update (oneshot/crc16.hpp).
+constexpr std::uint16_t crc16(std::uint16_t crc, std::uint8_t byte) { return crc16_update(crc, byte); }
 
 /// A decoded frame.
 struct Frame {

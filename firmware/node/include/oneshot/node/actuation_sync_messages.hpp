@@ -7,7 +7,8 @@
 ///   msg 3, controller → actuator: Message<VectorPayload<S, M>> with seq = k (message.hpp)
 /// The echo is the input really applied at t_{k−1} (the held value when the command was
 /// late), so the controller predicts with what the plant got. Wire form: k (4) | instant
-/// (4) | [τ_us (4, signed)] | scalars as in message.hpp.
+/// (4) | [τ_us (4, signed)] | scalars | crc (2), as in message.hpp (CRC-16/CCITT-FALSE of
+/// the bytes before it).
 #pragma once
 
 #include <cstddef>
@@ -40,13 +41,13 @@ struct SampleReport {
 /// Encoded size of an ActuationRequest.
 template <typename S, std::size_t M>
 constexpr std::size_t request_size() {
-  return kHeaderBytes + M * detail::scalar_bytes<S>();
+  return kHeaderBytes + M * detail::scalar_bytes<S>() + kCrcBytes;
 }
 
 /// Encoded size of a SampleReport.
 template <typename S, std::size_t P, std::size_t M>
 constexpr std::size_t report_size() {
-  return kHeaderBytes + 4 + (P + M) * detail::scalar_bytes<S>();
+  return kHeaderBytes + 4 + (P + M) * detail::scalar_bytes<S>() + kCrcBytes;
 }
 
 /// Encodes a request into `out`; returns the byte count.
@@ -56,13 +57,15 @@ std::size_t encode(const ActuationRequest<S, M>& m, std::uint8_t* out) {
   detail::put_le(out, m.k, 4);
   detail::put_le(out + 4, m.t_k.ticks(), 4);
   for (std::size_t i = 0; i < M; ++i) detail::put_scalar(out + kHeaderBytes + i * detail::scalar_bytes<S>(), m.u_applied[i]);
-  return request_size<S, M>();
+  return detail::seal(out, request_size<S, M>() - kCrcBytes);
 }
 
-/// Decodes a request: kOk, or kMalformed (m untouched) when the size is not a request's.
+/// Decodes a request: kOk, kMalformed (m untouched) when the size is not a request's, or
+/// kCorrupt (m untouched) when the CRC does not match.
 template <typename S, std::size_t M>
 [[nodiscard]] FrameStatus decode(const std::uint8_t* in, std::size_t size, ActuationRequest<S, M>& m) {
   if (size != request_size<S, M>()) return FrameStatus::kMalformed;
+  if (!detail::intact(in, size)) return FrameStatus::kCorrupt;
   m.k = static_cast<SequenceNumber>(detail::get_le(in, 4));
   m.t_k = McuInstant(static_cast<std::uint32_t>(detail::get_le(in + 4, 4)));
   for (std::size_t i = 0; i < M; ++i) m.u_applied[i] = detail::get_scalar<S>(in + kHeaderBytes + i * detail::scalar_bytes<S>());
@@ -79,13 +82,15 @@ std::size_t encode(const SampleReport<S, P, M>& m, std::uint8_t* out) {
   detail::put_le(out + 8, static_cast<std::uint32_t>(m.tau_us), 4);
   for (std::size_t i = 0; i < P; ++i) detail::put_scalar(out + 12 + i * kB, m.y[i]);
   for (std::size_t i = 0; i < M; ++i) detail::put_scalar(out + 12 + (P + i) * kB, m.u_applied[i]);
-  return report_size<S, P, M>();
+  return detail::seal(out, report_size<S, P, M>() - kCrcBytes);
 }
 
-/// Decodes a report: kOk, or kMalformed (m untouched) when the size is not a report's.
+/// Decodes a report: kOk, kMalformed (m untouched) when the size is not a report's, or
+/// kCorrupt (m untouched) when the CRC does not match.
 template <typename S, std::size_t P, std::size_t M>
 [[nodiscard]] FrameStatus decode(const std::uint8_t* in, std::size_t size, SampleReport<S, P, M>& m) {
   if (size != report_size<S, P, M>()) return FrameStatus::kMalformed;
+  if (!detail::intact(in, size)) return FrameStatus::kCorrupt;
   constexpr std::size_t kB = detail::scalar_bytes<S>();
   m.k = static_cast<SequenceNumber>(detail::get_le(in, 4));
   m.t_s = McuInstant(static_cast<std::uint32_t>(detail::get_le(in + 4, 4)));

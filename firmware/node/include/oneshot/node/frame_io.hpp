@@ -40,8 +40,8 @@ template <typename Board, typename Msg>
   return SendResult::kRefused;
 }
 
-/// One frame from `source`: decoded into a Msg (kMalformed when it does not; `received` counts
-/// those that do), then check(m, source) gives its status (use the frame when accepted());
+/// One frame from `source`: decoded into a Msg (kMalformed when its size is not the Msg's,
+/// kCorrupt when its CRC-16 does not match; `received` counts those that decode), then check(m, source) gives its status (use the frame when accepted());
 /// the status is counted by cause into `r` and returned.
 template <typename Msg, typename Check>
 [[nodiscard]] FrameStatus admit_frame(std::uint8_t source, const std::uint8_t* bytes, std::size_t size,

@@ -6,7 +6,9 @@
 /// (one uniform per frame, whatever happens: the hits of a clause never move when another
 /// clause or the link's delays change) and ".../pick" (which value, which bits; drawn only
 /// on a hit), i the clause's position in the spec. A frame meets the clauses in spec order:
-/// nan, flip and forge_seq change it in place, dup and replay add frames delivered right
+/// nan, flip and forge_seq change it in place (when the layout has a CRC, nan and forge_seq
+/// rewrite it — a wrong sender sends a valid frame — while flip leaves it: a transfer error
+/// the receiver's CRC check refuses), dup and replay add frames delivered right
 /// after it (same arrival, after it in order), travelling with it (lost with it). The same
 /// seed and spec give the same bytes whatever the thread count or the process (the engine
 /// and the live relay use this class alike).
