@@ -16,6 +16,7 @@
 #include "study_bus_analysis.hpp"
 #include "study_cpu.hpp"
 #include "study_ncs_runner.hpp"
+#include "study_plant_map.hpp"
 
 namespace oneshot::study {
 namespace {

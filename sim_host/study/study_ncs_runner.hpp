@@ -12,9 +12,11 @@
 /// background traffic) under the sampling loops (I, S, SK, IK): the actuation-synchronized
 /// approaches and S+ are refused then, as is the leg as on a bus. The set-point is the
 /// scenario's or the file's `reference` (square, steps, file), else the params' square wave; the
-/// one-shot loops' sensor may run send-on-delta or MTM. Everything else the schema accepts
-/// (clock offsets, other trigger rules, other addresses, other plant shapes, discrete plants) is
-/// refused with the field and the reason.
+/// one-shot loops' sensor may run send-on-delta or MTM, the one-shot controller's timer takes a
+/// phase, and in a file with several loops (`loops[]`) a loop's sensor phase (its
+/// `clock_offset_us`) is mapped. Everything else the schema accepts (other clock offsets, other
+/// trigger rules, other addresses, other plant shapes, discrete plants) is refused with the field
+/// and the reason. The plant's mapping (plant file or inline plant) is study_plant_map.hpp's.
 #pragma once
 
 #include <array>
@@ -28,6 +30,7 @@
 #include "ncs_live.hpp"
 #include "ncs_model.hpp"
 #include "oneshot/engine/study_file.hpp"
+#include "study_plant_map.hpp"
 
 namespace oneshot::study {
 
@@ -50,12 +53,6 @@ const NcsLeg* find_ncs_leg(const std::string& name);
 /// approaches; scenario params amplitude_volts, period_s — required by map_ncs_study() unless a
 /// `reference` gives the set-point —, noise_scale default 1).
 const engine::StudySchema& ncs_schema();
-
-/// Why a discrete inline plant (plant.discrete) does not run: one line.
-inline constexpr const char* kDiscretePlantRefusal =
-    "the ncs loop integrates the continuous model between the delays, which fall between samples; a discrete "
-    "plant would run only with every delay 0 or a whole number of periods, which the loop does not model: give "
-    "plant.continuous (or a plant file)";
 
 /// A study file resolved onto the ncs loop.
 struct NcsStudy {
@@ -96,9 +93,6 @@ NcsStudy map_ncs_loops(const engine::StudyFile& file);
 /// the links between them (names kept), the file's buses, approaches and scenarios (their
 /// overrides of the loop's links only); no `loops`, no CPUs.
 engine::StudyFile loop_view(const engine::StudyFile& file, std::size_t i);
-
-/// The plant file a study file names, relative paths taken from the study file's folder.
-std::string plant_file_path(const engine::StudyFile& file);
 
 /// Maps a file parsed with ncs_schema() onto the ncs loop; engine::InputError naming the
 /// file and the field for anything the loop cannot run, and for a scenario on which the

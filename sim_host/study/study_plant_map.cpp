@@ -1,0 +1,77 @@
+/// @file study_plant_map.cpp
+/// @brief The plant of a study file mapped onto the ncs loop (see study_plant_map.hpp).
+#include "study_plant_map.hpp"
+
+#include <cstddef>
+#include <exception>
+#include <filesystem>
+#include <utility>
+
+#include "ncs_model.hpp"
+#include "oneshot/engine/study_file.hpp"
+#include "study_fields.hpp"
+
+namespace oneshot::study {
+namespace {
+
+/// The ncs context of an inline continuous plant: the shape the loop runs (n = 2, m = 1, p = 2,
+/// C = I), the design keys, then the same design step as a plant file; refusals name the key.
+std::shared_ptr<const ncs::Context> inline_context(const engine::PlantSpec& plant, const std::string& source) {
+  const engine::ContinuousModel& m = plant.continuous;
+  const std::string g = "plant.continuous";
+  const std::string runs = "study ncs runs n = 2 states, m = 1 input, p = 2 outputs with C = I (other shapes need the "
+                           "ncs loop on other dimensions)";
+  if (m.a.rows != ncs::kN) refuse(g + ".A", "n = " + std::to_string(m.a.rows) + "; " + runs);
+  if (m.b.cols != ncs::kM) refuse(g + ".B", "m = " + std::to_string(m.b.cols) + "; " + runs);
+  if (m.c.rows != ncs::kP) refuse(g + ".C", "p = " + std::to_string(m.c.rows) + "; " + runs);
+  for (std::size_t i = 0; i < ncs::kP; ++i)
+    for (std::size_t j = 0; j < ncs::kN; ++j)
+      if (m.c(i, j) != (i == j ? 1.0 : 0.0)) refuse(g + ".C", "is not the identity; " + runs);
+  if (!plant.design) {
+    refuse(g + ".measurement_covariance",
+           "missing: the ncs design needs the plant file's keys inline (period_us, measurement_covariance, Q1c, Q2c, "
+           "board)");
+  }
+  if (plant.design->cost_form == design::CostForm::kNone) refuse(g + ".Q1c", "missing: the ncs loop's LQR gain needs Q1c and Q2c");
+  if (!plant.design->has_board) {
+    refuse(g + ".board", "missing: the ncs loop's converter models (PWM actuator, ADC) need a board (an actuator range alone "
+                         "does not run)");
+  }
+  design::PlantDescription d = *plant.design;
+  d.source = source + ": " + g;
+  try {
+    return ncs::Context::from(std::move(d));
+  } catch (const std::exception& e) {
+    refuse(g, e.what());
+  }
+}
+
+}  // namespace
+
+std::string plant_file_path(const engine::StudyFile& file) {
+  const std::filesystem::path p(file.plant.file);
+  if (p.is_absolute()) return p.string();
+  return (std::filesystem::path(file.source).parent_path() / p).lexically_normal().string();
+}
+
+NcsPlant map_ncs_plant(const engine::StudyFile& file) {
+  if (file.plant.kind == engine::PlantSpec::Kind::kDiscrete) {
+    refuse("plant.discrete", kDiscretePlantRefusal);
+  }
+  NcsPlant out;
+  out.covariance_field = "plant.file";
+  if (file.plant.kind == engine::PlantSpec::Kind::kContinuous) {
+    out.ctx = inline_context(file.plant, file.source);
+    out.covariance_field = "plant.continuous.measurement_covariance";
+  } else {
+    out.plant_path = plant_file_path(file);
+    try {
+      out.ctx = ncs::Context::load(out.plant_path);
+    } catch (const std::exception& e) {
+      refuse("plant.file", e.what());
+    }
+  }
+  return out;
+}
+
+}  // namespace oneshot::study
