@@ -94,6 +94,10 @@ class Harness {
     if (own_world_ || !opt.faults.empty()) net_.set_faults(opt.faults);  // a shared run has none
     opt_faults_empty_ = opt.faults.empty();
     if (one_shot(a) && opt.analytic) throw std::invalid_argument(std::string("ncs: ") + name(a) + " has no analytic cost");
+    // The tracker and the trace take the run's time; a loop shifted by φ runs on its own.
+    if (offset_ != Duration{0} && (opt.analytic || opt.trace_step_s > 0)) {
+      throw std::invalid_argument("ncs: a loop with a clock offset has no analytic cost and no trace");
+    }
     if (opt.record_messages) net_.record_messages();
     if (!legs_from_file(sc) && !(sc.max_delay_ms * 1000 >= static_cast<double>(ctx.timing().leg_min_us))) {
       throw std::invalid_argument("ncs scenario " + sc.name + ": d must be at least 0.5 ms");

@@ -66,6 +66,18 @@ TEST(Crc16, GivesTheCcittFalseCheckValue) {
   EXPECT_EQ(crc16_ccitt_false(kCheck, 0), kCrc16Init);
 }
 
+TEST(Crc16, TheNibbleTableStepIsTheBitwiseStepForEveryRegister) {
+  // The bitwise definition (8 shift/XOR steps per byte, MSB first) against the table form.
+  const auto bitwise = [](std::uint16_t crc, std::uint8_t byte) {
+    unsigned c = crc ^ (static_cast<unsigned>(byte) << 8U);
+    for (int i = 0; i < 8; ++i) c = ((c & 0x8000U) != 0U ? (c << 1U) ^ 0x1021U : c << 1U) & 0xFFFFU;
+    return static_cast<std::uint16_t>(c);
+  };
+  for (unsigned r = 0; r < 0x10000U; ++r)
+    for (const std::uint8_t b : {std::uint8_t{0x00}, std::uint8_t{0x0F}, std::uint8_t{0x5A}, std::uint8_t{0xF0}, std::uint8_t{0xFF}})
+      ASSERT_EQ(crc16_update(static_cast<std::uint16_t>(r), b), bitwise(static_cast<std::uint16_t>(r), b)) << r << " " << +b;
+}
+
 /// Encodes `m`; checks the trailer is the CRC of the bytes before it (low byte first), then
 /// that every frame with `flips` (1 or 2) distinct bits inverted decodes as kCorrupt and
 /// leaves the message untouched. Returns the frames tried.

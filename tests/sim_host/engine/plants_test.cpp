@@ -221,7 +221,16 @@ TEST(PlantCachePool, AHitReturnsTheSameBytesAndDifferentPlantsNeverShare) {
     ak(1, 0) = -4.0 - k;
     pool.take(ak, b, cfg.qc, cfg.q1c);
   }
-  EXPECT_LE(pool.size(), (4 * PlantCachePool<3, 2>::kPlantsPerThread));  // two threads, two kinds
+  // This thread: a full shelf of each kind; the other thread: its one plant's two caches.
+  EXPECT_EQ(pool.size(), (2 * PlantCachePool<3, 2>::kPlantsPerThread + 2));
+  // A plant without process noise takes no noise cache.
+  EXPECT_EQ(pool.take(cfg.a, b, cfg.qc, cfg.q1c, false).noise, nullptr);
+  // The entry counts follow the byte budget within their bounds.
+  using Pool = PlantCachePool<3, 2>;
+  EXPECT_EQ(Pool::entries_for(1), Pool::kMaxEntries);
+  EXPECT_EQ(Pool::entries_for(Pool::kCacheBytes), Pool::kMinEntries);
+  EXPECT_LE(Pool::segment_entries() * sizeof(ExactSegment<3, 2>), Pool::kCacheBytes);
+  EXPECT_LE((PlantCachePool<16, 8>::segment_entries() * sizeof(ExactSegment<16, 8>)), 2 * Pool::kCacheBytes);
   EXPECT_TRUE(same_bytes(c1.segments->get(1'000).phi, own.get(1'000).phi));
 }
 

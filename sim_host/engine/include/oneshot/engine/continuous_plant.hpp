@@ -72,7 +72,7 @@ class ContinuousPlant {
   /// cache: the same run, bit for bit.
   ContinuousPlant(const ContinuousPlantConfig<N, M, P, W>& config, RandomStream noise, PlantCachePool<N, M + W>* pool)
       : ContinuousPlant(config, std::move(noise)) {
-    if (pool != nullptr) shared_ = pool->take(config.a, held_input_matrix(config), config.qc, config.q1c);
+    if (pool != nullptr) shared_ = pool->take(config.a, held_input_matrix(config), config.qc, config.q1c, config.process_noise);
   }
 
   /// Current time.

@@ -14,8 +14,11 @@
 /// inside a run the caches are used without locks by the one thread that runs it.
 /// Memory: per thread at most kPlantsPerThread caches of each kind (the least recently taken
 /// one leaves the pool when a new plant needs a place; a run still holding it keeps it until
-/// it ends), each cleared when it passes kEntries interval lengths; all of it goes with the
-/// pool, whose lifetime is the sweep's.
+/// it ends), each cleared when it passes its entry count: about kCacheBytes of entries
+/// (hash-node overhead counted), between kMinEntries and kMaxEntries interval lengths — at
+/// most 2 · kPlantsPerThread · kCacheBytes ≈ 128 MiB per thread whatever N; all of it goes
+/// with the pool, whose lifetime is the sweep's. A plant without process noise takes no
+/// noise cache.
 #pragma once
 
 #include <cstddef>
@@ -44,20 +47,35 @@ struct SharedPlantCaches {
 template <std::size_t N, std::size_t U>
 class PlantCachePool {
  public:
-  static constexpr std::size_t kPlantsPerThread = 4;    ///< Caches of each kind kept per thread.
-  static constexpr std::size_t kEntries = 1u << 16;     ///< Interval lengths per cache before it is cleared.
+  static constexpr std::size_t kPlantsPerThread = 4;        ///< Caches of each kind kept per thread.
+  static constexpr std::size_t kCacheBytes = std::size_t{16} << 20;  ///< Budget of one cache's entries.
+  static constexpr std::size_t kMinEntries = 1024;          ///< Fewest interval lengths a cache keeps.
+  static constexpr std::size_t kMaxEntries = 1u << 16;      ///< Most interval lengths a cache keeps.
+  /// Interval lengths one cache keeps before it is cleared, for entries of `entry_bytes` (plus
+  /// kNodeBytes of hash-table node each): kCacheBytes of them, within [kMinEntries, kMaxEntries].
+  static constexpr std::size_t entries_for(std::size_t entry_bytes) {
+    const std::size_t n = kCacheBytes / (entry_bytes + kNodeBytes);
+    return n < kMinEntries ? kMinEntries : (n > kMaxEntries ? kMaxEntries : n);
+  }
+  /// Interval lengths per interval-map cache.
+  static constexpr std::size_t segment_entries() { return entries_for(sizeof(ExactSegment<N, U>)); }
+  /// Interval lengths per noise cache.
+  static constexpr std::size_t noise_entries() { return entries_for(ProcessNoise<N>::entry_bytes()); }
 
-  /// The calling thread's caches of the plant (A, B held, Q_c, Q1c), created on first use.
+  /// The calling thread's caches of the plant (A, B held, Q_c, Q1c), created on first use; no
+  /// noise cache when `noisy` is false (the plant draws no process noise).
   SharedPlantCaches<N, U> take(const Matrix<double, N, N>& a, const Matrix<double, N, U>& b,
-                               const Matrix<double, N, N>& qc, const Matrix<double, N, N>& q1c) {
+                               const Matrix<double, N, N>& qc, const Matrix<double, N, N>& q1c, bool noisy = true) {
     const std::lock_guard<std::mutex> lock(mutex_);
     Shelf& shelf = shelves_[std::this_thread::get_id()];
     ++shelf.clock;
     SharedPlantCaches<N, U> out;
     out.segments = find_or_add(shelf.segments, shelf.clock, key_of(a, b, q1c),
-                               [&] { return std::make_shared<ExactSegmentCache<N, U>>(a, b, q1c, kEntries); });
-    out.noise = find_or_add(shelf.noise, shelf.clock, key_of(a, qc, q1c),
-                            [&] { return std::make_shared<ProcessNoise<N>>(a, qc, q1c, kEntries); });
+                               [&] { return std::make_shared<ExactSegmentCache<N, U>>(a, b, q1c, segment_entries()); });
+    if (noisy) {
+      out.noise = find_or_add(shelf.noise, shelf.clock, key_of(a, qc, q1c),
+                              [&] { return std::make_shared<ProcessNoise<N>>(a, qc, q1c, noise_entries()); });
+    }
     return out;
   }
 
@@ -70,6 +88,7 @@ class PlantCachePool {
   }
 
  private:
+  static constexpr std::size_t kNodeBytes = 48;  // an unordered_map node: key, links, hash
   using Key = std::vector<unsigned char>;
   template <typename T>
   struct Slot {
@@ -101,6 +120,8 @@ class PlantCachePool {
     return k;
   }
 
+  /// The cache of `key` on a shelf (marked used at `now`), made by make() when absent; the least
+  /// recently used one leaves a full shelf first.
   template <typename T, typename Make>
   static std::shared_ptr<T> find_or_add(std::vector<Slot<T>>& slots, std::uint64_t now, Key key, Make make) {
     for (Slot<T>& s : slots) {

@@ -134,6 +134,9 @@ class ProcessNoise {
     return gain * end + psd_cholesky(cov) * z;
   }
 
+ /// Bytes of one cached interval length (Q_d, its factor and the expected cost).
+  static constexpr std::size_t entry_bytes() { return sizeof(Entry); }
+
  private:
   static constexpr std::size_t kTerms = 40;
   struct Entry {
