@@ -89,7 +89,7 @@ json parse_strict(const std::string& text, const std::string& source) {
     throw PlantError(source + ": not valid JSON: " + e.what());
   }
   if (!duplicate.empty()) {
-    throw PlantError(source + ": field '" + duplicate + "': given twice (duplicate JSON key)");
+    throw PlantError(source, duplicate, "given twice (duplicate JSON key)");
   }
   return root;
 }
@@ -101,7 +101,7 @@ bool is_identifier(const std::string& s) {
 }
 
 void Checker::fail(const std::string& field, const std::string& what) const {
-  throw PlantError(source_ + ": field '" + field + "': " + what);
+  throw PlantError(source_, field, what);
 }
 
 const json& Checker::require(const json& obj, const std::string& key, const std::string& path) const {

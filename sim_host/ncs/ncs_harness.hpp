@@ -22,6 +22,7 @@
 #include "oneshot/engine/cpu.hpp"
 #include "oneshot/engine/kernel.hpp"
 #include "oneshot/engine/network.hpp"
+#include "oneshot/engine/plant_cache_pool.hpp"
 #include "oneshot/host/host_network.hpp"
 #include "oneshot/node/message.hpp"
 #include "oneshot/plant_structure.hpp"

@@ -13,6 +13,7 @@
 #include "ncs_analytic.hpp"
 #include "ncs_experiments.hpp"
 #include "ncs_loop.hpp"
+#include "oneshot/engine/plant_cache_pool.hpp"
 #include "oneshot/engine/sweep_statistics.hpp"
 #include "oneshot/util/output_files.hpp"
 

@@ -15,6 +15,7 @@
 #include <string>
 #include <thread>
 
+#include "oneshot/engine/plant_cache_pool.hpp"
 #include "oneshot/engine/study_file.hpp"
 #include "oneshot/sim/study_descriptor.hpp"
 #include "oneshot/util/output_files.hpp"

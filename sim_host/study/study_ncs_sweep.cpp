@@ -15,6 +15,7 @@
 #include "ncs_cpu.hpp"
 #include "ncs_experiments.hpp"
 #include "ncs_loop.hpp"
+#include "oneshot/engine/plant_cache_pool.hpp"
 #include "oneshot/engine/sweep_statistics.hpp"
 #include "oneshot/util/statistics.hpp"
 

@@ -144,14 +144,9 @@ std::shared_ptr<const design::PlantDescription> inline_design(const json& c, con
   f["noise"] = {{"process_intensity", c["Q_c"]}, {"measurement_covariance", c["measurement_covariance"]}};
   try {
     return std::make_shared<const design::PlantDescription>(design::parse_plant(f.dump(), g));
-  } catch (const design::PlantError& e) {
-    const std::string what = e.what();
-    const std::string open = "field '";
-    const std::size_t a = what.find(open);
-    const std::size_t b = a == std::string::npos ? a : what.find('\'', a + open.size());
-    if (b == std::string::npos) throw InputError("field '" + g + "': " + what);
-    const std::string field = what.substr(a + open.size(), b - a - open.size());
-    throw InputError("field '" + g + "." + inline_key(field) + "'" + what.substr(b + 1));
+  } catch (const design::PlantError& e) {  // the design parser's field, renamed to the inline key
+    if (e.field().empty()) throw InputError("field '" + g + "': " + e.what());
+    throw InputError("field '" + g + "." + inline_key(e.field()) + "': " + e.reason());
   }
 }
 

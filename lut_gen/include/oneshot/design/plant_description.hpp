@@ -26,6 +26,17 @@ namespace oneshot::design {
 class PlantError : public std::runtime_error {
  public:
   using std::runtime_error::runtime_error;
+  /// A refusal of `field` of `source`: what() is "<source>: field '<field>': <reason>".
+  PlantError(const std::string& source, const std::string& field, const std::string& reason)
+      : std::runtime_error(source + ": field '" + field + "': " + reason), field_(field), reason_(reason) {}
+  /// The field refused ("" when the error names none: an unreadable file, bad JSON …).
+  const std::string& field() const { return field_; }
+  /// Why the field is refused, without the source and the field ("" when no field).
+  const std::string& reason() const { return reason_; }
+
+ private:
+  std::string field_;
+  std::string reason_;
 };
 
 /// How the plant's dynamics are given.

@@ -24,9 +24,9 @@
 #include "oneshot/assert_handler.hpp"
 #include "oneshot/engine/cost.hpp"
 #include "oneshot/engine/exact_segment.hpp"
-#include "oneshot/engine/plant_cache_pool.hpp"
 #include "oneshot/engine/process_noise.hpp"
 #include "oneshot/engine/random_stream.hpp"
+#include "oneshot/engine/shared_plant_caches.hpp"
 #include "oneshot/engine/sim_time.hpp"
 #include "oneshot/engine/trace_sample.hpp"
 #include "oneshot/matrix.hpp"
@@ -69,7 +69,7 @@ class ContinuousPlant {
 
   /// The same, with the interval maps and noise terms taken from (and added to) `pool`'s caches
   /// for this plant (nullptr: its own). The values per interval length do not depend on the
-  /// cache: the same run, bit for bit.
+  /// cache: the same run, bit for bit. A caller passing a pool includes plant_cache_pool.hpp.
   ContinuousPlant(const ContinuousPlantConfig<N, M, P, W>& config, RandomStream noise, PlantCachePool<N, M + W>* pool)
       : ContinuousPlant(config, std::move(noise)) {
     if (pool != nullptr) shared_ = pool->take(config.a, held_input_matrix(config), config.qc, config.q1c, config.process_noise);

@@ -32,16 +32,10 @@
 
 #include "oneshot/engine/exact_segment.hpp"
 #include "oneshot/engine/process_noise.hpp"
+#include "oneshot/engine/shared_plant_caches.hpp"
 #include "oneshot/matrix.hpp"
 
 namespace oneshot::engine {
-
-/// The caches a plant takes from a pool (either may be null: the plant's own then).
-template <std::size_t N, std::size_t U>
-struct SharedPlantCaches {
-  std::shared_ptr<ExactSegmentCache<N, U>> segments;  ///< Interval maps of (A, B held, Q1c).
-  std::shared_ptr<ProcessNoise<N>> noise;             ///< Noise terms of (A, Q_c, Q1c).
-};
 
 /// Per-thread caches of exact interval maps and noise terms, keyed by the plant's matrices.
 template <std::size_t N, std::size_t U>
