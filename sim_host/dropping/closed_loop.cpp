@@ -133,7 +133,10 @@ RunMetrics run_impl(const DroppingPlant& plant, const RunConfig& cfg, std::uint6
   double sum_shadow_small = 0, sum_shadow_nominal = 0;
   const bool buffered = cfg.estimator == EstimatorKind::kBuffered;
 
-  engine::Link link(sensor_link(cfg.mean_delay_periods, cfg.loss, period), seed);
+  engine::LinkConfig link_config = cfg.link ? *cfg.link : sensor_link(cfg.mean_delay_periods, cfg.loss, period);
+  link_config.name = "sensor";  // the study's link: its streams whatever a study file calls it
+  engine::Link link(link_config, seed);
+  std::size_t channel_lost = 0;  // Bernoulli channel: γ_k = 0 (clean runs)
   engine::RandomStream meas = kernel.stream("measurement");
   engine::RandomStream gamma_rng = kernel.stream("gamma");
   const double sd_v = std::sqrt(plant.r(0, 0));
@@ -166,6 +169,8 @@ RunMetrics run_impl(const DroppingPlant& plant, const RunConfig& cfg, std::uint6
     if (!newest || j > *newest) {
       newest = static_cast<std::uint32_t>(j);
       newest_y = ys[j];
+    } else {
+      out.stale += 1;
     }
   });
   // The controller's frame checks: y finite, stamp not after the period it arrives in (a
@@ -227,6 +232,8 @@ RunMetrics run_impl(const DroppingPlant& plant, const RunConfig& cfg, std::uint6
       if (const auto at = link.transmit(now)) kernel.schedule(*at, engine::EventClass::kDelivery, deliver, k);
     } else if (gamma_rng.bernoulli(cfg.bernoulli_lambda)) {
       kernel.schedule(now + period / 2, engine::EventClass::kDelivery, deliver, k);
+    } else {
+      ++channel_lost;
     }
     if (cfg.trace) {
       out.trace.y.push_back(ys[k]);
@@ -268,7 +275,7 @@ RunMetrics run_impl(const DroppingPlant& plant, const RunConfig& cfg, std::uint6
     }
     if (st != Status::kOk) out.failed = true;
     if (faulted && !all_finite(xhat)) out.estimate_non_finite += 1;
-    const double r_k = ((static_cast<std::int64_t>(k) / half_wave) % 2 == 0) ? 1.0 : -1.0;
+    const double r_k = ((static_cast<std::int64_t>(k) / half_wave) % 2 == 0) ? cfg.square_wave_amplitude : -cfg.square_wave_amplitude;
     InputVec u = -(plant.l * xhat);
     u[0] += r_k;
     sys.set_input(u);
@@ -301,6 +308,9 @@ RunMetrics run_impl(const DroppingPlant& plant, const RunConfig& cfg, std::uint6
   out.corrections = sum_corr / n;
   out.cost = sys.cost().total() / n;
   out.reordered = static_cast<double>(link.statistics().reordered);
+  const bool network = cfg.channel == ChannelKind::kNetwork;
+  out.sent = network ? static_cast<double>(link.statistics().sent) : n;
+  out.lost = network ? static_cast<double>(link.statistics().lost) : static_cast<double>(channel_lost);
   const double nan = std::numeric_limits<double>::quiet_NaN();
   out.trace_p_anchor = buffered && anchors > 0 ? sum_tr_a / static_cast<double>(anchors) : nan;
   out.err_anchor = buffered && anchors > 0 ? sum_err_a / static_cast<double>(anchors) : nan;
@@ -360,6 +370,8 @@ RunMetrics run_closed_loop(const DroppingPlant& plant, const RunConfig& cfg, std
   check_dropping_faults(cfg.faults);
   if (cfg.steps < 2) throw std::invalid_argument("a run needs at least 2 steps");
   if (!(cfg.square_wave_period_s > 0)) throw std::invalid_argument("square-wave period must be positive");
+  if (std::llround(cfg.square_wave_period_s * 0.5e9 / (static_cast<double>(plant.plant.period_us) * 1e3)) < 1)
+    throw std::invalid_argument("square-wave period must be at least two steps");
   switch (cfg.t_hold) {
     case 1: return run_impl<1>(plant, cfg, seed);
     case 2: return run_impl<2>(plant, cfg, seed);

@@ -24,12 +24,14 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "dropping_plant.hpp"
 #include "oneshot/engine/fault_spec.hpp"
 #include "oneshot/engine/frame_faults.hpp"
+#include "oneshot/engine/link.hpp"
 
 namespace oneshot::dropping {
 
@@ -55,7 +57,12 @@ struct RunConfig {
   double bernoulli_lambda = 0.5;       ///< λ of the Bernoulli channel.
   double unaware_r = 2.5;              ///< R the delay-unaware KF assumes.
   std::size_t steps = 1000;            ///< Steps simulated.
-  double square_wave_period_s = 4;     ///< Period of r_k.
+  double square_wave_period_s = 4;     ///< Period of r_k (half of it a whole number of steps).
+  double square_wave_amplitude = 1;    ///< r_k = ±this.
+  /// The network's delay and loss models and order (a study file's link; run under the name
+  /// "sensor", its streams link/sensor/delay|loss); unset: Poisson(D) whole periods + T/2,
+  /// Bernoulli(ε), any order (mean_delay_periods, loss).
+  std::optional<engine::LinkConfig> link;
   bool trace = false;                  ///< Keep per-step traces.
   engine::FaultSpec faults;            ///< Frame faults on link "sensor" (empty: clean run).
 };
@@ -86,7 +93,9 @@ struct RunMetrics {
   bool failed = false;         ///< An estimator step reported a failure (innovation variance).
   double refused_non_finite = 0;  ///< Frames refused by the controller: y not finite (faults only).
   double refused_sequence = 0;    ///< Frames refused: stamp j after the arrival's period (faults only).
-  double stale = 0;               ///< Unaware KF: frames not newer than the period's newest (faults only).
+  double stale = 0;               ///< Frames not newer than the period's newest (what the unaware KF drops).
+  double sent = 0;                ///< Samples sent (the link's, or the Bernoulli channel's draws).
+  double lost = 0;                ///< Of them lost (the link's loss, or γ_k = 0; clean runs).
   double estimate_non_finite = 0; ///< Steps whose loop estimate x̂(k|Y_k) was not finite (faults only).
   engine::FaultCounters injected; ///< Faults injected on the link.
   RunTrace trace;              ///< Traces (when asked).

@@ -21,6 +21,7 @@
 #include "oneshot/util/output_files.hpp"
 #include "ncs_loop.hpp"
 #include "study_check.hpp"
+#include "study_dropping_runner.hpp"
 #include "study_file_report.hpp"
 #include "study_ncs_runner.hpp"
 #include "study_ncs_sweep.hpp"
@@ -32,7 +33,8 @@ namespace {
 /// can run it, mapped onto that loop.
 struct Checked {
   nlohmann::json resolution;             ///< resolve_study(), plus "runnable" (and "refusal").
-  std::optional<study::NcsStudy> ncs;    ///< Set when the file runs.
+  std::optional<study::NcsStudy> ncs;    ///< Set when the file runs on the ncs loop.
+  std::shared_ptr<const study::DroppingStudy> dropping;  ///< Set when it runs on the dropping loop.
   std::string refusal;                   ///< "field '<f>': <reason>" when it does not run.
 };
 
@@ -44,18 +46,25 @@ Checked check_file(const std::string& path) {
   Checked c;
   c.resolution = study::resolve_study(generic);
   try {
-    c.ncs = generic.study != "ncs" ? study::map_ncs_study(generic)  // refuses naming 'study'
-                                   : study::map_ncs_study(engine::load_study(path, &study::ncs_schema()));
+    if (generic.study == "dropping") {
+      c.dropping = study::map_dropping_study(engine::load_study(path, &study::dropping_schema()));
+    } else {
+      c.ncs = generic.study != "ncs" ? study::map_ncs_study(generic)  // refuses naming 'study'
+                                     : study::map_ncs_study(engine::load_study(path, &study::ncs_schema()));
+    }
   } catch (const engine::InputError& e) {
     c.refusal = e.what();
     const std::string prefix = generic.source + ": ";
     if (c.refusal.rfind(prefix, 0) == 0) c.refusal.erase(0, prefix.size());
   }
-  c.resolution["runnable"] = c.ncs.has_value();
+  c.resolution["runnable"] = c.ncs.has_value() || c.dropping != nullptr;
   if (c.ncs) {
     study::add_ncs_designs(c.resolution, *c.ncs);
     study::attach_bus_bounds(*c.ncs, c.resolution);
     c.resolution["runs_with"] = "ncs";
+  } else if (c.dropping) {
+    study::add_dropping_design(c.resolution, *c.dropping);
+    c.resolution["runs_with"] = "dropping";
   } else {
     c.resolution["refusal"] = c.refusal;
   }
@@ -99,6 +108,8 @@ struct BenchCli {
 
 /// The file's ncs loop, its scenarios cut at `max_duration_s` when the option was given.
 study::NcsStudy runnable(const Checked& k, const CLI::Option* max_duration, double max_duration_s) {
+  if (k.dropping)  // study run runs it (run_dropping below); report, bench and --max-duration take ncs files
+    throw engine::InputError(k.resolution.at("source").get<std::string>() + ": field 'study': a dropping file runs with study run only");
   if (!k.ncs) throw engine::InputError(k.resolution.at("source").get<std::string>() + ": " + k.refusal);  // one line, nothing written
   study::NcsStudy s = *k.ncs;
   if (max_duration->count() > 0) study::cap_duration(s, max_duration_s, "--max-duration");
@@ -203,6 +214,26 @@ nlohmann::json bench(const study::NcsStudy& s, std::size_t seeds, unsigned threa
           {"events_per_cpu_s", cpu > 0 ? events / cpu : 0.0}};
 }
 
+/// `study run` of a dropping file: its sweep (or shard), the summary, the same outputs as an ncs file's.
+void run_dropping(const study::DroppingStudy& s, const RunCli& c, const CLI::Option* max_duration) {
+  if (c.analytic) throw engine::InputError("field '--analytic': no exact cost for the dropping loop (its filters run on what arrives)");
+  if (max_duration->count() > 0) throw engine::InputError("field '--max-duration': a dropping file's runs take its duration_s");
+  const engine::Shard part = engine::parse_shard(c.shard);
+  util::make_directory(c.out);
+  const auto start = std::chrono::steady_clock::now();
+  const engine::SweepResults r = study::run_dropping_sweep(s, c.seeds, c.threads, part);
+  const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  nlohmann::json j;
+  if (!part.whole()) {
+    j = engine::write_shard_file(r, c.out, "run", part);
+  } else {
+    j = study::dropping_run_outputs(r, c.out, !c.no_plots);
+    if (c.json != "-") std::cout << j.at("markdown").get<std::string>() << "order: " << j.at("order_text").get<std::string>() << "\n";
+  }
+  if (!c.json.empty()) util::write_json(c.json, j);
+  if (c.json != "-") std::cout << "study run: " << r.spec.runs() << " runs, wall time " << wall << " s, written to " << c.out << "\n";
+}
+
 constexpr const char* kMaxDurationHelp = "cap every scenario's simulated seconds (at least one period h; default: the file's)";
 
 void add_study_commands(CLI::App* group) {
@@ -218,9 +249,10 @@ void add_study_commands(CLI::App* group) {
       if (!c->json.empty()) util::write_json(c->json, k.resolution);
       if (c->json != "-") {
         std::cout << study::describe_resolution(k.resolution);
-        if (k.ncs) std::cout << "runs with: oneshot-sim study run " << c->file << "\n";
+        if (k.dropping) std::cout << study::describe_dropping(k.resolution);
+        if (k.ncs || k.dropping) std::cout << "runs with: oneshot-sim study run " << c->file << "\n";
       }
-      if (!k.ncs) {  // the resolution is out; the refusal is the last line, and the exit is non-zero
+      if (!k.ncs && !k.dropping) {  // the resolution is out; the refusal is the last line, and the exit is non-zero
         std::cout.flush();
         std::cerr << "cannot run: " << k.refusal << "\n";
         throw CLI::RuntimeError(1);
@@ -229,7 +261,7 @@ void add_study_commands(CLI::App* group) {
   }
   {
     auto c = std::make_shared<RunCli>();
-    CLI::App* cmd = group->add_subcommand("run", "Run a study file's approaches x scenarios x seeds (today: files with \"study\": \"ncs\")");
+    CLI::App* cmd = group->add_subcommand("run", "Run a study file's approaches x scenarios x seeds (files with \"study\": \"ncs\" or \"dropping\")");
     cmd->add_option("file", c->file, "study file (oneshot-study/1)")->required();
     cmd->add_option("--seeds", c->seeds, "seeds per scenario (default: the file's seeds.count)")->check(CLI::Range(2, 10000000));
     cmd->add_option("--threads", c->threads, "worker threads (0: every core)")->capture_default_str();
@@ -243,7 +275,12 @@ void add_study_commands(CLI::App* group) {
                   "(analytic_mean, analytic_ci95, variance_reduction, ...; approaches whose runs leave the linear "
                   "loop: analytic_refused with the reason)");
     cmd->callback([c, max_duration]() {
-      const study::NcsStudy s = runnable(check_file(c->file), max_duration, c->max_duration_s);
+      const Checked k = check_file(c->file);
+      if (k.dropping) {
+        run_dropping(*k.dropping, *c, max_duration);
+        return;
+      }
+      const study::NcsStudy s = runnable(k, max_duration, c->max_duration_s);
       const engine::Shard part = engine::parse_shard(c->shard);
       util::make_directory(c->out);
       const auto start = std::chrono::steady_clock::now();
@@ -354,7 +391,7 @@ void add_study_commands(CLI::App* group) {
 
 StudyDescriptor study_files_study() {
   return {"study", "Study files (oneshot-study/1): check what a file resolves to, run it, report it (docs/study-files.md)",
-          add_study_commands, {{"run", study::run_outputs}}, std::nullopt};
+          add_study_commands, {{"run", study::run_outputs}, {"run-dropping", study::dropping_run_outputs}}, std::nullopt};
 }
 
 }  // namespace oneshot::sim
