@@ -16,6 +16,7 @@
 #include "oneshot/engine/random_stream.hpp"
 #include "oneshot/engine/study_file.hpp"
 #include "study_check.hpp"
+#include "study_dropping_runner.hpp"
 #include "study_ncs_runner.hpp"
 #include "support/run_command.hpp"
 #include "support/temp_files.hpp"
@@ -256,12 +257,19 @@ TEST(StudyCheck, EveryShippedExampleResolvesAndMaps) {
     std::stringstream text;
     text << in.rdbuf();
     const std::string name = entry.path().filename().string();
+    if (nlohmann::json::parse(text.str()).at("study") == "dropping") {  // the dropping loop (study_dropping_test.cpp)
+      const engine::StudyFile f = engine::parse_study(text.str(), entry.path().string(), &dropping_schema(), ONESHOT_STUDY_EXAMPLES_DIR);
+      expect_finite(resolve_study(f), name);
+      EXPECT_NO_THROW(static_cast<void>(map_dropping_study(f))) << name;
+      ++files;
+      continue;
+    }
     const engine::StudyFile f = engine::parse_study(text.str(), entry.path().string(), &ncs_schema(), ONESHOT_STUDY_EXAMPLES_DIR);
     expect_finite(resolve_study(f), name);
     EXPECT_NO_THROW(static_cast<void>(map_ncs_study(f))) << name;
     ++files;
   }
-  EXPECT_GE(files, 9U);  // ncs, ncs_can, three on CPUs, sod_ge_oneshot, two_loops_can, two_loops_can_phase, mtm_file_oneshot
+  EXPECT_GE(files, 10U);  // dropping, ncs, ncs_can, three on CPUs, sod_ge_oneshot, two_loops_can, two_loops_can_phase, mtm_file_oneshot
 }
 
 TEST(StudyCheck, CommandLine) {
