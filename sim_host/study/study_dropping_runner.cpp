@@ -205,6 +205,14 @@ double drop_mean(const std::vector<double>& v) {
   return n == 0 ? std::nan("") : s / static_cast<double>(n);
 }
 
+/// `v` in `format` for a table, "—" when not finite (a diverged loop).
+std::string drop_md(double v, const char* format) {
+  if (!std::isfinite(v)) return "—";
+  char b[48];
+  std::snprintf(b, sizeof b, format, v);
+  return b;
+}
+
 }  // namespace
 
 const engine::StudySchema& dropping_schema() {
@@ -360,11 +368,9 @@ nlohmann::json dropping_run_outputs(const engine::SweepResults& r, const std::st
                            {"trace_p_mean", dropping::num(drop_mean(trp))},
                            {"gamma_mean", dropping::num(drop_mean(gam))},
                            {"failed_runs", failed}};
-    char line[400];
-    std::snprintf(line, sizeof line, "| %s | %s | %.6g | ± %.3g | %.4f ± %.4f | %.6g | %.6g | %s | %.0f |\n", nm.c_str(), kind.c_str(),
-                  sm.value[a].mean, sm.value[a].ci95, sm.ratio_of_means[a], sm.ratio[a].ci95, drop_mean(err), drop_mean(trp),
-                  std::isnan(drop_mean(gam)) ? "—" : dropping::fmt_f(drop_mean(gam), 4).c_str(), failed);
-    md << line;
+    md << "| " << nm << " | " << kind << " | " << drop_md(sm.value[a].mean, "%.6g") << " | ± " << drop_md(sm.value[a].ci95, "%.3g") << " | "
+       << drop_md(sm.ratio_of_means[a], "%.4f") << " ± " << drop_md(sm.ratio[a].ci95, "%.4f") << " | " << drop_md(drop_mean(err), "%.6g")
+       << " | " << drop_md(drop_mean(trp), "%.6g") << " | " << drop_md(drop_mean(gam), "%.4f") << " | " << failed << " |\n";
     order.emplace_back(sm.value[a].mean, nm);
   }
   std::stable_sort(order.begin(), order.end());
@@ -390,9 +396,7 @@ nlohmann::json dropping_run_outputs(const engine::SweepResults& r, const std::st
       e["cost_ci95"][nm] = dropping::num(sm.per_scenario[a][x].ci95);
       e["ratio_to_" + ref][nm] = dropping::num(sm.per_scenario_ratio[a][x].mean);
       e["ratio_to_" + ref + "_ci95"][nm] = dropping::num(sm.per_scenario_ratio[a][x].ci95);
-      char cellv[64];
-      std::snprintf(cellv, sizeof cellv, " %.6g |", sm.per_scenario[a][x].mean);
-      md << cellv;
+      md << " " << drop_md(sm.per_scenario[a][x].mean, "%.6g") << " |";
     }
     md << "\n";
     j["per_scenario"].push_back(e);
