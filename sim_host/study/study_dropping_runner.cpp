@@ -82,11 +82,15 @@ void apply_drop_reference(const engine::ReferenceSpec* ref, std::int64_t period_
   c.square_wave_amplitude = ref->amplitude_volts;
 }
 
+/// The approach's parameter `key`, kDropAbsent when the file does not give it.
+double drop_param(const engine::ApproachSpec& a, const char* key) {
+  const auto it = a.params.find(key);
+  return it == a.params.end() ? kDropAbsent : it->second;
+}
+
 /// The approach's parameter `key` ("approaches[i].params.<key>") must be absent for its kind.
 void refuse_drop_param(const engine::ApproachSpec& a, std::size_t i, const char* key) {
-  const auto it = a.params.find(key);
-  if (it != a.params.end() && it->second != kDropAbsent)
-    refuse(at("approaches", i) + ".params." + key, "not a parameter of kind '" + a.kind + "'");
+  if (drop_param(a, key) != kDropAbsent) refuse(at("approaches", i) + ".params." + key, "not a parameter of kind '" + a.kind + "'");
 }
 
 std::shared_ptr<const DroppingStudy> map_drop(const engine::StudyFile& file) {
@@ -140,22 +144,24 @@ std::shared_ptr<const DroppingStudy> map_drop(const engine::StudyFile& file) {
              "k - T_hold ... k - 1), refused by the buffered filter as a future stamp while the unaware KF would take it");
     for (std::size_t i = 0; i < file.approaches.size(); ++i) {
       const engine::ApproachSpec& a = file.approaches[i];
+      if (a.kind != "buffered" && a.kind != "unaware" && a.kind != "bernoulli")
+        refuse(at("approaches", i) + ".kind", "'" + a.kind + "' (buffered, unaware, bernoulli)");
       dropping::RunConfig c = base;
-      const double t_hold = a.params.at("t_hold");
+      const double t_hold = drop_param(a, "t_hold");
       c.t_hold = t_hold == kDropAbsent ? 1 : static_cast<int>(t_hold);
       if (a.kind == "unaware") {
         refuse_drop_param(a, i, "t_hold");
         refuse_drop_param(a, i, "lambda");
         c.estimator = dropping::EstimatorKind::kUnaware;
         c.t_hold = 1;
-        const double r = a.params.at("r");
+        const double r = drop_param(a, "r");
         c.unaware_r = r == kDropAbsent ? out->plant.r(0, 0) : r;
       } else {
         refuse_drop_param(a, i, "r");
         c.estimator = dropping::EstimatorKind::kBuffered;
         if (a.kind == "bernoulli") {
           c.channel = dropping::ChannelKind::kBernoulli;
-          const double l = a.params.at("lambda");
+          const double l = drop_param(a, "lambda");
           if (l != kDropAbsent) {
             c.bernoulli_lambda = l;
           } else if (x.params_given.count("lambda") != 0) {

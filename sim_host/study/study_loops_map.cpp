@@ -31,7 +31,7 @@ std::string renumber(std::string what, const std::string& list, const std::vecto
 }  // namespace
 
 NcsStudy map_ncs_loops(const engine::StudyFile& file) {
-  if (file.study != "ncs") refuse("study", "'" + file.study + "' has no runner yet (study run runs 'ncs')");
+  if (file.study != "ncs") refuse("study", "'" + file.study + "' has no runner yet (study run runs 'ncs' and 'dropping')");
   if (!file.cpus.empty()) refuse("cpus", "a file with several loops (loops[]) runs no node on a CPU");
   for (std::size_t i = 0; i < file.approaches.size(); ++i) {
     const std::string& k = file.approaches[i].kind;

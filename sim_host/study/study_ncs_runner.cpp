@@ -67,7 +67,7 @@ NcsStudy map_ncs_study(const engine::StudyFile& file) {
     if (!file.loops.empty()) return map_ncs_loops(file);
     NcsStudy out;
     out.source = file.source;
-    if (file.study != "ncs") refuse("study", "'" + file.study + "' has no runner yet (study run runs 'ncs')");
+    if (file.study != "ncs") refuse("study", "'" + file.study + "' has no runner yet (study run runs 'ncs' and 'dropping')");
     NcsPlant plant = map_ncs_plant(file);
     out.ctx = std::move(plant.ctx);
     out.plant_path = std::move(plant.plant_path);
