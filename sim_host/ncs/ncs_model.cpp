@@ -163,19 +163,27 @@ std::shared_ptr<const Context> Context::from(design::PlantDescription plant) {
   return ctx;
 }
 
-Design Context::controller_design(double s) const {
-  Design d = design::controller_design<double, kN, kM, kP>(plant_, design_);
+template <typename S>
+typename S::Design Context::controller_design_of(double s) const {
+  typename S::Design d = design::controller_design<double, S::n, S::m, S::p>(plant_, design_);
   d.q_constant = d.q_constant * s;
   d.r = d.r * s;
   d.p0 = d.r * 10.0;  // brief §3: P⁻ = 10·R
   return d;
 }
 
-Disc::Model Context::discretizer_model(double s) const {
-  Disc::Model m = design::continuous_model_per_us<double, kN, kM>(plant_, design_);
+template <typename S>
+typename S::Disc::Model Context::discretizer_model_of(double s) const {
+  typename S::Disc::Model m = design::continuous_model_per_us<double, S::n, S::m>(plant_, design_);
   m.qc_per_us = m.qc_per_us * s;
   return m;
 }
+
+#define ONESHOT_NCS_CONTEXT_OF(n, m, p)                                                                      \
+  template Shape<n, m, p>::Design Context::controller_design_of<Shape<n, m, p>>(double) const;              \
+  template Shape<n, m, p>::Disc::Model Context::discretizer_model_of<Shape<n, m, p>>(double) const;
+ONESHOT_NCS_SHAPES(ONESHOT_NCS_CONTEXT_OF)
+#undef ONESHOT_NCS_CONTEXT_OF
 
 void set_steps(Scenario& sc, std::int64_t h_us, const std::vector<std::pair<double, double>>& steps,
                const std::vector<std::size_t>& lines, const std::string& source) {

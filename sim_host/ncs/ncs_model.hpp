@@ -28,8 +28,24 @@ inline constexpr std::size_t kN = 2;  ///< States v1, v2.
 inline constexpr std::size_t kM = 1;  ///< One input.
 inline constexpr std::size_t kP = 2;  ///< Both states measured (C = I).
 using Fmt = UniformFormat<double>;
-using Design = ControllerDesign<Fmt, kN, kM, kP>;
-using Disc = GenericDiscretizer<Fmt, kN, kM>;
+
+/// A loop's plant shape: n states, m inputs, p outputs, and the design types of that shape.
+/// The loops the study files run (I, S, SK, IK) take it as a template parameter
+/// (ncs_harness.hpp); ncs_loop.cpp instantiates them for each shape of ONESHOT_NCS_SHAPES.
+template <std::size_t N, std::size_t M, std::size_t P>
+struct Shape {
+  static constexpr std::size_t n = N;  ///< States.
+  static constexpr std::size_t m = M;  ///< Inputs.
+  static constexpr std::size_t p = P;  ///< Outputs.
+  using Design = ControllerDesign<Fmt, N, M, P>;  ///< The controller design of this shape.
+  using Disc = GenericDiscretizer<Fmt, N, M>;     ///< Its discretizer.
+};
+/// The board's shape (2, 1, 2): every approach runs on it (the others: I, S, SK, IK only).
+using BoardShape = Shape<kN, kM, kP>;
+/// The shapes the loops are instantiated for, as X(n, m, p) (the board's first).
+#define ONESHOT_NCS_SHAPES(X) X(2, 1, 2)
+using Design = BoardShape::Design;
+using Disc = BoardShape::Disc;
 
 /// The approaches of brief §5, in table order (I first: the reference of every ratio), then
 /// the one-shot loops of study files (kOneShotApproaches; not in study ncs's table).
@@ -171,9 +187,15 @@ class Context {
   const Timing& timing() const { return timing_; }                  ///< Delay/computation ranges.
 
   /// The controller design at noise scale s: R = s·R_n, Q = s·Q_n (constant), P0 = 10·R.
-  Design controller_design(double noise_scale) const;
+  Design controller_design(double noise_scale) const { return controller_design_of<BoardShape>(noise_scale); }
   /// The continuous model (per µs) at noise scale s (Q_c scaled), for the discretizer.
-  Disc::Model discretizer_model(double noise_scale) const;
+  Disc::Model discretizer_model(double noise_scale) const { return discretizer_model_of<BoardShape>(noise_scale); }
+  /// controller_design() for the plant of shape S (one of ONESHOT_NCS_SHAPES; the plant's own).
+  template <typename S>
+  typename S::Design controller_design_of(double noise_scale) const;
+  /// discretizer_model() for the plant of shape S.
+  template <typename S>
+  typename S::Disc::Model discretizer_model_of(double noise_scale) const;
   /// Worst τ_sc + τ_c + τ_ca of a scenario (µs): D of late sampling (std::invalid_argument
   /// when a leg of the study file has no upper bound).
   std::int32_t worst_chain_us(const Scenario& s) const;
