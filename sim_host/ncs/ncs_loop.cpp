@@ -314,6 +314,7 @@ RunResult run_on(BasicHarness<S>& hs, Approach a) {
   using Ref = typename BasicHarness<S>::Ref;
   using Feedback = node::StateFeedbackLaw<double, S::n, S::m, Ref>;
   using Kalman = KalmanLawOf<S>;
+  static_assert(S::p == S::n, "I and S feed the sampled state back: every shape has C = I");
   switch (a) {
     case Approach::kI:
     case Approach::kS:

@@ -148,18 +148,23 @@ std::shared_ptr<const Context> Context::from(design::PlantDescription plant) {
   auto ctx = std::make_shared<Context>();
   ctx->plant_ = std::move(plant);
   const design::PlantDescription& p = ctx->plant_;
-  if (!p.continuous() || p.a.rows != kN || p.b.cols != kM || p.c.rows != kP || !p.b_w.values.empty()) {
-    throw std::invalid_argument(p.source + ": study 'ncs' needs a continuous plant with n = 2, m = 1, p = 2 and no B_w");
+  if (!p.continuous() || !ncs_shape_runs(p.a.rows, p.b.cols, p.c.rows) || !p.b_w.values.empty()) {
+    throw std::invalid_argument(p.source + ": study 'ncs' needs a continuous plant of " + kNcsShapesText + " and no B_w (this one: n = " +
+                                std::to_string(p.a.rows) + ", m = " + std::to_string(p.b.cols) + ", p = " + std::to_string(p.c.rows) + ")");
   }
-  for (std::size_t i = 0; i < kP; ++i)
-    for (std::size_t j = 0; j < kN; ++j)
+  for (std::size_t i = 0; i < p.c.rows; ++i)
+    for (std::size_t j = 0; j < p.a.rows; ++j)
       if (p.c(i, j) != (i == j ? 1.0 : 0.0)) throw std::invalid_argument(p.source + ": study 'ncs' needs C = I (eq. 10)");
   ctx->design_ = design::synthesize(p);
   if (!ctx->design_.tracking) {
     throw std::invalid_argument(p.source + ": no set-point feed-forward: " + ctx->design_.tracking_unavailable_reason);
   }
-  if (ctx->design_.u_min.size() != kM) throw std::invalid_argument(p.source + ": study 'ncs' needs an actuator range");
-  (void)ctx->controller_design(1.0);  // refuses plants without a board or LQR gain, naming why
+  if (ctx->design_.u_min.size() != p.b.cols) throw std::invalid_argument(p.source + ": study 'ncs' needs an actuator range");
+  // refuses plants without a board or LQR gain, naming why (the design of the plant's shape)
+#define ONESHOT_NCS_DESIGN_OF(n_, m_, p_) \
+  if (p.a.rows == (n_) && p.b.cols == (m_) && p.c.rows == (p_)) (void)ctx->controller_design_of<Shape<n_, m_, p_>>(1.0);
+  ONESHOT_NCS_SHAPES(ONESHOT_NCS_DESIGN_OF)
+#undef ONESHOT_NCS_DESIGN_OF
   return ctx;
 }
 

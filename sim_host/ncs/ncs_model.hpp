@@ -42,8 +42,23 @@ struct Shape {
 };
 /// The board's shape (2, 1, 2): every approach runs on it (the others: I, S, SK, IK only).
 using BoardShape = Shape<kN, kM, kP>;
-/// The shapes the loops are instantiated for, as X(n, m, p) (the board's first).
-#define ONESHOT_NCS_SHAPES(X) X(2, 1, 2)
+/// The shapes the loops are instantiated for, as X(n, m, p) (the board's first): a first-order
+/// plant (1, 1, 1: the closed forms of a scalar loop are its oracles) and a cart-pole-like plant
+/// with its four states measured (4, 1, 4). Every shape has p = n and C = I: the reference loop
+/// I (and S) feed the sampled state back (node::StateFeedbackLaw takes y as x). Each shape costs
+/// one instantiation of the sampling loops in ncs_loop.cpp (compile time).
+#define ONESHOT_NCS_SHAPES(X) X(2, 1, 2) X(1, 1, 1) X(4, 1, 4)
+/// The shapes of ONESHOT_NCS_SHAPES in words, for refusals.
+inline constexpr const char* kNcsShapesText = "(n, m, p) = (2, 1, 2) (every approach), (1, 1, 1) or (4, 1, 4) (I, S, SK, IK), with C = I";
+/// True when the loops are instantiated for a plant of n states, m inputs, p outputs.
+constexpr bool ncs_shape_runs(std::size_t n, std::size_t m, std::size_t p) {
+#define ONESHOT_NCS_SHAPE_IS(n_, m_, p_) (n == (n_) && m == (m_) && p == (p_)) ||
+  return ONESHOT_NCS_SHAPES(ONESHOT_NCS_SHAPE_IS) false;
+#undef ONESHOT_NCS_SHAPE_IS
+}
+/// True for the board's shape (2, 1, 2): every approach, --analytic and the live run.
+constexpr bool board_shape(std::size_t n, std::size_t m, std::size_t p) { return n == kN && m == kM && p == kP; }
+
 using Design = BoardShape::Design;
 using Disc = BoardShape::Disc;
 
@@ -60,6 +75,11 @@ inline constexpr std::array<Approach, 9> kAllApproaches = {Approach::kI,   Appro
 inline constexpr std::array<Approach, 3> kOneShotApproaches = {Approach::kOS, Approach::kOSp, Approach::kOSK};
 /// True for the one-shot loops (OS, OSp, OSK).
 constexpr bool one_shot(Approach a) { return a == Approach::kOS || a == Approach::kOSp || a == Approach::kOSK; }
+/// True for the approaches every shape of ONESHOT_NCS_SHAPES runs (I, S, SK, IK); the others
+/// run on the board's shape only.
+constexpr bool any_shape_approach(Approach a) {
+  return a == Approach::kI || a == Approach::kS || a == Approach::kSK || a == Approach::kIK;
+}
 /// True for the loops whose controller runs a Kalman filter with a covariance P (AK, AKx,
 /// AKl, SK, IK, OS, OSp, OSK): the ones with a NEES.
 constexpr bool filtered_approach(Approach a) {
