@@ -144,6 +144,16 @@ std::shared_ptr<const Context> Context::load(const std::string& plant_path) {
   return from(design::load_plant_file(plant_path.empty() ? std::string(ONESHOT_STUDY_PLANT_FILE) : plant_path));
 }
 
+std::shared_ptr<const Context> Context::load_board(const std::string& plant_path) {
+  std::shared_ptr<const Context> ctx = load(plant_path);
+  const design::PlantDescription& p = ctx->plant();
+  if (!board_shape(p.a.rows, p.b.cols, p.c.rows)) {
+    throw std::invalid_argument(p.source + ": this ncs command runs the board's shape n = 2, m = 1, p = 2 only (study files run " +
+                                kNcsShapesText + ")");
+  }
+  return ctx;
+}
+
 std::shared_ptr<const Context> Context::from(design::PlantDescription plant) {
   auto ctx = std::make_shared<Context>();
   ctx->plant_ = std::move(plant);

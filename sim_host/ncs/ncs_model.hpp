@@ -200,6 +200,9 @@ class Context {
   static std::shared_ptr<const Context> load(const std::string& plant_path);
   /// The same from a plant description already parsed (a study file's inline plant).
   static std::shared_ptr<const Context> from(design::PlantDescription plant);
+  /// load() for the commands that run the board's shape only (the live run, its replay, the
+  /// fault table, the stationary costs): std::invalid_argument for another shape.
+  static std::shared_ptr<const Context> load_board(const std::string& plant_path);
 
   const design::PlantDescription& plant() const { return plant_; }  ///< The plant file.
   const design::DesignResult& design() const { return design_; }    ///< The design step's result.
