@@ -225,7 +225,7 @@ void add_ncs_faults_command(CLI::App* study) {
     }
     std::error_code ec;
     o->executable = std::filesystem::read_symlink("/proc/self/exe", ec).string();
-    const auto ctx = ncs::Context::load(*plant);
+    const auto ctx = ncs::Context::load_board(*plant);
     const nlohmann::json j = ncs::fault_table(*ctx, *o);
     if (*json != "-") std::cout << j.at("markdown").get<std::string>() << "written to " << o->out_dir << "/faults.md\n";
     if (!json->empty()) util::write_json(*json, j);

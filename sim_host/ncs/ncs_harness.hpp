@@ -10,6 +10,7 @@
 #include <memory>
 #include <stdexcept>
 #include <string>
+#include <type_traits>
 #include <utility>
 #include <vector>
 
@@ -57,28 +58,40 @@ struct World {
   SimTime end{0};  ///< The run's end: the latest loop's (the kernel and the background traffic run to it).
 };
 
-/// What every loop shares: kernel, plant, network, set-point, noise and timing streams.
-class Harness {
+/// What every loop shares: kernel, plant, network, set-point, noise and timing streams, for
+/// a plant of shape S (ncs_model.hpp; the analytic tracker on the board's shape only).
+template <typename S>
+class BasicHarness {
  public:
+  static constexpr bool kBoard = std::is_same_v<S, BoardShape>;  ///< The board's shape (2, 1, 2).
+  using Design = typename S::Design;                              ///< The controller design.
+  using Disc = typename S::Disc;                                  ///< The discretizer.
+  using Structure = DenseStructure<S::n, S::m, S::p>;             ///< Dense matrices.
+  using Ref = BasicSetpointReference<S::n, S::m>;                 ///< The set-point.
+  using Plant = engine::ContinuousPlant<S::n, S::m, S::p, 1>;     ///< The continuous plant.
+  using InputVec = Vector<double, S::m>;                          ///< u.
+  using OutputVec = Vector<double, S::p>;                         ///< y.
+  using StateVec = Vector<double, S::n>;                          ///< x.
+
   /// A loop on its own engine, or (`world`, `on`) one of several loops on a shared one: its
   /// random streams then named "<loop>/<source>", its nodes at the loop's addresses.
-  Harness(const Context& ctx, Approach a, const Scenario& sc, std::uint64_t seed, const RunOptions& opt,
-          World* world = nullptr, const LoopOnBus* on = nullptr)
+  BasicHarness(const Context& ctx, Approach a, const Scenario& sc, std::uint64_t seed, const RunOptions& opt,
+               World* world = nullptr, const LoopOnBus* on = nullptr)
       : ctx_(ctx),
         approach_(a),
         sc_(sc),
-        design_(ctx.controller_design(sc.noise_scale)),
-        disc_(ctx.discretizer_model(sc.noise_scale)),
+        design_(ctx.controller_design_of<S>(sc.noise_scale)),
+        disc_(ctx.discretizer_model_of<S>(sc.noise_scale)),
         prefix_(on != nullptr && !on->name.empty() ? on->name + "/" : std::string()),
         own_world_(world == nullptr ? std::make_unique<World>(seed) : nullptr),
         world_(world == nullptr ? *own_world_ : *world),
         kernel_(world_.kernel),
-        plant_(plant_config(ctx, sc, noisy(a, opt)),
-               engine::RandomStream(opt.noise_seed != 0 ? opt.noise_seed : seed, prefix_ + "process"), opt.caches),
+        plant_(plant_config_of<S>(ctx, sc, noisy(a, opt)),
+               engine::RandomStream(opt.noise_seed != 0 ? opt.noise_seed : seed, prefix_ + "process"), caches(opt)),
         net_(world_.net),
         measurement_(opt.noise_seed != 0 ? opt.noise_seed : seed, prefix_ + "measurement"),
         compute_(kernel_.stream(prefix_ + "compute")),
-        ref_(reference(ctx, sc)),
+        ref_(reference_of<S>(ctx, sc)),
         noisy_(noisy(a, opt)),
         h_(engine::from_us(ctx.period_us())),
         offset_(engine::from_us(on != nullptr ? on->clock_offset_us : 0)),
@@ -103,22 +116,26 @@ class Harness {
     if (!legs_from_file(sc) && !(sc.max_delay_ms * 1000 >= static_cast<double>(ctx.timing().leg_min_us))) {
       throw std::invalid_argument("ncs scenario " + sc.name + ": d must be at least 0.5 ms");
     }
-    const auto chol = measurement_cholesky(design_);
-    for (std::size_t i = 0; i < 3; ++i) r_chol_[i] = chol[i];
-    const live::InputRange range = live::actuator_range(ctx);
-    u_min_ = range.lo;
-    u_max_ = range.hi;
-    const Vector<double, kN> x0 = ref_.state(0);
+    r_chol_ = lower_cholesky<S::p>(design_.r);
+    for (std::size_t j = 0; j < S::m; ++j) {  // the actuator's range (live::actuator_range() on the board)
+      u_min_[j] = ctx.design().u_min[j];
+      u_max_[j] = ctx.design().u_max[j];
+    }
+    const StateVec x0 = ref_.state(0);
     plant_.set_state(x0);
     plant_.set_reference(x0, ref_.input(0));
-    if (opt.analytic) an_ = make_tracker(ctx, sc, a, design_, opt, x0, ref_.input(0));
+    if constexpr (kBoard) {
+      if (opt.analytic) an_ = make_tracker(ctx, sc, a, design_, opt, x0, ref_.input(0));
+    } else if (opt.analytic) {
+      throw std::invalid_argument("ncs: --analytic runs the board's plant (n = 2, m = 1, p = 2) only: its tracker is 2-state");
+    }
     if (opt.trace_step_s > 0) plant_.record_trace(engine::from_seconds(opt.trace_step_s, "trace step"), kernel_.stream(prefix_ + "trace"));
     // Set-point switches on the kh grid (before anything else at that instant but the plant).
     const HandlerId sw = kernel_.add_handler("setpoint", [this](std::uint64_t k) {
       advance();
       const auto kk = static_cast<node::SequenceNumber>(k);
       plant_.set_reference(ref_.state(kk), ref_.input(kk));
-      if (an_) an_->set_reference(ref_.state(kk), ref_.input(kk));
+      tracker([&](auto& t) { t.set_reference(ref_.state(kk), ref_.input(kk)); });
     });
     const auto k_end = static_cast<std::uint64_t>(((end_ - offset_).count() + h_.count() - 1) / h_.count());
     for (std::uint64_t k : ref_.switches(k_end)) {
@@ -136,7 +153,7 @@ class Harness {
       if (a != Approach::kS && a != Approach::kSK) {
         throw std::invalid_argument(std::string("ncs: the sensor on a CPU runs with S and SK only, not ") + name(a));
       }
-      if (an_) throw std::invalid_argument("ncs: no analytic cost with the sensor on a CPU");
+      if (opt.analytic) throw std::invalid_argument("ncs: no analytic cost with the sensor on a CPU");
       sensor_cpu_ = std::make_unique<engine::cpu::Cpu>(kernel_, sc.sensor_cpu->set);
       sensor_task_ = sc.sensor_cpu->task;
       sensor_cpu_->start(end_);
@@ -148,7 +165,7 @@ class Harness {
       const SimTime mark{engine::from_seconds(opt.analytic_mark_s, "analytic mark")};
       if (mark > end_) throw std::invalid_argument("the analytic mark is after the end of the run");
       const HandlerId at_mark = kernel_.add_handler("analytic mark", [this](std::uint64_t) {
-        result_.analytic_at_mark = an_->cost_at(kernel_.now());
+        tracker([&](auto& t) { result_.analytic_at_mark = t.cost_at(kernel_.now()); });
       });
       kernel_.schedule(mark, EventClass::kRecord, at_mark);
     }
@@ -157,12 +174,40 @@ class Harness {
   /// Whether a run of `a` under `opt` draws process and measurement noise.
   static bool noisy(Approach a, const RunOptions& opt) { return !opt.noise_free && !opt.analytic && a != Approach::kI; }
 
+  /// The sweep's shared plant caches (RunOptions::caches: the board's shape; none for another).
+  static engine::PlantCachePool<S::n, S::m + 1>* caches(const RunOptions& opt) {
+    if constexpr (kBoard) {
+      return opt.caches;
+    } else {
+      return nullptr;
+    }
+  }
+
+  /// Calls fn(tracker) when the run has an analytic tracker (the board's shape only).
+  template <typename Fn>
+  void tracker(Fn&& fn) {
+    if constexpr (kBoard) {
+      if (an_) fn(*an_);
+    }
+  }
+
+  /// The first two entries of `v` (the second 0 for a vector of one) at time `t_s`: a row of
+  /// the run's records (Point).
+  template <std::size_t K>
+  static Point point(double t_s, const Vector<double, K>& v) {
+    if constexpr (K > 1) {
+      return Point{t_s, {v[0], v[1]}};
+    } else {
+      return Point{t_s, {v[0], 0.0}};
+    }
+  }
+
   /// The plant (and the analytic tracker) at now: on the plant's time, the loop's (now − φ,
   /// the loop's clock offset), held at the loop's end in a run that goes on for a later loop.
   void advance() {
     const SimTime t = std::min(std::max(kernel_.now(), offset_), end_);
     plant_.advance_to(t - offset_);
-    if (an_) an_->flow_to(t);
+    tracker([&](auto& tr) { tr.flow_to(t); });
   }
 
   /// Leg `name`'s link of this scenario and approach.
@@ -228,17 +273,19 @@ class Harness {
   OutputVec sample() {
     advance();
     OutputVec y = plant_.output();
-    if (noisy_) {
-      const double n0 = measurement_.normal();
-      const double n1 = measurement_.normal();
-      y[0] += r_chol_[0] * n0;
-      y[1] += r_chol_[1] * n0 + r_chol_[2] * n1;
+    if (noisy_) {  // v = L n, n ~ N(0, I) drawn in output order
+      OutputVec n;
+      for (std::size_t i = 0; i < S::p; ++i) n[i] = measurement_.normal();
+      for (std::size_t i = 0; i < S::p; ++i) {
+        double v = 0;
+        for (std::size_t j = 0; j <= i; ++j) v += r_chol_(i, j) * n[j];
+        y[i] += v;
+      }
     }
     const double t = engine::to_seconds(kernel_.now());
-    const OutputVec clean = plant_.output();
-    result_.samples.push_back(Point{t, {y[0], y[1]}});
-    result_.sample_truth.push_back(Point{t, {clean[0], clean[1]}});
-    if (an_) an_->sample(kernel_.now(), y);
+    result_.samples.push_back(point(t, y));
+    result_.sample_truth.push_back(point(t, plant_.output()));
+    tracker([&](auto& tr) { tr.sample(kernel_.now(), y); });
     return y;
   }
 
@@ -246,26 +293,41 @@ class Harness {
   void apply(const InputVec& u) {
     advance();
     plant_.set_input(u);
-    if (an_) an_->apply(u);
+    tracker([&](auto& t) { t.apply(u); });
     ++result_.commands;
   }
 
   /// Records estimate x̂ of period k (at kh).
-  void estimate(node::SequenceNumber k, const Vector<double, kN>& x) {
-    result_.estimates.push_back(Point{static_cast<double>(k) * engine::to_seconds(h_), {x[0], x[1]}});
+  void estimate(node::SequenceNumber k, const StateVec& x) {
+    result_.estimates.push_back(point(static_cast<double>(k) * engine::to_seconds(h_), x));
   }
 
   /// Adds e_kᵀ P⁻¹ e_k, e_k = x − x̂, of the estimate `xh` with covariance `p` of the true state
   /// `x` to the run's NEES (RunResult::nees); nothing when P is singular (noise scale 0) or the
   /// value is not finite.
-  void add_nees(const Vector<double, kN>& x, const Vector<double, kN>& xh, const Matrix<double, kN, kN>& p) {
-    const double e0 = x[0] - xh[0];
-    const double e1 = x[1] - xh[1];
-    const double det = p(0, 0) * p(1, 1) - p(0, 1) * p(1, 0);
-    if (!(det > 0)) return;
-    static_assert(kN == 2, "the NEES below inverts a 2 x 2 covariance in closed form");
-    // eᵀ P⁻¹ e with P⁻¹ = [[p11, −p01], [−p10, p00]] / det
-    const double q = (e0 * e0 * p(1, 1) - e0 * e1 * (p(0, 1) + p(1, 0)) + e1 * e1 * p(0, 0)) / det;
+  void add_nees(const StateVec& x, const StateVec& xh, const Matrix<double, S::n, S::n>& p) {
+    double q = 0;
+    if constexpr (S::n == 2) {  // the closed form (the board's figures as before, to the bit)
+      const double e0 = x[0] - xh[0];
+      const double e1 = x[1] - xh[1];
+      const double det = p(0, 0) * p(1, 1) - p(0, 1) * p(1, 0);
+      if (!(det > 0)) return;
+      // eᵀ P⁻¹ e with P⁻¹ = [[p11, −p01], [−p10, p00]] / det
+      q = (e0 * e0 * p(1, 1) - e0 * e1 * (p(0, 1) + p(1, 0)) + e1 * e1 * p(0, 0)) / det;
+    } else {  // eᵀ P⁻¹ e = |L⁻¹ e|², P = L Lᵀ (a Cholesky solve), nothing unless P > 0
+      Matrix<double, S::n, S::n> sym;
+      for (std::size_t i = 0; i < S::n; ++i)
+        for (std::size_t j = 0; j < S::n; ++j) sym(i, j) = 0.5 * (p(i, j) + p(j, i));
+      const Matrix<double, S::n, S::n> l = lower_cholesky<S::n>(sym);
+      StateVec z;
+      for (std::size_t i = 0; i < S::n; ++i) {
+        if (!(l(i, i) > 0)) return;
+        double v = x[i] - xh[i];
+        for (std::size_t j = 0; j < i; ++j) v -= l(i, j) * z[j];
+        z[i] = v / l(i, i);
+        q += z[i] * z[i];
+      }
+    }
     if (!std::isfinite(q)) return;
     nees_sum_ += q;
     ++nees_n_;
@@ -302,12 +364,12 @@ class Harness {
       result_.links.emplace_back(nm, ls);
       result_.bus_legs.emplace_back(nm, st);
     }
-    if (an_) an_->report(result_);
+    tracker([&](auto& t) { t.report(result_); });
     if (cpu_) cpu_stats(*cpu_, cpu_task_, result_.cpu);
     if (sensor_cpu_) cpu_stats(*sensor_cpu_, sensor_task_, result_.sensor_cpu);
     for (const auto& s : plant_.trace()) {
       const double t = engine::to_seconds(s.t);
-      result_.truth.push_back(Point{t, {s.x[0], s.x[1]}});
+      result_.truth.push_back(point(t, s.x));
       result_.setpoint.push_back(Point{t, {s.r[0], s.u[0]}});
     }
     return std::move(result_);
@@ -349,7 +411,7 @@ class Harness {
   Duration h_;
   Duration offset_;  ///< The loop's clock offset φ (LoopOnBus::clock_offset_us): its timer at kh + φ.
   SimTime end_;      ///< The loop's end: φ + the scenario's duration.
-  double r_chol_[3] = {};
+  Matrix<double, S::p, S::p> r_chol_{};  ///< Lower Cholesky factor of R (the measurement noise).
   InputVec u_min_;
   InputVec u_max_;
   RunResult result_;
@@ -369,6 +431,9 @@ class Harness {
   std::unique_ptr<engine::cpu::Cpu> sensor_cpu_;  ///< The sensor's CPU (Scenario::sensor_cpu).
   std::size_t sensor_task_ = 0;                   ///< The sensor's job in it.
 };
+
+/// The harness of the board's plant (every approach).
+using Harness = BasicHarness<BoardShape>;
 
 /// The one-shot loop OS, OSp or OSK `a` on `hs` (ncs_one_shot_loop.cpp).
 RunResult run_one_shot(Harness& hs, Approach a);

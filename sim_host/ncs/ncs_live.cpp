@@ -145,7 +145,7 @@ int high_fd(int fd) {
 
 nlohmann::json analyse_live(const std::string& dir) {
   const LiveRun run = load_live_run(dir);
-  const auto ctx = Context::load(run.plant_file);
+  const auto ctx = Context::load_board(run.plant_file);
   const std::int64_t h_ns = std::int64_t{ctx->period_us()} * 1000;
   const std::int64_t end = engine::from_seconds(run.scenario.duration_s, "live duration").count();
   const auto plant = read_log(dir, "plant");
@@ -237,7 +237,7 @@ nlohmann::json analyse_live(const std::string& dir) {
 }
 
 nlohmann::json run_live(const LiveOptions& o) {
-  const auto ctx = Context::load(o.plant_file);
+  const auto ctx = Context::load_board(o.plant_file);
   if (!actuation_synchronized(o.approach)) {
     throw std::invalid_argument(std::string("ncs live: approach ") + name(o.approach) + " is not actuation-synchronized (A, AK, AKx, AKl)");
   }

@@ -101,7 +101,7 @@ std::vector<std::vector<std::uint8_t>> read_injected(const std::string& dir) {
 
 ReplayResult replay_live(const std::string& dir, bool ideal_instants) {
   const LiveRun run = load_live_run(dir);
-  const auto ctx = Context::load(run.plant_file);
+  const auto ctx = Context::load_board(run.plant_file);
   const Scenario& sc = run.scenario;
   const Design design = ctx->controller_design(sc.noise_scale);
   const Disc disc(ctx->discretizer_model(sc.noise_scale));

@@ -351,7 +351,7 @@ int run_live_role(const std::string& role, const LiveRun& run, int net_fd, int i
   const Clock c{run.t0_ns};
   for (int fd : {net_fd, io_fd})
     if (fd >= 0) posix::set_nonblocking(fd);
-  const auto ctx = Context::load(run.plant_file);  // the design step runs before t0
+  const auto ctx = Context::load_board(run.plant_file);  // the design step runs before t0
   ::prctl(PR_SET_TIMERSLACK, 1UL, 0UL, 0UL, 0UL);  // wake-ups as close to the deadline as the kernel can
   const auto start = [&]() { wait_readable(-1, run.t0_ns); };  // everything starts at t0
   if (role == "plant") return start(), run_plant(run, ctx, net_fd, c);

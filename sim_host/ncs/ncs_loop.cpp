@@ -24,11 +24,18 @@
 namespace oneshot::ncs::loop {
 namespace {
 
-/// The Kalman law of the sampling loops SK, IK (its filter has a covariance: the NEES).
-using KalmanLaw = node::PeriodicKalmanLaw<Fmt, Structure, Ref>;
+/// The Kalman law of the sampling loops SK, IK on the plant of shape S (its filter has a covariance: the NEES).
+template <typename S>
+using KalmanLawOf = node::PeriodicKalmanLaw<Fmt, typename BasicHarness<S>::Structure, typename BasicHarness<S>::Ref>;
 /// True for a sampling loop's law with a Kalman filter.
 template <typename Law>
-constexpr bool kIsKalmanLaw = std::is_same_v<Law, KalmanLaw>;
+struct IsKalmanLaw : std::false_type {};
+/// The periodic Kalman law.
+template <typename F, typename St, typename R>
+struct IsKalmanLaw<node::PeriodicKalmanLaw<F, St, R>> : std::true_type {};
+/// True for a sampling loop's law with a Kalman filter.
+template <typename Law>
+constexpr bool kIsKalmanLaw = IsKalmanLaw<Law>::value;
 /// True for an actuation-synchronized estimator with a covariance (AK, AKx, AKl; not A's predictor).
 template <typename Estimator>
 constexpr bool kHasCovariance = !std::is_same_v<Estimator, node::SampledStatePredictor<Fmt, Structure, Disc>>;
@@ -155,19 +162,25 @@ RunResult run_synchronized(Harness& hs, Estimator est, std::int32_t late_us) {
   return r;
 }
 
-/// The sampling-synchronized baseline with law `law`; `saturated(law)` reads its count.
-template <typename Law, typename Saturated>
-RunResult run_sampling(Harness& hs, Law law, Saturated saturated) {
-  using Trigger = node::PeriodicTrigger<double, kP>;
-  using Sensor = node::SensorNode<Board, Trigger, double, kP>;
-  using Ctrl = node::ControllerNode<Board, Law, double, kP, kM>;
-  using Act = node::ActuatorNode<Board, double, kM>;
+/// The sampling-synchronized baseline with law `law` on the plant of shape S; `saturated(law)`
+/// reads its count.
+template <typename S, typename Law, typename Saturated>
+RunResult run_sampling(BasicHarness<S>& hs, Law law, Saturated saturated) {
+  using Trigger = node::PeriodicTrigger<double, S::p>;
+  using Sensor = node::SensorNode<Board, Trigger, double, S::p>;
+  using Ctrl = node::ControllerNode<Board, Law, double, S::p, S::m>;
+  using Act = node::ActuatorNode<Board, double, S::m>;
+  using InputVec = typename BasicHarness<S>::InputVec;
+  using OutputVec = typename BasicHarness<S>::OutputVec;
   const std::uint8_t sensor_at = hs.sensor_at_, controller_at = hs.controller_at_, actuator_at = hs.actuator_at_;
   std::optional<Sensor> sensor(std::in_place, controller_at, Trigger(1));
   std::optional<Ctrl> ctrl(std::in_place, actuator_at, node::ControllerMode::kOnArrival, law);
   std::optional<Act> act(std::in_place, node::ActuatorMode::kOnArrival, InputVec{});
   const auto check_ctrl = [&]() { ctrl->expect_source(sensor_at); };  // samples: finite (the plant is not clamped)
-  const auto check_act = [&]() { live::check_commands(hs.ctx_, *act, controller_at); };
+  const auto check_act = [&]() {  // live::check_commands() for any shape
+    act->expect_source(controller_at);
+    act->set_command_range(hs.u_min_, hs.u_max_);
+  };
   check_ctrl();
   check_act();
   std::uint64_t sensor_n0 = 0;  // sample index of the sensor's power-on (its sequence = n − n0)
@@ -177,7 +190,7 @@ RunResult run_sampling(Harness& hs, Law law, Saturated saturated) {
   std::uint32_t samples = 0;  // the sequence number of the next sample (no restart in analytic runs)
   // The NEES (the Kalman law of SK, IK): x̂_{k|k}, P_{k|k} of each computation against the true
   // state at its sample's instant (kh; the sampling job's sample point on a CPU), by sequence number.
-  std::vector<Vector<double, kN>> truth;
+  std::vector<Vector<double, S::n>> truth;
   std::vector<bool> truth_set;
   const auto note_truth = [&](node::SequenceNumber seq) {
     if (!kIsKalmanLaw<Law> || !hs.opt_faults_empty_) return;
@@ -192,7 +205,7 @@ RunResult run_sampling(Harness& hs, Law law, Saturated saturated) {
     const Law before = ctrl->law();
     const std::uint32_t runs = ctrl->statistics().computations;
     net.run_node(controller_at, [&]() { ctrl->on_receive(net.node_clock(controller_at)); });
-    if (hs.an_) hs.an_->compute_law(before, samples - 1);
+    hs.tracker([&](auto& t) { t.compute_law(before, samples - 1); });
     if constexpr (kIsKalmanLaw<Law>) {
       const node::SequenceNumber seq = ctrl->latest().seq;
       if (ctrl->statistics().computations != runs && seq < truth.size() && truth_set[seq]) {
@@ -291,30 +304,18 @@ RunResult run(const Context& ctx, Approach a, const Scenario& sc, std::uint64_t 
 
 namespace {
 
-/// Approach `a`'s loop on `hs`.
-RunResult run_on(Harness& hs, Approach a) {
+/// Approach `a`'s loop on `hs`: every approach on the board's shape, the sampling loops I, S,
+/// SK, IK on another (std::invalid_argument naming the approach otherwise).
+template <typename S>
+RunResult run_on(BasicHarness<S>& hs, Approach a) {
   const Context& ctx = hs.ctx_;
   const Scenario& sc = hs.sc_;
-  const Vector<double, kN> x0 = hs.ref_.state(0);
-  using HalfEst = node::HalfKalmanEstimator<Fmt, Structure, Disc>;
-  using Pred = node::SampledStatePredictor<Fmt, Structure, Disc>;
-  const auto half = [&](NoiseModel noise) {
-    HalfEst e(hs.design_, hs.disc_, noise);
-    e.reset(x0, hs.design_.p0, InputVec{});
-    return e;
-  };
-  using Feedback = node::StateFeedbackLaw<double, kN, kM, Ref>;
-  using Kalman = KalmanLaw;
-  using Compensated = node::DelayCompensatedLaw<double, kN, kM, Ref>;
+  const Vector<double, S::n> x0 = hs.ref_.state(0);
+  using Ref = typename BasicHarness<S>::Ref;
+  using Feedback = node::StateFeedbackLaw<double, S::n, S::m, Ref>;
+  using Kalman = KalmanLawOf<S>;
+  static_assert(S::p == S::n, "I and S feed the sampled state back: every shape has C = I");
   switch (a) {
-    case Approach::kA:
-      return run_synchronized(hs, Pred(hs.disc_), 0);
-    case Approach::kAK:
-      return run_synchronized(hs, half(NoiseModel::kConstant), 0);
-    case Approach::kAKx:
-      return run_synchronized(hs, half(NoiseModel::kExact), 0);
-    case Approach::kAKl:
-      return run_synchronized(hs, half(NoiseModel::kConstant), ctx.worst_chain_us(sc));
     case Approach::kI:
     case Approach::kS:
       return run_sampling(hs, Feedback{hs.design_.l, hs.u_min_, hs.u_max_, hs.ref_},
@@ -322,27 +323,73 @@ RunResult run_on(Harness& hs, Approach a) {
     case Approach::kSK:
     case Approach::kIK: {
       Kalman law(hs.design_, NoiseModel::kConstant, hs.u_min_, hs.u_max_, hs.ref_);
-      law.filter().reset(x0, hs.design_.p0, InputVec{});
+      law.filter().reset(x0, hs.design_.p0, typename BasicHarness<S>::InputVec{});
       return run_sampling(hs, law, [](Kalman& f) { return f.saturated(); });
     }
-    case Approach::kSPlus: {
-      const SplitGain g = delay_compensated_split(ctx, ctx.mean_tau_io_us(sc));
-      Compensated law{g.lx, g.lu, hs.u_min_, hs.u_max_, hs.ref_};
-      return run_sampling(hs, law, [](const Compensated& f) { return f.saturated; });
-    }
-    case Approach::kOS:
-    case Approach::kOSp:
-    case Approach::kOSK:
-      return run_one_shot(hs, a);
+    default:
+      break;
   }
-  throw std::logic_error("ncs: unknown approach");
+  if constexpr (BasicHarness<S>::kBoard) {
+    using HalfEst = node::HalfKalmanEstimator<Fmt, Structure, Disc>;
+    using Pred = node::SampledStatePredictor<Fmt, Structure, Disc>;
+    const auto half = [&](NoiseModel noise) {
+      HalfEst e(hs.design_, hs.disc_, noise);
+      e.reset(x0, hs.design_.p0, InputVec{});
+      return e;
+    };
+    using Compensated = node::DelayCompensatedLaw<double, kN, kM, Ref>;
+    switch (a) {
+      case Approach::kA:
+        return run_synchronized(hs, Pred(hs.disc_), 0);
+      case Approach::kAK:
+        return run_synchronized(hs, half(NoiseModel::kConstant), 0);
+      case Approach::kAKx:
+        return run_synchronized(hs, half(NoiseModel::kExact), 0);
+      case Approach::kAKl:
+        return run_synchronized(hs, half(NoiseModel::kConstant), ctx.worst_chain_us(sc));
+      case Approach::kSPlus: {
+        const SplitGain g = delay_compensated_split(ctx, ctx.mean_tau_io_us(sc));
+        Compensated law{g.lx, g.lu, hs.u_min_, hs.u_max_, hs.ref_};
+        return run_sampling(hs, law, [](const Compensated& f) { return f.saturated; });
+      }
+      case Approach::kOS:
+      case Approach::kOSp:
+      case Approach::kOSK:
+        return run_one_shot(hs, a);
+      default:
+        throw std::logic_error("ncs: unknown approach");
+    }
+  } else {
+    static_cast<void>(ctx);
+    static_cast<void>(sc);
+    throw std::invalid_argument(std::string("ncs: approach ") + name(a) + " runs the board's plant (n = 2, m = 1, p = 2) only; a plant of n = " +
+                                std::to_string(S::n) + ", m = " + std::to_string(S::m) + ", p = " + std::to_string(S::p) +
+                                " runs I, S, SK, IK");
+  }
+}
+
+/// fn(S{}) with the shape S of ONESHOT_NCS_SHAPES of the plant of `ctx` (std::invalid_argument
+/// naming plant.continuous.A when it has none: Context refuses such plants first).
+template <typename Fn>
+auto on_shape(const Context& ctx, Fn&& fn) -> decltype(fn(BoardShape{})) {
+  const std::size_t n = ctx.plant().a.rows;
+  const std::size_t m = ctx.plant().b.cols;
+  const std::size_t p = ctx.plant().c.rows;
+#define ONESHOT_NCS_ON_SHAPE(n_, m_, p_) \
+  if (n == (n_) && m == (m_) && p == (p_)) return fn(Shape<n_, m_, p_>{});
+  ONESHOT_NCS_SHAPES(ONESHOT_NCS_ON_SHAPE)
+#undef ONESHOT_NCS_ON_SHAPE
+  throw std::invalid_argument("plant.continuous.A: the ncs loops run no plant of n = " + std::to_string(n) + ", m = " + std::to_string(m) +
+                              ", p = " + std::to_string(p));
 }
 
 }  // namespace
 
 RunResult run_approach(const Context& ctx, Approach a, const Scenario& sc, std::uint64_t seed, const RunOptions& options) {
-  Harness hs(ctx, a, sc, seed, options);
-  return run_on(hs, a);
+  return on_shape(ctx, [&](auto shape) {
+    BasicHarness<decltype(shape)> hs(ctx, a, sc, seed, options);
+    return run_on(hs, a);
+  });
 }
 
 std::vector<RunResult> run_loops(const std::vector<LoopOnBus>& loops, Approach a, std::uint64_t seed) {
@@ -360,9 +407,11 @@ std::vector<RunResult> run_loops(const std::vector<LoopOnBus>& loops, Approach a
   // the kernel, and each collects its results as the calls return.
   std::function<void(std::size_t)> run_from = [&](std::size_t i) {
     const LoopOnBus& l = loops[i];
-    Harness hs(*l.ctx, a, *l.scenario, seed, RunOptions{}, &world, &l);
-    if (i + 1 < loops.size()) hs.inner_ = [&run_from, i]() { run_from(i + 1); };
-    out[i] = run_on(hs, a);
+    out[i] = on_shape(*l.ctx, [&](auto shape) {  // each loop on its own plant's shape
+      BasicHarness<decltype(shape)> hs(*l.ctx, a, *l.scenario, seed, RunOptions{}, &world, &l);
+      if (i + 1 < loops.size()) hs.inner_ = [&run_from, i]() { run_from(i + 1); };
+      return run_on(hs, a);
+    });
   };
   run_from(0);
   return out;

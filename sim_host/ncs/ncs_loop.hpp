@@ -21,6 +21,8 @@
 #pragma once
 
 #include <array>
+#include <cmath>
+#include <cstddef>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -128,15 +130,41 @@ struct RunResult {
   std::vector<Point> setpoint;   ///< x_ref,1 and u at each trace step.
 };
 
-/// The plant of a run (process noise when `noisy`), shared by the simulation and the live plant.
-engine::ContinuousPlantConfig<kN, kM, kP, 1> plant_config(const Context& ctx, const Scenario& sc, bool noisy);
-/// The set-point of a scenario (x_ref, u_ref per period index): its steps
+/// The plant of shape S of a run (process noise when `noisy`; S one of ONESHOT_NCS_SHAPES).
+template <typename S>
+engine::ContinuousPlantConfig<S::n, S::m, S::p, 1> plant_config_of(const Context& ctx, const Scenario& sc, bool noisy);
+/// The board's plant of a run, shared by the simulation and the live plant.
+inline engine::ContinuousPlantConfig<kN, kM, kP, 1> plant_config(const Context& ctx, const Scenario& sc, bool noisy) {
+  return plant_config_of<BoardShape>(ctx, sc, noisy);
+}
+/// The set-point of a scenario for the plant of shape S (x_ref, u_ref = N_x r_k, N_u r_k per
+/// period index, N_x, N_u the design's feed-forward of the tracked output): its steps
 /// (Scenario::setpoint_changes) or the square wave ±A_r of period T_r.
-SetpointReference reference(const Context& ctx, const Scenario& sc);
+template <typename S>
+BasicSetpointReference<S::n, S::m> reference_of(const Context& ctx, const Scenario& sc);
+/// reference_of() for the board's plant.
+inline SetpointReference reference(const Context& ctx, const Scenario& sc) { return reference_of<BoardShape>(ctx, sc); }
 /// Network leg `name` ("as", "sc", "ca"): U[0.5, d] ms in whole µs, FIFO, or the scenario's
 /// leg from a study file (Scenario::legs); none for I, IK.
 engine::LinkConfig leg(const Context& ctx, const Scenario& sc, Approach a, const char* name);
-/// Lower Cholesky factor of R = s·R_n: y = C x + [[c0, 0], [c1, c2]] n, n ~ N(0, I).
+/// Lower Cholesky factor L of a measurement covariance R (p × p): y = C x + L n, n ~ N(0, I);
+/// a column whose pivot is not positive is 0 (R singular, e.g. noise scale 0).
+template <std::size_t P>
+Matrix<double, P, P> lower_cholesky(const Matrix<double, P, P>& r) {
+  Matrix<double, P, P> l{};
+  for (std::size_t j = 0; j < P; ++j) {
+    double d = 0;
+    for (std::size_t k = 0; k < j; ++k) d += l(j, k) * l(j, k);
+    l(j, j) = std::sqrt(std::fmax(0.0, r(j, j) - d));
+    for (std::size_t i = j + 1; i < P; ++i) {
+      double s = 0;
+      for (std::size_t k = 0; k < j; ++k) s += l(i, k) * l(j, k);
+      l(i, j) = l(j, j) > 0 ? (r(i, j) - s) / l(j, j) : 0;
+    }
+  }
+  return l;
+}
+/// Lower Cholesky factor of R = s·R_n of the board: y = C x + [[c0, 0], [c1, c2]] n, n ~ N(0, I).
 std::array<double, 3> measurement_cholesky(const Design& d);
 
 /// Names of the node counters of approach `a` (RunResult::counters).

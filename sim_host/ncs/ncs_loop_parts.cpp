@@ -11,33 +11,42 @@
 
 namespace oneshot::ncs {
 
-engine::ContinuousPlantConfig<kN, kM, kP, 1> plant_config(const Context& ctx, const Scenario& sc, bool noisy) {
-  engine::ContinuousPlantConfig<kN, kM, kP, 1> c;
+template <typename S>
+engine::ContinuousPlantConfig<S::n, S::m, S::p, 1> plant_config_of(const Context& ctx, const Scenario& sc, bool noisy) {
+  engine::ContinuousPlantConfig<S::n, S::m, S::p, 1> c;
   const design::PlantDescription& p = ctx.plant();
-  for (std::size_t i = 0; i < kN; ++i) {
-    for (std::size_t j = 0; j < kN; ++j) {
+  for (std::size_t i = 0; i < S::n; ++i) {
+    for (std::size_t j = 0; j < S::n; ++j) {
       c.a(i, j) = p.a(i, j);
       c.qc(i, j) = ctx.design().qc(i, j) * sc.noise_scale;
       c.q1c(i, j) = p.q1c(i, j);
     }
-    for (std::size_t j = 0; j < kM; ++j) c.b(i, j) = p.b(i, j);
+    for (std::size_t j = 0; j < S::m; ++j) c.b(i, j) = p.b(i, j);
   }
-  for (std::size_t i = 0; i < kP; ++i)
-    for (std::size_t j = 0; j < kN; ++j) c.c(i, j) = p.c(i, j);
-  c.q2c(0, 0) = p.q2c(0, 0);
+  for (std::size_t i = 0; i < S::p; ++i)
+    for (std::size_t j = 0; j < S::n; ++j) c.c(i, j) = p.c(i, j);
+  for (std::size_t i = 0; i < S::m; ++i)
+    for (std::size_t j = 0; j < S::m; ++j) c.q2c(i, j) = p.q2c(i, j);
   c.process_noise = noisy;
   return c;
 }
 
-SetpointReference reference(const Context& ctx, const Scenario& sc) {
+template <typename S>
+BasicSetpointReference<S::n, S::m> reference_of(const Context& ctx, const Scenario& sc) {
   const std::size_t out = ctx.design().tracked_outputs.empty() ? 0 : ctx.design().tracked_outputs[0];
-  Vector<double, kN> nx;
-  Vector<double, kM> nu;
-  for (std::size_t i = 0; i < kN; ++i) nx[i] = ctx.design().nx(i, out);
-  for (std::size_t j = 0; j < kM; ++j) nu[j] = ctx.design().nu(j, out);
-  if (sc.setpoint_changes) return SetpointReference(sc.setpoint_r0, sc.setpoint_changes, nx, nu);
-  return SetpointReference(sc.amplitude_volts, static_cast<std::uint32_t>(half_wave_periods(ctx, sc)), nx, nu);
+  Vector<double, S::n> nx;
+  Vector<double, S::m> nu;
+  for (std::size_t i = 0; i < S::n; ++i) nx[i] = ctx.design().nx(i, out);
+  for (std::size_t j = 0; j < S::m; ++j) nu[j] = ctx.design().nu(j, out);
+  if (sc.setpoint_changes) return BasicSetpointReference<S::n, S::m>(sc.setpoint_r0, sc.setpoint_changes, nx, nu);
+  return BasicSetpointReference<S::n, S::m>(sc.amplitude_volts, static_cast<std::uint32_t>(half_wave_periods(ctx, sc)), nx, nu);
 }
+
+#define ONESHOT_NCS_PARTS_OF(n, m, p)                                                                                \
+  template engine::ContinuousPlantConfig<n, m, p, 1> plant_config_of<Shape<n, m, p>>(const Context&, const Scenario&, bool); \
+  template BasicSetpointReference<n, m> reference_of<Shape<n, m, p>>(const Context&, const Scenario&);
+ONESHOT_NCS_SHAPES(ONESHOT_NCS_PARTS_OF)
+#undef ONESHOT_NCS_PARTS_OF
 
 engine::LinkConfig leg(const Context& ctx, const Scenario& sc, Approach a, const char* name) {
   engine::LinkConfig c;
@@ -62,12 +71,8 @@ engine::LinkConfig leg(const Context& ctx, const Scenario& sc, Approach a, const
 }
 
 std::array<double, 3> measurement_cholesky(const Design& d) {
-  std::array<double, 3> c{};
-  const double r00 = d.r(0, 0);
-  c[0] = std::sqrt(r00);
-  c[1] = r00 > 0 ? d.r(1, 0) / c[0] : 0;
-  c[2] = std::sqrt(std::fmax(0.0, d.r(1, 1) - c[1] * c[1]));
-  return c;
+  const Matrix<double, kP, kP> l = lower_cholesky<kP>(d.r);
+  return {l(0, 0), l(1, 0), l(1, 1)};
 }
 
 std::vector<std::string> counter_names(Approach a) {

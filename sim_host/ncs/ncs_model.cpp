@@ -144,38 +144,61 @@ std::shared_ptr<const Context> Context::load(const std::string& plant_path) {
   return from(design::load_plant_file(plant_path.empty() ? std::string(ONESHOT_STUDY_PLANT_FILE) : plant_path));
 }
 
+std::shared_ptr<const Context> Context::load_board(const std::string& plant_path) {
+  std::shared_ptr<const Context> ctx = load(plant_path);
+  const design::PlantDescription& p = ctx->plant();
+  if (!board_shape(p.a.rows, p.b.cols, p.c.rows)) {
+    throw std::invalid_argument(p.source + ": this ncs command runs the board's shape n = 2, m = 1, p = 2 only (study files run " +
+                                kNcsShapesText + ")");
+  }
+  return ctx;
+}
+
 std::shared_ptr<const Context> Context::from(design::PlantDescription plant) {
   auto ctx = std::make_shared<Context>();
   ctx->plant_ = std::move(plant);
   const design::PlantDescription& p = ctx->plant_;
-  if (!p.continuous() || p.a.rows != kN || p.b.cols != kM || p.c.rows != kP || !p.b_w.values.empty()) {
-    throw std::invalid_argument(p.source + ": study 'ncs' needs a continuous plant with n = 2, m = 1, p = 2 and no B_w");
+  if (!p.continuous() || !ncs_shape_runs(p.a.rows, p.b.cols, p.c.rows) || !p.b_w.values.empty()) {
+    throw std::invalid_argument(p.source + ": study 'ncs' needs a continuous plant of " + kNcsShapesText + " and no B_w (this one: n = " +
+                                std::to_string(p.a.rows) + ", m = " + std::to_string(p.b.cols) + ", p = " + std::to_string(p.c.rows) + ")");
   }
-  for (std::size_t i = 0; i < kP; ++i)
-    for (std::size_t j = 0; j < kN; ++j)
+  for (std::size_t i = 0; i < p.c.rows; ++i)
+    for (std::size_t j = 0; j < p.a.rows; ++j)
       if (p.c(i, j) != (i == j ? 1.0 : 0.0)) throw std::invalid_argument(p.source + ": study 'ncs' needs C = I (eq. 10)");
   ctx->design_ = design::synthesize(p);
   if (!ctx->design_.tracking) {
     throw std::invalid_argument(p.source + ": no set-point feed-forward: " + ctx->design_.tracking_unavailable_reason);
   }
-  if (ctx->design_.u_min.size() != kM) throw std::invalid_argument(p.source + ": study 'ncs' needs an actuator range");
-  (void)ctx->controller_design(1.0);  // refuses plants without a board or LQR gain, naming why
+  if (ctx->design_.u_min.size() != p.b.cols) throw std::invalid_argument(p.source + ": study 'ncs' needs an actuator range");
+  // refuses plants without a board or LQR gain, naming why (the design of the plant's shape)
+#define ONESHOT_NCS_DESIGN_OF(n_, m_, p_) \
+  if (p.a.rows == (n_) && p.b.cols == (m_) && p.c.rows == (p_)) (void)ctx->controller_design_of<Shape<n_, m_, p_>>(1.0);
+  ONESHOT_NCS_SHAPES(ONESHOT_NCS_DESIGN_OF)
+#undef ONESHOT_NCS_DESIGN_OF
   return ctx;
 }
 
-Design Context::controller_design(double s) const {
-  Design d = design::controller_design<double, kN, kM, kP>(plant_, design_);
+template <typename S>
+typename S::Design Context::controller_design_of(double s) const {
+  typename S::Design d = design::controller_design<double, S::n, S::m, S::p>(plant_, design_);
   d.q_constant = d.q_constant * s;
   d.r = d.r * s;
   d.p0 = d.r * 10.0;  // brief §3: P⁻ = 10·R
   return d;
 }
 
-Disc::Model Context::discretizer_model(double s) const {
-  Disc::Model m = design::continuous_model_per_us<double, kN, kM>(plant_, design_);
+template <typename S>
+typename S::Disc::Model Context::discretizer_model_of(double s) const {
+  typename S::Disc::Model m = design::continuous_model_per_us<double, S::n, S::m>(plant_, design_);
   m.qc_per_us = m.qc_per_us * s;
   return m;
 }
+
+#define ONESHOT_NCS_CONTEXT_OF(n, m, p)                                                                      \
+  template Shape<n, m, p>::Design Context::controller_design_of<Shape<n, m, p>>(double) const;              \
+  template Shape<n, m, p>::Disc::Model Context::discretizer_model_of<Shape<n, m, p>>(double) const;
+ONESHOT_NCS_SHAPES(ONESHOT_NCS_CONTEXT_OF)
+#undef ONESHOT_NCS_CONTEXT_OF
 
 void set_steps(Scenario& sc, std::int64_t h_us, const std::vector<std::pair<double, double>>& steps,
                const std::vector<std::size_t>& lines, const std::string& source) {

@@ -28,8 +28,39 @@ inline constexpr std::size_t kN = 2;  ///< States v1, v2.
 inline constexpr std::size_t kM = 1;  ///< One input.
 inline constexpr std::size_t kP = 2;  ///< Both states measured (C = I).
 using Fmt = UniformFormat<double>;
-using Design = ControllerDesign<Fmt, kN, kM, kP>;
-using Disc = GenericDiscretizer<Fmt, kN, kM>;
+
+/// A loop's plant shape: n states, m inputs, p outputs, and the design types of that shape.
+/// The loops the study files run (I, S, SK, IK) take it as a template parameter
+/// (ncs_harness.hpp); ncs_loop.cpp instantiates them for each shape of ONESHOT_NCS_SHAPES.
+template <std::size_t N, std::size_t M, std::size_t P>
+struct Shape {
+  static constexpr std::size_t n = N;  ///< States.
+  static constexpr std::size_t m = M;  ///< Inputs.
+  static constexpr std::size_t p = P;  ///< Outputs.
+  using Design = ControllerDesign<Fmt, N, M, P>;  ///< The controller design of this shape.
+  using Disc = GenericDiscretizer<Fmt, N, M>;     ///< Its discretizer.
+};
+/// The board's shape (2, 1, 2): every approach runs on it (the others: I, S, SK, IK only).
+using BoardShape = Shape<kN, kM, kP>;
+/// The shapes the loops are instantiated for, as X(n, m, p) (the board's first): a first-order
+/// plant (1, 1, 1: the closed forms of a scalar loop are its oracles) and a cart-pole-like plant
+/// with its four states measured (4, 1, 4). Every shape has p = n and C = I: the reference loop
+/// I (and S) feed the sampled state back (node::StateFeedbackLaw takes y as x). Each shape costs
+/// one instantiation of the sampling loops in ncs_loop.cpp (compile time).
+#define ONESHOT_NCS_SHAPES(X) X(2, 1, 2) X(1, 1, 1) X(4, 1, 4)
+/// The shapes of ONESHOT_NCS_SHAPES in words, for refusals.
+inline constexpr const char* kNcsShapesText = "(n, m, p) = (2, 1, 2) (every approach), (1, 1, 1) or (4, 1, 4) (I, S, SK, IK), with C = I";
+/// True when the loops are instantiated for a plant of n states, m inputs, p outputs.
+constexpr bool ncs_shape_runs(std::size_t n, std::size_t m, std::size_t p) {
+#define ONESHOT_NCS_SHAPE_IS(n_, m_, p_) (n == (n_) && m == (m_) && p == (p_)) ||
+  return ONESHOT_NCS_SHAPES(ONESHOT_NCS_SHAPE_IS) false;
+#undef ONESHOT_NCS_SHAPE_IS
+}
+/// True for the board's shape (2, 1, 2): every approach, --analytic and the live run.
+constexpr bool board_shape(std::size_t n, std::size_t m, std::size_t p) { return n == kN && m == kM && p == kP; }
+
+using Design = BoardShape::Design;
+using Disc = BoardShape::Disc;
 
 /// The approaches of brief §5, in table order (I first: the reference of every ratio), then
 /// the one-shot loops of study files (kOneShotApproaches; not in study ncs's table).
@@ -44,6 +75,11 @@ inline constexpr std::array<Approach, 9> kAllApproaches = {Approach::kI,   Appro
 inline constexpr std::array<Approach, 3> kOneShotApproaches = {Approach::kOS, Approach::kOSp, Approach::kOSK};
 /// True for the one-shot loops (OS, OSp, OSK).
 constexpr bool one_shot(Approach a) { return a == Approach::kOS || a == Approach::kOSp || a == Approach::kOSK; }
+/// True for the approaches every shape of ONESHOT_NCS_SHAPES runs (I, S, SK, IK); the others
+/// run on the board's shape only.
+constexpr bool any_shape_approach(Approach a) {
+  return a == Approach::kI || a == Approach::kS || a == Approach::kSK || a == Approach::kIK;
+}
 /// True for the loops whose controller runs a Kalman filter with a covariance P (AK, AKx,
 /// AKl, SK, IK, OS, OSp, OSK): the ones with a NEES.
 constexpr bool filtered_approach(Approach a) {
@@ -164,6 +200,9 @@ class Context {
   static std::shared_ptr<const Context> load(const std::string& plant_path);
   /// The same from a plant description already parsed (a study file's inline plant).
   static std::shared_ptr<const Context> from(design::PlantDescription plant);
+  /// load() for the commands that run the board's shape only (the live run, its replay, the
+  /// fault table, the stationary costs): std::invalid_argument for another shape.
+  static std::shared_ptr<const Context> load_board(const std::string& plant_path);
 
   const design::PlantDescription& plant() const { return plant_; }  ///< The plant file.
   const design::DesignResult& design() const { return design_; }    ///< The design step's result.
@@ -171,9 +210,15 @@ class Context {
   const Timing& timing() const { return timing_; }                  ///< Delay/computation ranges.
 
   /// The controller design at noise scale s: R = s·R_n, Q = s·Q_n (constant), P0 = 10·R.
-  Design controller_design(double noise_scale) const;
+  Design controller_design(double noise_scale) const { return controller_design_of<BoardShape>(noise_scale); }
   /// The continuous model (per µs) at noise scale s (Q_c scaled), for the discretizer.
-  Disc::Model discretizer_model(double noise_scale) const;
+  Disc::Model discretizer_model(double noise_scale) const { return discretizer_model_of<BoardShape>(noise_scale); }
+  /// controller_design() for the plant of shape S (one of ONESHOT_NCS_SHAPES; the plant's own).
+  template <typename S>
+  typename S::Design controller_design_of(double noise_scale) const;
+  /// discretizer_model() for the plant of shape S.
+  template <typename S>
+  typename S::Disc::Model discretizer_model_of(double noise_scale) const;
   /// Worst τ_sc + τ_c + τ_ca of a scenario (µs): D of late sampling (std::invalid_argument
   /// when a leg of the study file has no upper bound).
   std::int32_t worst_chain_us(const Scenario& s) const;

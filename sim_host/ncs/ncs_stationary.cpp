@@ -331,7 +331,7 @@ void add_ncs_stationary_command(CLI::App* study) {
         o->approaches.push_back(ap);
       }
     }
-    const auto ctx = ncs::Context::load(*plant);
+    const auto ctx = ncs::Context::load_board(*plant);
     nlohmann::json j = ncs::stationary_table(*ctx, *o);
     j["experiment"] = "stationary";
     util::create_directories(*out);

@@ -155,6 +155,13 @@ NcsStudy map_ncs_study(const engine::StudyFile& file) {
       }
       out.links.push_back(l.name);
     }
+    {
+      const design::PlantDescription& pd = out.ctx->plant();
+      if (!file.buses.empty() && !ncs::board_shape(pd.a.rows, pd.b.cols, pd.c.rows)) {
+        refuse("buses", "the bus analysis takes the board's frames (2 outputs, 1 input): a plant of n = " + std::to_string(pd.a.rows) +
+                        " runs on point-to-point legs only");
+      }
+    }
     for (std::size_t b = 0; b < file.buses.size(); ++b) {
       bool used = false;
       for (const engine::LinkSpec& l : file.links) used = used || l.bus == file.buses[b].config.name;
@@ -174,6 +181,11 @@ NcsStudy map_ncs_study(const engine::StudyFile& file) {
       for (ncs::Approach k : ncs::kAllApproaches) known = known || a.kind == ncs::name(k);
       for (ncs::Approach k : ncs::kOneShotApproaches) known = known || a.kind == ncs::name(k);
       if (!known) refuse(f + ".kind", "unknown kind '" + a.kind + "' (I, S, A, AK, AKx, AKl, SK, S+, IK, OS, OSp, OSK)");
+      const design::PlantDescription& pd = out.ctx->plant();
+      if (!ncs::board_shape(pd.a.rows, pd.b.cols, pd.c.rows) && !ncs::any_shape_approach(ncs::parse_any_approach(a.kind))) {
+        refuse(f + ".kind", a.kind + " runs the board's plant (n = 2, m = 1, p = 2) only (its estimators, S+'s gain and the "
+                            "one-shot loops are 2-state); a plant of n = " + std::to_string(pd.a.rows) + " runs I, S, SK, IK");
+      }
       if (!a.params.empty()) refuse(f + ".params", "the ncs approaches take no parameters");
       if (a.name != a.kind) refuse(f + ".name", "must be its kind '" + a.kind + "' (the ncs table names approaches by kind)");
       const ncs::Approach ap = ncs::parse_any_approach(a.kind);

@@ -203,7 +203,8 @@ void add_one_shot(nlohmann::json& j, const engine::SweepResults& results) {
 /// the markdown.
 void add_nees(nlohmann::json& j, const engine::SweepResults& results) {
   const engine::SweepSpec& spec = results.spec;
-  std::string md = "\n| approach | NEES (n = " + std::to_string(ncs::kN) + ") | 95 % CI | filter steps |\n|---|---:|---:|---:|\n";
+  const std::size_t n = spec.config.contains("states") ? spec.config.at("states").get<std::size_t>() : ncs::kN;
+  std::string md = "\n| approach | NEES (n = " + std::to_string(n) + ") | 95 % CI | filter steps |\n|---|---:|---:|---:|\n";
   for (std::size_t a = 0; a < spec.approaches.size(); ++a) {
     if (!ncs::filtered_approach(ncs::parse_any_approach(spec.approaches[a]))) continue;
     const nlohmann::json e = nees_of(results, a);

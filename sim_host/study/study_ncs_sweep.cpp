@@ -215,6 +215,12 @@ engine::SweepResults run_ncs_sweep(const NcsStudy& s, std::size_t seeds, unsigne
   if (analytic && one_shot) {
     throw engine::InputError("field '--analytic': the one-shot approaches (OS, OSp, OSK) have no analytic cost");
   }
+  const design::PlantDescription& plant = s.ctx->plant();
+  const bool board = ncs::board_shape(plant.a.rows, plant.b.cols, plant.c.rows);
+  if (analytic && !board) {
+    throw engine::InputError("field '--analytic': the analytic tracker is 2-state: it runs the board's plant (n = 2, m = 1, p = 2) only, not n = " +
+                             std::to_string(plant.a.rows));
+  }
   const bool sensor_on_cpu = !s.scenarios.empty() && s.scenarios[0].sensor_cpu != nullptr;
   if (analytic && sensor_on_cpu) {
     throw engine::InputError("field '--analytic': no analytic cost with the sensor on a CPU (its samples lag kh by the schedule)");
@@ -263,6 +269,7 @@ engine::SweepResults run_ncs_sweep(const NcsStudy& s, std::size_t seeds, unsigne
                                         {"k_ref_max", x.mtm_k_ref_max}};
     }
   }
+  if (!board) spec.config["states"] = plant.a.rows;  // the NEES's n (only then: the board's spec stays as it was)
   if (analytic) {  // only then, as ncs table: the spec stays as it was without
     spec.config["analytic"] = true;
     spec.metrics.insert(spec.metrics.end(), std::begin(ncs::kAnalyticMetrics), std::end(ncs::kAnalyticMetrics));

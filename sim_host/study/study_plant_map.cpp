@@ -19,13 +19,13 @@ namespace {
 std::shared_ptr<const ncs::Context> inline_context(const engine::PlantSpec& plant, const std::string& source) {
   const engine::ContinuousModel& m = plant.continuous;
   const std::string g = "plant.continuous";
-  const std::string runs = "study ncs runs n = 2 states, m = 1 input, p = 2 outputs with C = I (other shapes need the "
-                           "ncs loop on other dimensions)";
-  if (m.a.rows != ncs::kN) refuse(g + ".A", "n = " + std::to_string(m.a.rows) + "; " + runs);
-  if (m.b.cols != ncs::kM) refuse(g + ".B", "m = " + std::to_string(m.b.cols) + "; " + runs);
-  if (m.c.rows != ncs::kP) refuse(g + ".C", "p = " + std::to_string(m.c.rows) + "; " + runs);
-  for (std::size_t i = 0; i < ncs::kP; ++i)
-    for (std::size_t j = 0; j < ncs::kN; ++j)
+  const std::string runs = std::string("study ncs runs ") + ncs::kNcsShapesText;
+  if (!ncs::ncs_shape_runs(m.a.rows, m.b.cols, m.c.rows)) {
+    refuse(g + ".A", "n = " + std::to_string(m.a.rows) + ", m = " + std::to_string(m.b.cols) + ", p = " + std::to_string(m.c.rows) +
+                         "; " + runs);
+  }
+  for (std::size_t i = 0; i < m.c.rows; ++i)
+    for (std::size_t j = 0; j < m.a.rows; ++j)
       if (m.c(i, j) != (i == j ? 1.0 : 0.0)) refuse(g + ".C", "is not the identity; " + runs);
   if (!plant.design) {
     refuse(g + ".measurement_covariance",

@@ -9,6 +9,7 @@
 #include <cstring>
 #include <random>
 
+#include "ncs_loop.hpp"
 #include "ncs_reference.hpp"
 #include "ncs_test_support.hpp"
 #include "oneshot/host/host_network.hpp"
@@ -324,6 +325,50 @@ TEST(NcsReference, TheSquareWaveFollowsItsLawAndSwitchesWhereTheSignFlips) {
     for (std::size_t i = 0; i < sw.size(); ++i) EXPECT_EQ(sw[i], (i + 1) * half);
     EXPECT_EQ(sw.size(), (60 - 1) / half);
   }
+}
+
+TEST(NcsShapes, TheMeasurementFactorOfAnyOutputCountMultipliesBackToItsCovariance) {
+  // The oracle: L Lᵀ = R to rounding for a regular R of 1, 2, 3 and 4 outputs (L lower, its
+  // diagonal positive), and a column of 0 for a singular R (noise scale 0).
+  std::mt19937_64 gen(26);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  const auto check = [&](auto r, double tol) {
+    constexpr std::size_t kDim = decltype(r)::kRows;
+    const auto l = lower_cholesky<kDim>(r);
+    for (std::size_t i = 0; i < kDim; ++i) {
+      EXPECT_GT(l(i, i), 0.0);
+      for (std::size_t j = 0; j < kDim; ++j) {
+        if (j > i) {
+          EXPECT_EQ(l(i, j), 0.0);
+        }
+        double s = 0;
+        for (std::size_t k = 0; k < kDim; ++k) s += l(i, k) * l(j, k);
+        EXPECT_NEAR(s, r(i, j), tol) << kDim << " " << i << " " << j;
+      }
+    }
+  };
+  const auto random_spd = [&](auto zero) {  // G Gᵀ + I: symmetric positive definite
+    decltype(zero) g{}, r{};
+    constexpr std::size_t kDim = decltype(zero)::kRows;
+    for (std::size_t i = 0; i < kDim; ++i)
+      for (std::size_t j = 0; j < kDim; ++j) g(i, j) = u(gen);
+    for (std::size_t i = 0; i < kDim; ++i)
+      for (std::size_t j = 0; j < kDim; ++j) {
+        r(i, j) = i == j ? 1.0 : 0.0;
+        for (std::size_t k = 0; k < kDim; ++k) r(i, j) += g(i, k) * g(j, k);
+      }
+    return r;
+  };
+  for (int trial = 0; trial < 20; ++trial) {
+    check(random_spd(Matrix<double, 1, 1>{}), 1e-14);
+    check(random_spd(Matrix<double, 2, 2>{}), 1e-13);
+    check(random_spd(Matrix<double, 3, 3>{}), 1e-13);
+    check(random_spd(Matrix<double, 4, 4>{}), 1e-13);
+  }
+  const Matrix<double, 2, 2> zero{};
+  const auto l0 = lower_cholesky<2>(zero);
+  for (std::size_t i = 0; i < 2; ++i)
+    for (std::size_t j = 0; j < 2; ++j) EXPECT_EQ(l0(i, j), 0.0);
 }
 
 }  // namespace
