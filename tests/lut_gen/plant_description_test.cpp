@@ -209,7 +209,10 @@ TEST(PlantDescription, DiscreteFormParses) {
   EXPECT_EQ(p.tracked_outputs, std::vector<std::size_t>{0});
 }
 
-TEST(PlantDescription, DiscreteFormRefusesContinuousOnlyFields) {
+// Continuous-only keys: an intensity is refused; a continuous cost or a table makes the
+// parser read the plant as its exact continuous equivalent (zoh_inverse), refused naming the
+// per-step covariance when no Q_c gives it, naming Phi when Φ has no real principal logarithm.
+TEST(PlantDescription, DiscreteFormRefusesContinuousOnlyFieldsOrReadsItsContinuousEquivalent) {
   nlohmann::json j = nlohmann::json::parse(kDiscrete);
   nlohmann::json bad = j;
   bad["noise"]["process_intensity"] = bad["noise"]["process_covariance_per_period"];
@@ -218,10 +221,22 @@ TEST(PlantDescription, DiscreteFormRefusesContinuousOnlyFields) {
             std::string::npos);
   bad = j;
   bad["table"] = {{"granularity_us", 1000}, {"range_us", 10000}, {"max_bytes", 256}};
-  EXPECT_NE(error_of(bad.dump()).find("field 'table': a Phi(tau) table needs a continuous plant"), std::string::npos);
-  bad = j;
   bad["cost"] = {{"Q1c", j["cost"]["Q1"]}, {"Q2c", j["cost"]["Q2"]}};
-  EXPECT_NE(error_of(bad.dump()).find("a continuous cost needs a continuous plant"), std::string::npos);
+  // 20·I per step is no white noise's sampling through this Φ (its Q_c is indefinite).
+  EXPECT_NE(error_of(bad.dump()).find("field 'noise.process_covariance_per_period': the continuous intensity Q_c"),
+            std::string::npos) << error_of(bad.dump());
+  bad["noise"]["process_covariance_per_period"] = {{0, 0, 0}, {0, 0, 0}, {0, 0, 0}};
+  const PlantDescription p = parse_plant(bad.dump(), "equivalent.json");
+  EXPECT_TRUE(p.continuous());
+  EXPECT_TRUE(p.from_discrete);
+  EXPECT_TRUE(p.has_table);
+  EXPECT_EQ(p.cost_form, CostForm::kContinuous);
+  EXPECT_LT(p.d2c_relative_error, 1e-14);
+  EXPECT_EQ(p.phi.rows, 0U);
+  EXPECT_DOUBLE_EQ(p.d2c_phi(0, 0), 1.25);
+  bad["Phi"][0][0] = -1.25;
+  EXPECT_NE(error_of(bad.dump()).find("field 'Phi': eigenvalue -1.25 on the negative real axis"), std::string::npos)
+      << error_of(bad.dump());
   bad = j;
   bad["A"] = j["Phi"];
   EXPECT_NE(error_of(bad.dump()).find("field 'A': belongs to the continuous form"), std::string::npos);
