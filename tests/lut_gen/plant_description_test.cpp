@@ -7,7 +7,9 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 
+#include "oneshot/design/dense_ops.hpp"
 #include "oneshot/design/plant_description.hpp"
+#include "oneshot/design/sampled_model.hpp"
 #include "support/run_command.hpp"
 #include "support/test_plants.hpp"
 #include "support/expect_error.hpp"
@@ -225,8 +227,21 @@ TEST(PlantDescription, DiscreteFormRefusesContinuousOnlyFieldsOrReadsItsContinuo
   // 20·I per step is no white noise's sampling through this Φ (its Q_c is indefinite).
   EXPECT_NE(error_of(bad.dump()).find("field 'noise.process_covariance_per_period': the continuous intensity Q_c"),
             std::string::npos) << error_of(bad.dump());
-  bad["noise"]["process_covariance_per_period"] = {{0, 0, 0}, {0, 0, 0}, {0, 0, 0}};
+  // A consistent one: Q_d of Q_c = I through the continuous equivalent (Van Loan).
+  const PlantDescription disc = parse_plant(kDiscrete, "discrete.json");
+  const DenseMatrix a = zoh_inverse(disc.phi, disc.gamma, 0.01).a;
+  DenseMatrix vl = DenseMatrix::zeros(6, 6);
+  set_block(vl, 0, 0, -a * 0.01);
+  set_block(vl, 0, 3, identity(3) * 0.01);
+  set_block(vl, 3, 3, transpose(a) * 0.01);
+  const DenseMatrix e = expm(vl, "test");
+  DenseMatrix qd = transpose(block(e, 3, 3, 3, 3)) * block(e, 0, 3, 3, 3);
+  symmetrize(qd);
+  bad["noise"]["process_covariance_per_period"] = {{qd(0, 0), qd(0, 1), qd(0, 2)}, {qd(1, 0), qd(1, 1), qd(1, 2)},
+                                                   {qd(2, 0), qd(2, 1), qd(2, 2)}};
   const PlantDescription p = parse_plant(bad.dump(), "equivalent.json");
+  EXPECT_LT(p.d2c_noise_relative_error, 1e-13);
+  EXPECT_NEAR(p.process_intensity(1, 1), 1.0, 1e-12);
   EXPECT_TRUE(p.continuous());
   EXPECT_TRUE(p.from_discrete);
   EXPECT_TRUE(p.has_table);
