@@ -4,6 +4,7 @@
 
 #include <cmath>
 
+#include "oneshot/design/sampled_model.hpp"
 #include "plant_json_reader.hpp"
 #include "plant_parts.hpp"
 
@@ -184,6 +185,40 @@ void parse_sections(const json& root, PlantDescription& p, const Checker& check)
   within_limit(check, "sections.disturbance", p.b_w.cols, kMaxDisturbances, "disturbance inputs", "kMaxDisturbances");
 }
 
+/// Whether the root holds what only a continuous plant takes: cost.Q1c or Q2c, a board, a table.
+bool wants_continuous(const json& root) {
+  if (root.contains("board") || root.contains("table")) return true;
+  const auto cost = root.find("cost");
+  return cost != root.end() && cost->is_object() && (cost->contains("Q1c") || cost->contains("Q2c"));
+}
+
+/// The discrete plant `p` (matrices and per-step noise read) replaced by its exact continuous
+/// equivalent (zoh_inverse); refusals name Phi, B_w or noise.process_covariance_per_period.
+void to_continuous_equivalent(PlantDescription& p, const Checker& check) {
+  const std::string why = " (a discrete plant with cost.Q1c/Q2c, a board or a table is read as its continuous equivalent)";
+  if (p.q() != 0) check.fail("B_w", "a per-step disturbance input has no continuous equivalent here" + why);
+  ZohInverse r;
+  try {
+    r = zoh_inverse(p.phi, p.gamma, static_cast<double>(p.period_us) * 1e-6, p.process_covariance_per_period);
+  } catch (const ZohInverseError& e) {
+    check.fail(e.part() == ZohInverseError::Part::kPhi ? "Phi" : "noise.process_covariance_per_period", e.what() + why);
+  } catch (const std::exception& e) {
+    check.fail("Phi", e.what() + why);
+  }
+  p.form = PlantForm::kContinuous;
+  p.from_discrete = true;
+  p.d2c_relative_error = r.relative_error;
+  p.d2c_noise_relative_error = r.noise_relative_error;
+  p.d2c_phi = std::move(p.phi);
+  p.d2c_gamma = std::move(p.gamma);
+  p.phi = {};
+  p.gamma = {};
+  p.a = std::move(r.a);
+  p.b = std::move(r.b);
+  p.process_intensity = std::move(r.qc);
+  p.process_covariance_per_period = {};
+}
+
 }  // namespace
 
 const char* to_string(PlantForm f) {
@@ -229,8 +264,15 @@ PlantDescription parse_plant(const std::string& json_text, const std::string& so
   p.outputs = check.names(root, "outputs", p.p(), "y");
   p.disturbances = check.names(root, "disturbances", p.q(), "w");
 
+  // A discrete plant with what only a continuous one takes: its exact continuous equivalent,
+  // from the per-step noise (read as the discrete form reads it) on.
+  const bool equivalent = p.form == PlantForm::kDiscrete && wants_continuous(root);
+  if (equivalent) {
+    detail::parse_noise(root, p, check);
+    to_continuous_equivalent(p, check);
+  }
   detail::parse_cost(root, p, check);
-  detail::parse_noise(root, p, check);
+  if (!equivalent) detail::parse_noise(root, p, check);
   detail::parse_tracked_outputs(root, p, check);
   detail::parse_table(root, p, check);
   detail::parse_board_or_actuator(root, p, check);

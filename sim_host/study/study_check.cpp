@@ -89,11 +89,19 @@ json plant_section(const engine::StudyFile& f, json& designs) {
       }
       break;
     case engine::PlantSpec::Kind::kDiscrete:
-      j = {{"kind", "discrete"}, {"n", f.plant.discrete.phi.rows}, {"m", f.plant.discrete.gamma.cols},
-           {"p", f.plant.discrete.c.rows}, {"period_us", to_us(f.plant.discrete.period)}, {"designed", false},
-           {"why_not_designed", f.study == "ncs" ? std::string(kDiscretePlantRefusal)
-                                                  : std::string("an inline discrete plant carries no measurement covariance")}};
-      return j;
+      if (!f.plant.design) {
+        j = {{"kind", "discrete"}, {"n", f.plant.discrete.phi.rows}, {"m", f.plant.discrete.gamma.cols},
+             {"p", f.plant.discrete.c.rows}, {"period_us", to_us(f.plant.discrete.period)}, {"designed", false},
+             {"why_not_designed", "no design keys: give measurement_covariance, Q1c, Q2c and a board (the plant then runs as "
+                                  "its exact continuous equivalent)"}};
+        return j;
+      }
+      p = *f.plant.design;
+      field = "plant.discrete";
+      if (p.cost_form == design::CostForm::kNone) {
+        throw InputError("field 'plant.discrete.Q1c': missing: no LQR gain without Q1c and Q2c");
+      }
+      break;
     case engine::PlantSpec::Kind::kFile: {
       const std::string path = plant_file_path(f);
       try {
@@ -114,10 +122,17 @@ json plant_section(const engine::StudyFile& f, json& designs) {
   if (f.plant.kind == engine::PlantSpec::Kind::kFile) {
     j = {{"kind", "file"}, {"file", p.source}};
   } else {
-    j = {{"kind", "continuous"}};
+    j = {{"kind", f.plant.kind == engine::PlantSpec::Kind::kDiscrete ? "discrete" : "continuous"}};
   }
   j.update({{"name", p.name}, {"form", design::to_string(p.form)}, {"n", p.n()}, {"m", p.m()}, {"p", p.p()},
             {"period_us", p.period_us}, {"designed", true}});
+  if (p.from_discrete) {  // the exact continuous equivalent the loop runs (design::zoh_inverse)
+    j["continuous_equivalent"] = {{"A", rows(p.a)},
+                                  {"B", rows(p.b)},
+                                  {"Q_c", rows(p.process_intensity)},
+                                  {"reconstruction_relative_error", p.d2c_relative_error},
+                                  {"noise_relative_error", p.d2c_noise_relative_error}};
+  }
   designs["lqr_gain"] = rows(d.l);
   designs["closed_loop_spectral_radius"] = d.closed_loop_radius;
   designs["kalman_gain"] = rows(d.kalman_gain);
@@ -298,6 +313,12 @@ std::string describe_resolution(const json& r) {
     o << "plant: " << p.at("kind").get<std::string>() << ", n = " << p.at("n") << ", m = " << p.at("m") << ", p = " << p.at("p");
     if (p.contains("name")) o << " (" << p.at("name").get<std::string>() << ", h = " << p.at("period_us") << " us)";
     o << "\n";
+    if (p.contains("continuous_equivalent")) {
+      const json& e = p.at("continuous_equivalent");
+      o << "  runs as its exact continuous equivalent (ZOH inverse): A = " << e.at("A").dump() << ", B = " << e.at("B").dump()
+        << ", Q_c = " << e.at("Q_c").dump() << "; sampled back at h: relative error " << e.at("reconstruction_relative_error")
+        << " (Phi, Gamma), " << e.at("noise_relative_error") << " (Q)\n";
+    }
   };
   const auto approach_lines = [&o](const json& list, const char* indent) {
   for (const json& a : list) {

@@ -14,23 +14,29 @@
 namespace oneshot::study {
 namespace {
 
-/// The ncs context of an inline continuous plant: the shape the loop runs (n = 2, m = 1, p = 2,
-/// C = I), the design keys, then the same design step as a plant file; refusals name the key.
+/// The ncs context of an inline plant (continuous, or discrete read as its exact continuous
+/// equivalent): a shape the loop runs (ncs::kNcsShapesText, C = I), the design keys, then the
+/// same design step as a plant file; refusals name the key under `g`.
 std::shared_ptr<const ncs::Context> inline_context(const engine::PlantSpec& plant, const std::string& source) {
-  const engine::ContinuousModel& m = plant.continuous;
-  const std::string g = "plant.continuous";
+  const bool discrete = plant.kind == engine::PlantSpec::Kind::kDiscrete;
+  const engine::DenseMatrix& a = discrete ? plant.discrete.phi : plant.continuous.a;
+  const engine::DenseMatrix& b = discrete ? plant.discrete.gamma : plant.continuous.b;
+  const engine::DenseMatrix& c = discrete ? plant.discrete.c : plant.continuous.c;
+  const std::string g = discrete ? "plant.discrete" : "plant.continuous";
   const std::string runs = std::string("study ncs runs ") + ncs::kNcsShapesText;
-  if (!ncs::ncs_shape_runs(m.a.rows, m.b.cols, m.c.rows)) {
-    refuse(g + ".A", "n = " + std::to_string(m.a.rows) + ", m = " + std::to_string(m.b.cols) + ", p = " + std::to_string(m.c.rows) +
-                         "; " + runs);
+  if (!ncs::ncs_shape_runs(a.rows, b.cols, c.rows)) {
+    refuse(g + (discrete ? ".Phi" : ".A"), "n = " + std::to_string(a.rows) + ", m = " + std::to_string(b.cols) +
+                                               ", p = " + std::to_string(c.rows) + "; " + runs);
   }
-  for (std::size_t i = 0; i < m.c.rows; ++i)
-    for (std::size_t j = 0; j < m.a.rows; ++j)
-      if (m.c(i, j) != (i == j ? 1.0 : 0.0)) refuse(g + ".C", "is not the identity; " + runs);
+  for (std::size_t i = 0; i < c.rows; ++i)
+    for (std::size_t j = 0; j < a.rows; ++j)
+      if (c(i, j) != (i == j ? 1.0 : 0.0)) refuse(g + ".C", "is not the identity; " + runs);
   if (!plant.design) {
     refuse(g + ".measurement_covariance",
-           "missing: the ncs design needs the plant file's keys inline (period_us, measurement_covariance, Q1c, Q2c, "
-           "board)");
+           discrete ? "missing: the ncs design needs the plant file's keys inline (measurement_covariance, Q1c, Q2c, board); "
+                      "the plant then runs as its exact continuous equivalent"
+                    : "missing: the ncs design needs the plant file's keys inline (period_us, measurement_covariance, Q1c, "
+                      "Q2c, board)");
   }
   if (plant.design->cost_form == design::CostForm::kNone) refuse(g + ".Q1c", "missing: the ncs loop's LQR gain needs Q1c and Q2c");
   if (!plant.design->has_board) {
@@ -55,14 +61,12 @@ std::string plant_file_path(const engine::StudyFile& file) {
 }
 
 NcsPlant map_ncs_plant(const engine::StudyFile& file) {
-  if (file.plant.kind == engine::PlantSpec::Kind::kDiscrete) {
-    refuse("plant.discrete", kDiscretePlantRefusal);
-  }
   NcsPlant out;
   out.covariance_field = "plant.file";
-  if (file.plant.kind == engine::PlantSpec::Kind::kContinuous) {
+  if (file.plant.kind != engine::PlantSpec::Kind::kFile) {
     out.ctx = inline_context(file.plant, file.source);
-    out.covariance_field = "plant.continuous.measurement_covariance";
+    out.covariance_field = file.plant.kind == engine::PlantSpec::Kind::kDiscrete ? "plant.discrete.measurement_covariance"
+                                                                                  : "plant.continuous.measurement_covariance";
   } else {
     out.plant_path = plant_file_path(file);
     try {

@@ -102,6 +102,13 @@ void check_plant(const e::PlantSpec& p) {
     require_psd(m.q, "plant.discrete.Q");
     require_psd(m.q1, "plant.discrete.Q1");
     require_psd(m.q2, "plant.discrete.Q2");
+    if (p.design) {  // the design keys: the plant file of form discrete (continuous equivalent with Q1c/Q2c or a board)
+      const oneshot::design::PlantDescription& d = *p.design;
+      require(d.n() == m.phi.rows && d.m() == m.gamma.cols && d.p() == m.c.rows, "plant.discrete: design of another shape");
+      require(!d.from_discrete || (d.continuous() && d.d2c_relative_error <= 1e-10),
+              "plant.discrete: a continuous equivalent that does not sample back to Phi, Gamma");
+      require_psd(d.measurement_covariance, "plant.discrete.measurement_covariance");
+    }
   } else {
     require(!p.file.empty(), "plant: empty file name");
   }

@@ -7,7 +7,9 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 
+#include "oneshot/design/dense_ops.hpp"
 #include "oneshot/design/plant_description.hpp"
+#include "oneshot/design/sampled_model.hpp"
 #include "support/run_command.hpp"
 #include "support/test_plants.hpp"
 #include "support/expect_error.hpp"
@@ -209,7 +211,10 @@ TEST(PlantDescription, DiscreteFormParses) {
   EXPECT_EQ(p.tracked_outputs, std::vector<std::size_t>{0});
 }
 
-TEST(PlantDescription, DiscreteFormRefusesContinuousOnlyFields) {
+// Continuous-only keys: an intensity is refused; a continuous cost or a table makes the
+// parser read the plant as its exact continuous equivalent (zoh_inverse), refused naming the
+// per-step covariance when no Q_c gives it, naming Phi when Φ has no real principal logarithm.
+TEST(PlantDescription, DiscreteFormRefusesContinuousOnlyFieldsOrReadsItsContinuousEquivalent) {
   nlohmann::json j = nlohmann::json::parse(kDiscrete);
   nlohmann::json bad = j;
   bad["noise"]["process_intensity"] = bad["noise"]["process_covariance_per_period"];
@@ -218,10 +223,35 @@ TEST(PlantDescription, DiscreteFormRefusesContinuousOnlyFields) {
             std::string::npos);
   bad = j;
   bad["table"] = {{"granularity_us", 1000}, {"range_us", 10000}, {"max_bytes", 256}};
-  EXPECT_NE(error_of(bad.dump()).find("field 'table': a Phi(tau) table needs a continuous plant"), std::string::npos);
-  bad = j;
   bad["cost"] = {{"Q1c", j["cost"]["Q1"]}, {"Q2c", j["cost"]["Q2"]}};
-  EXPECT_NE(error_of(bad.dump()).find("a continuous cost needs a continuous plant"), std::string::npos);
+  // 20·I per step is no white noise's sampling through this Φ (its Q_c is indefinite).
+  EXPECT_NE(error_of(bad.dump()).find("field 'noise.process_covariance_per_period': the continuous intensity Q_c"),
+            std::string::npos) << error_of(bad.dump());
+  // A consistent one: Q_d of Q_c = I through the continuous equivalent (Van Loan).
+  const PlantDescription disc = parse_plant(kDiscrete, "discrete.json");
+  const DenseMatrix a = zoh_inverse(disc.phi, disc.gamma, 0.01).a;
+  DenseMatrix vl = DenseMatrix::zeros(6, 6);
+  set_block(vl, 0, 0, -a * 0.01);
+  set_block(vl, 0, 3, identity(3) * 0.01);
+  set_block(vl, 3, 3, transpose(a) * 0.01);
+  const DenseMatrix e = expm(vl, "test");
+  DenseMatrix qd = transpose(block(e, 3, 3, 3, 3)) * block(e, 0, 3, 3, 3);
+  symmetrize(qd);
+  bad["noise"]["process_covariance_per_period"] = {{qd(0, 0), qd(0, 1), qd(0, 2)}, {qd(1, 0), qd(1, 1), qd(1, 2)},
+                                                   {qd(2, 0), qd(2, 1), qd(2, 2)}};
+  const PlantDescription p = parse_plant(bad.dump(), "equivalent.json");
+  EXPECT_LT(p.d2c_noise_relative_error, 1e-13);
+  EXPECT_NEAR(p.process_intensity(1, 1), 1.0, 1e-12);
+  EXPECT_TRUE(p.continuous());
+  EXPECT_TRUE(p.from_discrete);
+  EXPECT_TRUE(p.has_table);
+  EXPECT_EQ(p.cost_form, CostForm::kContinuous);
+  EXPECT_LT(p.d2c_relative_error, 1e-14);
+  EXPECT_EQ(p.phi.rows, 0U);
+  EXPECT_DOUBLE_EQ(p.d2c_phi(0, 0), 1.25);
+  bad["Phi"][0][0] = -1.25;
+  EXPECT_NE(error_of(bad.dump()).find("field 'Phi': eigenvalue -1.25 on the negative real axis"), std::string::npos)
+      << error_of(bad.dump());
   bad = j;
   bad["A"] = j["Phi"];
   EXPECT_NE(error_of(bad.dump()).find("field 'A': belongs to the continuous form"), std::string::npos);

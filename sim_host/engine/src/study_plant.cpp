@@ -103,9 +103,12 @@ void linear_model(const json& c, const std::string& g, const std::array<const ch
   psd(*out[6], in.cols, field(6));
 }
 
-/// The plant-file field a design error names, as the inline key (noise.* and cost.* are flat inline).
+/// The plant-file field a design error names, as the inline key (noise.* and cost.* are flat inline;
+/// a discrete plant's per-step covariance is Q, its disturbance input Gamma_w).
 std::string inline_key(const std::string& plant_file_field) {
   if (plant_file_field == "noise.process_intensity") return "Q_c";
+  if (plant_file_field == "noise.process_covariance_per_period") return "Q";
+  if (plant_file_field == "B_w") return "Gamma_w";
   if (plant_file_field.rfind("noise.", 0) == 0 || plant_file_field.rfind("cost.", 0) == 0) {
     return plant_file_field.substr(plant_file_field.find('.') + 1);
   }
@@ -150,6 +153,48 @@ std::shared_ptr<const design::PlantDescription> inline_design(const json& c, con
   }
 }
 
+/// The design keys of an inline discrete plant (its period_us is the sampling period h).
+constexpr std::array<const char*, 10> kDiscreteDesignKeys = {"measurement_covariance", "Q1c",     "Q2c",   "name",
+                                                             "states",  "inputs", "outputs", "tracked_outputs",
+                                                             "actuator", "board"};
+
+/// The plant-file description of an inline discrete plant with design keys: the plant file of
+/// form discrete (Phi, Gamma, C, period_us, names, cost {Q1c, Q2c}, noise {process_covariance_per_period
+/// = Q, measurement_covariance}, actuator or board), which the plant-file parser reads as its exact
+/// continuous equivalent (d2c) when it has Q1c/Q2c or a board; errors name the inline key.
+std::shared_ptr<const design::PlantDescription> inline_discrete_design(const json& c, const std::string& g,
+                                                                       const DiscreteModel& m) {
+  if (!c.contains("measurement_covariance")) {
+    throw InputError("field '" + g + ".measurement_covariance': missing (an inline discrete plant with design keys needs it)");
+  }
+  if (m.gamma_w.rows != 0) {
+    throw InputError("field '" + g + ".Gamma_w': the design step takes no disturbance input in an inline plant (give a "
+                     "plant file with its disturbance noise)");
+  }
+  for (const char* k : {"Q1", "Q2"})
+    if (c.contains(k)) {
+      throw InputError("field '" + g + "." + k + "': with the design keys the cost is the continuous plant's: give Q1c "
+                       "and Q2c (the design is then the same as for the continuous equivalent)");
+    }
+  static_cast<void>(integer_in(c, g, "period_us", 1, 60'000'000));
+  const DenseMatrix r = matrix(c, g, "measurement_covariance", false);
+  psd(r, m.c.rows, g + ".measurement_covariance");
+  json f = json::object();
+  f["name"] = c.contains("name") ? c["name"] : json("inline");
+  f["form"] = "discrete";
+  for (const char* k : {"Phi", "Gamma", "C", "period_us", "states", "inputs", "outputs", "tracked_outputs", "actuator", "board"})
+    if (c.contains(k)) f[k] = c[k];
+  for (const char* k : {"Q1c", "Q2c"})
+    if (c.contains(k)) f["cost"][k] = c[k];
+  f["noise"] = {{"process_covariance_per_period", c["Q"]}, {"measurement_covariance", c["measurement_covariance"]}};
+  try {
+    return std::make_shared<const design::PlantDescription>(design::parse_plant(f.dump(), g));
+  } catch (const design::PlantError& e) {
+    if (e.field().empty()) throw InputError("field '" + g + "': " + e.what());
+    throw InputError("field '" + g + "." + inline_key(e.field()) + "': " + e.reason());
+  }
+}
+
 }  // namespace
 
 PlantSpec parse_plant(const json& j, const std::string& f) {
@@ -176,11 +221,15 @@ PlantSpec parse_plant(const json& j, const std::string& f) {
   }
   const std::string g = f + ".discrete";
   const json& c = j["discrete"];
-  require_keys(c, g, {"Phi", "Gamma", "Gamma_w", "C", "Q", "Q1", "Q2", "period_us"});
+  require_keys(c, g, {"Phi", "Gamma", "Gamma_w", "C", "Q", "Q1", "Q2", "period_us", "measurement_covariance", "Q1c", "Q2c",
+                      "name", "states", "inputs", "outputs", "tracked_outputs", "actuator", "board"});
   p.kind = PlantSpec::Kind::kDiscrete;
   DiscreteModel& m = p.discrete;
   linear_model(c, g, {"Phi", "Gamma", "Gamma_w", "C", "Q", "Q1", "Q2"}, {&m.phi, &m.gamma, &m.gamma_w, &m.c, &m.q, &m.q1, &m.q2});
   m.period = from_us(integer_in(c, g, "period_us", 1, 3'600'000'000));
+  bool designed = false;
+  for (const char* k : kDiscreteDesignKeys) designed = designed || c.contains(k);
+  if (designed) p.design = inline_discrete_design(c, g, m);
   return p;
 }
 

@@ -4,7 +4,9 @@
 /// A JSON object in one of three forms (README, "Plant description"):
 ///  * "continuous" (default): A, B, C, period h; process noise as an intensity Q_c or a
 ///    per-period covariance; cost continuous (Q1c, Q2c) or discrete (Q1|Qy, Q2);
-///  * "discrete": Φ, Γ, C per step T; per-step process covariance; discrete cost;
+///  * "discrete": Φ, Γ, C per step T; per-step process covariance; discrete cost; with a
+///    continuous cost (Q1c, Q2c), a board or a table it is read as its exact continuous
+///    equivalent (zoh_inverse: the form becomes continuous, `from_discrete` set);
 ///  * "sections": transfer-function sections realized into the discrete form
 ///    (plant_sections.hpp), with an optional disturbance model appended as exogenous states.
 /// Every field is checked; an error names the field and what is wrong, so a bad file never
@@ -109,6 +111,16 @@ struct PlantDescription {
   BoardDescription board;                  ///< Emulated board (when has_board).
   bool has_actuator_range = false;         ///< Whether an `actuator` range was given (no PWM board).
   std::vector<double> u_min, u_max;        ///< Actuator range per input (board: the PWM levels).
+
+  /// A discrete plant (Φ, Γ, Q_d per step) read as its exact continuous equivalent, because it
+  /// carries a continuous cost (cost.Q1c, Q2c), a board or a table: A, B from the principal
+  /// logarithm of [[Φ, Γ], [0, I]] over h, Q_c whose Van Loan sampling is Q_d (sampled_model.hpp
+  /// zoh_inverse); the form is then continuous and phi, gamma, process_covariance_per_period empty.
+  bool from_discrete = false;
+  double d2c_relative_error = 0;        ///< from_discrete: ‖e^{[[A, B], [0, 0]]h} − [[Φ, Γ], [0, I]]‖₁ relative.
+  double d2c_noise_relative_error = 0;  ///< from_discrete: ‖Q_d(Q_c) − Q_d‖₁ relative.
+  DenseMatrix d2c_phi;                  ///< from_discrete: the Φ given.
+  DenseMatrix d2c_gamma;                ///< from_discrete: the Γ given.
 
   bool has_sections = false;               ///< Sections form: the specification the model was realized from.
   SectionsDescription sections;            ///< The sections (when has_sections).

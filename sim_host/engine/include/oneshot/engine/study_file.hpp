@@ -67,7 +67,10 @@ struct PlantSpec {
   ContinuousModel continuous;  ///< kContinuous: the matrices.
   DiscreteModel discrete;      ///< kDiscrete: the matrices and period.
   /// kContinuous with the design keys (period_us, measurement_covariance, ...): the same
-  /// description a plant file with these keys gives (design::parse_plant), else null.
+  /// description a plant file with these keys gives (design::parse_plant), else null. kDiscrete
+  /// with the design keys (measurement_covariance, Q1c, Q2c, names, actuator or board): the plant
+  /// file of form discrete, read with Q1c/Q2c or a board as its exact continuous equivalent
+  /// (PlantDescription::from_discrete), else null.
   std::shared_ptr<const design::PlantDescription> design;
 };
 
