@@ -173,7 +173,7 @@ RunMetrics run_impl(const DroppingPlant& plant, const RunConfig& cfg, std::uint6
       out.stale += 1;
     }
   });
-  // The controller's frame checks: y finite, stamp not after the period it arrives in (a
+  // The controller's frame checks: CRC-16 (corrupt), y finite, stamp not after the period it arrives in (a
   // genuine sample arrives at least half a period after it was taken), then the buffer's
   // window (over-delayed, duplicate) or, for the unaware KF, newer than the period's newest.
   engine::HandlerId deliver_frame{};
@@ -181,7 +181,11 @@ RunMetrics run_impl(const DroppingPlant& plant, const RunConfig& cfg, std::uint6
     deliver_frame = kernel.add_handler("deliver frame", [&](std::uint64_t i) {
       std::uint32_t j = 0;
       double yj = 0;
-      if (!engine::decode_sequenced_frame(frames[i], j, &yj, 1)) return;  // every fault keeps the size
+      switch (engine::decode_sequenced_frame(frames[i], j, &yj, 1)) {
+        case engine::SequencedFrameStatus::kOk: break;
+        case engine::SequencedFrameStatus::kCorrupt: out.corrupt += 1; return;  // a lost sample (γ = 0)
+        case engine::SequencedFrameStatus::kMalformed: throw std::logic_error("dropping: a frame changed its size");  // no fault does
+      }
       if (!std::isfinite(yj)) {
         out.refused_non_finite += 1;
         return;

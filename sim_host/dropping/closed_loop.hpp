@@ -11,9 +11,10 @@
 /// r_k: ±1 square wave, 4 s period. x₀ ~ N(0, P₀), x̂₀ = 0.
 ///
 /// With a fault spec (RunConfig::faults; docs/faults.md, "Study dropping") each sample
-/// travels as a frame [j: u32][y: f64] (engine/sequenced_frame.hpp) through the link
+/// travels as a frame [j: u32][y: f64][crc: u16] (engine/sequenced_frame.hpp) through the link
 /// "sensor"'s engine::LinkFaults before the link's delay and loss draws (or the Bernoulli
-/// channel's draw); the controller decodes it and refuses a non-finite y
+/// channel's draw); the controller decodes it, refuses a frame whose CRC-16 does not match
+/// (corrupt: a flipped bit; the sample is lost, as a lost packet), then a non-finite y
 /// (refused_non_finite) and a stamp not yet sampled, j > the period it arrives in
 /// (refused_sequence: a forged or corrupted stamp), before the threshold buffer (which drops
 /// over-delayed stamps and duplicates) or the delay-unaware KF (which takes only a stamp
@@ -91,6 +92,7 @@ struct RunMetrics {
   double duplicates = 0;       ///< Duplicate packets ignored.
   double reordered = 0;        ///< Packets the link delivered out of order.
   bool failed = false;         ///< An estimator step reported a failure (innovation variance).
+  double corrupt = 0;             ///< Frames refused by the controller: CRC-16 mismatch (faults only).
   double refused_non_finite = 0;  ///< Frames refused by the controller: y not finite (faults only).
   double refused_sequence = 0;    ///< Frames refused: stamp j after the arrival's period (faults only).
   double stale = 0;               ///< Frames not newer than the period's newest (what the unaware KF drops).

@@ -53,6 +53,7 @@ inline std::vector<double> with_faults(std::vector<double> v, const DroppingPlan
   if (c.faults.empty()) return v;
   sim::RunFaultCounts f;
   f.injected = static_cast<double>(m.injected.injected());
+  f.corrupt = m.corrupt;
   f.refused_non_finite = m.refused_non_finite;
   f.refused_sequence = m.refused_sequence;
   f.stale = m.stale;

@@ -2,11 +2,12 @@
 /// @brief The petc loop's messages as frames under a fault spec (docs/faults.md, "Study
 ///        petc"): what the controller and the actuator check before they use one.
 ///
-/// Links "sc" (sensor → controller: [k: u32][y: f64]) and "ca" (controller → actuator:
-/// [k: u32][u_k … u_{k+H}: f64 × (H + 1)]), engine/sequenced_frame.hpp. Both links have no
-/// delay and no loss, and the nodes share the period clock, so the only genuine frame is the
-/// one stamped with the receiver's current period k_now. A receiver refuses a frame with a
-/// non-finite value (refused_non_finite) or a value outside its range (refused_out_of_range),
+/// Links "sc" (sensor → controller: [k: u32][y: f64][crc: u16]) and "ca" (controller →
+/// actuator: [k: u32][u_k … u_{k+H}: f64 × (H + 1)][crc: u16]), engine/sequenced_frame.hpp.
+/// Both links have no delay and no loss, and the nodes share the period clock, so the only
+/// genuine frame is the one stamped with the receiver's current period k_now. A receiver
+/// refuses a frame whose CRC-16 does not match its bytes (corrupt: a flipped bit), a frame
+/// with a non-finite value (refused_non_finite) or a value outside its range (refused_out_of_range),
 /// drops a frame not newer than the last one it accepted (stale: a duplicate, a replay) and
 /// refuses any other k ≠ k_now (refused_sequence: forged or corrupted).
 #pragma once
@@ -14,7 +15,10 @@
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <stdexcept>
+#include <vector>
 
+#include "oneshot/engine/sequenced_frame.hpp"
 #include "oneshot/node/frame_checks.hpp"
 
 namespace oneshot::sim::petc {
@@ -29,6 +33,16 @@ class FrameReceiver {
  public:
   /// Values must lie in [−range, range] (range > 0).
   explicit FrameReceiver(double range) : range_(range) {}
+  /// Decodes `frame` (stamp into k, `n` values into v) and checks it with accept(): true when
+  /// it may be used at period `k_now`; a CRC mismatch is counted as corrupt.
+  bool receive(const std::vector<std::uint8_t>& frame, std::uint32_t& k, double* v, std::size_t n, std::uint32_t k_now) {
+    switch (engine::decode_sequenced_frame(frame, k, v, n)) {
+      case engine::SequencedFrameStatus::kOk: break;
+      case engine::SequencedFrameStatus::kCorrupt: ++counts_.corrupt; return false;
+      case engine::SequencedFrameStatus::kMalformed: throw std::logic_error("petc: a frame changed its size");  // no fault does
+    }
+    return accept(k, v, n, k_now);
+  }
   /// True when the frame (stamp k, `n` values) may be used at period `k_now`; counts otherwise.
   bool accept(std::uint32_t k, const double* v, std::size_t n, std::uint32_t k_now) {
     for (std::size_t i = 0; i < n; ++i)

@@ -131,8 +131,7 @@ std::vector<double> simulate(const PetcSetup& s, const CaseSpec& c, std::uint64_
     on_rx_frame = kernel.add_handler("actuator frame", [&](std::uint64_t i) {
       std::uint32_t k = 0;
       double u[kHorizon + 1];
-      if (!engine::decode_sequenced_frame(ca_frames[i], k, u, kHorizon + 1)) return;  // every fault keeps the size
-      if (!act_rx.accept(k, u, kHorizon + 1, period_now())) return;
+      if (!act_rx.receive(ca_frames[i], k, u, kHorizon + 1, period_now())) return;
       static_cast<void>(actuator.accept(k, u));  // act_rx passed it: never older than the one in force
       plant.set_input(scalar(actuator.value(k)));
     });
@@ -161,8 +160,7 @@ std::vector<double> simulate(const PetcSetup& s, const CaseSpec& c, std::uint64_
     on_arrival_frame = kernel.add_handler("controller frame", [&](std::uint64_t i) {
       std::uint32_t k = 0;
       double y = 0;
-      if (!engine::decode_sequenced_frame(sc_frames[i], k, &y, 1)) return;
-      if (ctrl_rx.accept(k, &y, 1, period_now())) arrive(k, y);
+      if (ctrl_rx.receive(sc_frames[i], k, &y, 1, period_now())) arrive(k, y);
     });
   engine::HandlerId on_sample = kernel.add_handler("sensor sample", [&](std::uint64_t k) {
     const auto kk = static_cast<std::uint32_t>(k);
@@ -236,6 +234,7 @@ std::vector<double> simulate(const PetcSetup& s, const CaseSpec& c, std::uint64_
       inj += ca_faults->counters();
       n.injected = static_cast<double>(inj.injected());
       for (const FrameCounts& rc : {ctrl_rx.counts(), act_rx.counts()}) {
+        n.corrupt += rc.corrupt;
         n.refused_non_finite += rc.refused_non_finite;
         n.refused_out_of_range += rc.refused_out_of_range;
         n.refused_sequence += rc.refused_sequence;

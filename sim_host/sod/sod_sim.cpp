@@ -128,7 +128,11 @@ RunResult simulate_run(const SodModel& model, const RunConfig& cfg, std::uint64_
       const std::size_t i = arg & 1u;
       node::SequenceNumber k = 0;
       double y = 0;
-      if (!engine::decode_sequenced_frame(frames[arg >> 1], k, &y, 1)) return;  // every fault keeps the size
+      switch (engine::decode_sequenced_frame(frames[arg >> 1], k, &y, 1)) {
+        case engine::SequencedFrameStatus::kOk: break;
+        case engine::SequencedFrameStatus::kCorrupt: res.corrupt += 1; return;  // as a lost packet
+        case engine::SequencedFrameStatus::kMalformed: throw std::logic_error("sod: a frame changed its size");  // no fault does
+      }
       if (std::int64_t{k} != step_now) {  // no delay on the link: only the current sample is genuine
         res.refused_sequence += 1;
         return;

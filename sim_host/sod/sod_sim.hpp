@@ -11,8 +11,10 @@
 /// and measurement streams, so plain SOD sends the same packets at every ξ for a seed.
 ///
 /// With a fault spec (RunConfig::faults, frame faults on links "node1", "node2" only) each
-/// packet travels as a frame [k: u32 LE][y: f64] through the link's engine::LinkFaults
-/// before the loss draw; the receiver takes a frame only when its k is the current sample
+/// packet travels as a frame [k: u32 LE][y: f64][crc: u16] (engine/sequenced_frame.hpp)
+/// through the link's engine::LinkFaults before the loss draw; the receiver refuses a frame
+/// whose CRC-16 does not match (corrupt: to the receiver a lost packet, which its detector
+/// counts as one), then takes a frame only when its k is the current sample
 /// (the links have no delay: another k is a replay or forged, refused_sequence) and its y is
 /// finite (refused_non_finite). An empty spec is the clean run, bit for bit.
 #pragma once
@@ -65,6 +67,7 @@ struct RunResult {
   double lost[kNodes] = {};       ///< Lost on the link.
   double detected[kNodes] = {};   ///< Losses the detector proved (Σ increments of d).
   double estimator_resets = 0;    ///< Steps whose estimate turned non-finite (reset to x0, P0).
+  double corrupt = 0;             ///< Frames the receiver refused: CRC-16 mismatch (faults only).
   double refused_non_finite = 0;  ///< Frames the receiver refused: y not finite (faults only).
   double refused_sequence = 0;    ///< Frames the receiver refused: k not the current sample (faults only).
   engine::FaultCounters injected; ///< Faults injected on both links.

@@ -34,7 +34,8 @@ const std::vector<std::string> kMetrics = {"e1", "e2", "e1_tail", "e2_tail", "ne
                                            "time_sends1", "time_sends2", "lost1", "lost2", "detected1", "detected2"};
 
 /// Per-run counters of a faulted table (RunResult): faults injected, frames refused, estimator resets.
-const std::vector<std::string> kFaultMetrics = {"injected", "refused_non_finite", "refused_sequence", "estimator_resets"};
+const std::vector<std::string> kFaultMetrics = {"injected", "corrupt", "refused_non_finite", "refused_sequence",
+                                                "estimator_resets"};
 
 using util::path_in;
 std::string f4(double v) { return util::format_g(v, 4); }
@@ -91,7 +92,7 @@ nlohmann::json run_table(const SodModel& model, const StudyOptions& opt) {
         std::vector<double> v{x.e[0], x.e[1], x.e_tail[0], x.e_tail[1], x.nees, x.sends[0], x.sends[1],
                               x.time_sends[0], x.time_sends[1], x.lost[0], x.lost[1], x.detected[0], x.detected[1]};
         if (!opt.faults.empty())
-          v.insert(v.end(), {static_cast<double>(x.injected.injected()), x.refused_non_finite, x.refused_sequence,
+          v.insert(v.end(), {static_cast<double>(x.injected.injected()), x.corrupt, x.refused_non_finite, x.refused_sequence,
                              x.estimator_resets});
         return v;
       }, "sod table");

@@ -11,9 +11,9 @@
 namespace oneshot::sim {
 
 const std::vector<std::string>& fault_metric_names() {
-  static const std::vector<std::string> names = {"injected",         "refused_non_finite", "refused_out_of_range",
-                                                 "refused_sequence", "stale",              "estimator_resets",
-                                                 "ratio_to_clean"};
+  static const std::vector<std::string> names = {"injected",         "corrupt", "refused_non_finite",
+                                                 "refused_out_of_range", "refused_sequence", "stale",
+                                                 "estimator_resets", "ratio_to_clean"};
   return names;
 }
 
@@ -25,7 +25,7 @@ void add_fault_metrics(engine::SweepSpec& spec, const engine::FaultSpec& faults,
 }
 
 void append_fault_values(std::vector<double>& values, const RunFaultCounts& c) {
-  values.insert(values.end(), {c.injected, c.refused_non_finite, c.refused_out_of_range, c.refused_sequence, c.stale,
+  values.insert(values.end(), {c.injected, c.corrupt, c.refused_non_finite, c.refused_out_of_range, c.refused_sequence, c.stale,
                                c.estimator_resets, c.ratio_to_clean});
 }
 
@@ -58,13 +58,13 @@ std::string fault_markdown(const engine::SweepResults& r) {
   md << "Faults `" << r.spec.config.at("inject").get<std::string>() << "`, " << r.spec.seeds << " seeds from "
      << r.spec.first_seed << "; per run (mean); ratio = " << r.spec.config.at("inject_ratio_of").get<std::string>()
      << " faulted / clean, same seed (mean ± 95 % CI):\n\n"
-     << "| approach | scenario | injected | refused non-finite | refused out of range | refused sequence | stale | "
-        "estimator resets | ratio to clean | finite runs |\n|---|---|---|---|---|---|---|---|---|---|\n";
+     << "| approach | scenario | injected | corrupt | refused non-finite | refused out of range | refused sequence | stale | "
+        "estimator resets | ratio to clean | finite runs |\n|---|---|---|---|---|---|---|---|---|---|---|\n";
   for (std::size_t a = 0; a < r.spec.approaches.size(); ++a)
     for (std::size_t s = 0; s < r.spec.scenarios.size(); ++s) {
       const nlohmann::json row = fault_row(r, a, s);
       md << "| " << r.spec.approaches[a] << " | " << r.spec.scenarios[s];
-      for (const char* m : {"injected", "refused_non_finite", "refused_out_of_range", "refused_sequence", "stale",
+      for (const char* m : {"injected", "corrupt", "refused_non_finite", "refused_out_of_range", "refused_sequence", "stale",
                             "estimator_resets"})
         md << " | " << g(row.at(m).at("mean"));
       const nlohmann::json& q = row.at("ratio_to_clean");

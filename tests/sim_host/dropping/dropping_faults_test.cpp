@@ -3,7 +3,8 @@
 ///        run bit for bit; NaN, replayed, duplicated and forged samples are refused or dropped
 ///        and counted by the controller; the buffered loop, and the delay-unaware KFs that
 ///        run beside it on the same frames (shadows), stay finite within a few times the
-///        clean run; restarts are refused. (The unaware KF closing the loop itself diverges
+///        clean run; every flipped frame is refused as corrupt (its CRC-16); restarts are
+///        refused. (The unaware KF closing the loop itself diverges
 ///        on this plant even clean: it is checked for its counters only.)
 #include <gtest/gtest.h>
 
@@ -122,6 +123,25 @@ TEST(DroppingFaults, ReplaysAndDuplicatesAreDropped) {
     EXPECT_GE(b.faulted.stale, 0.9 * injected) << spec;
     expect_finite_and_bounded(b, spec);
   }
+}
+
+TEST(DroppingFaults, EveryFlippedFrameIsRefusedAsCorrupt) {
+  // The Bernoulli channel at λ = 1 delivers every frame half a period later, in order: each
+  // flipped frame reaches the controller, and no genuine one is stale.
+  for (const char* spec : {"flip:rate=0.05", "flip:bits=2,rate=0.05"})
+    for (EstimatorKind e : kBoth) {
+      RunConfig c = config(e, spec);
+      c.channel = ChannelKind::kBernoulli;
+      c.bernoulli_lambda = 1;
+      Pair p{run_closed_loop(study_plant(), c, 13), {}};
+      c.faults = {};
+      p.clean = run_closed_loop(study_plant(), c, 13);
+      EXPECT_GT(p.faulted.injected.flip, 50U) << spec;
+      EXPECT_EQ(p.faulted.corrupt, static_cast<double>(p.faulted.injected.flip)) << spec;
+      if (e != EstimatorKind::kBuffered) continue;  // the unaware loop diverges: its own samples turn non-finite
+      EXPECT_EQ(p.faulted.refused_non_finite + p.faulted.refused_sequence + p.faulted.stale, 0) << spec;
+      expect_finite_and_bounded(p, spec);
+    }
 }
 
 TEST(DroppingFaults, RestartsAreRefusedNamingTheNode) {

@@ -5,7 +5,10 @@
 ///        bytes for the same seed, clauses that never move one another; on the network:
 ///        the extra frames arrive right after theirs, restarts run their hook at their
 ///        instant, and unknown targets are refused; with a CRC in the layout, nan and
-///        forge_seq rewrite it and flip does not.
+///        forge_seq rewrite it and flip does not. The studies' sequenced frames
+///        (sequenced_frame.hpp): their CRC-16 against a bitwise one written here, every 1-bit
+///        flip of both sizes the studies send and every 2-bit flip of the 1-value frame
+///        decoded as corrupt, a wrong size as malformed, nan and forge_seq still decoded.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -16,6 +19,7 @@
 #include "oneshot/engine/json_fields.hpp"
 #include "oneshot/engine/kernel.hpp"
 #include "oneshot/engine/network.hpp"
+#include "oneshot/engine/sequenced_frame.hpp"
 
 namespace oneshot::engine {
 namespace {
@@ -230,6 +234,120 @@ TEST(FrameFaults, NetworkDeliversExtrasAfterTheFrameAndRunsRestartHooks) {
   } catch (const InputError& e) {
     EXPECT_NE(std::string(e.what()).find("no restartable node 'c' in this run (b)"), std::string::npos) << e.what();
   }
+}
+
+/// CRC-16/CCITT-FALSE bit by bit, as its definition reads (poly 0x1021, init 0xFFFF, MSB first).
+std::uint16_t bitwise_crc(const std::uint8_t* p, std::size_t n) {
+  unsigned crc = 0xFFFF;
+  for (std::size_t i = 0; i < n; ++i) {
+    crc ^= static_cast<unsigned>(p[i]) << 8;
+    for (int b = 0; b < 8; ++b) crc = ((crc & 0x8000U) != 0U ? (crc << 1) ^ 0x1021U : crc << 1) & 0xFFFFU;
+  }
+  return static_cast<std::uint16_t>(crc);
+}
+
+/// The sizes the studies send: one sample (dropping, sod, petc's sc) and petc's packet of 201 inputs (ca).
+constexpr std::size_t kStudyValueCounts[] = {1, 201};
+
+/// A sequenced frame of `n` values: seq 0x8123'4567, values with varied bits.
+Bytes sequenced(std::size_t n) {
+  std::vector<double> v(n);
+  for (std::size_t i = 0; i < n; ++i) v[i] = (i % 2 == 0 ? 1 : -1) * (0.37 + 1.5e-3 * static_cast<double>(i * i));
+  return encode_sequenced_frame(0x8123'4567U, v.data(), n);
+}
+
+TEST(SequencedFrame, EndsInTheCrc16OfItsBytesAndDecodesToWhatWasSent) {
+  for (std::size_t n : kStudyValueCounts) {
+    const Bytes b = sequenced(n);
+    ASSERT_EQ(b.size(), 4 + 8 * n + 2);
+    const std::uint16_t c = bitwise_crc(b.data(), b.size() - 2);
+    EXPECT_EQ(b[b.size() - 2], c & 0xFFU) << n;  // low byte first
+    EXPECT_EQ(b[b.size() - 1], c >> 8) << n;
+    std::uint32_t seq = 0;
+    std::vector<double> v(n);
+    ASSERT_EQ(decode_sequenced_frame(b, seq, v.data(), n), SequencedFrameStatus::kOk) << n;
+    EXPECT_EQ(seq, 0x8123'4567U);
+    for (std::size_t i = 0; i < n; ++i) EXPECT_EQ(v[i], (i % 2 == 0 ? 1 : -1) * (0.37 + 1.5e-3 * static_cast<double>(i * i)));
+  }
+  const double y = 2.5;
+  EXPECT_EQ(bitwise_crc(reinterpret_cast<const std::uint8_t*>("123456789"), 9), 0x29B1);  // the oracle's check value
+  EXPECT_LT(static_cast<int>(SequencedFrameStatus::kOk), static_cast<int>(SequencedFrameStatus::kCorrupt));
+  EXPECT_LT(static_cast<int>(SequencedFrameStatus::kCorrupt), static_cast<int>(SequencedFrameStatus::kMalformed));
+  EXPECT_EQ(encode_sequenced_frame(7, &y, 1).size(), sequenced_frame_bytes(1));
+}
+
+TEST(SequencedFrame, EveryOneBitFlipIsCorruptAndWritesNothing) {
+  for (std::size_t n : kStudyValueCounts) {
+    const Bytes sent = sequenced(n);
+    std::vector<double> v(n, 0.0);
+    for (std::size_t bit = 0; bit < sent.size() * 8; ++bit) {
+      Bytes b = sent;
+      b[bit / 8] = static_cast<std::uint8_t>(b[bit / 8] ^ (1U << (bit % 8)));
+      std::uint32_t seq = 7;
+      ASSERT_EQ(decode_sequenced_frame(b, seq, v.data(), n), SequencedFrameStatus::kCorrupt) << n << " values, bit " << bit;
+      ASSERT_EQ(seq, 7U);
+    }
+    for (double x : v) EXPECT_EQ(x, 0.0);
+  }
+}
+
+TEST(SequencedFrame, EveryTwoBitFlipOfTheOneValueFrameIsCorrupt) {
+  const Bytes sent = sequenced(1);
+  const std::size_t bits = sent.size() * 8;
+  std::size_t pairs = 0;
+  for (std::size_t i = 0; i < bits; ++i)
+    for (std::size_t j = i + 1; j < bits; ++j) {
+      Bytes b = sent;
+      b[i / 8] = static_cast<std::uint8_t>(b[i / 8] ^ (1U << (i % 8)));
+      b[j / 8] = static_cast<std::uint8_t>(b[j / 8] ^ (1U << (j % 8)));
+      std::uint32_t seq = 0;
+      double y = 0;
+      ASSERT_EQ(decode_sequenced_frame(b, seq, &y, 1), SequencedFrameStatus::kCorrupt) << "bits " << i << ", " << j;
+      ++pairs;
+    }
+  EXPECT_EQ(pairs, bits * (bits - 1) / 2);
+}
+
+TEST(SequencedFrame, AWrongSizeIsMalformed) {
+  for (std::size_t n : kStudyValueCounts) {
+    std::vector<double> v(n);
+    std::uint32_t seq = 0;
+    Bytes b = sequenced(n);
+    b.push_back(0);
+    EXPECT_EQ(decode_sequenced_frame(b, seq, v.data(), n), SequencedFrameStatus::kMalformed) << n;
+    b.resize(b.size() - 2);
+    EXPECT_EQ(decode_sequenced_frame(b, seq, v.data(), n), SequencedFrameStatus::kMalformed) << n;
+    EXPECT_EQ(decode_sequenced_frame(Bytes{}, seq, v.data(), n), SequencedFrameStatus::kMalformed) << n;
+  }
+}
+
+TEST(SequencedFrame, ThroughLinkFaultsNanAndForgedSequenceDecodeAndFlipsAreCorrupt) {
+  for (std::size_t n : kStudyValueCounts)
+    for (const char* spec : {"nan:rate=1", "forge_seq:rate=1,jump=5", "flip:rate=1", "flip:bits=2,rate=1", "flip:bits=3,rate=1"}) {
+      LinkFaults f(parse_fault_spec(spec), "sc", kSequencedFrameLayout, 9);
+      const bool flip = std::string(spec).rfind("flip", 0) == 0;
+      for (std::uint32_t k = 0; k < 40; ++k) {
+        Bytes b = sequenced(n);
+        std::vector<Bytes> extra;
+        f.apply(SimTime{std::int64_t{k} * 10'000'000}, b, extra);
+        std::uint32_t seq = 0;
+        std::vector<double> v(n);
+        const SequencedFrameStatus st = decode_sequenced_frame(b, seq, v.data(), n);
+        if (flip) {
+          EXPECT_EQ(st, SequencedFrameStatus::kCorrupt) << spec << ", " << n << " values, frame " << k;
+          continue;
+        }
+        ASSERT_EQ(st, SequencedFrameStatus::kOk) << spec << ", " << n << " values, frame " << k;
+        if (spec[0] == 'n') {
+          std::size_t nans = 0;
+          for (double x : v) nans += std::isnan(x) ? 1U : 0U;
+          EXPECT_EQ(nans, 1U) << n;
+          EXPECT_EQ(seq, 0x8123'4567U);
+        } else {
+          EXPECT_EQ(seq, 0x8123'4567U + 5U);
+        }
+      }
+    }
 }
 
 }  // namespace

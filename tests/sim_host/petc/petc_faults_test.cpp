@@ -2,8 +2,8 @@
 /// @brief Frame faults and restarts in the petc loop (FaultRun): an empty spec is the clean
 ///        run bit for bit; NaN, replayed, duplicated and forged frames on links sc and ca are
 ///        refused and counted by the controller and the actuator, the run stays finite and its
-///        tracking error within a few times the clean run's; node restarts run; unknown
-///        targets are refused.
+///        tracking error within a few times the clean run's; every flipped frame is refused as
+///        corrupt (its CRC-16); node restarts run; unknown targets are refused.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -71,8 +71,8 @@ TEST(PetcFaults, ASpecThatNeverFiresChangesNothing) {
   for (const CaseSpec& c : default_cases()) {
     const Faulted f = run(c, "nan:at_s=1", 5);  // the run lasts 9.28 ms
     EXPECT_EQ(f.run.tracking_error, f.clean_tracking) << "case " << c.name;
-    EXPECT_EQ(f.run.counts.refused_non_finite + f.run.counts.refused_out_of_range + f.run.counts.refused_sequence +
-                  f.run.counts.stale,
+    EXPECT_EQ(f.run.counts.corrupt + f.run.counts.refused_non_finite + f.run.counts.refused_out_of_range +
+                  f.run.counts.refused_sequence + f.run.counts.stale,
               0)
         << "case " << c.name;
   }
@@ -121,6 +121,20 @@ INSTANTIATE_TEST_SUITE_P(
                       InjectedCase{"restart:node=controller,at_s=0.004", nullptr, false},
                       InjectedCase{"restart:node=actuator,at_s=0.004", nullptr, false}),
     [](const ::testing::TestParamInfo<InjectedCase>& i) { return oneshot::test::param_name(i.param.spec); });
+
+TEST(PetcFaults, EveryFlippedFrameIsRefusedAsCorrupt) {
+  // The links have no delay and no loss: every flipped frame reaches its receiver.
+  for (const CaseSpec& c : default_cases())
+    for (const char* spec : {"flip:rate=0.05", "flip:bits=2,rate=0.05"}) {
+      const Faulted f = run(c, spec, 11);
+      const oneshot::sim::RunFaultCounts& n = f.run.counts;
+      EXPECT_GT(n.injected, 0) << "case " << c.name << ", " << spec;
+      EXPECT_EQ(n.corrupt, n.injected) << "case " << c.name << ", " << spec;
+      EXPECT_EQ(n.refused_non_finite + n.refused_out_of_range + n.refused_sequence + n.stale, 0)
+          << "case " << c.name << ", " << spec;
+      expect_finite_and_bounded(f, spec);
+    }
+}
 
 TEST(PetcFaults, UnknownTargetsAreRefused) {
   FaultRun f;

@@ -1,8 +1,9 @@
 /// @file sod_faults_test.cpp
 /// @brief Frame faults in the send-on-delta run (RunConfig::faults): an empty spec is the
 ///        clean run bit for bit; NaN, replayed, duplicated and forged frames leave a finite
-///        estimate, are counted as injected and as refused by the receiver; node restarts are
-///        refused (the study has no restartable node).
+///        estimate, are counted as injected and as refused by the receiver; every flipped frame
+///        is refused as corrupt (its CRC-16); node restarts are refused (the study has no
+///        restartable node).
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -72,6 +73,23 @@ TEST(SodFaults, FaultedFramesAreRefusedCountedAndTheEstimateStaysFinite) {
     }
     if (!c.nan_refused && !c.seq_refused) {
       EXPECT_EQ(r.refused_sequence + r.refused_non_finite, 0) << c.spec;
+    }
+    EXPECT_EQ(r.corrupt, 0) << c.spec;  // nan and forge_seq re-seal the frame: a wrong sender, not a transfer error
+  }
+}
+
+TEST(SodFaults, EveryFlippedFrameIsRefusedAsCorrupt) {
+  // No loss (ξ = 0), no delay: every flipped frame reaches the receiver.
+  const RunResult clean = simulate_run(study_model(), config(""), 5);
+  for (const char* spec : {"flip:rate=0.05", "flip:bits=2,rate=0.05"}) {
+    const RunResult r = simulate_run(study_model(), config(spec), 5);
+    EXPECT_GT(r.injected.flip, 5U) << spec;
+    EXPECT_EQ(r.corrupt, static_cast<double>(r.injected.flip)) << spec;
+    EXPECT_EQ(r.refused_non_finite + r.refused_sequence, 0) << spec;
+    EXPECT_EQ(r.estimator_resets, 0) << spec;
+    for (std::size_t i = 0; i < kNodes; ++i) {
+      EXPECT_TRUE(std::isfinite(r.e[i])) << spec;
+      EXPECT_LT(r.e[i], 3 * clean.e[i]) << spec;
     }
   }
 }

@@ -1,6 +1,7 @@
 /// @file crc16.hpp
 /// @brief CRC-16/CCITT-FALSE, a nibble at a time (freestanding): the integrity check of the node
-///        frames (node/message.hpp) and of the PIL link (app/pil_protocol.hpp).
+///        frames (node/message.hpp), of the PIL link (app/pil_protocol.hpp) and of the
+///        simulator's sequenced frames (engine/sequenced_frame.hpp).
 ///
 /// Generator g(x) = x^16 + x^12 + x^5 + 1 (poly 0x1021), MSB first, register initialized
 /// to 0xFFFF, no reflection, no final XOR; check value: the CRC of the ASCII bytes

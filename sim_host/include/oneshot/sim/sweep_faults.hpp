@@ -22,6 +22,7 @@ namespace oneshot::sim {
 /// Counters of one faulted run (summed over the run's receiving nodes).
 struct RunFaultCounts {
   double injected = 0;              ///< Faults injected (engine::FaultCounters::injected()).
+  double corrupt = 0;               ///< Frames refused: CRC-16 mismatch (bits altered on the way).
   double refused_non_finite = 0;    ///< Frames refused: a value not finite.
   double refused_out_of_range = 0;  ///< Frames refused: a value outside the design's range.
   double refused_sequence = 0;      ///< Frames refused: sequence number outside its window.

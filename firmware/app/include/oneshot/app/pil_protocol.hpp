@@ -35,9 +35,6 @@ enum class Type : std::uint8_t {
   kFault = 0xFF,      ///< Firmware → host: an invariant failed (payload: line, file).
 };
 
-/// CRC-16/CCITT-FALSE update (oneshot/crc16.hpp).
-constexpr std::uint16_t crc16(std::uint16_t crc, std::uint8_t byte) { return crc16_update(crc, byte); }
-
 /// A decoded frame.
 struct Frame {
   Type type = Type::kEcho;                ///< Message type.
@@ -49,7 +46,7 @@ struct Frame {
 /// Encodes `f` into `out` (capacity ≥ 2·(kMaxPayload+5)+2); returns the byte count.
 constexpr std::size_t encode(const Frame& f, std::uint8_t* out) {
   std::size_t n = 0;
-  std::uint16_t crc = 0xFFFF;
+  std::uint16_t crc = kCrc16Init;
   const auto put = [&](std::uint8_t b) {
     if (b == kFlag || b == kEscape) {
       out[n++] = kEscape;
@@ -59,7 +56,7 @@ constexpr std::size_t encode(const Frame& f, std::uint8_t* out) {
     }
   };
   const auto put_crc = [&](std::uint8_t b) {
-    crc = crc16(crc, b);
+    crc = crc16_update(crc, b);
     put(b);
   };
   out[n++] = kFlag;
@@ -113,8 +110,8 @@ class Decoder {
       ++dropped_;
       return false;
     }
-    std::uint16_t crc = 0xFFFF;
-    for (std::size_t i = 0; i + 2 < used_; ++i) crc = crc16(crc, buffer_[i]);
+    std::uint16_t crc = kCrc16Init;
+    for (std::size_t i = 0; i + 2 < used_; ++i) crc = crc16_update(crc, buffer_[i]);
     const auto got = static_cast<std::uint16_t>(buffer_[used_ - 2] | (buffer_[used_ - 1] << 8));
     if (crc != got) {
       ++dropped_;
