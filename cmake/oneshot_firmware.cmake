@@ -64,24 +64,55 @@ endif()
 # startup.cpp implements memcpy/memset: keep the compiler from turning their loops into calls to themselves.
 set_source_files_properties(firmware/app/mcu/startup.cpp PROPERTIES COMPILE_OPTIONS "-fno-builtin;-fno-tree-loop-distribute-patterns")
 
-# oneshot_firmware_image(<image> SOURCES <src>... [C_JOB] [PIL] [EXCLUDE_FROM_ALL] [STACK_BOUND]
-#                        [INCLUDES <dir>...] [DEFINES <def>...] [OPTIONS <opt>...])
+# The sources of the PIL images of main.cpp that read none of an image's defines (startup, the
+# PIL link, the generated C99 job with every variant) compile once per target, with the same
+# flags, into these objects: the six images link the same objects they compiled each before
+# (five compiles of the C job, pil_link.cpp and startup.cpp fewer per target).
+add_library(oneshot-pil-common-${ONESHOT_FIRMWARE_TARGET} OBJECT
+  firmware/app/mcu/startup.cpp firmware/app/mcu/pil_link.cpp ${c_job_source})
+set_target_properties(oneshot-pil-common-${ONESHOT_FIRMWARE_TARGET} PROPERTIES C_STANDARD 99 C_STANDARD_REQUIRED ON C_EXTENSIONS OFF)
+add_dependencies(oneshot-pil-common-${ONESHOT_FIRMWARE_TARGET} oneshot_generated)
+target_include_directories(oneshot-pil-common-${ONESHOT_FIRMWARE_TARGET} PRIVATE firmware/core/include hal/mcu/include
+                           firmware/app/include hal/include ${generated_dir} ${generated_dir}/oneshot_c)
+target_compile_options(oneshot-pil-common-${ONESHOT_FIRMWARE_TARGET} PRIVATE ${fw_common_options})
+target_compile_definitions(oneshot-pil-common-${ONESHOT_FIRMWARE_TARGET} PRIVATE ${soc_define})
+
+# oneshot_firmware_image(<image> SOURCES <src>... [C_JOB] [PIL] [PIL_COMMON] [EXCLUDE_FROM_ALL]
+#                        [STACK_BOUND] [INCLUDES <dir>...] [DEFINES <def>...] [OPTIONS <opt>...])
 # One firmware image <image>.elf for ONESHOT_FIRMWARE_TARGET: SOURCES with startup.cpp, the
 # SoC's define and linker script, the firmware flags (OPTIONS replaces them), -nostdlib (libgcc
 # only, so any heap use fails the link), its size printed after the link. C_JOB adds the
 # generated tables and C99 job; PIL the PIL link (pil_link.cpp: the runtime's vectors and
-# assert handler); STACK_BOUND writes <image>.elf.stack.txt, the sum of every frame in the
-# image (-fstack-usage; no recursion, so no call chain can need more).
+# assert handler); PIL_COMMON (with C_JOB and PIL, the firmware flags) takes startup, the PIL
+# link and the C job from the target's shared objects above; STACK_BOUND writes
+# <image>.elf.stack.txt, the sum of every frame in the image's own objects (-fstack-usage; no
+# recursion, so no call chain can need more): never with PIL_COMMON.
 function(oneshot_firmware_image image)
-  cmake_parse_arguments(PARSE_ARGV 1 arg "C_JOB;PIL;EXCLUDE_FROM_ALL;STACK_BOUND" "" "SOURCES;INCLUDES;DEFINES;OPTIONS")
-  set(sources ${arg_SOURCES} firmware/app/mcu/startup.cpp)
+  cmake_parse_arguments(PARSE_ARGV 1 arg "C_JOB;PIL;PIL_COMMON;EXCLUDE_FROM_ALL;STACK_BOUND" "" "SOURCES;INCLUDES;DEFINES;OPTIONS")
   set(includes firmware/core/include hal/mcu/include ${arg_INCLUDES})
+  if(arg_PIL_COMMON)
+    if(NOT arg_C_JOB OR NOT arg_PIL OR arg_STACK_BOUND OR DEFINED arg_OPTIONS)
+      message(FATAL_ERROR "oneshot_firmware_image(${image}): PIL_COMMON needs C_JOB and PIL, the firmware flags, no STACK_BOUND")
+    endif()
+    # The image's own sources compile in an object library too: the link takes them first, in
+    # the order the image compiled them before (its own sources, startup, the PIL link, the job).
+    set(compiled ${image}-objects)
+    add_library(${compiled} OBJECT ${arg_SOURCES})
+    set(sources $<TARGET_OBJECTS:${compiled}> $<TARGET_OBJECTS:oneshot-pil-common-${ONESHOT_FIRMWARE_TARGET}>)
+  else()
+    set(compiled ${image})
+    set(sources ${arg_SOURCES} firmware/app/mcu/startup.cpp)
+    if(arg_PIL)
+      list(APPEND sources firmware/app/mcu/pil_link.cpp)
+    endif()
+    if(arg_C_JOB)
+      list(APPEND sources ${c_job_source})
+    endif()
+  endif()
   if(arg_PIL)
-    list(APPEND sources firmware/app/mcu/pil_link.cpp)
     list(APPEND includes firmware/app/include hal/include)
   endif()
   if(arg_C_JOB)
-    list(APPEND sources ${c_job_source})
     list(APPEND includes ${generated_dir} ${generated_dir}/oneshot_c)
   endif()
   set(exclude)
@@ -89,17 +120,18 @@ function(oneshot_firmware_image image)
     set(exclude EXCLUDE_FROM_ALL)
   endif()
   add_executable(${image} ${exclude} ${sources})
-  set_target_properties(${image} PROPERTIES SUFFIX ".elf" C_STANDARD 99 C_STANDARD_REQUIRED ON C_EXTENSIONS OFF)
+  set_target_properties(${image} PROPERTIES SUFFIX ".elf" C_STANDARD 99 C_STANDARD_REQUIRED ON C_EXTENSIONS OFF
+                                            LINKER_LANGUAGE CXX)
   if(arg_C_JOB)
-    add_dependencies(${image} oneshot_generated)
+    add_dependencies(${compiled} oneshot_generated)
   endif()
-  target_include_directories(${image} PRIVATE ${includes})
+  target_include_directories(${compiled} PRIVATE ${includes})
   if(DEFINED arg_OPTIONS)
-    target_compile_options(${image} PRIVATE ${arg_OPTIONS})
+    target_compile_options(${compiled} PRIVATE ${arg_OPTIONS})
   else()
-    target_compile_options(${image} PRIVATE ${fw_common_options})
+    target_compile_options(${compiled} PRIVATE ${fw_common_options})
   endif()
-  target_compile_definitions(${image} PRIVATE ${soc_define} ${arg_DEFINES})
+  target_compile_definitions(${compiled} PRIVATE ${soc_define} ${arg_DEFINES})
   target_link_options(${image} PRIVATE -nostdlib -T ${linker_script} -L ${PROJECT_SOURCE_DIR}/firmware/app/mcu
                       -Wl,--gc-sections -Wl,-Map=$<TARGET_FILE:${image}>.map)
   target_link_libraries(${image} PRIVATE gcc)
@@ -143,7 +175,7 @@ endfunction()
 foreach(format float fixed)
   foreach(disc table nearest generic)
     oneshot_main_defines(${format} ${disc} main_defines)
-    oneshot_firmware_image(oneshot-${ONESHOT_FIRMWARE_TARGET}-${format}-${disc} C_JOB PIL
+    oneshot_firmware_image(oneshot-${ONESHOT_FIRMWARE_TARGET}-${format}-${disc} C_JOB PIL PIL_COMMON
       SOURCES firmware/app/mcu/main.cpp DEFINES ${main_defines})
   endforeach()
 endforeach()
