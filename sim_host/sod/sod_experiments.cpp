@@ -123,7 +123,8 @@ nlohmann::json run_design(const SodModel& model, const StudyOptions& opt) {
   nlohmann::json j = {{"experiment", "design"}, {"plant", model.plant_name}, {"delta_y", opt.delta_y}, {"mu", opt.mu},
                       {"seeds", opt.seeds}, {"first_seed", opt.seed}, {"amplitude", opt.amplitude},
                       {"mean_gap_s", {g.mean_s[0], g.mean_s[1]}}, {"mean_gap_ci95_s", {g.ci95_s[0], g.ci95_s[1]}}};
-  double lo[kNodes] = {INFINITY, INFINITY}, hi[kNodes] = {0, 0};
+  double lo[kNodes] = {std::numeric_limits<double>::infinity(), std::numeric_limits<double>::infinity()};
+  double hi[kNodes] = {0, 0};
   bool any_bounded[kNodes] = {false, false};
   for (double xi : opt.design_losses) {
     const DeltaTDesign d = design_at(model, opt, g, opt.delta_y, xi);

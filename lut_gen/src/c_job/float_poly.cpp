@@ -20,7 +20,7 @@ constexpr int kCheckPoints = 2001;
 
 /// c0 + Σ c_e t^e in double, with the float coefficients the job uses.
 double eval(float c0, const std::vector<int>& exps, const std::vector<float>& c, double t) {
-  double v = c0;
+  double v = static_cast<double>(c0);
   for (std::size_t k = 0; k < exps.size(); ++k) v += static_cast<double>(c[k]) * std::pow(t, exps[k]);
   return v;
 }
