@@ -224,6 +224,8 @@ RunMetrics run_impl(const DroppingPlant& plant, const RunConfig& cfg, std::uint6
         at = link.transmit(now);
       } else if (gamma_rng.bernoulli(cfg.bernoulli_lambda)) {
         at = now + period / 2;
+      } else {
+        ++channel_lost;
       }
       if (at) {
         extra.insert(extra.begin(), std::move(bytes));

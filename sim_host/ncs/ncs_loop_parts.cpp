@@ -4,6 +4,7 @@
 ///        counters, links and nodes (see ncs_loop.hpp).
 #include <cmath>
 #include <string>
+#include <stdexcept>
 
 #include "ncs_counters.hpp"
 #include "ncs_loop.hpp"
@@ -15,6 +16,10 @@ template <typename S>
 engine::ContinuousPlantConfig<S::n, S::m, S::p, 1> plant_config_of(const Context& ctx, const Scenario& sc, bool noisy) {
   engine::ContinuousPlantConfig<S::n, S::m, S::p, 1> c;
   const design::PlantDescription& p = ctx.plant();
+  if (p.a.rows != S::n || p.b.cols != S::m || p.c.rows != S::p || p.q1c.rows != S::n || p.q2c.rows != S::m) {
+    throw std::logic_error("ncs: the plant's shape or cost is not the loop's (" + std::to_string(p.a.rows) + ", " +
+                           std::to_string(p.b.cols) + ", " + std::to_string(p.c.rows) + ")");
+  }
   for (std::size_t i = 0; i < S::n; ++i) {
     for (std::size_t j = 0; j < S::n; ++j) {
       c.a(i, j) = p.a(i, j);

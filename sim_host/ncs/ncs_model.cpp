@@ -165,6 +165,10 @@ std::shared_ptr<const Context> Context::from(design::PlantDescription plant) {
   for (std::size_t i = 0; i < p.c.rows; ++i)
     for (std::size_t j = 0; j < p.a.rows; ++j)
       if (p.c(i, j) != (i == j ? 1.0 : 0.0)) throw std::invalid_argument(p.source + ": study 'ncs' needs C = I (eq. 10)");
+  // The loop's cost is the continuous one (J = ∫ xᵀQ1c x + uᵀQ2c u dt over the run): a discrete cost has no Q1c, Q2c.
+  if (p.cost_form != design::CostForm::kContinuous) {
+    throw std::invalid_argument(p.source + ": study 'ncs' needs cost.Q1c and cost.Q2c (the loop's cost is continuous)");
+  }
   ctx->design_ = design::synthesize(p);
   if (!ctx->design_.tracking) {
     throw std::invalid_argument(p.source + ": no set-point feed-forward: " + ctx->design_.tracking_unavailable_reason);

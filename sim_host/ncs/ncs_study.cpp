@@ -120,7 +120,7 @@ void add_ncs_commands(CLI::App* study) {
         ->capture_default_str();
     cmd->callback([c, t, shard, approaches, scenario_file, inject]() {
       t->faults = engine::parse_fault_spec(*inject);
-      const auto ctx = ncs::Context::load(c->plant);
+      const auto ctx = ncs::Context::load_board(c->plant);
       if (!scenario_file->empty()) t->scenarios = ncs::load_scenarios(*scenario_file);
       if (!approaches->empty()) {
         t->approaches.clear();
@@ -153,7 +153,7 @@ void add_ncs_commands(CLI::App* study) {
     add_common(cmd, *c, std::string("out/ncs-") + nm);
     cmd->add_option("--duration", *d, "simulated seconds")->check(CLI::Range(0.1, 3600.0))->capture_default_str();
     cmd->callback([c, d, f]() {
-      const auto ctx = ncs::Context::load(c->plant);
+      const auto ctx = ncs::Context::load_board(c->plant);
       emit(*c, f(*ctx, c->seed, *d, c->out, !c->no_plots));
     });
   };
@@ -185,7 +185,7 @@ void add_ncs_commands(CLI::App* study) {
                                           "Cost of `table --analytic`: covariance propagation per event, analytic run "
                                           "against the noise-free run (benchmark, not a test)");
     add_common(cmd, *c, "out/ncs-analytic-benchmark");
-    cmd->callback([c]() { emit(*c, ncs::analytic_benchmark(*ncs::Context::load(c->plant), c->seed)); });
+    cmd->callback([c]() { emit(*c, ncs::analytic_benchmark(*ncs::Context::load_board(c->plant), c->seed)); });
   }
   add_ncs_live_commands(study);
   add_ncs_faults_command(study);

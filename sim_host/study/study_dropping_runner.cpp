@@ -316,7 +316,7 @@ engine::SweepResults run_dropping_sweep(const DroppingStudy& s, std::size_t seed
                                    m.sent,
                                    m.lost,
                                    buffered ? m.over_delayed : m.stale,
-                                   m.refused_non_finite + m.refused_sequence};
+                                   m.refused_non_finite + m.refused_sequence + m.corrupt};
       },
       "study run (dropping)");
 }

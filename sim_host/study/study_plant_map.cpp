@@ -8,6 +8,7 @@
 #include <utility>
 
 #include "ncs_model.hpp"
+#include "oneshot/dimension_limits.hpp"
 #include "oneshot/engine/study_file.hpp"
 #include "study_fields.hpp"
 
@@ -25,7 +26,17 @@ std::shared_ptr<const ncs::Context> inline_context(const engine::PlantSpec& plan
   const std::string g = discrete ? "plant.discrete" : "plant.continuous";
   const std::string runs = std::string("study ncs runs ") + ncs::kNcsShapesText;
   if (!ncs::ncs_shape_runs(a.rows, b.cols, c.rows)) {
-    refuse(g + (discrete ? ".Phi" : ".A"), "n = " + std::to_string(a.rows) + ", m = " + std::to_string(b.cols) +
+    // Name the matrix whose size is off: A (Φ) when no shape has n states, else B (Γ) when no shape
+    // of n states has m inputs, else C.
+    bool n_runs = false, nm_runs = false;
+    for (std::size_t mm = 1; mm <= kMaxInputs; ++mm)
+      for (std::size_t pp = 1; pp <= kMaxOutputs; ++pp)
+        if (ncs::ncs_shape_runs(a.rows, mm, pp)) {
+          n_runs = true;
+          nm_runs = nm_runs || mm == b.cols;
+        }
+    const char* key = !n_runs ? (discrete ? ".Phi" : ".A") : !nm_runs ? (discrete ? ".Gamma" : ".B") : ".C";
+    refuse(g + key, "n = " + std::to_string(a.rows) + ", m = " + std::to_string(b.cols) +
                                                ", p = " + std::to_string(c.rows) + "; " + runs);
   }
   for (std::size_t i = 0; i < c.rows; ++i)

@@ -128,8 +128,8 @@ TEST(StudyInlinePlant, WhatTheLoopCannotRunIsRefusedNamingTheKey) {
     c["C"] = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
     c["Q_c"] = c["Q1c"] = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
   }, "field 'plant.continuous.A': n = 3, m = 1, p = 3; study ncs runs (n, m, p) = (2, 1, 2)");
-  expect([&](nlohmann::json& c) { bare(c); c["B"] = {{0, 1}, {1, 0}}; c["Q2c"] = {{1, 0}, {0, 1}}; }, "field 'plant.continuous.A': n = 2, m = 2");
-  expect([&](nlohmann::json& c) { bare(c); c["C"] = {{1, 0}}; }, "field 'plant.continuous.A': n = 2, m = 1, p = 1");
+  expect([&](nlohmann::json& c) { bare(c); c["B"] = {{0, 1}, {1, 0}}; c["Q2c"] = {{1, 0}, {0, 1}}; }, "field 'plant.continuous.B': n = 2, m = 2");
+  expect([&](nlohmann::json& c) { bare(c); c["C"] = {{1, 0}}; }, "field 'plant.continuous.C': n = 2, m = 1, p = 1");
   expect([](nlohmann::json& c) { c["C"] = {{1, 0}, {0, 2}}; }, "field 'plant.continuous.C': is not the identity");
   expect(bare, "field 'plant.continuous.measurement_covariance': missing");
   expect([](nlohmann::json& c) { c.erase("Q1c"); c.erase("Q2c"); }, "field 'plant.continuous.Q1c'");
@@ -275,6 +275,7 @@ TEST(StudyPlantShapes, TheFiltersOfAFirstOrderPlantAreConsistent) {
     std::printf("%s: NEES %.4f (standard error %.4f over %d seeds)\n", ncs::name(a), mean, se, seeds);
     EXPECT_NEAR(mean, 1.0, 4 * se + 0.02) << ncs::name(a);
   }
+}
 
 nlohmann::json matrix_rows(const design::DenseMatrix& m) {
   nlohmann::json r = nlohmann::json::array();
@@ -379,6 +380,12 @@ TEST(StudyDiscretePlant, APlantFileOfFormDiscreteRunsAsItsContinuousEquivalent) 
   f["Phi"] = {{-0.5, 0.1}, {0, 0.9}};
   std::ofstream(path) << f.dump(2);
   kInlineNcs.expect_refused([&](nlohmann::json& j) { j["plant"] = {{"file", path}}; }, "field 'Phi': eigenvalue -0.5");
+  // A discrete cost (Q1, Q2 per step) beside a board: the plant converts, the loop's continuous
+  // cost has no weights: refused, never run on empty Q1c, Q2c.
+  f["Phi"] = c.at("Phi");
+  f["cost"] = {{"Q1", {{1, 0}, {0, 1}}}, {"Q2", {{1}}}};
+  std::ofstream(path) << f.dump(2);
+  kInlineNcs.expect_refused([&](nlohmann::json& j) { j["plant"] = {{"file", path}}; }, "needs cost.Q1c and cost.Q2c");
 }
 
 // (c) Refusals naming the field: no real logarithm, a singular Φ, a Q no white noise gives, a
