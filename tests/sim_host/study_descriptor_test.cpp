@@ -60,7 +60,8 @@ TEST(StudyDescriptors, MergeFindsEverySummarizerAndNamesTheKnownOnes) {
   } catch (const std::invalid_argument& e) {
     EXPECT_STREQ(e.what(),
                  "no study experiment 'oneshot noise' can merge sweeps (known: dropping arrival, dropping closed-loop, "
-                 "dropping hold, ncs table, oneshot kernel, oneshot table1, petc gpi, petc table, sod table, study run)");
+                 "dropping hold, ncs table, oneshot kernel, oneshot table1, petc gpi, petc table, sod table, study run, "
+                 "study run-dropping)");
   }
 }
 
