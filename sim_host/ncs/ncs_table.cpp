@@ -120,7 +120,6 @@ nlohmann::json table_outputs(const engine::SweepResults& results, const std::str
   std::ostringstream md;
   md << "| approach | description | mean cost J | 95 % CI | ratio to I (95 % CI) | scenario-weighted ratio (95 % CI) | late | saturated |\n"
         "|---|---|---|---|---|---|---|---|\n";
-  std::vector<std::pair<double, std::string>> order;
   for (std::size_t a = 0; a < na; ++a) {
     double late = 0;
     double sat = 0;
@@ -150,19 +149,10 @@ nlohmann::json table_outputs(const engine::SweepResults& results, const std::str
                   description(ap), sm.value[a].mean, sm.value[a].ci95, sm.ratio_of_means[a], sm.ratio[a].ci95,
                   sm.ratio_weighted[a].mean, sm.ratio_weighted[a].ci95, late, sat);
     md << line;
-    order.emplace_back(sm.value[a].mean, nm);
   }
-  std::stable_sort(order.begin(), order.end());
-  std::string order_text;
-  for (const auto& o : order) {
-    j["order_by_mean_cost"].push_back(o.second);
-    order_text += (order_text.empty() ? "" : " < ") + o.second;
-  }
-  j["order_text"] = order_text;
-  for (const auto& p : sm.paired) {
-    j["paired_differences"][spec.approaches[p.a] + "-" + spec.approaches[p.b]] = {{"mean", p.diff.mean},
-                                                                                 {"ci95", p.diff.ci95}};
-  }
+  engine::add_order_by_mean(j, results, sm);
+  const std::string order_text = j.at("order_text").get<std::string>();
+  if (!sm.paired.empty()) j["paired_differences"] = engine::paired_differences_json(results, sm);
   // Per scenario: mean cost and ratio to I.
   std::ostringstream per;
   per << "| scenario | I";
@@ -241,7 +231,8 @@ std::string paired_differences_markdown(const nlohmann::json& table, const std::
   for (const std::string& key : pairs) {
     if (!p.contains(key)) continue;
     char line[160];
-    std::snprintf(line, sizeof line, " | %.6f | ± %.6f |\n", p.at(key).at("mean").get<double>(), p.at(key).at("ci95").get<double>());
+    const auto value = [](const nlohmann::json& v) { return v.is_null() ? std::nan("") : v.get<double>(); };  // null: not finite
+    std::snprintf(line, sizeof line, " | %.6f | ± %.6f |\n", value(p.at(key).at("mean")), value(p.at(key).at("ci95")));
     md << "| " << key << line;
   }
   return md.str();

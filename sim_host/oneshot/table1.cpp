@@ -146,10 +146,7 @@ nlohmann::json table1_outputs(const engine::SweepResults& results, const std::st
     }
   }
   // Paired differences of the per-seed mean cost (every approach sees the same draws).
-  for (const auto& p : sm.paired) {
-    j["paired_differences"][spec.approaches[p.a] + "-" + spec.approaches[p.b]] = {{"mean", p.diff.mean},
-                                                                                 {"ci95", p.diff.ci95}};
-  }
+  if (!sm.paired.empty()) j["paired_differences"] = engine::paired_differences_json(results, sm);
   // Per-scenario table: mean cost and ratio to A.
   std::ostringstream per;
   per << "| scenario | jitter | amplitude (V) | change period (s) | " << spec.approaches[0];

@@ -2,10 +2,13 @@
 /// @brief Sweep summaries (see sweep_statistics.hpp).
 #include "oneshot/engine/sweep_statistics.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <sstream>
 #include <stdexcept>
+#include <string>
+#include <utility>
 
 #include "oneshot/util/output_files.hpp"
 
@@ -93,12 +96,29 @@ nlohmann::json summary_json(const SweepResults& r, const SweepSummary& sm) {
     per.push_back(e);
   }
   j["per_scenario"] = per;
-  j["paired_differences"] = nlohmann::json::object();
+  j["paired_differences"] = paired_differences_json(r, sm);
+  return j;
+}
+
+nlohmann::json paired_differences_json(const SweepResults& r, const SweepSummary& sm) {
+  nlohmann::json j = nlohmann::json::object();
   for (const auto& p : sm.paired) {
-    j["paired_differences"][r.spec.approaches[p.a] + "-" + r.spec.approaches[p.b]] = {{"mean", p.diff.mean},
-                                                                                      {"ci95", p.diff.ci95}};
+    j[r.spec.approaches[p.a] + "-" + r.spec.approaches[p.b]] = {{"mean", number_or_null(p.diff.mean)},
+                                                                {"ci95", number_or_null(p.diff.ci95)}};
   }
   return j;
+}
+
+void add_order_by_mean(nlohmann::json& j, const SweepResults& r, const SweepSummary& sm) {
+  std::vector<std::pair<double, std::string>> order;
+  for (std::size_t a = 0; a < r.spec.approaches.size(); ++a) order.emplace_back(sm.value[a].mean, r.spec.approaches[a]);
+  std::stable_sort(order.begin(), order.end());
+  std::string text;
+  for (const auto& o : order) {
+    j["order_by_mean_cost"].push_back(o.second);
+    text += (text.empty() ? "" : " < ") + o.second;
+  }
+  j["order_text"] = text;
 }
 
 void write_runs_csv(const SweepResults& r, const std::string& path, util::NonFinite non_finite) {

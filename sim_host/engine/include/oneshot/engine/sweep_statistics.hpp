@@ -57,6 +57,16 @@ SweepSummary summarize_metric(const SweepResults& results, std::size_t metric, s
 /// ratios are null.
 nlohmann::json summary_json(const SweepResults& results, const SweepSummary& summary);
 
+/// The paired differences of `summary` as JSON: {"<a>-<b>": {"mean", "ci95"}} for every pair
+/// a < b (names in the sweep's order), diff_ab = mean_k (m_a,k − m_b,k); a non-finite mean or
+/// interval (a diverged run) is null. Empty object for a single approach.
+nlohmann::json paired_differences_json(const SweepResults& results, const SweepSummary& summary);
+
+/// The approaches ordered by their mean over seeds, ascending (std::stable_sort of (mean, name)
+/// pairs: equal means by name): {"order_by_mean_cost": [names], "order_text": "a < b < ..."}
+/// merged into `j` (the keys of `ncs table --json`).
+void add_order_by_mean(nlohmann::json& j, const SweepResults& results, const SweepSummary& summary);
+
 /// Writes the raw runs as CSV: approach_index, scenario_index, seed, one column per metric;
 /// a NaN or infinite value is refused unless `non_finite` is kMissing (a divergence the study reports).
 void write_runs_csv(const SweepResults& results, const std::string& path,
