@@ -300,6 +300,8 @@ RunMetrics run_impl(const DroppingPlant& plant, const RunConfig& cfg, std::uint6
       out.trace.cxhat.push_back((plant.c * xhat)[0]);
       out.trace.trace_p.push_back(tr);
       out.trace.err.push_back(e);
+      out.trace.u.push_back(u[0]);
+      out.trace.r.push_back(r_k);
     }
   });
   for (std::size_t k = 0; k < steps; ++k) {
@@ -308,6 +310,7 @@ RunMetrics run_impl(const DroppingPlant& plant, const RunConfig& cfg, std::uint6
     kernel.schedule(t, engine::EventClass::kCompute, compute, k);
   }
   kernel.run_until(end);
+  out.events = static_cast<double>(kernel.events_run());
   const double n = static_cast<double>(steps);
   out.trace_p = sum_tr / n;
   out.err = sum_err / n;

@@ -75,6 +75,8 @@ struct RunTrace {
   std::vector<double> cxhat;     ///< C x̂(k|Y_k).
   std::vector<double> trace_p;   ///< tr P_k.
   std::vector<double> err;       ///< |x_k − x̂(k|Y_k)|².
+  std::vector<double> u;         ///< u_k = −L x̂(k|Y_k) + r_k, the input applied for step k.
+  std::vector<double> r;         ///< r_k, the square wave's value at step k.
 };
 
 /// What a run measures (time averages over the steps).
@@ -100,6 +102,7 @@ struct RunMetrics {
   double lost = 0;                ///< Of them lost (the link's loss, or γ_k = 0; clean runs).
   double estimate_non_finite = 0; ///< Steps whose loop estimate x̂(k|Y_k) was not finite (faults only).
   engine::FaultCounters injected; ///< Faults injected on the link.
+  double events = 0;              ///< Kernel events run (the engine's event queue pops: samples, computations, deliveries).
   RunTrace trace;              ///< Traces (when asked).
 };
 

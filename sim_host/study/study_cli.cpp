@@ -5,23 +5,25 @@
 ///        command line; `merge` finishes the shards of `study run`.
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
-#include <ctime>
 #include <filesystem>
 #include <iostream>
 #include <memory>
 #include <optional>
 #include <sstream>
+#include <stdexcept>
 #include <string>
-#include <thread>
 
-#include "oneshot/engine/plant_cache_pool.hpp"
 #include "oneshot/engine/study_file.hpp"
 #include "oneshot/sim/study_descriptor.hpp"
 #include "oneshot/util/output_files.hpp"
 #include "ncs_loop.hpp"
+#include "study_bench.hpp"
 #include "study_check.hpp"
+#include "study_dropping_report.hpp"
 #include "study_dropping_runner.hpp"
+#include "study_dropping_study.hpp"
 #include "study_file_report.hpp"
 #include "study_ncs_runner.hpp"
 #include "study_ncs_sweep.hpp"
@@ -108,8 +110,8 @@ struct BenchCli {
 
 /// The file's ncs loop, its scenarios cut at `max_duration_s` when the option was given.
 study::NcsStudy runnable(const Checked& k, const CLI::Option* max_duration, double max_duration_s) {
-  if (k.dropping)  // study run runs it (run_dropping below); report, bench and --max-duration take ncs files
-    throw engine::InputError(k.resolution.at("source").get<std::string>() + ": field 'study': a dropping file runs with study run only");
+  if (k.dropping)  // the commands route a dropping file before (run_dropping, report_dropping, dropping_bench)
+    throw std::logic_error("a dropping file on the ncs loop");
   if (!k.ncs) throw engine::InputError(k.resolution.at("source").get<std::string>() + ": " + k.refusal);  // one line, nothing written
   study::NcsStudy s = *k.ncs;
   if (max_duration->count() > 0) study::cap_duration(s, max_duration_s, "--max-duration");
@@ -143,77 +145,6 @@ std::string simulated_time_text(const study::NcsStudy& s, const CLI::Option* max
   return t.str();
 }
 
-/// `study bench`: the file's sweep (approaches x scenarios x seeds, ncs::run with the sweep's
-/// seeds) timed, each run's kernel events counted (an event: one pop of the engine's event
-/// queue, whatever its handler: sampling, timers, computations, deliveries, set-point
-/// switches, CAN frames and background traffic); per approach the mean cost over its runs
-/// (`cost_mean`; a file with several loops: one run of them all, `loops.<loop>.cost_mean`).
-nlohmann::json bench(const study::NcsStudy& s, std::size_t seeds, unsigned threads) {
-  engine::SweepSpec spec = study::study_sweep_spec(s, seeds, "bench");
-  // Several loops: each loop's cost "<loop>/cost" (the loops of one shared run), then the run's figures.
-  for (const study::NcsStudy& l : s.loops) spec.metrics.push_back(l.loop + "/cost");
-  if (s.loops.empty()) spec.metrics.emplace_back("cost");
-  std::int64_t last_offset_us = 0;  // the shared run goes on to the latest loop's end
-  for (const study::NcsStudy& l : s.loops) last_offset_us = std::max(last_offset_us, l.clock_offset_us);
-  for (const char* m : {"events", "simulated_s", "run_s"}) spec.metrics.emplace_back(m);
-  spec.config = {{"study_file", s.source}};
-  const unsigned used = threads == 0 ? std::max(1U, std::thread::hardware_concurrency()) : threads;
-  const std::clock_t cpu0 = std::clock();
-  const auto start = std::chrono::steady_clock::now();
-  engine::PlantCachePool<ncs::kN, ncs::kM + 1> pool;  // as study run's sweep
-  ncs::RunOptions options;
-  options.caches = &pool;
-  const engine::SweepResults r = engine::run_sweep(
-      spec, engine::Shard{}, used,
-      [&s, &options, last_offset_us](std::size_t a, std::size_t k, std::uint64_t seed) {
-        const auto t0 = std::chrono::steady_clock::now();
-        // Several loops: one run of them all on the shared engine (its events, every loop's cost).
-        const std::vector<ncs::RunResult> x =
-            s.loops.empty() ? std::vector<ncs::RunResult>{ncs::run(*s.ctx, s.approaches[a], s.scenarios[k], seed, options)}
-                            : ncs::run_loops(study::loops_on_bus(s, k), s.approaches[a], seed);
-        const double run_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-        std::vector<double> v;
-        for (const ncs::RunResult& l : x) v.push_back(l.cost);
-        v.insert(v.end(), {static_cast<double>(x[0].events), s.scenarios[k].duration_s + 1e-6 * static_cast<double>(last_offset_us), run_s});
-        return v;
-      },
-      "study bench");
-  const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  const double cpu = static_cast<double>(std::clock() - cpu0) / CLOCKS_PER_SEC;
-  double events = 0;
-  double simulated = 0;
-  const std::size_t ev = r.metric("events");
-  const std::size_t sim = r.metric("simulated_s");
-  const std::size_t rs = r.metric("run_s");
-  nlohmann::json per = nlohmann::json::object();  // per approach: its runs' events and their time on their thread
-  for (std::size_t a = 0; a < spec.approaches.size(); ++a) {
-    double ea = 0;
-    double ta = 0;
-    for (std::size_t x = 0; x < spec.scenarios.size(); ++x)
-      for (std::size_t k = 0; k < spec.seeds; ++k) {
-        ea += r.at(a, x, k, ev);
-        ta += r.at(a, x, k, rs);
-        simulated += r.at(a, x, k, sim);
-      }
-    events += ea;
-    per[spec.approaches[a]] = {{"events", ea}, {"run_s", ta}, {"events_per_run_s", ta > 0 ? ea / ta : 0.0}};
-    // The mean cost over the approach's runs: the loop's, or per loop of a file with several.
-    const auto cost_mean = [&](const std::string& metric) {
-      const std::size_t m = r.metric(metric);
-      double sum = 0;
-      for (std::size_t x = 0; x < spec.scenarios.size(); ++x)
-        for (std::size_t k = 0; k < spec.seeds; ++k) sum += r.at(a, x, k, m);
-      return sum / static_cast<double>(spec.scenarios.size() * spec.seeds);
-    };
-    if (s.loops.empty()) per[spec.approaches[a]]["cost_mean"] = cost_mean("cost");
-    for (const study::NcsStudy& l : s.loops) per[spec.approaches[a]]["loops"][l.loop]["cost_mean"] = cost_mean(l.loop + "/cost");
-  }
-  return {{"per_approach", per}, {"study_file", s.source}, {"runs", spec.runs()}, {"seeds", spec.seeds}, {"threads", used},
-          {"events", events}, {"simulated_s", simulated}, {"wall_s", wall}, {"cpu_s", cpu},
-          {"events_per_s", events / wall}, {"events_per_s_per_thread", events / wall / used},
-          {"events_per_cpu_s", cpu > 0 ? events / cpu : 0.0}};
-}
-
 /// `study run` of a dropping file: its sweep (or shard), the summary, the same outputs as an ncs file's.
 void run_dropping(const study::DroppingStudy& s, const RunCli& c, const CLI::Option* max_duration) {
   if (c.analytic) throw engine::InputError("field '--analytic': no exact cost for the dropping loop (its filters run on what arrives)");
@@ -232,6 +163,38 @@ void run_dropping(const study::DroppingStudy& s, const RunCli& c, const CLI::Opt
   }
   if (!c.json.empty()) util::write_json(c.json, j);
   if (c.json != "-") std::cout << "study run: " << r.spec.runs() << " runs, wall time " << wall << " s, written to " << c.out << "\n";
+}
+
+/// `study report` of a dropping file: its sweep, the summary, the cost plot, the traced runs and
+/// OUT/report.md, OUT/report.json (refusals of the options before anything is written).
+void report_dropping(const Checked& k, const ReportCli& c, const CLI::Option* max_duration, const CLI::Option* trace) {
+  const study::DroppingStudy& s = *k.dropping;
+  if (max_duration->count() > 0) throw engine::InputError("field '--max-duration': a dropping file's runs take its duration_s");
+  if (trace->count() > 0 && c.trace.empty()) throw engine::InputError("field '--trace': an empty approach name");
+  const std::vector<std::size_t> traced = study::trace_selection(s.approaches, s.source, c.trace);
+  util::make_directory(c.out);
+  const engine::SweepResults r = study::run_dropping_sweep(s, c.seeds, c.threads, engine::Shard{});
+  nlohmann::json j = study::dropping_run_outputs(r, c.out, false);
+  for (const auto& f : study::write_dropping_cost_plot(r, c.out, !c.no_plots)) j["files"].push_back(f);
+  nlohmann::json traces = study::write_dropping_traces(s, traced, c.out, !c.no_plots);
+  for (std::size_t a : traced) {  // the traced run is the sweep's: the same cost, bit for bit
+    const std::string& an = r.spec.approaches[a];
+    if (!traces.contains(an)) continue;
+    const nlohmann::json cost = traces[an].at("cost");  // null: not finite (a diverged loop), as the sweep's must be
+    const double swept = r.at(a, 0, 0, r.metric("cost"));
+    const bool same = cost.is_null() ? !std::isfinite(swept) : cost.get<double>() == swept;
+    traces[an]["same_cost_as_sweep"] = same;
+  }
+  j["traces"] = traces;
+  nlohmann::json resolution = k.resolution;  // the grid that ran: --seeds overrides the file's count
+  resolution["seeds"]["count"] = r.spec.seeds;
+  resolution["grid"]["runs"] = r.spec.runs();
+  const std::string md = study::dropping_report_markdown(
+      s, c.file, study::describe_resolution(resolution) + study::describe_dropping(resolution), r, j, c.no_plots ? "" : "table.png",
+      traces, !c.no_plots);
+  util::write_text((std::filesystem::path(c.out) / "report.md").string(), md);
+  util::write_json((std::filesystem::path(c.out) / "report.json").string(), j);
+  std::cout << "study report: " << r.spec.runs() << " runs, written to " << (std::filesystem::path(c.out) / "report.md").string() << "\n";
 }
 
 constexpr const char* kMaxDurationHelp = "cap every scenario's simulated seconds (at least one period h; default: the file's)";
@@ -301,7 +264,7 @@ void add_study_commands(CLI::App* group) {
     auto c = std::make_shared<ReportCli>();
     CLI::App* cmd = group->add_subcommand(
         "report", "Run a study file as `study run` does and write OUTDIR/report.md: the resolved configuration, costs with "
-                  "95 % intervals, ratios to I, paired differences, per-link counters, the cost plot; OUTDIR/report.json");
+                  "95 % intervals, ratios to I (a dropping file: to its first approach), paired differences, per-link counters, the cost plot; OUTDIR/report.json");
     cmd->add_option("file", c->file, "study file (oneshot-study/1)")->required();
     cmd->add_option("outdir", c->out, "output directory")->required();
     cmd->add_option("--seeds", c->seeds, "seeds per scenario (default: the file's seeds.count)")->check(CLI::Range(2, 10000000));
@@ -314,6 +277,10 @@ void add_study_commands(CLI::App* group) {
         "CSV of states, estimates, input and messages, and a plot each");
     cmd->callback([c, max_duration, trace]() {
       const Checked k = check_file(c->file);
+      if (k.dropping) {
+        report_dropping(k, *c, max_duration, trace);
+        return;
+      }
       const study::NcsStudy s = runnable(k, max_duration, c->max_duration_s);
       if (trace->count() > 0 && c->trace.empty()) throw engine::InputError("field '--trace': an empty approach name");
       if (trace->count() > 0 && !s.loops.empty()) throw engine::InputError("field '--trace': no traces of a file with several loops (loops[])");
@@ -373,16 +340,13 @@ void add_study_commands(CLI::App* group) {
     const CLI::Option* max_duration = cmd->add_option("--max-duration", c->max_duration_s, kMaxDurationHelp);
     cmd->add_option("--json", c->json, "write the figures as JSON to PATH, or '-' for standard output");
     cmd->callback([c, max_duration]() {
-      const study::NcsStudy s = runnable(check_file(c->file), max_duration, c->max_duration_s);
-      const nlohmann::json j = bench(s, c->seeds, c->threads);
+      const Checked k = check_file(c->file);
+      if (k.dropping && max_duration->count() > 0)
+        throw engine::InputError("field '--max-duration': a dropping file's runs take its duration_s");
+      const nlohmann::json j = k.dropping ? study::dropping_bench(*k.dropping, c->seeds, c->threads)
+                                          : study::ncs_bench(runnable(k, max_duration, c->max_duration_s), c->seeds, c->threads);
       if (!c->json.empty()) util::write_json(c->json, j);
-      if (c->json != "-") {
-        std::printf("study bench %s: %zu runs (%zu seeds) on %u threads: %.0f events, %.1f s simulated, wall %.2f s, CPU %.2f s; "
-                    "%.3g events/s per thread, %.3g events per CPU second\n",
-                    c->file.c_str(), j.at("runs").get<std::size_t>(), j.at("seeds").get<std::size_t>(), j.at("threads").get<unsigned>(),
-                    j.at("events").get<double>(), j.at("simulated_s").get<double>(), j.at("wall_s").get<double>(),
-                    j.at("cpu_s").get<double>(), j.at("events_per_s_per_thread").get<double>(), j.at("events_per_cpu_s").get<double>());
-      }
+      if (c->json != "-") std::cout << study::bench_line(c->file, j);
     });
   }
 }

@@ -103,27 +103,34 @@ std::string trace_plot(const std::string& stem, const std::string& title, bool e
 
 }  // namespace
 
-std::vector<std::size_t> trace_selection(const NcsStudy& s, const std::string& names) {
+std::vector<std::size_t> trace_selection(const std::vector<std::string>& approaches, const std::string& source,
+                                         const std::string& names) {
   std::vector<std::size_t> out;
   if (names.empty()) {
-    for (std::size_t a = 0; a < s.approaches.size() && a < kMaxDefaultTraces; ++a) out.push_back(a);
+    for (std::size_t a = 0; a < approaches.size() && a < kMaxDefaultTraces; ++a) out.push_back(a);
     return out;
   }
   std::string known;
-  for (ncs::Approach a : s.approaches) known += (known.empty() ? "" : ", ") + std::string(ncs::name(a));
+  for (const std::string& a : approaches) known += (known.empty() ? "" : ", ") + a;
   std::istringstream in(names);
   std::string n;
   while (std::getline(in, n, ',')) {
     std::size_t a = 0;
-    while (a < s.approaches.size() && n != ncs::name(s.approaches[a])) ++a;
-    if (a == s.approaches.size()) {
-      throw engine::InputError("field '--trace': no approach '" + n + "' in " + s.source + " (its approaches: " + known + ")");
+    while (a < approaches.size() && n != approaches[a]) ++a;
+    if (a == approaches.size()) {
+      throw engine::InputError("field '--trace': no approach '" + n + "' in " + source + " (its approaches: " + known + ")");
     }
     if (std::find(out.begin(), out.end(), a) != out.end()) throw engine::InputError("field '--trace': approach '" + n + "' given twice");
     out.push_back(a);
   }
   if (out.empty() || names.back() == ',') throw engine::InputError("field '--trace': an empty approach name");
   return out;
+}
+
+std::vector<std::size_t> trace_selection(const NcsStudy& s, const std::string& names) {
+  std::vector<std::string> approaches;
+  for (ncs::Approach a : s.approaches) approaches.emplace_back(ncs::name(a));
+  return trace_selection(approaches, s.source, names);
 }
 
 nlohmann::json write_traces(const NcsStudy& s, const std::vector<std::size_t>& selected, const std::string& out_dir, bool plots) {

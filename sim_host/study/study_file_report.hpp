@@ -24,6 +24,10 @@ inline constexpr std::size_t kMaxDefaultTraces = 10;
 /// `--trace` for an empty or unknown name or one given twice.
 std::vector<std::size_t> trace_selection(const NcsStudy& s, const std::string& names);
 
+/// The same selection among `approaches` (any study's names, in its order) of the file `source`.
+std::vector<std::size_t> trace_selection(const std::vector<std::string>& approaches, const std::string& source,
+                                         const std::string& names);
+
 /// One traced run per approach of `selected` on the first scenario and the first seed, the
 /// same run as the sweep's (same seed and streams; the trace and the message log only
 /// observe): OUT_DIR/trace_<A>_states.csv (t_s, x1, x2, r1, u: the plant's true states, the

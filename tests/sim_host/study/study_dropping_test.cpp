@@ -217,9 +217,6 @@ TEST(StudyDropping, CheckGivesTheDesignAndRunRefusesWhatItCannotRun) {
     EXPECT_NE(x.exit_code, 0);
     EXPECT_NE(x.output.find("field '" + std::string(opt) + "'"), std::string::npos) << x.output;
   }
-  const test::CommandResult rep = test::run_command({ONESHOT_SIM_PATH, "study", "report", kDroppingExample, dir + "/rep"});
-  EXPECT_NE(rep.exit_code, 0);
-  EXPECT_NE(rep.output.find("field 'study'"), std::string::npos) << rep.output;
 }
 
 }  // namespace

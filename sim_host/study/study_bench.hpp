@@ -1,0 +1,45 @@
+/// @file study_bench.hpp
+/// @brief What `oneshot-sim study bench` reports for any study file's timed sweep: events, wall
+///        and CPU time, events per second per thread and per CPU second, per approach its runs'
+///        events over their time on their thread (docs/study-files.md, Speed).
+#pragma once
+
+#include <cstddef>
+#include <string>
+
+#include <nlohmann/json.hpp>
+
+#include "oneshot/engine/sweep.hpp"
+
+namespace oneshot::study {
+
+/// The figures of a timed sweep `r` whose metrics include "events" (kernel events of the run),
+/// "simulated_s" (its simulated seconds) and "run_s" (its time on its thread): per approach
+/// {events, run_s, events_per_run_s = events / run_s}; study_file `source`, runs, seeds,
+/// threads, events, simulated_s, wall_s, cpu_s, events_per_s = events / wall_s,
+/// events_per_s_per_thread = events / wall_s / threads, events_per_cpu_s = events / cpu_s
+/// (0 when a time is 0).
+nlohmann::json bench_figures(const engine::SweepResults& r, const std::string& source, unsigned threads, double wall_s,
+                             double cpu_s);
+
+struct NcsStudy;
+struct DroppingStudy;
+
+/// `study bench` of an ncs file: its sweep (approaches x scenarios x seeds, ncs::run with the
+/// sweep's seeds; a file with several loops: ncs::run_loops, one run of them all) timed, each
+/// run's kernel events counted (an event: one pop of the engine's event queue, whatever its
+/// handler: sampling, timers, computations, deliveries, set-point switches, CAN frames and
+/// background traffic); bench_figures() plus per approach the mean cost over its runs
+/// (`cost_mean`; a file with several loops: `loops.<loop>.cost_mean`).
+nlohmann::json ncs_bench(const NcsStudy& s, std::size_t seeds, unsigned threads);
+
+/// `study bench` of a dropping file: its sweep as `study run` runs it (dropping::run_closed_loop
+/// with the sweep's seeds) timed, each run's kernel events counted (the engine's queue pops:
+/// plant steps, samples, computations, deliveries); bench_figures() plus per approach the mean
+/// cost over its runs (`cost_mean`, null when a run diverged).
+nlohmann::json dropping_bench(const DroppingStudy& s, std::size_t seeds, unsigned threads);
+
+/// The line `study bench` prints for the figures `j` of `file`.
+std::string bench_line(const std::string& file, const nlohmann::json& j);
+
+}  // namespace oneshot::study
