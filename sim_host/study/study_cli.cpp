@@ -15,10 +15,10 @@
 #include <string>
 #include <thread>
 
-#include "oneshot/engine/plant_cache_pool.hpp"
 #include "oneshot/engine/study_file.hpp"
 #include "oneshot/sim/study_descriptor.hpp"
 #include "oneshot/util/output_files.hpp"
+#include "ncs_cache_pools.hpp"
 #include "ncs_loop.hpp"
 #include "study_check.hpp"
 #include "study_dropping_runner.hpp"
@@ -160,7 +160,7 @@ nlohmann::json bench(const study::NcsStudy& s, std::size_t seeds, unsigned threa
   const unsigned used = threads == 0 ? std::max(1U, std::thread::hardware_concurrency()) : threads;
   const std::clock_t cpu0 = std::clock();
   const auto start = std::chrono::steady_clock::now();
-  engine::PlantCachePool<ncs::kN, ncs::kM + 1> pool;  // as study run's sweep
+  ncs::ShapeCachePools pool;  // as study run's sweep
   ncs::RunOptions options;
   options.caches = &pool;
   const engine::SweepResults r = engine::run_sweep(
@@ -170,7 +170,7 @@ nlohmann::json bench(const study::NcsStudy& s, std::size_t seeds, unsigned threa
         // Several loops: one run of them all on the shared engine (its events, every loop's cost).
         const std::vector<ncs::RunResult> x =
             s.loops.empty() ? std::vector<ncs::RunResult>{ncs::run(*s.ctx, s.approaches[a], s.scenarios[k], seed, options)}
-                            : ncs::run_loops(study::loops_on_bus(s, k), s.approaches[a], seed);
+                            : ncs::run_loops(study::loops_on_bus(s, k), s.approaches[a], seed, options.caches);
         const double run_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
         std::vector<double> v;
         for (const ncs::RunResult& l : x) v.push_back(l.cost);
