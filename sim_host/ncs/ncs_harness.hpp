@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "ncs_analytic.hpp"
+#include "ncs_cache_pools.hpp"
 #include "ncs_cpu.hpp"
 #include "ncs_live_nodes.hpp"
 #include "ncs_loop.hpp"
@@ -174,13 +175,9 @@ class BasicHarness {
   /// Whether a run of `a` under `opt` draws process and measurement noise.
   static bool noisy(Approach a, const RunOptions& opt) { return !opt.noise_free && !opt.analytic && a != Approach::kI; }
 
-  /// The sweep's shared plant caches (RunOptions::caches: the board's shape; none for another).
+  /// The sweep's shared plant caches of shape S (RunOptions::caches; none: the run's own).
   static engine::PlantCachePool<S::n, S::m + 1>* caches(const RunOptions& opt) {
-    if constexpr (kBoard) {
-      return opt.caches;
-    } else {
-      return nullptr;
-    }
+    return opt.caches != nullptr ? opt.caches->template pool<S>() : nullptr;
   }
 
   /// Calls fn(tracker) when the run has an analytic tracker (the board's shape only).

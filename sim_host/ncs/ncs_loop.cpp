@@ -392,7 +392,7 @@ RunResult run_approach(const Context& ctx, Approach a, const Scenario& sc, std::
   });
 }
 
-std::vector<RunResult> run_loops(const std::vector<LoopOnBus>& loops, Approach a, std::uint64_t seed) {
+std::vector<RunResult> run_loops(const std::vector<LoopOnBus>& loops, Approach a, std::uint64_t seed, ShapeCachePools* caches) {
   if (loops.empty()) throw std::invalid_argument("ncs: run_loops needs a loop");
   if (a != Approach::kI && a != Approach::kS && a != Approach::kSK && a != Approach::kIK) {
     throw std::invalid_argument(std::string("ncs: several loops in one run take I, S, SK, IK, not ") + name(a));
@@ -403,12 +403,14 @@ std::vector<RunResult> run_loops(const std::vector<LoopOnBus>& loops, Approach a
     if (end > world.end) world.end = end;
   }
   std::vector<RunResult> out(loops.size());
+  RunOptions options;  // the defaults but the sweep's shared caches
+  options.caches = caches;
   // Loop i's nodes and timers are set up, then loop i + 1's inside its finish(); the last runs
   // the kernel, and each collects its results as the calls return.
   std::function<void(std::size_t)> run_from = [&](std::size_t i) {
     const LoopOnBus& l = loops[i];
     out[i] = on_shape(*l.ctx, [&](auto shape) {  // each loop on its own plant's shape
-      BasicHarness<decltype(shape)> hs(*l.ctx, a, *l.scenario, seed, RunOptions{}, &world, &l);
+      BasicHarness<decltype(shape)> hs(*l.ctx, a, *l.scenario, seed, options, &world, &l);
       if (i + 1 < loops.size()) hs.inner_ = [&run_from, i]() { run_from(i + 1); };
       return run_on(hs, a);
     });

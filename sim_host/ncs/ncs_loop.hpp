@@ -38,6 +38,8 @@
 
 namespace oneshot::ncs {
 
+class ShapeCachePools;  // ncs_cache_pools.hpp
+
 /// Options of a run.
 struct RunOptions {
   bool noise_free = false;  ///< No process or measurement noise (delays stay).
@@ -55,9 +57,10 @@ struct RunOptions {
   double analytic_mark_s = 0;
   /// Log every message of the legs in RunResult::messages (observes only: the run is unchanged).
   bool record_messages = false;
-  /// The plant's interval maps and noise terms from these caches shared by a sweep's runs
-  /// (plant_cache_pool.hpp; nullptr: the run's own). The same run, bit for bit.
-  engine::PlantCachePool<kN, kM + 1>* caches = nullptr;
+  /// The plant's interval maps and noise terms from these caches shared by a sweep's runs,
+  /// the pool of the plant's shape (ncs_cache_pools.hpp; nullptr: the run's own). The same
+  /// run, bit for bit.
+  ShapeCachePools* caches = nullptr;
 };
 
 /// One row of a recorded sample or estimate.
@@ -202,7 +205,10 @@ struct LoopOnBus {
 /// kernel, one network, their bus legs
 /// on the same buses (arbitration by identifier with each other and the background traffic,
 /// stream "can/<bus>/jitter"), each loop's streams named per loop. One result per loop, in order.
-std::vector<RunResult> run_loops(const std::vector<LoopOnBus>& loops, Approach a, std::uint64_t seed);
+/// With `caches` each loop's plant takes its interval maps and noise terms from the pool of
+/// its shape (RunOptions::caches: the same bytes as without).
+std::vector<RunResult> run_loops(const std::vector<LoopOnBus>& loops, Approach a, std::uint64_t seed,
+                                 ShapeCachePools* caches = nullptr);
 
 /// The run without the analytic post-checks.
 RunResult run_approach(const Context& ctx, Approach a, const Scenario& scenario, std::uint64_t seed, const RunOptions& options);

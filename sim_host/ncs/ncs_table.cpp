@@ -12,8 +12,8 @@
 
 #include "ncs_analytic.hpp"
 #include "ncs_experiments.hpp"
+#include "ncs_cache_pools.hpp"
 #include "ncs_loop.hpp"
-#include "oneshot/engine/plant_cache_pool.hpp"
 #include "oneshot/engine/sweep_statistics.hpp"
 #include "oneshot/util/output_files.hpp"
 
@@ -74,7 +74,7 @@ engine::SweepResults table_sweep(const Context& ctx, const TableOptions& opt, co
     spec.metrics.insert(spec.metrics.end(), std::begin(kAnalyticMetrics), std::end(kAnalyticMetrics));
   }
   const std::vector<Approach> approaches = opt.approaches;
-  engine::PlantCachePool<kN, kM + 1> pool;  // the sweep's: per thread, bounded (plant_cache_pool.hpp)
+  ShapeCachePools pool;  // the sweep's: per thread, bounded (plant_cache_pool.hpp)
   RunOptions ro;
   ro.noise_free = opt.noise_free;
   ro.faults = opt.faults;

@@ -13,7 +13,7 @@
 
 #include "closed_loop.hpp"
 #include "ncs_loop.hpp"
-#include "oneshot/engine/plant_cache_pool.hpp"
+#include "ncs_cache_pools.hpp"
 #include "study_dropping_study.hpp"
 #include "study_format.hpp"
 #include "study_ncs_runner.hpp"
@@ -71,7 +71,7 @@ nlohmann::json ncs_bench(const NcsStudy& s, std::size_t seeds, unsigned threads)
   const unsigned used = threads == 0 ? std::max(1U, std::thread::hardware_concurrency()) : threads;
   const std::clock_t cpu0 = std::clock();
   const auto start = std::chrono::steady_clock::now();
-  engine::PlantCachePool<ncs::kN, ncs::kM + 1> pool;  // as study run's sweep
+  ncs::ShapeCachePools pool;  // as study run's sweep
   ncs::RunOptions options;
   options.caches = &pool;
   const engine::SweepResults r = engine::run_sweep(
@@ -81,7 +81,7 @@ nlohmann::json ncs_bench(const NcsStudy& s, std::size_t seeds, unsigned threads)
         // Several loops: one run of them all on the shared engine (its events, every loop's cost).
         const std::vector<ncs::RunResult> x =
             s.loops.empty() ? std::vector<ncs::RunResult>{ncs::run(*s.ctx, s.approaches[a], s.scenarios[k], seed, options)}
-                            : ncs::run_loops(loops_on_bus(s, k), s.approaches[a], seed);
+                            : ncs::run_loops(loops_on_bus(s, k), s.approaches[a], seed, options.caches);
         const double run_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
         std::vector<double> v;
         for (const ncs::RunResult& l : x) v.push_back(l.cost);

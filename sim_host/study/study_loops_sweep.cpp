@@ -7,6 +7,7 @@
 #include <utility>
 #include <vector>
 
+#include "ncs_cache_pools.hpp"
 #include "ncs_loop.hpp"
 #include "oneshot/util/number_text.hpp"
 #include "oneshot/util/statistics.hpp"
@@ -54,7 +55,7 @@ LegDelays leg_delays(const engine::SweepResults& r, std::size_t a, const std::st
 }  // namespace
 
 engine::SweepResults run_loops_sweep(const NcsStudy& s, std::size_t seeds, unsigned threads, const engine::Shard& shard,
-                                     bool analytic) {
+                                     bool analytic, bool share_caches) {
   if (analytic) throw engine::InputError("field '--analytic': no analytic cost for a file with several loops (loops[])");
   engine::SweepSpec spec = study_sweep_spec(s, seeds, "run");
   bool filtered = false;  // SK or IK: each loop's NEES
@@ -80,12 +81,14 @@ engine::SweepResults run_loops_sweep(const NcsStudy& s, std::size_t seeds, unsig
   }
   const NcsStudy* study = &s;
   const std::vector<std::vector<std::string>>* legs_on_bus = &bus_legs;
+  ncs::ShapeCachePools pool;  // the sweep's, per plant shape: per thread, bounded (plant_cache_pool.hpp)
+  ncs::ShapeCachePools* caches = share_caches ? &pool : nullptr;
   return engine::run_sweep(
       spec, shard, threads,
-      [study, legs_on_bus, filtered](std::size_t a, std::size_t k, std::uint64_t seed) {
+      [study, legs_on_bus, filtered, caches](std::size_t a, std::size_t k, std::uint64_t seed) {
         const ncs::Approach ap = study->approaches[a];
         const std::vector<ncs::LoopOnBus> loops = loops_on_bus(*study, k);
-        const std::vector<ncs::RunResult> shared = ncs::run_loops(loops, ap, seed);
+        const std::vector<ncs::RunResult> shared = ncs::run_loops(loops, ap, seed, caches);
         std::vector<double> v;
         for (std::size_t i = 0; i < loops.size(); ++i) {
           const std::vector<double> x = loop_sweep_values(study->loops[i], a, shared[i], (*legs_on_bus)[i]);
@@ -93,7 +96,7 @@ engine::SweepResults run_loops_sweep(const NcsStudy& s, std::size_t seeds, unsig
           if (filtered) v.insert(v.end(), {shared[i].nees, static_cast<double>(shared[i].nees_steps)});
         }
         for (std::size_t i = 0; i < loops.size(); ++i) {  // the loop alone on the engine: the same seed and streams
-          const ncs::RunResult alone = ncs::run_loops({loops[i]}, ap, seed)[0];
+          const ncs::RunResult alone = ncs::run_loops({loops[i]}, ap, seed, caches)[0];
           v.push_back(alone.cost);
           for (const std::string& leg : (*legs_on_bus)[i]) {
             double d[std::size(kBusDelayMetrics)] = {};

@@ -14,8 +14,8 @@
 #include "ncs_analytic.hpp"
 #include "ncs_cpu.hpp"
 #include "ncs_experiments.hpp"
+#include "ncs_cache_pools.hpp"
 #include "ncs_loop.hpp"
-#include "oneshot/engine/plant_cache_pool.hpp"
 #include "oneshot/engine/sweep_statistics.hpp"
 #include "oneshot/util/statistics.hpp"
 
@@ -209,7 +209,7 @@ std::vector<double> loop_sweep_values(const NcsStudy& s, std::size_t a, const nc
 
 engine::SweepResults run_ncs_sweep(const NcsStudy& s, std::size_t seeds, unsigned threads, const engine::Shard& shard,
                                    bool analytic, bool share_caches) {
-  if (!s.loops.empty()) return run_loops_sweep(s, seeds, threads, shard, analytic);  // study_loops_sweep.cpp
+  if (!s.loops.empty()) return run_loops_sweep(s, seeds, threads, shard, analytic, share_caches);  // study_loops_sweep.cpp
   bool one_shot = false;
   for (ncs::Approach a : s.approaches) one_shot = one_shot || ncs::one_shot(a);
   if (analytic && one_shot) {
@@ -283,7 +283,7 @@ engine::SweepResults run_ncs_sweep(const NcsStudy& s, std::size_t seeds, unsigne
   const NcsStudy* study = &s;
   const std::vector<std::vector<LinkCounterMap>>* counter_maps = &maps;
   const std::vector<std::string>* bus = &on_bus;
-  engine::PlantCachePool<ncs::kN, ncs::kM + 1> pool;  // the sweep's: per thread, bounded (plant_cache_pool.hpp)
+  ncs::ShapeCachePools pool;  // the sweep's, per plant shape: per thread, bounded (plant_cache_pool.hpp)
   ncs::RunOptions options;
   if (share_caches) options.caches = &pool;
   return engine::run_sweep(

@@ -71,9 +71,10 @@ std::vector<double> loop_sweep_values(const NcsStudy& s, std::size_t a, const nc
 /// filter as in a file of one loop) and "<loop>/alone.cost", "<loop>/alone.<leg>.<bus delay
 /// metric>"; the configuration {"study_file", "loops": [loop_sweep_config() + "name",
 /// "addresses", "file_links", "clock_offset_us" when not 0, ...]}. `analytic` is refused
-/// (engine::InputError naming `--analytic`).
+/// (engine::InputError naming `--analytic`). `share_caches` as run_ncs_sweep(): every loop's
+/// plant, in the shared run and alone, takes its caches from the sweep's pool of its shape.
 engine::SweepResults run_loops_sweep(const NcsStudy& s, std::size_t seeds, unsigned threads, const engine::Shard& shard,
-                                     bool analytic);
+                                     bool analytic, bool share_caches = true);
 
 /// The loops of `s` (a file with several loops) on scenario index `scenario`, for ncs::run_loops().
 std::vector<ncs::LoopOnBus> loops_on_bus(const NcsStudy& s, std::size_t scenario);
@@ -99,8 +100,9 @@ nlohmann::json loops_outputs(const engine::SweepResults& results, const std::str
 /// timing in the metrics "analytic", "analytic_refused" (the refusal's code, 0 when valid) and
 /// "analytic_mismatch", and "analytic": true in the configuration (only then: the sweep's
 /// spec, and its shards, stay as they are without). With `share_caches` the runs of each
-/// thread take the plant's interval maps and noise terms from one pool for the sweep
-/// (ncs::RunOptions::caches); without, each run its own: the same bytes either way.
+/// thread take the plant's interval maps and noise terms from one pool for the sweep, per
+/// plant shape (ncs::RunOptions::caches, ncs::ShapeCachePools); without, each run its own: the
+/// same bytes either way.
 engine::SweepResults run_ncs_sweep(const NcsStudy& s, std::size_t seeds, unsigned threads, const engine::Shard& shard,
                                    bool analytic = false, bool share_caches = true);
 
