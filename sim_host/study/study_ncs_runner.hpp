@@ -30,6 +30,7 @@
 #include "ncs_live.hpp"
 #include "ncs_model.hpp"
 #include "oneshot/engine/study_file.hpp"
+#include "study_one_shot_discretizer.hpp"
 #include "study_plant_map.hpp"
 
 namespace oneshot::study {
@@ -60,6 +61,9 @@ struct NcsStudy {
   std::string plant_path;                     ///< The plant file (resolved against the study file's folder; "" inline).
   std::shared_ptr<const ncs::Context> ctx;    ///< Plant and design.
   std::vector<ncs::Approach> approaches;      ///< In file order (I first).
+  /// Per approach (file order): the one-shot filter's discretizer (`params.discretizer`,
+  /// generic for the other approaches); its triple is in every scenario's one_shot_triples.
+  std::vector<OneShotDiscretization> discretizations;
   std::vector<ncs::Scenario> scenarios;       ///< In file order, legs from the file.
   std::vector<std::string> links;             ///< Leg names the file declares ("as", "sc", "ca" in file order).
   /// Per scenario (file order), per leg on a CAN bus: the worst-case response time of its

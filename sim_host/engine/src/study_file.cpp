@@ -61,25 +61,54 @@ TriggerSpec parse_trigger(const json& j, const std::string& f) {
   return t;
 }
 
-std::map<std::string, double> parse_params(const json& j, const std::string& f, const std::vector<ParamSpec>* specs) {
+/// The spec of `key` in `specs` (null when specs is null); InputError naming `g` when unknown.
+const ParamSpec* param_spec(const std::vector<ParamSpec>* specs, const std::string& key, const std::string& g) {
+  if (specs == nullptr) return nullptr;
+  for (const ParamSpec& p : *specs)
+    if (p.name == key) return &p;
+  std::string known;
+  for (const ParamSpec& p : *specs) known += (known.empty() ? "" : ", ") + p.name;
+  throw InputError("field '" + g + "': unknown parameter (known: " + (known.empty() ? "none" : known) + ")");
+}
+
+/// Word parameters (ParamSpec::words) go to *words (null: none accepted).
+std::map<std::string, double> parse_params(const json& j, const std::string& f, const std::vector<ParamSpec>* specs,
+                                           std::map<std::string, std::string>* words = nullptr) {
   std::map<std::string, double> out;
   const auto it = j.find("params");
   if (it != j.end() && !it->is_object()) throw InputError("field '" + f + ".params': must be an object");
   if (it != j.end()) {
     for (const auto& item : it->items()) {
       const std::string g = f + ".params." + item.key();
+      if (item.value().is_string() && words != nullptr) {
+        if (specs == nullptr) {  // no schema: any word (the study's mapping checks it)
+          (*words)[item.key()] = item.value().get<std::string>();
+          continue;
+        }
+        const ParamSpec* s = param_spec(specs, item.key(), g);
+        std::string list;
+        bool known = false;
+        if (s != nullptr) {
+          for (const std::string& w : s->words) {
+            known = known || w == item.value().get<std::string>();
+            list += (list.empty() ? "" : ", ") + w;
+          }
+        }
+        if (s == nullptr || s->words.empty()) throw InputError("field '" + g + "': must be a finite number");
+        if (!known) throw InputError("field '" + g + "': must be one of " + list);
+        (*words)[item.key()] = item.value().get<std::string>();
+        continue;
+      }
       if (!item.value().is_number() || !std::isfinite(item.value().get<double>())) {
         throw InputError("field '" + g + "': must be a finite number");
       }
       const double v = item.value().get<double>();
       if (specs != nullptr) {
-        const ParamSpec* s = nullptr;
-        for (const ParamSpec& p : *specs)
-          if (p.name == item.key()) s = &p;
-        if (s == nullptr) {
-          std::string known;
-          for (const ParamSpec& p : *specs) known += (known.empty() ? "" : ", ") + p.name;
-          throw InputError("field '" + g + "': unknown parameter (known: " + known + ")");
+        const ParamSpec* s = param_spec(specs, item.key(), g);
+        if (!s->words.empty()) {
+          std::string list;
+          for (const std::string& w : s->words) list += (list.empty() ? "" : ", ") + w;
+          throw InputError("field '" + g + "': must be one of " + list + " (a string)");
         }
         std::ostringstream range;
         range << "[" << s->min << ", " << s->max << "]";
@@ -91,7 +120,7 @@ std::map<std::string, double> parse_params(const json& j, const std::string& f, 
   }
   if (specs != nullptr) {
     for (const ParamSpec& p : *specs) {
-      if (out.count(p.name) != 0) continue;
+      if (out.count(p.name) != 0 || !p.words.empty()) continue;
       if (p.required) throw InputError("field '" + f + ".params." + p.name + "': missing");
       out[p.name] = p.fallback;
     }
@@ -338,7 +367,7 @@ StudyFile parse_study(const std::string& text, const std::string& source, const 
         }
         if (!known) throw InputError("field '" + f + ".kind': unknown kind '" + a.kind + "' (" + list + ")");
       }
-      a.params = parse_params(approaches[i], f, schema != nullptr ? &schema->approach_params : nullptr);
+      a.params = parse_params(approaches[i], f, schema != nullptr ? &schema->approach_params : nullptr, &a.words);
       s.approaches.push_back(a);
     }
     unique_names(s.approaches, "approaches");
