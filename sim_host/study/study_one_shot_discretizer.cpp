@@ -5,10 +5,10 @@
 #include <algorithm>
 #include <cmath>
 #include <exception>
+#include <stdexcept>
 #include <string>
 
 #include "oneshot/design/structure_analysis.hpp"
-#include "oneshot/design/table_builder.hpp"
 #include "oneshot/plant_structure.hpp"
 #include "oneshot/table_discretizer.hpp"
 #include "study_fields.hpp"
@@ -43,11 +43,18 @@ ncs::OneShotTriple evaluate(const View& view, std::int32_t& tau_us) {
   tau_us = table.quantize(tau_us);
   Discretization<ncs::Fmt, kN, kM> d{NoInit{}};
   const Status st = table.discretize(tau_us, d, WithQd::kYes);
-  if (st != Status::kOk) throw std::logic_error("one-shot table: tau = h outside the table's range");  // range ≥ h (parser)
+  if (st == Status::kClamped) throw std::invalid_argument("one-shot table: tau outside [0, 4 range]");
   return ncs::OneShotTriple{d.phi, d.gamma, d.qd};
 }
 
 }  // namespace
+
+ncs::OneShotTriple evaluate_one_shot_table(const design::TableData<double>& table, OneShotDiscretizer kind, std::int32_t& tau_us) {
+  const auto view = table.view<SlotIdFor<kN, kM>>();
+  if (kind == OneShotDiscretizer::kTable) return evaluate<SubGrid::kExact>(view, tau_us);
+  if (kind == OneShotDiscretizer::kNearest) return evaluate<SubGrid::kNearest>(view, tau_us);
+  throw std::invalid_argument("one-shot table: the generic discretizer has no table");
+}
 
 const char* name(OneShotDiscretizer d) {
   switch (d) {
@@ -79,19 +86,19 @@ OneShotDiscretization design_one_shot_discretization(const ncs::Context& ctx, On
                   "{granularity_us, range_us, max_bytes} (a continuous plant file; h a multiple of the granularity, range >= h)");
   }
   const design::DesignResult& dr = ctx.design();
-  design::TableData<double> data;
+  std::shared_ptr<const design::TableData<double>> table;
   try {
     const design::PlantPatterns patterns = design::analyse_structure(plant, dr);
-    data = design::build_table<double>(plant, dr, patterns);
+    table = std::make_shared<const design::TableData<double>>(design::build_table<double>(plant, dr, patterns));
   } catch (const std::exception& e) {
     refuse(plant_field, std::string("its Phi/Gamma/Q_d table (") + name(kind) + ", " + field + "): " + e.what());
   }
-  const auto view = data.view<SlotIdFor<kN, kM>>();
+  const design::TableData<double>& data = *table;
   std::int32_t tau = out.tau_us;
-  const ncs::OneShotTriple t = kind == OneShotDiscretizer::kTable ? evaluate<SubGrid::kExact>(view, tau)
-                                                                  : evaluate<SubGrid::kNearest>(view, tau);
+  const ncs::OneShotTriple t = evaluate_one_shot_table(data, kind, tau);
   out.tau_us = tau;
   out.triple = std::make_shared<const ncs::OneShotTriple>(t);
+  out.table = table;
   out.table_bytes = data.bytes();
   out.granularity_us = data.granularity_us;
   out.range_us = data.range_us;

@@ -20,6 +20,7 @@
 #include <string>
 
 #include "ncs_model.hpp"
+#include "oneshot/design/table_builder.hpp"
 
 namespace oneshot::study {
 
@@ -40,6 +41,8 @@ struct OneShotDiscretization {
   OneShotDiscretizer kind = OneShotDiscretizer::kGeneric;  ///< Its source.
   /// Φ(h), Γ(h), Q_d(h) of the table (kTable, kNearest); null for kGeneric (the design's).
   std::shared_ptr<const ncs::OneShotTriple> triple;
+  /// The table (kTable, kNearest; null for kGeneric), double storage: the loop's format.
+  std::shared_ptr<const design::TableData<double>> table;
   std::size_t table_bytes = 0;       ///< Every byte the look-up reads (table_bytes()); 0 for kGeneric.
   std::int32_t granularity_us = 0;   ///< Grid step g.
   std::int32_t range_us = 0;         ///< Range covered without composition.
@@ -49,6 +52,12 @@ struct OneShotDiscretization {
   /// max |X_table(h) − X(h)| / max |X(h)| against the design's exact Φ(h), Γ(h), Q_d(h).
   double phi_rel_error = 0, gamma_rel_error = 0, qd_rel_error = 0;
 };
+
+/// Φ(τ), Γ(τ), Q_d(τ) (noise scale 1) from `table` by the rule `kind` (kTable: exact between
+/// grid points; kNearest: τ rounded to the grid first, as the filters do), 0 ≤ τ ≤ 4·range
+/// (TableDiscretizer's out-of-range policy: composition beyond the range); `tau_us` becomes the τ
+/// used. std::invalid_argument for kGeneric or a τ the table clamps.
+ncs::OneShotTriple evaluate_one_shot_table(const design::TableData<double>& table, OneShotDiscretizer kind, std::int32_t& tau_us);
 
 /// The discretization `kind` of the one-shot filter on the context's plant: kGeneric needs
 /// nothing; kTable and kNearest build the plant's table (in double, the loop's format) with
