@@ -211,6 +211,22 @@ TEST(StudyOneShotDiscretizer, WhatCannotBeBuiltIsRefusedNamingTheField) {
   kOs.expect_refused(both(tiny, with_discretizer("table")), "field 'plant.file'");
 }
 
+TEST(StudyOneShotDiscretizer, TheShippedExampleRunsAsSodGeOneShotRunByRun) {
+  // sod_ge_oneshot_discretizers.json: OSK generic, OS table, OSp nearest on sod_ge_oneshot.json's loop.
+  const test_support::StudyExample ex("sod_ge_oneshot_discretizers.json");
+  const NcsStudy d = ex.study([](nlohmann::json&) {}, 4);
+  ASSERT_EQ(d.discretizations.size(), 5U);
+  EXPECT_EQ(d.discretizations[1].kind, OneShotDiscretizer::kGeneric);
+  EXPECT_EQ(d.discretizations[2].kind, OneShotDiscretizer::kTable);
+  EXPECT_EQ(d.discretizations[3].kind, OneShotDiscretizer::kNearest);
+  const NcsStudy base = kOs.study([](nlohmann::json&) {}, 4);
+  nlohmann::json a = run_outputs(run_ncs_sweep(d, 3, 1, engine::Shard{}), test::fresh_dir("oneshot_disc_test", "ex"), false);
+  nlohmann::json b = run_outputs(run_ncs_sweep(base, 3, 1, engine::Shard{}), test::fresh_dir("oneshot_disc_test", "base"), false);
+  a.erase("study_file");
+  b.erase("study_file");
+  EXPECT_EQ(a.dump(), b.dump());  // the table's triple at h is the exact one (Q_d to 1.8e-16): no cost bit moves
+}
+
 TEST(StudyOneShotDiscretizer, CheckPrintsTheDiscretizerAndTheTablesSize) {
   nlohmann::json j = kOs.json();
   with_discretizer("table")(j);
