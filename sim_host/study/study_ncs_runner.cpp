@@ -55,9 +55,9 @@ const engine::StudySchema& ncs_schema() {
     s.study = "ncs";
     for (ncs::Approach a : ncs::kAllApproaches) s.approach_kinds.emplace_back(ncs::name(a));
     for (ncs::Approach a : ncs::kOneShotApproaches) s.approach_kinds.emplace_back(ncs::name(a));
-    // amplitude_volts and period_s: required without a `reference` (map_ncs_study checks).
     // The one-shot filter's discretizer (study_one_shot_discretizer.hpp): a word, default generic.
     s.approach_params = {{"discretizer", 0, 0, false, false, 0, {"generic", "table", "nearest"}}};
+    // amplitude_volts and period_s: required without a `reference` (map_ncs_study checks).
     s.scenario_params = {{"amplitude_volts", 0, 100, false, false, 0},
                          {"period_s", 1e-3, 1e6, false, false, 1},
                          {"noise_scale", 0, 1e6, false, false, 1}};

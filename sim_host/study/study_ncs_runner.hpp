@@ -51,8 +51,9 @@ inline constexpr NcsLeg kNcsLegs[] = {
 const NcsLeg* find_ncs_leg(const std::string& name);
 
 /// What `study run` accepts from a file with "study": "ncs" (approach kinds: the ncs
-/// approaches; scenario params amplitude_volts, period_s — required by map_ncs_study() unless a
-/// `reference` gives the set-point —, noise_scale default 1).
+/// approaches; approach param `discretizer`, a word: generic, table, nearest (the one-shot
+/// approaches only, map_ncs_study() checks); scenario params amplitude_volts, period_s —
+/// required by map_ncs_study() unless a `reference` gives the set-point —, noise_scale default 1).
 const engine::StudySchema& ncs_schema();
 
 /// A study file resolved onto the ncs loop.
