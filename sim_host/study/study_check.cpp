@@ -277,18 +277,7 @@ void add_ncs_designs(json& r, const NcsStudy& s) {
   for (auto& a : r["approaches"]) {
     const std::size_t i = index++;
     if (i < s.discretizations.size() && one_shot_kind(a.at("kind").get<std::string>())) {
-      const OneShotDiscretization& d = s.discretizations[i];
-      json e = {{"kind", name(d.kind)}, {"tau_us", d.tau_us}};
-      if (d.kind == OneShotDiscretizer::kGeneric) {
-        e["source"] = "the design step's exact Phi(h), Gamma(h), Q_d(h) (matrix exponentials)";
-      } else {
-        e["source"] = d.kind == OneShotDiscretizer::kTable ? "the plant's table, exact between grid points (residual polynomial)"
-                                                           : "the plant's table at the nearest grid point";
-        e["table"] = {{"bytes", d.table_bytes}, {"storage", "double"}, {"granularity_us", d.granularity_us},
-                      {"range_us", d.range_us}, {"levels", d.levels}, {"entries", d.entries}};
-        e["relative_error_at_h"] = {{"phi", d.phi_rel_error}, {"gamma", d.gamma_rel_error}, {"qd", d.qd_rel_error}};
-      }
-      a["discretizer"] = e;
+      a["discretizer"] = discretizer_json(s.discretizations[i]);
     }
     if (a.at("kind") == "AKl") {  // D = max sc + max ca + max τ_c (the controller job's WCRT on a CPU)
       for (const ncs::Scenario& sc : s.scenarios) a["per_scenario"][sc.name] = {{"late_sampling_d_us", s.ctx->worst_chain_us(sc)}};
@@ -344,19 +333,7 @@ std::string describe_resolution(const json& r) {
     if (a.contains("lqr_gain")) o << "; L = " << a.at("lqr_gain").dump() << ", closed-loop radius " << a.at("closed_loop_spectral_radius");
     if (a.contains("kalman_gain")) o << "; K = " << a.at("kalman_gain").dump() << ", estimator radius " << a.at("estimator_spectral_radius");
     o << "\n";
-    if (a.contains("discretizer")) {  // the one-shot filter's Phi(h), Gamma(h), Q_d(h)
-      const json& d = a.at("discretizer");
-      o << indent << "  discretizer " << d.at("kind").get<std::string>() << " at tau = " << d.at("tau_us") << " us: "
-        << d.at("source").get<std::string>();
-      if (d.contains("table")) {
-        const json& t = d.at("table");
-        const json& err = d.at("relative_error_at_h");
-        o << "; table " << t.at("bytes") << " B (" << t.at("storage").get<std::string>() << "), grid " << t.at("granularity_us")
-          << " us over [0, " << t.at("range_us") << "] us, " << t.at("levels") << " levels, " << t.at("entries")
-          << " entries; relative error at h: Phi " << err.at("phi") << ", Gamma " << err.at("gamma") << ", Q_d " << err.at("qd");
-      }
-      o << "\n";
-    }
+    if (a.contains("discretizer")) o << indent << "  " << describe_discretizer(a.at("discretizer")) << "\n";
     if (a.contains("per_scenario"))
       for (const auto& [sc, g] : a.at("per_scenario").items()) o << "  " << sc << ": " << g.dump() << "\n";
   }

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <exception>
+#include <sstream>
 #include <stdexcept>
 #include <string>
 
@@ -108,6 +109,33 @@ OneShotDiscretization design_one_shot_discretization(const ncs::Context& ctx, On
   out.gamma_rel_error = relative_error(t.gamma, dr.gamma_h, kN, kM);
   out.qd_rel_error = relative_error(t.qd, dr.qd_h, kN, kN);
   return out;
+}
+
+nlohmann::json discretizer_json(const OneShotDiscretization& d) {
+  nlohmann::json e = {{"kind", name(d.kind)}, {"tau_us", d.tau_us}};
+  if (d.kind == OneShotDiscretizer::kGeneric) {
+    e["source"] = "the design step's exact Phi(h), Gamma(h), Q_d(h) (matrix exponentials)";
+    return e;
+  }
+  e["source"] = d.kind == OneShotDiscretizer::kTable ? "the plant's table, exact between grid points (residual polynomial)"
+                                                     : "the plant's table at the nearest grid point";
+  e["table"] = {{"bytes", d.table_bytes}, {"storage", "double"}, {"granularity_us", d.granularity_us},
+                {"range_us", d.range_us},  {"levels", d.levels},   {"entries", d.entries}};
+  e["relative_error_at_h"] = {{"phi", d.phi_rel_error}, {"gamma", d.gamma_rel_error}, {"qd", d.qd_rel_error}};
+  return e;
+}
+
+std::string describe_discretizer(const nlohmann::json& d) {
+  std::ostringstream o;
+  o << "discretizer " << d.at("kind").get<std::string>() << " at tau = " << d.at("tau_us") << " us: " << d.at("source").get<std::string>();
+  if (d.contains("table")) {
+    const nlohmann::json& t = d.at("table");
+    const nlohmann::json& err = d.at("relative_error_at_h");
+    o << "; table " << t.at("bytes") << " B (" << t.at("storage").get<std::string>() << "), grid " << t.at("granularity_us")
+      << " us over [0, " << t.at("range_us") << "] us, " << t.at("levels") << " levels, " << t.at("entries")
+      << " entries; relative error at h: Phi " << err.at("phi") << ", Gamma " << err.at("gamma") << ", Q_d " << err.at("qd");
+  }
+  return o.str();
 }
 
 }  // namespace oneshot::study

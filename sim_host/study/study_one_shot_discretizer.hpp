@@ -19,6 +19,8 @@
 #include <optional>
 #include <string>
 
+#include <nlohmann/json.hpp>
+
 #include "ncs_model.hpp"
 #include "oneshot/design/table_builder.hpp"
 
@@ -66,5 +68,13 @@ ncs::OneShotTriple evaluate_one_shot_table(const design::TableData<double>& tabl
 /// `table` section, naming `plant_field` when the table cannot be built within its max_bytes.
 OneShotDiscretization design_one_shot_discretization(const ncs::Context& ctx, OneShotDiscretizer kind,
                                                      const std::string& field, const std::string& plant_field);
+
+/// The discretization as `study check` gives it per one-shot approach: {"kind", "tau_us",
+/// "source"}, and for a table "table" {"bytes", "storage", "granularity_us", "range_us",
+/// "levels", "entries"} and "relative_error_at_h" {"phi", "gamma", "qd"}.
+nlohmann::json discretizer_json(const OneShotDiscretization& d);
+
+/// That JSON in one line of `study check`'s text ("discretizer table at tau = 50000 us: …").
+std::string describe_discretizer(const nlohmann::json& d);
 
 }  // namespace oneshot::study

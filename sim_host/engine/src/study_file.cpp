@@ -61,73 +61,6 @@ TriggerSpec parse_trigger(const json& j, const std::string& f) {
   return t;
 }
 
-/// The spec of `key` in `specs` (null when specs is null); InputError naming `g` when unknown.
-const ParamSpec* param_spec(const std::vector<ParamSpec>* specs, const std::string& key, const std::string& g) {
-  if (specs == nullptr) return nullptr;
-  for (const ParamSpec& p : *specs)
-    if (p.name == key) return &p;
-  std::string known;
-  for (const ParamSpec& p : *specs) known += (known.empty() ? "" : ", ") + p.name;
-  throw InputError("field '" + g + "': unknown parameter (known: " + (known.empty() ? "none" : known) + ")");
-}
-
-/// Word parameters (ParamSpec::words) go to *words (null: none accepted).
-std::map<std::string, double> parse_params(const json& j, const std::string& f, const std::vector<ParamSpec>* specs,
-                                           std::map<std::string, std::string>* words = nullptr) {
-  std::map<std::string, double> out;
-  const auto it = j.find("params");
-  if (it != j.end() && !it->is_object()) throw InputError("field '" + f + ".params': must be an object");
-  if (it != j.end()) {
-    for (const auto& item : it->items()) {
-      const std::string g = f + ".params." + item.key();
-      if (item.value().is_string() && words != nullptr) {
-        if (specs == nullptr) {  // no schema: any word (the study's mapping checks it)
-          (*words)[item.key()] = item.value().get<std::string>();
-          continue;
-        }
-        const ParamSpec* s = param_spec(specs, item.key(), g);
-        std::string list;
-        bool known = false;
-        if (s != nullptr) {
-          for (const std::string& w : s->words) {
-            known = known || w == item.value().get<std::string>();
-            list += (list.empty() ? "" : ", ") + w;
-          }
-        }
-        if (s == nullptr || s->words.empty()) throw InputError("field '" + g + "': must be a finite number");
-        if (!known) throw InputError("field '" + g + "': must be one of " + list);
-        (*words)[item.key()] = item.value().get<std::string>();
-        continue;
-      }
-      if (!item.value().is_number() || !std::isfinite(item.value().get<double>())) {
-        throw InputError("field '" + g + "': must be a finite number");
-      }
-      const double v = item.value().get<double>();
-      if (specs != nullptr) {
-        const ParamSpec* s = param_spec(specs, item.key(), g);
-        if (!s->words.empty()) {
-          std::string list;
-          for (const std::string& w : s->words) list += (list.empty() ? "" : ", ") + w;
-          throw InputError("field '" + g + "': must be one of " + list + " (a string)");
-        }
-        std::ostringstream range;
-        range << "[" << s->min << ", " << s->max << "]";
-        if (v < s->min || v > s->max) throw InputError("field '" + g + "': must be in " + range.str());
-        if (s->integer && std::floor(v) != v) throw InputError("field '" + g + "': must be a whole number");
-      }
-      out[item.key()] = v;
-    }
-  }
-  if (specs != nullptr) {
-    for (const ParamSpec& p : *specs) {
-      if (out.count(p.name) != 0 || !p.words.empty()) continue;
-      if (p.required) throw InputError("field '" + f + ".params." + p.name + "': missing");
-      out[p.name] = p.fallback;
-    }
-  }
-  return out;
-}
-
 template <typename T>
 void unique_names(const std::vector<T>& items, const std::string& f) {
   std::set<std::string> seen;
@@ -367,7 +300,7 @@ StudyFile parse_study(const std::string& text, const std::string& source, const 
         }
         if (!known) throw InputError("field '" + f + ".kind': unknown kind '" + a.kind + "' (" + list + ")");
       }
-      a.params = parse_params(approaches[i], f, schema != nullptr ? &schema->approach_params : nullptr, &a.words);
+      a.params = detail::parse_params(approaches[i], f, schema != nullptr ? &schema->approach_params : nullptr, &a.words);
       s.approaches.push_back(a);
     }
     unique_names(s.approaches, "approaches");
@@ -382,7 +315,7 @@ StudyFile parse_study(const std::string& text, const std::string& source, const 
       ScenarioSpec x;
       x.name = string_of(sc, f, "name");
       if (sc.contains("duration_s")) x.duration_s = number_in(sc, f, "duration_s", 1e-6, 1e6);
-      x.params = parse_params(sc, f, schema != nullptr ? &schema->scenario_params : nullptr);
+      x.params = detail::parse_params(sc, f, schema != nullptr ? &schema->scenario_params : nullptr);
       if (sc.contains("params")) {
         for (const auto& item : sc["params"].items()) x.params_given.insert(item.key());
       }
