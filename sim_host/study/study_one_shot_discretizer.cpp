@@ -84,7 +84,8 @@ OneShotDiscretization design_one_shot_discretization(const ncs::Context& ctx, On
   const design::PlantDescription& plant = ctx.plant();
   if (!plant.has_table) {
     refuse(field, std::string("'") + name(kind) + "' needs the plant's Phi(tau) table grid: its plant has no 'table' section "
-                  "{granularity_us, range_us, max_bytes} (a continuous plant file; h a multiple of the granularity, range >= h)");
+                  "{granularity_us, range_us, max_bytes} (in the plant file, or plant.continuous.table; h a multiple of the granularity, "
+                  "range >= h)");
   }
   const design::DesignResult& dr = ctx.design();
   std::shared_ptr<const design::TableData<double>> table;

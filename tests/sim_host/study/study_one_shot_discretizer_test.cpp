@@ -227,6 +227,42 @@ TEST(StudyOneShotDiscretizer, TheShippedExampleRunsAsSodGeOneShotRunByRun) {
   EXPECT_EQ(a.dump(), b.dump());  // the table's triple at h is the exact one (Q_d to 1.8e-16): no cost bit moves
 }
 
+/// The example's plant file written inline (plant.continuous with the design keys and its `table`).
+test_support::Edit inline_plant(const std::function<void(nlohmann::json&)>& edit) {
+  return [edit](nlohmann::json& j) {
+    const nlohmann::json p = nlohmann::json::parse(test::read_file(std::string(ONESHOT_STUDY_EXAMPLES_DIR) + "/" +
+                                                                   j["plant"]["file"].get<std::string>()));
+    nlohmann::json c;
+    for (const char* k : {"A", "B", "C", "period_us", "states", "inputs", "outputs", "tracked_outputs", "board", "table"}) c[k] = p[k];
+    c["Q1c"] = p["cost"]["Q1c"];
+    c["Q2c"] = p["cost"]["Q2c"];
+    c["Q_c"] = p["noise"]["process_intensity"];
+    c["measurement_covariance"] = p["noise"]["measurement_covariance"];
+    edit(c);
+    j["plant"] = {{"continuous", c}};
+  };
+}
+
+TEST(StudyOneShotDiscretizer, AnInlinePlantsTableIsThePlantFilesTable) {
+  const auto both = [](const test_support::Edit& x, const test_support::Edit& y) {
+    return [x, y](nlohmann::json& j) {
+      x(j);
+      y(j);
+    };
+  };
+  const NcsStudy file = kOs.study(with_discretizer("table"), 2);
+  const NcsStudy in = kOs.study(both(inline_plant([](nlohmann::json&) {}), with_discretizer("table")), 2);
+  ASSERT_NE(in.discretizations[2].table, nullptr);
+  EXPECT_EQ(in.discretizations[2].table_bytes, file.discretizations[2].table_bytes);
+  EXPECT_EQ(in.discretizations[2].table->values, file.discretizations[2].table->values);  // the same plant, the same builder
+  kOs.expect_refused(both(inline_plant([](nlohmann::json& c) { c["table"]["range_us"] = 40000; }), with_discretizer("table")),
+                     "field 'plant.continuous.table.range_us'");
+  kOs.expect_refused(both(inline_plant([](nlohmann::json& c) { c["table"]["max_bytes"] = 8; }), with_discretizer("nearest")),
+                     "field 'plant.continuous.table.max_bytes'");
+  kOs.expect_refused(both(inline_plant([](nlohmann::json& c) { c.erase("table"); }), with_discretizer("table")),
+                     "field 'approaches[1].params.discretizer'");
+}
+
 TEST(StudyOneShotDiscretizer, CheckPrintsTheDiscretizerAndTheTablesSize) {
   nlohmann::json j = kOs.json();
   with_discretizer("table")(j);
