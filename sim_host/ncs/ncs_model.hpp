@@ -112,6 +112,15 @@ struct BusLeg {
 
 struct ControllerCpu;  // ncs_cpu.hpp
 
+/// The one-shot filter's prediction over one period: Φ(h), Γ(h) and Q_d(h) at noise scale 1
+/// (x_{k+1} = Φ x_k + Γ u_k + w_k, E[w wᵀ] = s·Q_d): from a study file's table discretizer
+/// (study_one_shot_discretizer.hpp) instead of the design's exact triple.
+struct OneShotTriple {
+  Matrix<double, kN, kN> phi;    ///< Φ(h).
+  Matrix<double, kN, kM> gamma;  ///< Γ(h).
+  Matrix<double, kN, kN> qd;     ///< Q_d(h) at s = 1.
+};
+
 /// One scenario (brief §3): square wave ±A_r of period T_r, network legs U[0.5, d] ms,
 /// noise scale s.
 struct Scenario {
@@ -155,6 +164,10 @@ struct Scenario {
   /// One-shot loops: the controller's timer fires φ after each sampling instant, at kh + φ
   /// (0 < φ < h; std::invalid_argument otherwise).
   std::int64_t controller_phase_us = 0;
+  /// One-shot loops: the filter's Φ(h), Γ(h), Q_d(h) per approach (index in kOneShotApproaches:
+  /// OS, OSp, OSK) from a study file's `params.discretizer` "table" or "nearest"; null: the
+  /// design's exact triple ("generic", the default).
+  std::array<std::shared_ptr<const OneShotTriple>, 3> one_shot_triples;
   /// A stepped set-point (a study file's `reference` of kind steps or file) on the kh grid: the
   /// changes (period k > 0, new value), k strictly increasing, set_steps(); null: the square
   /// wave ±A_r of period T_r.

@@ -162,7 +162,12 @@ RunResult run_one_shot(Harness& hs, Approach a) {
   for (std::size_t i = 0; i < kP; ++i) r_diag[i] = hs.design_.r(i, i);
   OneShotLaw::Receiver rx(delta, r_diag, n_t, a == Approach::kOS ? node::SilencePolicy::kHeld : node::SilencePolicy::kPredictOnly);
   // Q_d at the scenario's noise scale s (the plant's process noise is s·Q_c; the design's qd_h is at s = 1).
-  OneShotLaw::Estimator est(hs.design_.phi_h, hs.design_.gamma_h, hs.design_.qd_h * sc.noise_scale, hs.design_.c);
+  // Φ(h), Γ(h), Q_d(h): the design's exact triple, or the study file's table discretizer's.
+  std::size_t slot = 0;
+  while (kOneShotApproaches[slot] != a) ++slot;
+  const OneShotTriple* table = sc.one_shot_triples[slot].get();
+  OneShotLaw::Estimator est(table != nullptr ? table->phi : hs.design_.phi_h, table != nullptr ? table->gamma : hs.design_.gamma_h,
+                            (table != nullptr ? table->qd : hs.design_.qd_h) * sc.noise_scale, hs.design_.c);
   const Vector<double, kN> x0 = hs.ref_.state(0);
   est.reset(x0, hs.design_.p0);
   Sensor sensor(kController, mtm ? OneShotTrigger(OneShotTrigger::Mtm(sc.mtm_sigma, sc.mtm_delta, sc.mtm_k_max, sc.mtm_k_ref_max))

@@ -200,6 +200,7 @@ json resolve_study(const engine::StudyFile& f) {
     std::shared_ptr<const ncs::Context> ctx;
     for (const engine::ApproachSpec& a : f.approaches) {
       json e = {{"name", a.name}, {"kind", a.kind}, {"params", a.params}};
+      for (const auto& [key, word] : a.words) e["params"][key] = word;  // word parameters (discretizer)
       if (!designed) {
         e["design"] = "none (plant not designed)";
       } else if (f.study != "ncs" || !ncs_kind(a.kind)) {
@@ -272,7 +273,12 @@ json resolve_study(const engine::StudyFile& f) {
 }
 
 void add_ncs_designs(json& r, const NcsStudy& s) {
+  std::size_t index = 0;
   for (auto& a : r["approaches"]) {
+    const std::size_t i = index++;
+    if (i < s.discretizations.size() && one_shot_kind(a.at("kind").get<std::string>())) {
+      a["discretizer"] = discretizer_json(s.discretizations[i]);
+    }
     if (a.at("kind") == "AKl") {  // D = max sc + max ca + max τ_c (the controller job's WCRT on a CPU)
       for (const ncs::Scenario& sc : s.scenarios) a["per_scenario"][sc.name] = {{"late_sampling_d_us", s.ctx->worst_chain_us(sc)}};
     }
@@ -327,6 +333,7 @@ std::string describe_resolution(const json& r) {
     if (a.contains("lqr_gain")) o << "; L = " << a.at("lqr_gain").dump() << ", closed-loop radius " << a.at("closed_loop_spectral_radius");
     if (a.contains("kalman_gain")) o << "; K = " << a.at("kalman_gain").dump() << ", estimator radius " << a.at("estimator_spectral_radius");
     o << "\n";
+    if (a.contains("discretizer")) o << indent << "  " << describe_discretizer(a.at("discretizer")) << "\n";
     if (a.contains("per_scenario"))
       for (const auto& [sc, g] : a.at("per_scenario").items()) o << "  " << sc << ": " << g.dump() << "\n";
   }

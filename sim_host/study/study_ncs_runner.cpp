@@ -2,6 +2,7 @@
 /// @brief A study file mapped onto study ncs's loop (see study_ncs_runner.hpp).
 #include "study_ncs_runner.hpp"
 
+#include <array>
 #include <cmath>
 #include <iterator>
 #include <map>
@@ -13,6 +14,7 @@
 #include "ncs_live.hpp"
 #include "study_cpu.hpp"
 #include "study_fields.hpp"
+#include "study_one_shot_discretizer.hpp"
 #include "study_plant_map.hpp"
 
 namespace oneshot::study {
@@ -53,6 +55,8 @@ const engine::StudySchema& ncs_schema() {
     s.study = "ncs";
     for (ncs::Approach a : ncs::kAllApproaches) s.approach_kinds.emplace_back(ncs::name(a));
     for (ncs::Approach a : ncs::kOneShotApproaches) s.approach_kinds.emplace_back(ncs::name(a));
+    // The one-shot filter's discretizer (study_one_shot_discretizer.hpp): a word, default generic.
+    s.approach_params = {{"discretizer", 0, 0, false, false, 0, {"generic", "table", "nearest"}}};
     // amplitude_volts and period_s: required without a `reference` (map_ncs_study checks).
     s.scenario_params = {{"amplitude_volts", 0, 100, false, false, 0},
                          {"period_s", 1e-3, 1e6, false, false, 1},
@@ -174,6 +178,7 @@ NcsStudy map_ncs_study(const engine::StudyFile& file) {
     };
     if (!has("sc") || !has("ca")) refuse("links", "study ncs needs the legs sc (sensor to controller) and ca (controller to actuator)");
     // Approaches: ncs names, I first.
+    std::array<std::shared_ptr<const ncs::OneShotTriple>, ncs::kOneShotApproaches.size()> one_shot_triples{};
     for (std::size_t i = 0; i < file.approaches.size(); ++i) {
       const engine::ApproachSpec& a = file.approaches[i];
       const std::string f = at("approaches", i);
@@ -220,6 +225,25 @@ NcsStudy map_ncs_study(const engine::StudyFile& file) {
       if (!first_bus_link.empty() && ap == ncs::Approach::kSPlus) {
         refuse(f + ".kind", "S+ designs on the legs' mean delays, which a leg on a CAN bus (" + first_bus_link +
                                 ") does not have before the run");
+      }
+      // The one-shot filter's discretizer, designed from the plant (a table built now).
+      const auto word = a.words.find("discretizer");
+      OneShotDiscretizer disc = OneShotDiscretizer::kGeneric;
+      if (word != a.words.end()) {
+        if (!ncs::one_shot(ap)) {
+          refuse(f + ".params.discretizer", a.kind + " runs no one-shot filter: the discretizer is the one-shot loops' (OS, OSp, OSK)");
+        }
+        disc = *one_shot_discretizer_named(word->second);
+      }
+      if (ncs::one_shot(ap)) {
+        out.discretizations.push_back(design_one_shot_discretization(
+            *out.ctx, disc, f + ".params.discretizer",
+            file.plant.kind == engine::PlantSpec::Kind::kFile ? "plant.file" : "plant.continuous.table.max_bytes"));
+        std::size_t slot = 0;
+        while (ncs::kOneShotApproaches[slot] != ap) ++slot;
+        one_shot_triples[slot] = out.discretizations.back().triple;
+      } else {
+        out.discretizations.emplace_back();
       }
       out.approaches.push_back(ap);
     }
@@ -336,6 +360,7 @@ NcsStudy map_ncs_study(const engine::StudyFile& file) {
           }
         }
       }
+      sc.one_shot_triples = one_shot_triples;
       out.scenarios.push_back(sc);
     }
     if (one_shot) {

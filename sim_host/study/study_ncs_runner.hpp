@@ -30,6 +30,7 @@
 #include "ncs_live.hpp"
 #include "ncs_model.hpp"
 #include "oneshot/engine/study_file.hpp"
+#include "study_one_shot_discretizer.hpp"
 #include "study_plant_map.hpp"
 
 namespace oneshot::study {
@@ -50,8 +51,9 @@ inline constexpr NcsLeg kNcsLegs[] = {
 const NcsLeg* find_ncs_leg(const std::string& name);
 
 /// What `study run` accepts from a file with "study": "ncs" (approach kinds: the ncs
-/// approaches; scenario params amplitude_volts, period_s — required by map_ncs_study() unless a
-/// `reference` gives the set-point —, noise_scale default 1).
+/// approaches; approach param `discretizer`, a word: generic, table, nearest (the one-shot
+/// approaches only, map_ncs_study() checks); scenario params amplitude_volts, period_s —
+/// required by map_ncs_study() unless a `reference` gives the set-point —, noise_scale default 1).
 const engine::StudySchema& ncs_schema();
 
 /// A study file resolved onto the ncs loop.
@@ -60,6 +62,9 @@ struct NcsStudy {
   std::string plant_path;                     ///< The plant file (resolved against the study file's folder; "" inline).
   std::shared_ptr<const ncs::Context> ctx;    ///< Plant and design.
   std::vector<ncs::Approach> approaches;      ///< In file order (I first).
+  /// Per approach (file order): the one-shot filter's discretizer (`params.discretizer`,
+  /// generic for the other approaches); its triple is in every scenario's one_shot_triples.
+  std::vector<OneShotDiscretization> discretizations;
   std::vector<ncs::Scenario> scenarios;       ///< In file order, legs from the file.
   std::vector<std::string> links;             ///< Leg names the file declares ("as", "sc", "ca" in file order).
   /// Per scenario (file order), per leg on a CAN bus: the worst-case response time of its

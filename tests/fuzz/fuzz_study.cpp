@@ -144,6 +144,10 @@ void check_params(const std::map<std::string, double>& params, const std::vector
   for (const auto& [name, v] : params) require(std::isfinite(v), what + "." + name + ": not finite");
   if (specs == nullptr) return;
   for (const e::ParamSpec& s : *specs) {
+    if (!s.words.empty()) {  // a word parameter: never among the numbers
+      require(params.count(s.name) == 0, what + "." + s.name + ": a word parameter taken as a number");
+      continue;
+    }
     const auto it = params.find(s.name);
     require(it != params.end(), what + ": parameter " + s.name + " missing after defaults");
     require(it->second >= s.min && it->second <= s.max, what + "." + s.name + ": out of range");
@@ -207,6 +211,13 @@ void check_study(const e::StudyFile& s, const e::StudySchema* schema) {
   }
   for (const e::ApproachSpec& a : s.approaches) {
     check_params(a.params, schema != nullptr ? &schema->approach_params : nullptr, "approaches." + a.name);
+    for (const auto& [key, word] : a.words) {  // a word parameter: one of its spec's words
+      bool known = schema == nullptr;  // no schema: any word
+      if (schema != nullptr)
+        for (const e::ParamSpec& p : schema->approach_params)
+          for (const std::string& w : p.words) known = known || (p.name == key && w == word);
+      require(known, "approaches." + a.name + "." + key + ": word '" + word + "' accepted");
+    }
     if (schema != nullptr) {
       bool known = false;
       for (const std::string& k : schema->approach_kinds) known = known || k == a.kind;

@@ -61,44 +61,6 @@ TriggerSpec parse_trigger(const json& j, const std::string& f) {
   return t;
 }
 
-std::map<std::string, double> parse_params(const json& j, const std::string& f, const std::vector<ParamSpec>* specs) {
-  std::map<std::string, double> out;
-  const auto it = j.find("params");
-  if (it != j.end() && !it->is_object()) throw InputError("field '" + f + ".params': must be an object");
-  if (it != j.end()) {
-    for (const auto& item : it->items()) {
-      const std::string g = f + ".params." + item.key();
-      if (!item.value().is_number() || !std::isfinite(item.value().get<double>())) {
-        throw InputError("field '" + g + "': must be a finite number");
-      }
-      const double v = item.value().get<double>();
-      if (specs != nullptr) {
-        const ParamSpec* s = nullptr;
-        for (const ParamSpec& p : *specs)
-          if (p.name == item.key()) s = &p;
-        if (s == nullptr) {
-          std::string known;
-          for (const ParamSpec& p : *specs) known += (known.empty() ? "" : ", ") + p.name;
-          throw InputError("field '" + g + "': unknown parameter (known: " + known + ")");
-        }
-        std::ostringstream range;
-        range << "[" << s->min << ", " << s->max << "]";
-        if (v < s->min || v > s->max) throw InputError("field '" + g + "': must be in " + range.str());
-        if (s->integer && std::floor(v) != v) throw InputError("field '" + g + "': must be a whole number");
-      }
-      out[item.key()] = v;
-    }
-  }
-  if (specs != nullptr) {
-    for (const ParamSpec& p : *specs) {
-      if (out.count(p.name) != 0) continue;
-      if (p.required) throw InputError("field '" + f + ".params." + p.name + "': missing");
-      out[p.name] = p.fallback;
-    }
-  }
-  return out;
-}
-
 template <typename T>
 void unique_names(const std::vector<T>& items, const std::string& f) {
   std::set<std::string> seen;
@@ -338,7 +300,7 @@ StudyFile parse_study(const std::string& text, const std::string& source, const 
         }
         if (!known) throw InputError("field '" + f + ".kind': unknown kind '" + a.kind + "' (" + list + ")");
       }
-      a.params = parse_params(approaches[i], f, schema != nullptr ? &schema->approach_params : nullptr);
+      a.params = detail::parse_params(approaches[i], f, schema != nullptr ? &schema->approach_params : nullptr, &a.words);
       s.approaches.push_back(a);
     }
     unique_names(s.approaches, "approaches");
@@ -353,7 +315,7 @@ StudyFile parse_study(const std::string& text, const std::string& source, const 
       ScenarioSpec x;
       x.name = string_of(sc, f, "name");
       if (sc.contains("duration_s")) x.duration_s = number_in(sc, f, "duration_s", 1e-6, 1e6);
-      x.params = parse_params(sc, f, schema != nullptr ? &schema->scenario_params : nullptr);
+      x.params = detail::parse_params(sc, f, schema != nullptr ? &schema->scenario_params : nullptr);
       if (sc.contains("params")) {
         for (const auto& item : sc["params"].items()) x.params_given.insert(item.key());
       }

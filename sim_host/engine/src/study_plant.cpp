@@ -116,13 +116,13 @@ std::string inline_key(const std::string& plant_file_field) {
 }
 
 /// The keys an inline continuous plant carries for the design step, with the plant file's names and units.
-constexpr std::array<const char*, 9> kDesignKeys = {"period_us", "measurement_covariance", "name",    "states", "inputs",
-                                                  "outputs",   "tracked_outputs",        "actuator", "board"};
+constexpr std::array<const char*, 10> kDesignKeys = {"period_us", "measurement_covariance", "name",     "states", "inputs",
+                                                   "outputs",   "tracked_outputs",        "actuator", "board",  "table"};
 
 /// The plant-file description of an inline continuous plant `c` at field `g` (already read into
 /// `m`): the same JSON a plant file would hold (A, B, C, period_us, names, tracked_outputs,
-/// cost {Q1c, Q2c}, noise {process_intensity = Q_c, measurement_covariance}, actuator or board),
-/// parsed by the plant-file parser, its errors naming the inline key.
+/// cost {Q1c, Q2c}, noise {process_intensity = Q_c, measurement_covariance}, actuator or board,
+/// table), parsed by the plant-file parser, its errors naming the inline key.
 std::shared_ptr<const design::PlantDescription> inline_design(const json& c, const std::string& g, const ContinuousModel& m) {
   for (const char* k : {"period_us", "measurement_covariance"}) {
     if (!c.contains(k)) {
@@ -140,7 +140,7 @@ std::shared_ptr<const design::PlantDescription> inline_design(const json& c, con
   json f = json::object();
   f["name"] = c.contains("name") ? c["name"] : json("inline");
   f["form"] = "continuous";
-  for (const char* k : {"A", "B", "C", "period_us", "states", "inputs", "outputs", "tracked_outputs", "actuator", "board"})
+  for (const char* k : {"A", "B", "C", "period_us", "states", "inputs", "outputs", "tracked_outputs", "actuator", "board", "table"})
     if (c.contains(k)) f[k] = c[k];
   for (const char* k : {"Q1c", "Q2c"})
     if (c.contains(k)) f["cost"][k] = c[k];
@@ -210,7 +210,7 @@ PlantSpec parse_plant(const json& j, const std::string& f) {
     const std::string g = f + ".continuous";
     const json& c = j["continuous"];
     require_keys(c, g, {"A", "B", "B_w", "C", "Q_c", "Q1c", "Q2c", "period_us", "measurement_covariance", "name", "states",
-                        "inputs", "outputs", "tracked_outputs", "actuator", "board"});
+                        "inputs", "outputs", "tracked_outputs", "actuator", "board", "table"});
     p.kind = PlantSpec::Kind::kContinuous;
     ContinuousModel& m = p.continuous;
     linear_model(c, g, {"A", "B", "B_w", "C", "Q_c", "Q1c", "Q2c"}, {&m.a, &m.b, &m.bw, &m.c, &m.qc, &m.q1c, &m.q2c});

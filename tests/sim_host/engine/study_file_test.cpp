@@ -69,6 +69,33 @@ std::string edited(const std::string& from, const std::string& to) {
   return s.replace(at, from.size(), to);
 }
 
+TEST(StudyFile, AWordParameterIsOneOfItsWordsAndNeverANumber) {
+  StudySchema schema = example_schema();
+  schema.approach_params.push_back({"rule", 0, 0, false, false, 0, {"fast", "slow"}});
+  const auto parse = [&](const std::string& to, const StudySchema* sc) {
+    return parse_study(edited("{\"process_noise_scale\": 1}", to), "x", sc);
+  };
+  const StudyFile f = parse("{\"process_noise_scale\": 1, \"rule\": \"slow\"}", &schema);
+  EXPECT_EQ(f.approaches[1].words.at("rule"), "slow");
+  EXPECT_EQ(f.approaches[1].params.count("rule"), 0U);          // not among the numbers
+  EXPECT_EQ(f.approaches[0].words.count("rule"), 0U);           // absent: not filled in (the study decides)
+  EXPECT_EQ(parse("{}", &schema).approaches[1].params.at("process_noise_scale"), 1.0);  // numbers still defaulted
+  const auto refused = [&](const std::string& to, const std::string& expect) {
+    try {
+      static_cast<void>(parse(to, &schema));
+      ADD_FAILURE() << to << " accepted";
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find(expect), std::string::npos) << e.what();
+    }
+  };
+  refused("{\"rule\": \"medium\"}", "field 'approaches[1].params.rule': must be one of fast, slow");
+  refused("{\"rule\": 1}", "field 'approaches[1].params.rule': must be one of fast, slow (a string)");
+  refused("{\"process_noise_scale\": \"one\"}", "field 'approaches[1].params.process_noise_scale': must be a finite number");
+  refused("{\"speed\": \"fast\"}", "field 'approaches[1].params.speed': unknown parameter");
+  // Without a schema any word passes, kept for the study's mapping.
+  EXPECT_EQ(parse("{\"rule\": \"any\"}", nullptr).approaches[1].words.at("rule"), "any");
+}
+
 TEST(StudyFile, AnInlinePlantWithDesignKeysIsThePlantFilesDescription) {
   const StudyFile bare = parse_study(example_text(), "example_study.json", nullptr);
   EXPECT_EQ(bare.plant.design, nullptr);  // no design keys: not designed

@@ -40,7 +40,8 @@ namespace oneshot::engine {
 /// The version string the "schema" field must hold.
 inline constexpr const char* kStudySchemaVersion = "oneshot-study/1";
 
-/// A numeric parameter a study accepts for its approaches or scenarios.
+/// A parameter a study accepts for its approaches or scenarios: a number, or (with `words`)
+/// one of a list of words.
 struct ParamSpec {
   std::string name;         ///< Key in "params".
   double min = 0;           ///< Smallest value.
@@ -48,6 +49,9 @@ struct ParamSpec {
   bool integer = false;     ///< Must be a whole number.
   bool required = false;    ///< Must be given (else `fallback`).
   double fallback = 0;      ///< Value when absent.
+  /// Non-empty: a word parameter, one of these strings (ApproachSpec::words; absent: not
+  /// filled in, the study's mapping decides); min, max, integer, fallback unused.
+  std::vector<std::string> words = {};
 };
 
 /// What a study accepts in its file.
@@ -150,6 +154,7 @@ struct ApproachSpec {
   std::string name;                       ///< Unique name (table column).
   std::string kind;                       ///< What the study runs.
   std::map<std::string, double> params;   ///< Parameters (schema defaults filled in).
+  std::map<std::string, std::string> words;  ///< Word parameters the file gave (ParamSpec::words).
 };
 
 /// A scenario: a name, numeric parameters, per-link model overrides.
