@@ -227,8 +227,8 @@ struct Timing {
 class Context {
  public:
   /// Loads the plant file (empty: the built-in default lut_gen/plants/networked_board.json)
-  /// and runs the design step; std::invalid_argument when the plant is not 2 states,
-  /// 1 input, 2 outputs with a board, or has no LQR gain or feed-forward.
+  /// and runs the design step; std::invalid_argument when the plant is past n = 16, m = 4,
+  /// p = 4 (naming A, B or C), not continuous, has no board, LQR gain or feed-forward.
   static std::shared_ptr<const Context> load(const std::string& plant_path);
   /// The same from a plant description already parsed (a study file's inline plant).
   static std::shared_ptr<const Context> from(design::PlantDescription plant);
