@@ -140,7 +140,7 @@ nlohmann::json table_outputs(const engine::SweepResults& results, const std::str
     j["approaches"][nm] = {{"description", description(ap)},
                            {"cost_mean", sm.value[a].mean},
                            {"cost_ci95", sm.value[a].ci95},
-                           {"ratio_to_I", sm.ratio_of_means[a]},
+                           {"ratio_to_" + reference, sm.ratio_of_means[a]},
                            {"ratio_mean", sm.ratio[a].mean},
                            {"ratio_ci95", sm.ratio[a].ci95},
                            {"ratio_scenario_weighted", sm.ratio_weighted[a].mean},
@@ -181,8 +181,8 @@ nlohmann::json table_outputs(const engine::SweepResults& results, const std::str
     for (std::size_t a = 0; a < na; ++a) {
       e["cost_mean"][spec.approaches[a]] = sm.per_scenario[a][s].mean;
       e["cost_ci95"][spec.approaches[a]] = sm.per_scenario[a][s].ci95;
-      e["ratio_to_I"][spec.approaches[a]] = sm.per_scenario_ratio[a][s].mean;
-      e["ratio_to_I_ci95"][spec.approaches[a]] = sm.per_scenario_ratio[a][s].ci95;
+      e["ratio_to_" + reference][spec.approaches[a]] = sm.per_scenario_ratio[a][s].mean;
+      e["ratio_to_" + reference + "_ci95"][spec.approaches[a]] = sm.per_scenario_ratio[a][s].ci95;
       if (a > 0) {
         std::snprintf(line, sizeof line, " %.4f |", sm.per_scenario_ratio[a][s].mean);
         per << line;
