@@ -465,6 +465,16 @@ TEST(StudyPlantShapes, APlantLargerThanTheLimitsIsRefusedNamingTheKey) {
                                              "supported limits (kMaxStates 16, kMaxInputs 4, kMaxOutputs 4");
   kInlineNcs.expect_refused(sized(3, 5, 1), "field 'plant.continuous.B': dimensions n = 3, m = 5");
   kInlineNcs.expect_refused(sized(3, 1, 5), "field 'plant.continuous.C': dimensions n = 3, m = 1, p = 5");
+  // A discrete plant names Phi and Gamma.
+  const auto discrete = [&](std::size_t n, std::size_t m) {
+    return [n, m, sized](nlohmann::json& j) {
+      sized(n, m, 1)(j);
+      nlohmann::json c = j["plant"]["continuous"];
+      j["plant"] = {{"discrete", {{"Phi", c["A"]}, {"Gamma", c["B"]}, {"C", c["C"]}, {"Q", c["Q_c"]}, {"period_us", 50000}}}};
+    };
+  };
+  kInlineNcs.expect_refused(discrete(17, 1), "field 'plant.discrete.Phi': dimensions n = 17");
+  kInlineNcs.expect_refused(discrete(3, 5), "field 'plant.discrete.Gamma': dimensions n = 3, m = 5");
 }
 
 nlohmann::json matrix_rows(const design::DenseMatrix& m) {
