@@ -24,6 +24,7 @@
 #include "oneshot/engine/cpu.hpp"
 #include "oneshot/engine/kernel.hpp"
 #include "oneshot/engine/network.hpp"
+#include "oneshot/engine/psd_math.hpp"
 #include "oneshot/engine/plant_cache_pool.hpp"
 #include "oneshot/host/host_network.hpp"
 #include "oneshot/node/message.hpp"
@@ -117,15 +118,18 @@ class BasicHarness {
     if (!legs_from_file(sc) && !(sc.max_delay_ms * 1000 >= static_cast<double>(ctx.timing().leg_min_us))) {
       throw std::invalid_argument("ncs scenario " + sc.name + ": d must be at least 0.5 ms");
     }
-    r_chol_ = lower_cholesky<S::p>(design_.r);
+    r_chol_ = engine::psd_cholesky<S::p>(design_.r);
     for (std::size_t j = 0; j < S::m; ++j) {  // the actuator's range (live::actuator_range() on the board)
-      u_min_[j] = ctx.design().u_min[j];
-      u_max_[j] = ctx.design().u_max[j];
+      u_min_[j] = j < m_ ? ctx.design().u_min[j] : -1.0;  // a padded input: [−1, 1] holds its 0
+      u_max_[j] = j < m_ ? ctx.design().u_max[j] : 1.0;
     }
     const StateVec x0 = ref_.state(0);
     plant_.set_state(x0);
     plant_.set_reference(x0, ref_.input(0));
     if constexpr (kBoard) {
+      if (opt.analytic && !ctx.board()) {
+        throw std::invalid_argument("ncs: --analytic runs the board's plant (n = 2, m = 1, p = 2, C = I) only: its tracker is 2-state");
+      }
       if (opt.analytic) an_ = make_tracker(ctx, sc, a, design_, opt, x0, ref_.input(0));
     } else if (opt.analytic) {
       throw std::invalid_argument("ncs: --analytic runs the board's plant (n = 2, m = 1, p = 2) only: its tracker is 2-state");
@@ -266,24 +270,45 @@ class BasicHarness {
     return engine::from_us(compute_.uniform_int(ctx_.timing().compute_min_us, ctx_.timing().compute_max_us));
   }
 
+  /// Adds the measurement noise v = L n, n ~ N(0, I) drawn in output order, to the first p
+  /// (the plant's real outputs: a padded output draws nothing) entries of `y`.
+  template <std::size_t K>
+  void add_measurement_noise(Vector<double, K>& y) {
+    Vector<double, S::p> n;
+    for (std::size_t i = 0; i < S::p && i < p_; ++i) n[i] = measurement_.normal();
+    for (std::size_t i = 0; i < S::p && i < K && i < p_; ++i) {
+      double v = 0;
+      for (std::size_t j = 0; j <= i; ++j) v += r_chol_(i, j) * n[j];
+      y[i] += v;
+    }
+  }
+
   /// The plant at now and a sample y = C x + v.
   OutputVec sample() {
     advance();
     OutputVec y = plant_.output();
-    if (noisy_) {  // v = L n, n ~ N(0, I) drawn in output order
-      OutputVec n;
-      for (std::size_t i = 0; i < S::p; ++i) n[i] = measurement_.normal();
-      for (std::size_t i = 0; i < S::p; ++i) {
-        double v = 0;
-        for (std::size_t j = 0; j <= i; ++j) v += r_chol_(i, j) * n[j];
-        y[i] += v;
-      }
-    }
+    if (noisy_) add_measurement_noise(y);
     const double t = engine::to_seconds(kernel_.now());
     result_.samples.push_back(point(t, y));
     result_.sample_truth.push_back(point(t, plant_.output()));
     tracker([&](auto& tr) { tr.sample(kernel_.now(), y); });
     return y;
+  }
+
+  /// The plant at now and the state it sends: x (the reference loop I: no noise), or for S
+  /// (C = I, p = n: y = x + v) x with the measurement noise of sample(), drawn alike.
+  StateVec sample_state() {
+    advance();
+    StateVec x = plant_.state();
+    if (noisy_) {
+      if (!ctx_.identity_output()) throw std::logic_error("ncs: a noisy state sample needs C = I");
+      add_measurement_noise(x);
+    }
+    const double t = engine::to_seconds(kernel_.now());
+    result_.samples.push_back(point(t, x));
+    result_.sample_truth.push_back(point(t, plant_.output()));
+    tracker([&](auto& tr) { tr.sample(kernel_.now(), x); });
+    return x;
   }
 
   /// The plant at now, then input `u` from now on (a command applied).
@@ -302,32 +327,43 @@ class BasicHarness {
   /// Adds e_kᵀ P⁻¹ e_k, e_k = x − x̂, of the estimate `xh` with covariance `p` of the true state
   /// `x` to the run's NEES (RunResult::nees); nothing when P is singular (noise scale 0) or the
   /// value is not finite.
+  /// Over the plant's real n states only (a padded state's P is 0).
   void add_nees(const StateVec& x, const StateVec& xh, const Matrix<double, S::n, S::n>& p) {
     double q = 0;
-    if constexpr (S::n == 2) {  // the closed form (the board's figures as before, to the bit)
-      const double e0 = x[0] - xh[0];
-      const double e1 = x[1] - xh[1];
-      const double det = p(0, 0) * p(1, 1) - p(0, 1) * p(1, 0);
-      if (!(det > 0)) return;
-      // eᵀ P⁻¹ e with P⁻¹ = [[p11, −p01], [−p10, p00]] / det
-      q = (e0 * e0 * p(1, 1) - e0 * e1 * (p(0, 1) + p(1, 0)) + e1 * e1 * p(0, 0)) / det;
-    } else {  // eᵀ P⁻¹ e = |L⁻¹ e|², P = L Lᵀ (a Cholesky solve), nothing unless P > 0
-      Matrix<double, S::n, S::n> sym;
-      for (std::size_t i = 0; i < S::n; ++i)
-        for (std::size_t j = 0; j < S::n; ++j) sym(i, j) = 0.5 * (p(i, j) + p(j, i));
-      const Matrix<double, S::n, S::n> l = lower_cholesky<S::n>(sym);
-      StateVec z;
-      for (std::size_t i = 0; i < S::n; ++i) {
-        if (!(l(i, i) > 0)) return;
-        double v = x[i] - xh[i];
-        for (std::size_t j = 0; j < i; ++j) v -= l(i, j) * z[j];
-        z[i] = v / l(i, i);
-        q += z[i] * z[i];
-      }
-    }
+    if (!nees_term(x, xh, p, q)) return;
     if (!std::isfinite(q)) return;
     nees_sum_ += q;
     ++nees_n_;
+  }
+
+  /// q = e_kᵀ P⁻¹ e_k on the real n states; false when P is not positive there.
+  bool nees_term(const StateVec& x, const StateVec& xh, const Matrix<double, S::n, S::n>& p, double& q) const {
+    if constexpr (S::n >= 2) {
+      if (n_ == 2) {  // the closed form (the board's figures as before, to the bit)
+        const double e0 = x[0] - xh[0];
+        const double e1 = x[1] - xh[1];
+        const double det = p(0, 0) * p(1, 1) - p(0, 1) * p(1, 0);
+        if (!(det > 0)) return false;
+        // eᵀ P⁻¹ e with P⁻¹ = [[p11, −p01], [−p10, p00]] / det
+        q = (e0 * e0 * p(1, 1) - e0 * e1 * (p(0, 1) + p(1, 0)) + e1 * e1 * p(0, 0)) / det;
+        return true;
+      }
+    }
+    // eᵀ P⁻¹ e = |L⁻¹ e|², P = L Lᵀ (a Cholesky solve), nothing unless P > 0 on the real states
+    Matrix<double, S::n, S::n> sym;
+    for (std::size_t i = 0; i < S::n; ++i)
+      for (std::size_t j = 0; j < S::n; ++j) sym(i, j) = 0.5 * (p(i, j) + p(j, i));
+    const Matrix<double, S::n, S::n> l = engine::psd_cholesky<S::n>(sym);
+    StateVec z;
+    q = 0;
+    for (std::size_t i = 0; i < S::n && i < n_; ++i) {
+      if (!(l(i, i) > 0)) return false;
+      double v = x[i] - xh[i];
+      for (std::size_t j = 0; j < i; ++j) v -= l(i, j) * z[j];
+      z[i] = v / l(i, i);
+      q += z[i] * z[i];
+    }
+    return true;
   }
 
   /// Node `address` restarts: whatever its interface held is lost.
@@ -390,6 +426,9 @@ class BasicHarness {
   }
 
   const Context& ctx_;
+  std::size_t n_ = ctx_.states();   ///< The plant's real n (≤ S::n: the rest padded).
+  std::size_t m_ = ctx_.inputs();   ///< Its real m.
+  std::size_t p_ = ctx_.outputs();  ///< Its real p.
   Approach approach_;
   const Scenario& sc_;
   Design design_;

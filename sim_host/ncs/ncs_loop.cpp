@@ -163,15 +163,28 @@ RunResult run_synchronized(Harness& hs, Estimator est, std::int32_t late_us) {
 }
 
 /// The sampling-synchronized baseline with law `law` on the plant of shape S; `saturated(law)`
-/// reads its count.
-template <typename S, typename Law, typename Saturated>
-RunResult run_sampling(BasicHarness<S>& hs, Law law, Saturated saturated) {
-  using Trigger = node::PeriodicTrigger<double, S::p>;
-  using Sensor = node::SensorNode<Board, Trigger, double, S::p>;
-  using Ctrl = node::ControllerNode<Board, Law, double, S::p, S::m>;
+/// reads its count. The sensor sends K values: y (K = p: BasicHarness::sample()) or, with
+/// `state_sensor` (K = n), the state x (BasicHarness::sample_state(): I, and S on C = I, when
+/// y is not x: C ≠ I or a padded shape).
+template <typename S, std::size_t K, typename Law, typename Saturated>
+RunResult run_sampling(BasicHarness<S>& hs, Law law, Saturated saturated, bool state_sensor = false) {
+  using Trigger = node::PeriodicTrigger<double, K>;
+  using Sensor = node::SensorNode<Board, Trigger, double, K>;
+  using Ctrl = node::ControllerNode<Board, Law, double, K, S::m>;
   using Act = node::ActuatorNode<Board, double, S::m>;
   using InputVec = typename BasicHarness<S>::InputVec;
-  using OutputVec = typename BasicHarness<S>::OutputVec;
+  using OutputVec = Vector<double, K>;
+  const auto take_sample = [&hs, state_sensor]() -> OutputVec {
+    if constexpr (K == S::n) {
+      if (state_sensor) return hs.sample_state();
+    }
+    if constexpr (K == S::p) {
+      return hs.sample();
+    } else {
+      if (!state_sensor) throw std::logic_error("ncs: a sensor of n values sends the state");
+      return hs.sample_state();
+    }
+  };
   const std::uint8_t sensor_at = hs.sensor_at_, controller_at = hs.controller_at_, actuator_at = hs.actuator_at_;
   std::optional<Sensor> sensor(std::in_place, controller_at, Trigger(1));
   std::optional<Ctrl> ctrl(std::in_place, actuator_at, node::ControllerMode::kOnArrival, law);
@@ -250,7 +263,7 @@ RunResult run_sampling(BasicHarness<S>& hs, Law law, Saturated saturated) {
   if (hs.sensor_cpu_) {
     hs.sensor_cpu_->on_point([&](std::size_t e, std::uint64_t n, engine::cpu::CpuEventKind kind) {
       if (e != hs.sensor_task_ || kind != engine::cpu::CpuEventKind::kSample || n >= jobs.size()) return;
-      jobs[n].y = hs.sample();
+      jobs[n].y = take_sample();
       note_truth(jobs[n].seq);
       jobs[n].sampled = true;
       ++samples;
@@ -274,7 +287,7 @@ RunResult run_sampling(BasicHarness<S>& hs, Law law, Saturated saturated) {
       if (t_next < hs.end_) k.schedule(t_next, EventClass::kSample, *timer_h, n + 1);
       return;
     }
-    const OutputVec y = hs.sample();
+    const OutputVec y = take_sample();
     ++samples;
     const auto seq = static_cast<node::SequenceNumber>(n - sensor_n0);
     note_truth(seq);
@@ -304,8 +317,9 @@ RunResult run(const Context& ctx, Approach a, const Scenario& sc, std::uint64_t 
 
 namespace {
 
-/// Approach `a`'s loop on `hs`: every approach on the board's shape, the sampling loops I, S,
-/// SK, IK on another (std::invalid_argument naming the approach otherwise).
+/// Approach `a`'s loop on `hs`: every approach on the board's plant, the sampling loops I, S,
+/// SK, IK on another (std::invalid_argument naming the approach otherwise): I feeds the true
+/// state back (for n ≤ 6: x fits a frame), S the measured one (C = I), SK and IK filter y.
 template <typename S>
 RunResult run_on(BasicHarness<S>& hs, Approach a) {
   const Context& ctx = hs.ctx_;
@@ -314,20 +328,35 @@ RunResult run_on(BasicHarness<S>& hs, Approach a) {
   using Ref = typename BasicHarness<S>::Ref;
   using Feedback = node::StateFeedbackLaw<double, S::n, S::m, Ref>;
   using Kalman = KalmanLawOf<S>;
-  static_assert(S::p == S::n, "I and S feed the sampled state back: every shape has C = I");
+  const std::string plant_shape = "a plant of n = " + std::to_string(ctx.states()) + ", m = " + std::to_string(ctx.inputs()) +
+                                  ", p = " + std::to_string(ctx.outputs());
   switch (a) {
     case Approach::kI:
     case Approach::kS:
-      return run_sampling(hs, Feedback{hs.design_.l, hs.u_min_, hs.u_max_, hs.ref_},
-                          [](const Feedback& f) { return f.saturated; });
+      if (a == Approach::kS && !ctx.identity_output()) {
+        throw std::invalid_argument("ncs: approach S feeds y back as x: it needs C = I (" + plant_shape + ")");
+      }
+      if constexpr (S::n <= kMaxStateFeedbackStates) {
+        // y is x (C = I on a shape with p = n: the board's runs as before, to the bit), else x itself
+        const bool y_is_x = S::p == S::n && ctx.identity_output();
+        return run_sampling<S, S::n>(hs, Feedback{hs.design_.l, hs.u_min_, hs.u_max_, hs.ref_},
+                                     [](const Feedback& f) { return f.saturated; }, !y_is_x);
+      } else {
+        throw std::invalid_argument(std::string("ncs: approach ") + name(a) + " sends the state in one frame: n <= 6 only (" +
+                                    plant_shape + ")");
+      }
     case Approach::kSK:
     case Approach::kIK: {
       Kalman law(hs.design_, NoiseModel::kConstant, hs.u_min_, hs.u_max_, hs.ref_);
       law.filter().reset(x0, hs.design_.p0, typename BasicHarness<S>::InputVec{});
-      return run_sampling(hs, law, [](Kalman& f) { return f.saturated(); });
+      return run_sampling<S, S::p>(hs, law, [](Kalman& f) { return f.saturated(); });
     }
     default:
       break;
+  }
+  if (!ctx.board()) {
+    throw std::invalid_argument(std::string("ncs: approach ") + name(a) + " runs the board's plant (n = 2, m = 1, p = 2, C = I) only; " +
+                                plant_shape + " runs I, S, SK, IK");
   }
   if constexpr (BasicHarness<S>::kBoard) {
     using HalfEst = node::HalfKalmanEstimator<Fmt, Structure, Disc>;
@@ -350,7 +379,7 @@ RunResult run_on(BasicHarness<S>& hs, Approach a) {
       case Approach::kSPlus: {
         const SplitGain g = delay_compensated_split(ctx, ctx.mean_tau_io_us(sc));
         Compensated law{g.lx, g.lu, hs.u_min_, hs.u_max_, hs.ref_};
-        return run_sampling(hs, law, [](const Compensated& f) { return f.saturated; });
+        return run_sampling<S, S::p>(hs, law, [](const Compensated& f) { return f.saturated; });
       }
       case Approach::kOS:
       case Approach::kOSp:
@@ -360,23 +389,27 @@ RunResult run_on(BasicHarness<S>& hs, Approach a) {
         throw std::logic_error("ncs: unknown approach");
     }
   } else {
-    static_cast<void>(ctx);
     static_cast<void>(sc);
-    throw std::invalid_argument(std::string("ncs: approach ") + name(a) + " runs the board's plant (n = 2, m = 1, p = 2) only; a plant of n = " +
-                                std::to_string(S::n) + ", m = " + std::to_string(S::m) + ", p = " + std::to_string(S::p) +
-                                " runs I, S, SK, IK");
+    throw std::logic_error("ncs: the board's plant runs on the board's shape");
   }
 }
 
-/// fn(S{}) with the shape S of ONESHOT_NCS_SHAPES of the plant of `ctx` (std::invalid_argument
-/// naming plant.continuous.A when it has none: Context refuses such plants first).
+/// fn(S{}) with the shape S of ONESHOT_NCS_SHAPES the plant of `ctx` runs on (ncs_shape_of(), or
+/// `force` when set: it must hold the plant); std::invalid_argument naming plant.continuous.A
+/// when none does (Context refuses such plants first).
 template <typename Fn>
-auto on_shape(const Context& ctx, Fn&& fn) -> decltype(fn(BoardShape{})) {
-  const std::size_t n = ctx.plant().a.rows;
-  const std::size_t m = ctx.plant().b.cols;
-  const std::size_t p = ctx.plant().c.rows;
+auto on_shape(const Context& ctx, Fn&& fn, NcsShapeOf force = {}) -> decltype(fn(BoardShape{})) {
+  const std::size_t n = ctx.states();
+  const std::size_t m = ctx.inputs();
+  const std::size_t p = ctx.outputs();
+  const NcsShapeOf on = force.n != 0 ? force : ncs_shape_of(n, m, p);
+  if (on.n < n || on.m < m || on.p < p) {
+    throw std::invalid_argument("ncs: the shape (" + std::to_string(on.n) + ", " + std::to_string(on.m) + ", " + std::to_string(on.p) +
+                                ") does not hold a plant of n = " + std::to_string(n) + ", m = " + std::to_string(m) + ", p = " +
+                                std::to_string(p));
+  }
 #define ONESHOT_NCS_ON_SHAPE(n_, m_, p_) \
-  if (n == (n_) && m == (m_) && p == (p_)) return fn(Shape<n_, m_, p_>{});
+  if (on.n == (n_) && on.m == (m_) && on.p == (p_)) return fn(Shape<n_, m_, p_>{});
   ONESHOT_NCS_SHAPES(ONESHOT_NCS_ON_SHAPE)
 #undef ONESHOT_NCS_ON_SHAPE
   throw std::invalid_argument("plant.continuous.A: the ncs loops run no plant of n = " + std::to_string(n) + ", m = " + std::to_string(m) +
@@ -389,7 +422,7 @@ RunResult run_approach(const Context& ctx, Approach a, const Scenario& sc, std::
   return on_shape(ctx, [&](auto shape) {
     BasicHarness<decltype(shape)> hs(ctx, a, sc, seed, options);
     return run_on(hs, a);
-  });
+  }, options.force_shape);
 }
 
 std::vector<RunResult> run_loops(const std::vector<LoopOnBus>& loops, Approach a, std::uint64_t seed, ShapeCachePools* caches) {

@@ -61,6 +61,9 @@ struct RunOptions {
   /// the pool of the plant's shape (ncs_cache_pools.hpp; nullptr: the run's own). The same
   /// run, bit for bit.
   ShapeCachePools* caches = nullptr;
+  /// Tests: run the plant embedded in this shape of ONESHOT_NCS_SHAPES (n, m, p; it must hold
+  /// the plant: std::invalid_argument otherwise) instead of ncs_shape_of()'s; {0, 0, 0}: that one.
+  NcsShapeOf force_shape{};
 };
 
 /// One row of a recorded sample or estimate.
@@ -150,23 +153,6 @@ inline SetpointReference reference(const Context& ctx, const Scenario& sc) { ret
 /// Network leg `name` ("as", "sc", "ca"): U[0.5, d] ms in whole µs, FIFO, or the scenario's
 /// leg from a study file (Scenario::legs); none for I, IK.
 engine::LinkConfig leg(const Context& ctx, const Scenario& sc, Approach a, const char* name);
-/// Lower Cholesky factor L of a measurement covariance R (p × p): y = C x + L n, n ~ N(0, I);
-/// a column whose pivot is not positive is 0 (R singular, e.g. noise scale 0).
-template <std::size_t P>
-Matrix<double, P, P> lower_cholesky(const Matrix<double, P, P>& r) {
-  Matrix<double, P, P> l{};
-  for (std::size_t j = 0; j < P; ++j) {
-    double d = 0;
-    for (std::size_t k = 0; k < j; ++k) d += l(j, k) * l(j, k);
-    l(j, j) = std::sqrt(std::fmax(0.0, r(j, j) - d));
-    for (std::size_t i = j + 1; i < P; ++i) {
-      double s = 0;
-      for (std::size_t k = 0; k < j; ++k) s += l(i, k) * l(j, k);
-      l(i, j) = l(j, j) > 0 ? (r(i, j) - s) / l(j, j) : 0;
-    }
-  }
-  return l;
-}
 /// Lower Cholesky factor of R = s·R_n of the board: y = C x + [[c0, 0], [c1, c2]] n, n ~ N(0, I).
 std::array<double, 3> measurement_cholesky(const Design& d);
 

@@ -8,6 +8,7 @@
 
 #include "ncs_counters.hpp"
 #include "ncs_loop.hpp"
+#include "oneshot/engine/psd_math.hpp"
 #include "oneshot/node/message.hpp"
 
 namespace oneshot::ncs {
@@ -16,33 +17,36 @@ template <typename S>
 engine::ContinuousPlantConfig<S::n, S::m, S::p, 1> plant_config_of(const Context& ctx, const Scenario& sc, bool noisy) {
   engine::ContinuousPlantConfig<S::n, S::m, S::p, 1> c;
   const design::PlantDescription& p = ctx.plant();
-  if (p.a.rows != S::n || p.b.cols != S::m || p.c.rows != S::p || p.q1c.rows != S::n || p.q2c.rows != S::m) {
-    throw std::logic_error("ncs: the plant's shape or cost is not the loop's (" + std::to_string(p.a.rows) + ", " +
-                           std::to_string(p.b.cols) + ", " + std::to_string(p.c.rows) + ")");
+  const std::size_t n = p.a.rows, m = p.b.cols, q = p.c.rows;
+  if (n > S::n || m > S::m || q > S::p || p.q1c.rows != n || p.q2c.rows != m) {
+    throw std::logic_error("ncs: the plant's shape or cost does not fit the loop's (" + std::to_string(n) + ", " + std::to_string(m) +
+                           ", " + std::to_string(q) + ")");
   }
-  for (std::size_t i = 0; i < S::n; ++i) {
-    for (std::size_t j = 0; j < S::n; ++j) {
+  // Embedded in a larger shape: A, B, C, Q_c, Q1c, Q2c zero padded (the padded states stay at 0).
+  for (std::size_t i = 0; i < n; ++i) {
+    for (std::size_t j = 0; j < n; ++j) {
       c.a(i, j) = p.a(i, j);
       c.qc(i, j) = ctx.design().qc(i, j) * sc.noise_scale;
       c.q1c(i, j) = p.q1c(i, j);
     }
-    for (std::size_t j = 0; j < S::m; ++j) c.b(i, j) = p.b(i, j);
+    for (std::size_t j = 0; j < m; ++j) c.b(i, j) = p.b(i, j);
   }
-  for (std::size_t i = 0; i < S::p; ++i)
-    for (std::size_t j = 0; j < S::n; ++j) c.c(i, j) = p.c(i, j);
-  for (std::size_t i = 0; i < S::m; ++i)
-    for (std::size_t j = 0; j < S::m; ++j) c.q2c(i, j) = p.q2c(i, j);
+  for (std::size_t i = 0; i < q; ++i)
+    for (std::size_t j = 0; j < n; ++j) c.c(i, j) = p.c(i, j);
+  for (std::size_t i = 0; i < m; ++i)
+    for (std::size_t j = 0; j < m; ++j) c.q2c(i, j) = p.q2c(i, j);
   c.process_noise = noisy;
+  c.active_states = n;  // the normals of the real states only: the padded run draws the plant's own numbers
   return c;
 }
 
 template <typename S>
 BasicSetpointReference<S::n, S::m> reference_of(const Context& ctx, const Scenario& sc) {
   const std::size_t out = ctx.design().tracked_outputs.empty() ? 0 : ctx.design().tracked_outputs[0];
-  Vector<double, S::n> nx;
+  Vector<double, S::n> nx;  // 0 on the padded states and inputs
   Vector<double, S::m> nu;
-  for (std::size_t i = 0; i < S::n; ++i) nx[i] = ctx.design().nx(i, out);
-  for (std::size_t j = 0; j < S::m; ++j) nu[j] = ctx.design().nu(j, out);
+  for (std::size_t i = 0; i < ctx.states(); ++i) nx[i] = ctx.design().nx(i, out);
+  for (std::size_t j = 0; j < ctx.inputs(); ++j) nu[j] = ctx.design().nu(j, out);
   if (sc.setpoint_changes) return BasicSetpointReference<S::n, S::m>(sc.setpoint_r0, sc.setpoint_changes, nx, nu);
   return BasicSetpointReference<S::n, S::m>(sc.amplitude_volts, static_cast<std::uint32_t>(half_wave_periods(ctx, sc)), nx, nu);
 }
@@ -76,7 +80,7 @@ engine::LinkConfig leg(const Context& ctx, const Scenario& sc, Approach a, const
 }
 
 std::array<double, 3> measurement_cholesky(const Design& d) {
-  const Matrix<double, kP, kP> l = lower_cholesky<kP>(d.r);
+  const Matrix<double, kP, kP> l = engine::psd_cholesky<kP>(d.r);
   return {l(0, 0), l(1, 0), l(1, 1)};
 }
 

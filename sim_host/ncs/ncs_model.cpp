@@ -158,13 +158,20 @@ std::shared_ptr<const Context> Context::from(design::PlantDescription plant) {
   auto ctx = std::make_shared<Context>();
   ctx->plant_ = std::move(plant);
   const design::PlantDescription& p = ctx->plant_;
-  if (!p.continuous() || !ncs_shape_runs(p.a.rows, p.b.cols, p.c.rows) || !p.b_w.values.empty()) {
-    throw std::invalid_argument(p.source + ": study 'ncs' needs a continuous plant of " + kNcsShapesText + " and no B_w (this one: n = " +
-                                std::to_string(p.a.rows) + ", m = " + std::to_string(p.b.cols) + ", p = " + std::to_string(p.c.rows) + ")");
+  const std::size_t n = p.a.rows, m = p.b.cols, q = p.c.rows;
+  const std::string shape = " (this one: n = " + std::to_string(n) + ", m = " + std::to_string(m) + ", p = " + std::to_string(q) + ")";
+  if (!p.continuous() || !p.b_w.values.empty()) {
+    throw std::invalid_argument(p.source + ": study 'ncs' needs a continuous plant of " + kNcsShapesText + " and no B_w" + shape);
   }
-  for (std::size_t i = 0; i < p.c.rows; ++i)
-    for (std::size_t j = 0; j < p.a.rows; ++j)
-      if (p.c(i, j) != (i == j ? 1.0 : 0.0)) throw std::invalid_argument(p.source + ": study 'ncs' needs C = I (eq. 10)");
+  if (!ncs_shape_runs(n, m, q)) {
+    const char* key = n > kMaxNcsStates ? "A" : m > kMaxNcsInputs ? "B" : "C";
+    throw std::invalid_argument(p.source + ": study 'ncs' runs plants of n <= 16 states, m <= 4 inputs, p <= 4 outputs; " + key +
+                                " is too large" + shape);
+  }
+  ctx->identity_output_ = q == n;
+  for (std::size_t i = 0; i < q; ++i)
+    for (std::size_t j = 0; j < n; ++j)
+      if (p.c(i, j) != (i == j ? 1.0 : 0.0)) ctx->identity_output_ = false;
   // The loop's cost is the continuous one (J = ∫ xᵀQ1c x + uᵀQ2c u dt over the run): a discrete cost has no Q1c, Q2c.
   if (p.cost_form != design::CostForm::kContinuous) {
     throw std::invalid_argument(p.source + ": study 'ncs' needs cost.Q1c and cost.Q2c (the loop's cost is continuous)");
@@ -175,25 +182,92 @@ std::shared_ptr<const Context> Context::from(design::PlantDescription plant) {
   }
   if (ctx->design_.u_min.size() != p.b.cols) throw std::invalid_argument(p.source + ": study 'ncs' needs an actuator range");
   // refuses plants without a board or LQR gain, naming why (the design of the plant's shape)
+  const NcsShapeOf on = ncs_shape_of(n, m, q);
 #define ONESHOT_NCS_DESIGN_OF(n_, m_, p_) \
-  if (p.a.rows == (n_) && p.b.cols == (m_) && p.c.rows == (p_)) (void)ctx->controller_design_of<Shape<n_, m_, p_>>(1.0);
+  if (on.n == (n_) && on.m == (m_) && on.p == (p_)) (void)ctx->controller_design_of<Shape<n_, m_, p_>>(1.0);
   ONESHOT_NCS_SHAPES(ONESHOT_NCS_DESIGN_OF)
 #undef ONESHOT_NCS_DESIGN_OF
   return ctx;
 }
 
+namespace {
+
+/// The R × C matrix holding `d` in its top-left corner, 0 elsewhere but `pad_diagonal` on the
+/// diagonal entries past d's (a plant embedded in a larger shape; std::logic_error when d is larger).
+template <std::size_t R, std::size_t C>
+Matrix<double, R, C> padded(const design::DenseMatrix& d, double pad_diagonal = 0) {
+  if (d.rows > R || d.cols > C) throw std::logic_error("ncs: a matrix larger than the loop's shape");
+  Matrix<double, R, C> out{};
+  for (std::size_t i = 0; i < d.rows; ++i)
+    for (std::size_t j = 0; j < d.cols; ++j) out(i, j) = d(i, j);
+  for (std::size_t i = d.rows; i < R && i < C; ++i) out(i, i) = pad_diagonal;
+  return out;
+}
+
+/// The R-vector holding `v` first, `pad` after.
+template <std::size_t R>
+Vector<double, R> padded(const std::vector<double>& v, double pad) {
+  if (v.size() > R) throw std::logic_error("ncs: a vector longer than the loop's shape");
+  Vector<double, R> out;
+  for (std::size_t i = 0; i < R; ++i) out[i] = i < v.size() ? v[i] : pad;
+  return out;
+}
+
+}  // namespace
+
 template <typename S>
 typename S::Design Context::controller_design_of(double s) const {
-  typename S::Design d = design::controller_design<double, S::n, S::m, S::p>(plant_, design_);
+  typename S::Design d;
+  if (plant_.a.rows == S::n && plant_.b.cols == S::m && plant_.c.rows == S::p) {
+    d = design::controller_design<double, S::n, S::m, S::p>(plant_, design_);
+  } else {  // embedded: the same checks, then the design zero padded
+    if (!design_.lqr_available) throw design::DesignError(plant_.source + ": no LQR gain: " + design_.lqr_unavailable_reason);
+    if (!plant_.has_board) throw design::DesignError(plant_.source + ": the controller's converter models need a PWM 'board'");
+    d = typename S::Design{};
+    d.period_us = plant_.period_us;
+    d.c = padded<S::p, S::n>(plant_.c);
+    d.l = padded<S::m, S::n>(design_.l);
+    d.nx = padded<S::n, S::p>(design_.nx);
+    d.nu = padded<S::m, S::p>(design_.nu);
+    d.q_constant = padded<S::n, S::n>(design_.q_constant);
+    d.r = padded<S::p, S::p>(design_.r, 1.0);  // S = C P Cᵀ + R stays invertible
+    d.p0 = padded<S::n, S::n>(design_.p0);
+    d.phi_h = padded<S::n, S::n>(design_.phi_h, 1.0);  // padded A = 0: Φ = I there
+    d.gamma_h = padded<S::n, S::m>(design_.gamma_h);
+    d.qd_h = padded<S::n, S::n>(design_.qd_h);
+    if (design_.deadbeat_gain.rows == plant_.a.rows && design_.deadbeat_gain.cols == plant_.c.rows) {
+      d.deadbeat_gain = padded<S::n, S::p>(design_.deadbeat_gain);
+    }
+    d.actuator.u_min = padded<S::m>(design_.u_min, -1.0);
+    d.actuator.volts_per_step = padded<S::m>(design_.volts_per_step, 1.0);
+    d.actuator.steps_per_volt = padded<S::m>(design_.steps_per_volt, 1.0);
+    d.actuator.steps = design_.actuator_steps;
+    d.sensor.y_offset = padded<S::p>(design_.y_offset, 0.0);
+    d.sensor.volts_per_code = padded<S::p>(design_.volts_per_code, 1.0);
+  }
   d.q_constant = d.q_constant * s;
   d.r = d.r * s;
-  d.p0 = d.r * 10.0;  // brief §3: P⁻ = 10·R
+  if (identity_output_) {  // brief §3: P⁻ = 10·R (on the real n = p states; 0 on the padded ones)
+    const std::size_t n = plant_.a.rows;
+    d.p0 = Matrix<double, S::n, S::n>{};
+    for (std::size_t i = 0; i < n; ++i)
+      for (std::size_t j = 0; j < n; ++j) d.p0(i, j) = d.r(i, j) * 10.0;
+  } else {
+    d.p0 = d.p0 * s;  // the design step's P0 (initial covariance or Kalman prior, at s = 1)
+  }
   return d;
 }
 
 template <typename S>
 typename S::Disc::Model Context::discretizer_model_of(double s) const {
-  typename S::Disc::Model m = design::continuous_model_per_us<double, S::n, S::m>(plant_, design_);
+  typename S::Disc::Model m;
+  if (plant_.a.rows == S::n && plant_.b.cols == S::m) {
+    m = design::continuous_model_per_us<double, S::n, S::m>(plant_, design_);
+  } else {  // embedded: A, B, Q_c zero padded, per µs
+    m.a_per_us = padded<S::n, S::n>(plant_.a) * 1e-6;
+    m.b_per_us = padded<S::n, S::m>(plant_.b) * 1e-6;
+    m.qc_per_us = padded<S::n, S::n>(design_.qc) * 1e-6;
+  }
   m.qc_per_us = m.qc_per_us * s;
   return m;
 }

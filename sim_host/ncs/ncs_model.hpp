@@ -42,20 +42,55 @@ struct Shape {
 };
 /// The board's shape (2, 1, 2): every approach runs on it (the others: I, S, SK, IK only).
 using BoardShape = Shape<kN, kM, kP>;
-/// The shapes the loops are instantiated for, as X(n, m, p) (the board's first): a first-order
-/// plant (1, 1, 1: the closed forms of a scalar loop are its oracles) and a cart-pole-like plant
-/// with its four states measured (4, 1, 4). Every shape has p = n and C = I: the reference loop
-/// I (and S) feed the sampled state back (node::StateFeedbackLaw takes y as x). Each shape costs
-/// one instantiation of the sampling loops in ncs_loop.cpp (compile time).
-#define ONESHOT_NCS_SHAPES(X) X(2, 1, 2) X(1, 1, 1) X(4, 1, 4)
+/// The largest plant the study files run: n ≤ 16 states, m ≤ 4 inputs, p ≤ 4 outputs.
+inline constexpr std::size_t kMaxNcsStates = 16;
+inline constexpr std::size_t kMaxNcsInputs = 4;   ///< m ≤ 4.
+inline constexpr std::size_t kMaxNcsOutputs = 4;  ///< p ≤ 4.
+/// The largest state count whose state fits one sensor frame (node::kMaxMessageBytes = 64:
+/// 8 header + 8n + 2 CRC bytes): the reference loop I sends x, so it runs for n ≤ 6 only.
+inline constexpr std::size_t kMaxStateFeedbackStates = 6;
+/// The shapes the loops are instantiated for, as X(n, m, p) (the board's first): the exact
+/// shapes, the board's (2, 1, 2), a first-order plant (1, 1, 1: the closed forms of a scalar
+/// loop are its oracles) and a cart-pole-like plant with its four states measured (4, 1, 4);
+/// then the capacity shapes (6, 4, 4), (8, 4, 4) and (16, 4, 4). A plant runs on its exact shape when it is
+/// listed, else embedded (zero padding: ncs_shape_of()) in the first listed shape that holds it:
+/// its padded states, inputs and outputs are inert (A, B, C, Q_c, Q1c, Q2c, L, N_x, N_u, Φ, Γ,
+/// Q_d, P0 0 there, R 1 on the padded diagonal, the padded inputs' range [−1, 1] holding their 0),
+/// and only the real dimensions draw noise: the padded run is the plant's own run. (6, 4, 4)
+/// holds every plant whose state fits the sensor frame of I (n ≤ 6): I runs on it; (8, 4, 4)
+/// the plants of n = 7, 8 (e.g. four structural modes) at half the matrices of (16, 4, 4),
+/// which holds the rest (a padded run does the larger shape's arithmetic: a plant of n = 8 runs
+/// 3.2 times faster on (8, 4, 4) than on (16, 4, 4)). Each shape costs one instantiation of the
+/// sampling loops in ncs_loop.cpp (about 1–3 s of its compile time).
+#define ONESHOT_NCS_SHAPES(X) X(2, 1, 2) X(1, 1, 1) X(4, 1, 4) X(6, 4, 4) X(8, 4, 4) X(16, 4, 4)
 /// The shapes of ONESHOT_NCS_SHAPES in words, for refusals.
-inline constexpr const char* kNcsShapesText = "(n, m, p) = (2, 1, 2) (every approach), (1, 1, 1) or (4, 1, 4) (I, S, SK, IK), with C = I";
-/// True when the loops are instantiated for a plant of n states, m inputs, p outputs.
-constexpr bool ncs_shape_runs(std::size_t n, std::size_t m, std::size_t p) {
-#define ONESHOT_NCS_SHAPE_IS(n_, m_, p_) (n == (n_) && m == (m_) && p == (p_)) ||
-  return ONESHOT_NCS_SHAPES(ONESHOT_NCS_SHAPE_IS) false;
+inline constexpr const char* kNcsShapesText =
+    "n <= 16 states, m <= 4 inputs, p <= 4 outputs (every approach on the board's shape n = 2, m = 1, p = 2 with C = I; "
+    "I, S, SK, IK on another)";
+/// The shape (N, M, P) of ONESHOT_NCS_SHAPES a plant of n states, m inputs, p outputs runs on:
+/// its own when listed, else the first that holds it; {0, 0, 0} when none does.
+struct NcsShapeOf {
+  std::size_t n = 0;  ///< N.
+  std::size_t m = 0;  ///< M.
+  std::size_t p = 0;  ///< P.
+  /// True when the plant runs padded (its shape is not listed).
+  bool padded = false;
+};
+/// ncs_shape_of(n, m, p): the shape the loops run a plant of n states, m inputs, p outputs on.
+constexpr NcsShapeOf ncs_shape_of(std::size_t n, std::size_t m, std::size_t p) {
+  if (n < 1 || m < 1 || p < 1) return {};
+#define ONESHOT_NCS_SHAPE_IS(n_, m_, p_) \
+  if (n == (n_) && m == (m_) && p == (p_)) return NcsShapeOf{n_, m_, p_, false};
+  ONESHOT_NCS_SHAPES(ONESHOT_NCS_SHAPE_IS)
 #undef ONESHOT_NCS_SHAPE_IS
+#define ONESHOT_NCS_SHAPE_HOLDS(n_, m_, p_) \
+  if (n <= (n_) && m <= (m_) && p <= (p_)) return NcsShapeOf{n_, m_, p_, true};
+  ONESHOT_NCS_SHAPES(ONESHOT_NCS_SHAPE_HOLDS)
+#undef ONESHOT_NCS_SHAPE_HOLDS
+  return {};
 }
+/// True when the loops run a plant of n states, m inputs, p outputs (exact or embedded).
+constexpr bool ncs_shape_runs(std::size_t n, std::size_t m, std::size_t p) { return ncs_shape_of(n, m, p).n != 0; }
 /// True for the board's shape (2, 1, 2): every approach, --analytic and the live run.
 constexpr bool board_shape(std::size_t n, std::size_t m, std::size_t p) { return n == kN && m == kM && p == kP; }
 
@@ -75,8 +110,8 @@ inline constexpr std::array<Approach, 9> kAllApproaches = {Approach::kI,   Appro
 inline constexpr std::array<Approach, 3> kOneShotApproaches = {Approach::kOS, Approach::kOSp, Approach::kOSK};
 /// True for the one-shot loops (OS, OSp, OSK).
 constexpr bool one_shot(Approach a) { return a == Approach::kOS || a == Approach::kOSp || a == Approach::kOSK; }
-/// True for the approaches every shape of ONESHOT_NCS_SHAPES runs (I, S, SK, IK); the others
-/// run on the board's shape only.
+/// True for the approaches every plant shape runs (I, S, SK, IK; I for n ≤ 6 and S for C = I
+/// only); the others run on the board's shape only.
 constexpr bool any_shape_approach(Approach a) {
   return a == Approach::kI || a == Approach::kS || a == Approach::kSK || a == Approach::kIK;
 }
@@ -208,8 +243,8 @@ struct Timing {
 class Context {
  public:
   /// Loads the plant file (empty: the built-in default lut_gen/plants/networked_board.json)
-  /// and runs the design step; std::invalid_argument when the plant is not 2 states,
-  /// 1 input, 2 outputs with a board, or has no LQR gain or feed-forward.
+  /// and runs the design step; std::invalid_argument when the plant is past n = 16, m = 4,
+  /// p = 4 (naming A, B or C), not continuous, has no board, LQR gain or feed-forward.
   static std::shared_ptr<const Context> load(const std::string& plant_path);
   /// The same from a plant description already parsed (a study file's inline plant).
   static std::shared_ptr<const Context> from(design::PlantDescription plant);
@@ -221,15 +256,25 @@ class Context {
   const design::DesignResult& design() const { return design_; }    ///< The design step's result.
   std::int32_t period_us() const { return plant_.period_us; }       ///< h.
   const Timing& timing() const { return timing_; }                  ///< Delay/computation ranges.
+  std::size_t states() const { return plant_.a.rows; }               ///< n.
+  std::size_t inputs() const { return plant_.b.cols; }               ///< m.
+  std::size_t outputs() const { return plant_.c.rows; }              ///< p.
+  /// True when C = I (p = n): the loop S may feed y back as x, P0 = 10·R.
+  bool identity_output() const { return identity_output_; }
+  /// True for a plant of the board's shape (2, 1, 2) with C = I: every approach, --analytic, buses.
+  bool board() const { return board_shape(states(), inputs(), outputs()) && identity_output_; }
 
   /// The controller design at noise scale s: R = s·R_n, Q = s·Q_n (constant), P0 = 10·R.
   Design controller_design(double noise_scale) const { return controller_design_of<BoardShape>(noise_scale); }
   /// The continuous model (per µs) at noise scale s (Q_c scaled), for the discretizer.
   Disc::Model discretizer_model(double noise_scale) const { return discretizer_model_of<BoardShape>(noise_scale); }
-  /// controller_design() for the plant of shape S (one of ONESHOT_NCS_SHAPES; the plant's own).
+  /// controller_design() for the plant embedded in shape S (one of ONESHOT_NCS_SHAPES holding
+  /// it; zero padded: L, N_x, N_u, C, Φ, Γ, Q, Q_d, P0 0, R 1 on the padded diagonal, the padded
+  /// inputs' range [−1, 1], sensor scale 1, offset 0). P0 = 10·R when C = I (brief §3), else
+  /// s·P0 of the design step (its initial covariance, or the Kalman prior at s = 1).
   template <typename S>
   typename S::Design controller_design_of(double noise_scale) const;
-  /// discretizer_model() for the plant of shape S.
+  /// discretizer_model() for the plant embedded in shape S (A, B, Q_c zero padded).
   template <typename S>
   typename S::Disc::Model discretizer_model_of(double noise_scale) const;
   /// Worst τ_sc + τ_c + τ_ca of a scenario (µs): D of late sampling (std::invalid_argument
@@ -243,6 +288,7 @@ class Context {
   design::PlantDescription plant_;
   design::DesignResult design_;
   Timing timing_;
+  bool identity_output_ = false;
 };
 
 /// Sum of the upper delay bounds of the legs "sc" and "ca" of a study-file scenario (a leg it

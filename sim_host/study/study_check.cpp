@@ -126,6 +126,12 @@ json plant_section(const engine::StudyFile& f, json& designs) {
   }
   j.update({{"name", p.name}, {"form", design::to_string(p.form)}, {"n", p.n()}, {"m", p.m()}, {"p", p.p()},
             {"period_us", p.period_us}, {"designed", true}});
+  if (f.study == "ncs") {  // the shape the ncs loops run it on (ncs_model.hpp): its own, or a larger one zero padded
+    const ncs::NcsShapeOf on = ncs::ncs_shape_of(p.n(), p.m(), p.p());
+    if (on.n != 0) {
+      j["runs_on_shape"] = {{"n", on.n}, {"m", on.m}, {"p", on.p}, {"padded", on.padded}};
+    }
+  }
   if (p.from_discrete) {  // the exact continuous equivalent the loop runs (design::zoh_inverse)
     j["continuous_equivalent"] = {{"A", rows(p.a)},
                                   {"B", rows(p.b)},
@@ -318,6 +324,11 @@ std::string describe_resolution(const json& r) {
   const auto plant_line = [&o](const json& p) {
     o << "plant: " << p.at("kind").get<std::string>() << ", n = " << p.at("n") << ", m = " << p.at("m") << ", p = " << p.at("p");
     if (p.contains("name")) o << " (" << p.at("name").get<std::string>() << ", h = " << p.at("period_us") << " us)";
+    if (p.contains("runs_on_shape")) {
+      const json& s = p.at("runs_on_shape");
+      o << "; the ncs loops run it on the shape (" << s.at("n") << ", " << s.at("m") << ", " << s.at("p") << ")"
+        << (s.at("padded").get<bool>() ? ", zero padded" : ", its own");
+    }
     o << "\n";
     if (p.contains("continuous_equivalent")) {
       const json& e = p.at("continuous_equivalent");

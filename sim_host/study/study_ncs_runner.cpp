@@ -161,9 +161,10 @@ NcsStudy map_ncs_study(const engine::StudyFile& file) {
     }
     {
       const design::PlantDescription& pd = out.ctx->plant();
-      if (!file.buses.empty() && !ncs::board_shape(pd.a.rows, pd.b.cols, pd.c.rows)) {
-        refuse("buses", "the bus analysis takes the board's frames (2 outputs, 1 input): a plant of n = " + std::to_string(pd.a.rows) +
-                        " runs on point-to-point legs only");
+      if (!file.buses.empty() && !out.ctx->board()) {
+        refuse("buses", "the bus analysis takes the board's frames (its plant: 2 outputs, 1 input, C = I): a plant of n = " +
+                        std::to_string(pd.a.rows) + ", m = " + std::to_string(pd.b.cols) + ", p = " + std::to_string(pd.c.rows) +
+                        (out.ctx->identity_output() ? "" : " (C not I)") + " runs on point-to-point legs only");
       }
     }
     for (std::size_t b = 0; b < file.buses.size(); ++b) {
@@ -186,10 +187,19 @@ NcsStudy map_ncs_study(const engine::StudyFile& file) {
       for (ncs::Approach k : ncs::kAllApproaches) known = known || a.kind == ncs::name(k);
       for (ncs::Approach k : ncs::kOneShotApproaches) known = known || a.kind == ncs::name(k);
       if (!known) refuse(f + ".kind", "unknown kind '" + a.kind + "' (I, S, A, AK, AKx, AKl, SK, S+, IK, OS, OSp, OSK)");
-      const design::PlantDescription& pd = out.ctx->plant();
-      if (!ncs::board_shape(pd.a.rows, pd.b.cols, pd.c.rows) && !ncs::any_shape_approach(ncs::parse_any_approach(a.kind))) {
-        refuse(f + ".kind", a.kind + " runs the board's plant (n = 2, m = 1, p = 2) only (its estimators, S+'s gain and the "
-                            "one-shot loops are 2-state); a plant of n = " + std::to_string(pd.a.rows) + " runs I, S, SK, IK");
+      const ncs::Context& cx = *out.ctx;
+      const std::string shape = "a plant of n = " + std::to_string(cx.states()) + ", m = " + std::to_string(cx.inputs()) +
+                                ", p = " + std::to_string(cx.outputs());
+      if (!cx.board() && !ncs::any_shape_approach(ncs::parse_any_approach(a.kind))) {
+        refuse(f + ".kind", a.kind + " runs the board's plant (n = 2, m = 1, p = 2, C = I) only (its estimators, S+'s gain and the "
+                            "one-shot loops are 2-state); " + shape + " runs I, S, SK, IK");
+      }
+      if (a.kind == "I" && cx.states() > ncs::kMaxStateFeedbackStates) {
+        refuse(f + ".kind", "I sends the state x in one sensor frame (64 bytes: n <= 6 doubles); " + shape +
+                            " runs IK as the reference (the first approach), SK");
+      }
+      if (a.kind == "S" && !cx.identity_output()) {
+        refuse(f + ".kind", "S feeds y back as the state: it needs C = I (" + shape + "; SK and IK filter y)");
       }
       if (!a.params.empty()) refuse(f + ".params", "the ncs approaches take no parameters");
       if (a.name != a.kind) refuse(f + ".name", "must be its kind '" + a.kind + "' (the ncs table names approaches by kind)");
@@ -212,7 +222,9 @@ NcsStudy map_ncs_study(const engine::StudyFile& file) {
       if (!first_bus_link.empty() && ncs::one_shot(ap)) {
         refuse(f + ".kind", a.kind + ": the one-shot loops do not run on a CAN bus (" + first_bus_link + ")");
       }
-      if (i == 0 && ap != ncs::Approach::kI) refuse(f + ".kind", "the first approach must be I (the reference of every ratio)");
+      if (i == 0 && ap != ncs::Approach::kI && !(ap == ncs::Approach::kIK && out.ctx->states() > ncs::kMaxStateFeedbackStates)) {
+        refuse(f + ".kind", "the first approach must be I (the reference of every ratio; IK for a plant of n > 6, which I cannot run)");
+      }
       if (ncs::actuation_synchronized(ap) && !has("as")) {
         refuse(f + ".kind", a.kind + " is actuation-synchronized: it needs the leg as (actuator to sensor)");
       }

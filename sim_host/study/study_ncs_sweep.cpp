@@ -216,9 +216,9 @@ engine::SweepResults run_ncs_sweep(const NcsStudy& s, std::size_t seeds, unsigne
     throw engine::InputError("field '--analytic': the one-shot approaches (OS, OSp, OSK) have no analytic cost");
   }
   const design::PlantDescription& plant = s.ctx->plant();
-  const bool board = ncs::board_shape(plant.a.rows, plant.b.cols, plant.c.rows);
+  const bool board = s.ctx->board();
   if (analytic && !board) {
-    throw engine::InputError("field '--analytic': the analytic tracker is 2-state: it runs the board's plant (n = 2, m = 1, p = 2) only, not n = " +
+    throw engine::InputError("field '--analytic': the analytic tracker is 2-state: it runs the board's plant (n = 2, m = 1, p = 2, C = I) only, not n = " +
                              std::to_string(plant.a.rows));
   }
   const bool sensor_on_cpu = !s.scenarios.empty() && s.scenarios[0].sensor_cpu != nullptr;

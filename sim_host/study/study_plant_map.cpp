@@ -8,7 +8,6 @@
 #include <utility>
 
 #include "ncs_model.hpp"
-#include "oneshot/dimension_limits.hpp"
 #include "oneshot/engine/study_file.hpp"
 #include "study_fields.hpp"
 
@@ -16,7 +15,7 @@ namespace oneshot::study {
 namespace {
 
 /// The ncs context of an inline plant (continuous, or discrete read as its exact continuous
-/// equivalent): a shape the loop runs (ncs::kNcsShapesText, C = I), the design keys, then the
+/// equivalent): a shape the loop runs (ncs::kNcsShapesText, any C), the design keys, then the
 /// same design step as a plant file; refusals name the key under `g`.
 std::shared_ptr<const ncs::Context> inline_context(const engine::PlantSpec& plant, const std::string& source) {
   const bool discrete = plant.kind == engine::PlantSpec::Kind::kDiscrete;
@@ -26,22 +25,12 @@ std::shared_ptr<const ncs::Context> inline_context(const engine::PlantSpec& plan
   const std::string g = discrete ? "plant.discrete" : "plant.continuous";
   const std::string runs = std::string("study ncs runs ") + ncs::kNcsShapesText;
   if (!ncs::ncs_shape_runs(a.rows, b.cols, c.rows)) {
-    // Name the matrix whose size is off: A (Φ) when no shape has n states, else B (Γ) when no shape
-    // of n states has m inputs, else C.
-    bool n_runs = false, nm_runs = false;
-    for (std::size_t mm = 1; mm <= kMaxInputs; ++mm)
-      for (std::size_t pp = 1; pp <= kMaxOutputs; ++pp)
-        if (ncs::ncs_shape_runs(a.rows, mm, pp)) {
-          n_runs = true;
-          nm_runs = nm_runs || mm == b.cols;
-        }
-    const char* key = !n_runs ? (discrete ? ".Phi" : ".A") : !nm_runs ? (discrete ? ".Gamma" : ".B") : ".C";
-    refuse(g + key, "n = " + std::to_string(a.rows) + ", m = " + std::to_string(b.cols) +
-                                               ", p = " + std::to_string(c.rows) + "; " + runs);
+    // Name the matrix whose size is off: A (Φ) for n, else B (Γ) for m, else C for p.
+    const char* key = a.rows > ncs::kMaxNcsStates ? (discrete ? ".Phi" : ".A")
+                      : b.cols > ncs::kMaxNcsInputs ? (discrete ? ".Gamma" : ".B")
+                                                    : ".C";
+    refuse(g + key, "n = " + std::to_string(a.rows) + ", m = " + std::to_string(b.cols) + ", p = " + std::to_string(c.rows) + "; " + runs);
   }
-  for (std::size_t i = 0; i < c.rows; ++i)
-    for (std::size_t j = 0; j < a.rows; ++j)
-      if (c(i, j) != (i == j ? 1.0 : 0.0)) refuse(g + ".C", "is not the identity; " + runs);
   if (!plant.design) {
     refuse(g + ".measurement_covariance",
            discrete ? "missing: the ncs design needs the plant file's keys inline (measurement_covariance, Q1c, Q2c, board); "

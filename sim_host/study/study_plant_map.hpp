@@ -33,7 +33,7 @@ struct NcsPlant {
 
 /// The plant of `file` on the ncs loop: a plant file loaded (refusals of its content named
 /// "plant.file"), an inline continuous or discrete plant of a shape the loop runs
-/// (ncs::kNcsShapesText, C = I) with its design keys (refusals naming the key under "plant.continuous" or
+/// (ncs::kNcsShapesText) with its design keys (refusals naming the key under "plant.continuous" or
 /// "plant.discrete"): engine::InputError.
 NcsPlant map_ncs_plant(const engine::StudyFile& file);
 

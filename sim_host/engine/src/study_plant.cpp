@@ -94,7 +94,9 @@ void linear_model(const json& c, const std::string& g, const std::array<const ch
   if (dist.rows != 0) shape(dist, n, dist.cols, field(2));
   DenseMatrix& out_c = *out[3] = matrix(c, g, keys[3], false);
   shape(out_c, out_c.rows, n, field(3));
-  dimension_limits(n, in.cols, out_c.rows, dist.cols, g);
+  // Named by the matrix whose size is past the limit: F (n), then G (m), C (p), G_w (w).
+  const std::string limited = n > kMaxStates ? field(0) : in.cols > kMaxInputs ? field(1) : out_c.rows > kMaxOutputs ? field(3) : field(2);
+  dimension_limits(n, in.cols, out_c.rows, dist.cols, limited);
   *out[4] = matrix(c, g, keys[4], false);
   psd(*out[4], n, field(4));
   *out[5] = matrix(c, g, keys[5], true);

@@ -103,6 +103,52 @@ TEST(ContinuousPlant, ExactPropagationAndCostAgainstEigen) {
   EXPECT_THROW(plant.set_reference(bad, Vector<double, 1>{}), std::invalid_argument);
 }
 
+TEST(ContinuousPlant, AnEmbeddedPlantDrawingItsActiveStatesOnlyIsItsOwnRun) {
+  // The oracle: ẋ = −2x + u with Q_c = 0.3, as a plant of its own (1 state) and zero padded in
+  // 3 states (A, B, C, Q_c, Q1c 0 on the padded ones) drawing the first normal only
+  // (active_states = 1): the same noise draws, so the same state, cost and trace; the padded
+  // states stay 0. Measured: identical to the bit; the tolerance allows 1e-15 relative.
+  ContinuousPlantConfig<1, 1, 1, 1> own;
+  own.a(0, 0) = -2;
+  own.b(0, 0) = 1;
+  own.c(0, 0) = 1;
+  own.qc(0, 0) = 0.3;
+  own.q1c(0, 0) = 1;
+  own.q2c(0, 0) = 0.5;
+  ContinuousPlantConfig<3, 1, 1, 1> padded;
+  padded.a(0, 0) = -2;
+  padded.b(0, 0) = 1;
+  padded.c(0, 0) = 1;
+  padded.qc(0, 0) = 0.3;
+  padded.q1c(0, 0) = 1;
+  padded.q2c(0, 0) = 0.5;
+  padded.active_states = 1;
+  ContinuousPlant<1, 1, 1, 1> a(own, RandomStream(7, "noise"));
+  ContinuousPlant<3, 1, 1, 1> b(padded, RandomStream(7, "noise"));
+  a.record_trace(Duration{3'000'000}, RandomStream(7, "trace"));
+  b.record_trace(Duration{3'000'000}, RandomStream(7, "trace"));
+  RandomStream rng(5, "events");
+  SimTime t{0};
+  for (int k = 0; k < 200; ++k) {
+    t += Duration{rng.uniform_int(1, 20'000'000)};
+    a.advance_to(t);
+    b.advance_to(t);
+    EXPECT_NEAR(b.state()[0], a.state()[0], 1e-15 * (1 + std::fabs(a.state()[0]))) << k;
+    EXPECT_EQ(b.state()[1], 0.0);
+    EXPECT_EQ(b.state()[2], 0.0);
+    Vector<double, 1> u;
+    u[0] = rng.uniform(-1, 1);
+    a.set_input(u);
+    b.set_input(u);
+  }
+  EXPECT_NEAR(b.cost().total(), a.cost().total(), 1e-15 * a.cost().total());
+  ASSERT_EQ(b.trace().size(), a.trace().size());
+  for (std::size_t i = 0; i < a.trace().size(); ++i) {
+    EXPECT_NEAR(b.trace()[i].x[0], a.trace()[i].x[0], 1e-15 * (1 + std::fabs(a.trace()[i].x[0]))) << i;
+    EXPECT_EQ(b.trace()[i].x[1], 0.0) << i;
+  }
+}
+
 TEST(ContinuousPlant, NoiseHasTheExactCovarianceAndTracesDoNotChangeTheRun) {
   const auto cfg = oscillator(true);
   const Duration delta{40'000'000};

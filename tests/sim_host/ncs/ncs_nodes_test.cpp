@@ -12,6 +12,7 @@
 #include "ncs_loop.hpp"
 #include "ncs_reference.hpp"
 #include "ncs_test_support.hpp"
+#include "oneshot/engine/psd_math.hpp"
 #include "oneshot/host/host_network.hpp"
 #include "oneshot/node/sync_actuator_node.hpp"
 #include "oneshot/node/sync_controller_node.hpp"
@@ -334,7 +335,7 @@ TEST(NcsShapes, TheMeasurementFactorOfAnyOutputCountMultipliesBackToItsCovarianc
   std::uniform_real_distribution<double> u(-1.0, 1.0);
   const auto check = [&](auto r, double tol) {
     constexpr std::size_t kDim = decltype(r)::kRows;
-    const auto l = lower_cholesky<kDim>(r);
+    const auto l = engine::psd_cholesky<kDim>(r);
     for (std::size_t i = 0; i < kDim; ++i) {
       EXPECT_GT(l(i, i), 0.0);
       for (std::size_t j = 0; j < kDim; ++j) {
@@ -366,7 +367,7 @@ TEST(NcsShapes, TheMeasurementFactorOfAnyOutputCountMultipliesBackToItsCovarianc
     check(random_spd(Matrix<double, 4, 4>{}), 1e-13);
   }
   const Matrix<double, 2, 2> zero{};
-  const auto l0 = lower_cholesky<2>(zero);
+  const auto l0 = engine::psd_cholesky<2>(zero);
   for (std::size_t i = 0; i < 2; ++i)
     for (std::size_t j = 0; j < 2; ++j) EXPECT_EQ(l0(i, j), 0.0);
 }

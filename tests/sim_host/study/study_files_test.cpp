@@ -292,8 +292,9 @@ TEST(StudyFiles, WhatTheLoopCannotRunIsRefusedNamingTheField) {
                  "field 'scenarios[0].params.amplitude_volts'");
   expect_refused([](nlohmann::json& j) { j["scenarios"][2]["duration_s"] = 2; }, "field 'scenarios[2].duration_s'");  // T_r/2 = 2 s
   expect_refused([](nlohmann::json& j) { j["duration_s"] = 0.5; }, "field 'duration_s'");
-  expect_refused([](nlohmann::json& j) { j["plant"] = {{"continuous", {{"A", {{0}}}, {"B", {{1, 1}}}, {"C", {{1}}}, {"Q_c", {{0}}}}}}; },
-                 "field 'plant.continuous.B': n = 1, m = 2");
+  expect_refused([](nlohmann::json& j) {
+    j["plant"] = {{"continuous", {{"A", {{0}}}, {"B", {{1, 1, 1, 1, 1}}}, {"C", {{1}}}, {"Q_c", {{0}}}}}};
+  }, "field 'plant.continuous.B': dimensions n = 1, m = 5");  // m ≤ 4
   // S+ needs a mean delay below h: 45 + 2.25 + 3 ms is not.
   expect_refused([](nlohmann::json& j) { j["links"][1]["delay"] = {{"model", "constant"}, {"delay_us", 45000}}; },
                  "with approach S+");

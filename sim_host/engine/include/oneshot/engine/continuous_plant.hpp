@@ -44,6 +44,9 @@ struct ContinuousPlantConfig {
   Matrix<double, N, N> q1c;  ///< Cost weight on e.
   Matrix<double, M, M> q2c;  ///< Cost weight on ũ.
   bool process_noise = true; ///< Inject process noise.
+  /// States whose noise is drawn (the first ones; N: all). A plant embedded in a larger shape
+  /// (its padded states inert, Q_c 0 there) draws the normals of its own n: the same run.
+  std::size_t active_states = N;
 };
 
 /// Exactly propagated continuous LTI plant with n = N states, m = M inputs, p = P outputs
@@ -153,10 +156,10 @@ class ContinuousPlant {
     now_ = t1;
     if (!cfg_.process_noise) return;
     ProcessNoise<N>& terms = noise();
-    const State n_end = terms.draw(delta, noise_rng_);
+    const State n_end = terms.draw(delta, noise_rng_, cfg_.active_states);
     x_ = x_ + n_end;
     cost_.noise += terms.interval_cost(delta);
-    bridge_trace_noise(trace_, first_new, start, t1, n_end, terms, trace_rng_);
+    bridge_trace_noise(trace_, first_new, start, t1, n_end, terms, trace_rng_, cfg_.active_states);
   }
 
   /// Q_d(Δ) of the process noise.

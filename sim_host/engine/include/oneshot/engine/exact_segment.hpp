@@ -82,15 +82,17 @@ class ExactSegmentCache {
 /// points [first, end) lie in (start, t_end], `n_end` is the noise drawn for the whole
 /// interval; each point gets a bridge draw from `rng` conditioned on the previous point and
 /// on n_end: the noise still to come after t_prev is n_end − Φ(t_end − t_prev) n(t_prev).
+/// `active`: the noisy states' count (ProcessNoise::bridge()).
 template <std::size_t N, typename Sample>
 void bridge_trace_noise(std::vector<Sample>& trace, std::size_t first, SimTime start, SimTime t_end,
-                        const Vector<double, N>& n_end, const ProcessNoise<N>& noise, RandomStream& rng) {
+                        const Vector<double, N>& n_end, const ProcessNoise<N>& noise, RandomStream& rng,
+                        std::size_t active = N) {
   Vector<double, N> n_prev{};
   SimTime t_prev = start;
   for (std::size_t i = first; i < trace.size(); ++i) {
     const SimTime s = trace[i].t;
     const Vector<double, N> rest = n_end - noise.transition(t_end - t_prev) * n_prev;
-    const Vector<double, N> n_s = noise.transition(s - t_prev) * n_prev + noise.bridge(s - t_prev, t_end - t_prev, rest, rng);
+    const Vector<double, N> n_s = noise.transition(s - t_prev) * n_prev + noise.bridge(s - t_prev, t_end - t_prev, rest, rng, active);
     trace[i].x = trace[i].x + n_s;
     n_prev = n_s;
     t_prev = s;

@@ -108,11 +108,13 @@ class ProcessNoise {
     return sum;
   }
 
-  /// n(Δ) ~ N(0, Q_d(Δ)): the Cholesky factor (cached per Δ) times N standard normals.
-  Vector<double, N> draw(Duration delta, RandomStream& rng) {
+  /// n(Δ) ~ N(0, Q_d(Δ)): the Cholesky factor (cached per Δ) times standard normals, the first
+  /// `active` drawn (the others 0: a plant embedded in a larger shape, whose padded states have
+  /// no noise, draws the numbers of its own shape; default all N).
+  Vector<double, N> draw(Duration delta, RandomStream& rng, std::size_t active = N) {
     const Entry& e = entry(delta);
     Vector<double, N> w;
-    for (std::size_t i = 0; i < N; ++i) w[i] = rng.normal();
+    for (std::size_t i = 0; i < active && i < N; ++i) w[i] = rng.normal();
     return e.chol * w;
   }
 
@@ -121,8 +123,10 @@ class ProcessNoise {
   /// Q_d(Δ) (cached with the cost).
   const Matrix<double, N, N>& interval_covariance(Duration delta) { return entry(delta).qd; }
 
-  /// n(a) given n(Δ) = `end` for a path started at 0 (0 < a ≤ Δ), from `rng`.
-  Vector<double, N> bridge(Duration a, Duration delta, const Vector<double, N>& end, RandomStream& rng) const {
+  /// n(a) given n(Δ) = `end` for a path started at 0 (0 < a ≤ Δ), from `rng` (its first
+  /// `active` normals, as draw()).
+  Vector<double, N> bridge(Duration a, Duration delta, const Vector<double, N>& end, RandomStream& rng,
+                           std::size_t active = N) const {
     if (a >= delta) return end;
     const Matrix<double, N, N> qa = covariance(a);
     const Matrix<double, N, N> s = qa * transition(delta - a).transposed();
@@ -130,7 +134,7 @@ class ProcessNoise {
     Matrix<double, N, N> cov = qa - gain * s.transposed();
     mirror_upper(cov);
     Vector<double, N> z;
-    for (std::size_t i = 0; i < N; ++i) z[i] = rng.normal();
+    for (std::size_t i = 0; i < active && i < N; ++i) z[i] = rng.normal();
     return gain * end + psd_cholesky(cov) * z;
   }
 
