@@ -6,31 +6,28 @@
 ///        plant file; what the loop cannot run (other shapes, C not the identity, missing design
 ///        keys, an unstabilizable or undetectable plant) and bad design keys (R not symmetric
 ///        or not positive definite, period 0, unknown keys and outputs, non-finite entries) are
-///        refused naming the field. A discrete plant (plant.discrete with the design keys, or a
-///        plant file of form discrete) runs as its exact continuous equivalent: ncs.json with its
-///        plant written as its ZOH sampling gives the costs of ncs.json to rounding; what has no
-///        such equivalent (Φ with a negative real eigenvalue, a singular Φ, a Q no white noise
-///        gives) and a node period other than the plant's are refused naming the field.
+///        refused naming the field; a first-order plant runs the sampling loops. The discrete
+///        plant: study_discrete_plant_test.cpp.
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <cstdio>
-#include <fstream>
 #include <functional>
 #include <string>
 
 #include "ncs_loop.hpp"
-#include "oneshot/design/plant_description.hpp"
-#include "oneshot/design/sampled_model.hpp"
 #include "oneshot/engine/study_file.hpp"
 #include "study_check.hpp"
 #include "study_example.hpp"
 #include "study_ncs_runner.hpp"
 #include "study_ncs_sweep.hpp"
+#include "study_plant_outputs.hpp"
 #include "support/temp_files.hpp"
 
 namespace oneshot::study {
 namespace {
+
+using test_support::outputs_of;
 
 const test_support::StudyExample kInlineNcs("ncs.json");
 const test_support::StudyExample kInlineLoops("two_loops_can.json");
@@ -48,24 +45,6 @@ nlohmann::json inline_plant_of(const char* name) {
   return {{"continuous", c}};
 }
 
-/// `j` without its "plant_source" keys (where the plant came from: the only difference).
-nlohmann::json without_plant_source(nlohmann::json j) {
-  if (j.is_object()) {
-    j.erase("plant_source");
-    for (auto& [k, v] : j.items()) v = without_plant_source(v);
-  } else if (j.is_array()) {
-    for (auto& v : j) v = without_plant_source(v);
-  }
-  return j;
-}
-
-/// The sweep's outputs of `s` (first seed `first`, `seeds` seeds) without plant_source.
-std::string outputs_of(NcsStudy s, std::uint64_t first, std::size_t seeds, const char* dir) {
-  s.first_seed = first;
-  for (NcsStudy& l : s.loops) l.first_seed = first;
-  const engine::SweepResults r = run_ncs_sweep(s, seeds, 2, engine::Shard{});
-  return without_plant_source(run_outputs(r, test::fresh_dir("oneshot_study_plant", dir), false)).dump();
-}
 
 TEST(StudyInlinePlant, NcsWithItsPlantFileWrittenInlineGivesTheSameBytes) {
   const auto inline_board = [](nlohmann::json& j) { j["plant"] = inline_plant_of("networked_board.json"); };
@@ -275,140 +254,6 @@ TEST(StudyPlantShapes, TheFiltersOfAFirstOrderPlantAreConsistent) {
     std::printf("%s: NEES %.4f (standard error %.4f over %d seeds)\n", ncs::name(a), mean, se, seeds);
     EXPECT_NEAR(mean, 1.0, 4 * se + 0.02) << ncs::name(a);
   }
-}
-
-nlohmann::json matrix_rows(const design::DenseMatrix& m) {
-  nlohmann::json r = nlohmann::json::array();
-  for (std::size_t i = 0; i < m.rows; ++i) {
-    nlohmann::json row = nlohmann::json::array();
-    for (std::size_t j = 0; j < m.cols; ++j) row.push_back(m(i, j));
-    r.push_back(row);
-  }
-  return r;
-}
-
-/// The plant file `name` as its ZOH sampling at its period (the design step's own sample_plant:
-/// Φ, Γ, the per-step Q_d) inline as plant.discrete with the design keys.
-nlohmann::json discrete_plant_of(const char* name) {
-  const std::string path = std::string(ONESHOT_STUDY_EXAMPLES_DIR) + "/../../../lut_gen/plants/" + name;
-  const nlohmann::json p = nlohmann::json::parse(test::read_file(path));
-  const design::SampledModel s = design::sample_plant(design::load_plant_file(path));
-  nlohmann::json c;
-  for (const char* k : {"name", "states", "inputs", "outputs", "C", "period_us", "tracked_outputs", "board"}) c[k] = p.at(k);
-  c["Phi"] = matrix_rows(s.phi);
-  c["Gamma"] = matrix_rows(s.gamma);
-  c["Q"] = matrix_rows(s.qd);
-  c["Q1c"] = p.at("cost").at("Q1c");
-  c["Q2c"] = p.at("cost").at("Q2c");
-  c["measurement_covariance"] = p.at("noise").at("measurement_covariance");
-  return {{"discrete", c}};
-}
-
-/// Largest relative difference of the numbers under a "cost_mean" key (per approach, per scenario
-/// and approach) of two outputs of the same structure; `compared` counts them.
-double cost_difference(const nlohmann::json& a, const nlohmann::json& b, std::size_t& compared, bool in_cost = false) {
-  double worst = 0;
-  if (a.is_object()) {
-    for (const auto& [k, v] : a.items()) {
-      if (!b.contains(k)) {
-        ADD_FAILURE() << "missing key " << k;
-        continue;
-      }
-      worst = std::fmax(worst, cost_difference(v, b.at(k), compared, in_cost || k == "cost_mean"));
-    }
-  } else if (a.is_array()) {
-    EXPECT_EQ(a.size(), b.size());
-    for (std::size_t i = 0; i < a.size() && i < b.size(); ++i) worst = std::fmax(worst, cost_difference(a[i], b[i], compared, in_cost));
-  } else if (in_cost && a.is_number() && b.is_number()) {
-    const double x = a.get<double>();
-    const double y = b.get<double>();
-    const double scale = std::fmax(std::fabs(x), std::fabs(y));
-    worst = scale > 0 ? std::fabs(x - y) / scale : 0.0;
-    ++compared;
-  }
-  return worst;
-}
-
-// (b) ncs.json with its plant written as its ZOH sampling (Φ, Γ, Q_d: the design step's own) runs
-// as its exact continuous equivalent: mean costs (per approach, and per scenario and approach)
-// within rounding of the plant file's, on two seed ranges. Measured ≤ 7.7e−16 relative over
-// 2 × 36 means (3 scenarios × 9 approaches × 3 seeds each); asserted 5e−15.
-TEST(StudyDiscretePlant, NcsWithItsPlantAsItsZohSamplingGivesTheSameCosts) {
-  const auto discrete = [](nlohmann::json& j) { j["plant"] = discrete_plant_of("networked_board.json"); };
-  NcsStudy file = kInlineNcs.study([](nlohmann::json&) {}, 3);
-  NcsStudy disc = kInlineNcs.study(discrete, 3);
-  file.scenarios.resize(3);
-  disc.scenarios.resize(3);
-  EXPECT_TRUE(disc.ctx->plant().from_discrete);
-  EXPECT_LT(disc.ctx->plant().d2c_relative_error, 1e-14);
-  double worst = 0;
-  for (const std::uint64_t first : {1U, 17U}) {
-    std::size_t compared = 0;
-    const double d = cost_difference(nlohmann::json::parse(outputs_of(file, first, 3, "disc_file")),
-                                     nlohmann::json::parse(outputs_of(disc, first, 3, "disc_inline")), compared);
-    EXPECT_GE(compared, 36U);  // 9 approaches, and each in 3 scenarios
-    EXPECT_LT(d, 5e-15) << "first seed " << first;
-    worst = std::fmax(worst, d);
-  }
-  std::printf("discrete plant: worst relative cost difference %.3g\n", worst);
-  // study check: the recovered A, B and the reconstruction error.
-  nlohmann::json j = kInlineNcs.json();
-  discrete(j);
-  const nlohmann::json r = resolve_study(kInlineNcs.parse(j));
-  const nlohmann::json& e = r.at("plant").at("continuous_equivalent");
-  EXPECT_EQ(r.at("plant").at("kind"), "discrete");
-  EXPECT_NEAR(e.at("A")[0][1].get<double>(), -23.8, 23.8 * 1e-13);
-  EXPECT_NEAR(e.at("B")[1][0].get<double>(), -23.8, 23.8 * 1e-13);
-  EXPECT_NEAR(e.at("Q_c")[1][1].get<double>(), 4e-6, 4e-6 * 1e-12);
-  EXPECT_LT(e.at("reconstruction_relative_error").get<double>(), 1e-14);
-}
-
-// The same plant as a plant file of form discrete (with Q1c, Q2c and a board) maps like the inline one.
-TEST(StudyDiscretePlant, APlantFileOfFormDiscreteRunsAsItsContinuousEquivalent) {
-  nlohmann::json c = discrete_plant_of("networked_board.json").at("discrete");
-  nlohmann::json f = {{"form", "discrete"}};
-  for (const char* k : {"name", "states", "inputs", "outputs", "Phi", "Gamma", "C", "period_us", "tracked_outputs", "board"}) f[k] = c.at(k);
-  f["cost"] = {{"Q1c", c.at("Q1c")}, {"Q2c", c.at("Q2c")}};
-  f["noise"] = {{"process_covariance_per_period", c.at("Q")}, {"measurement_covariance", c.at("measurement_covariance")}};
-  const std::string path = test::made_dir("oneshot_study_plant", "discrete_file") + "/discrete_board.json";
-  std::ofstream(path) << f.dump(2);
-  const NcsStudy s = kInlineNcs.study([&](nlohmann::json& j) { j["plant"] = {{"file", path}}; }, 3);
-  EXPECT_TRUE(s.ctx->plant().from_discrete);
-  EXPECT_TRUE(s.ctx->plant().continuous());
-  EXPECT_NEAR(s.ctx->plant().a(0, 1), -23.8, 23.8 * 1e-13);
-  // Φ with a negative real eigenvalue in the plant file: named as the plant file's field.
-  f["Phi"] = {{-0.5, 0.1}, {0, 0.9}};
-  std::ofstream(path) << f.dump(2);
-  kInlineNcs.expect_refused([&](nlohmann::json& j) { j["plant"] = {{"file", path}}; }, "field 'Phi': eigenvalue -0.5");
-  // A discrete cost (Q1, Q2 per step) beside a board: the plant converts, the loop's continuous
-  // cost has no weights: refused, never run on empty Q1c, Q2c.
-  f["Phi"] = c.at("Phi");
-  f["cost"] = {{"Q1", {{1, 0}, {0, 1}}}, {"Q2", {{1}}}};
-  std::ofstream(path) << f.dump(2);
-  kInlineNcs.expect_refused([&](nlohmann::json& j) { j["plant"] = {{"file", path}}; }, "needs cost.Q1c and cost.Q2c");
-}
-
-// (c) Refusals naming the field: no real logarithm, a singular Φ, a Q no white noise gives, a
-// node period other than the plant's sampling period, a discrete cost or disturbance beside the
-// design keys.
-TEST(StudyDiscretePlant, WhatHasNoContinuousEquivalentIsRefusedNamingTheKey) {
-  const auto expect = [](const std::function<void(nlohmann::json&)>& edit, const std::string& what) {
-    kInlineNcs.expect_refused([&](nlohmann::json& j) {
-      j["plant"] = discrete_plant_of("networked_board.json");
-      edit(j["plant"]["discrete"]);
-    }, what, true);
-  };
-  const std::string g = "field 'plant.discrete.";
-  expect([](nlohmann::json& c) { c["Phi"] = {{-0.5, 0.1}, {0, 0.9}}; }, g + "Phi': eigenvalue -0.5 on the negative real axis");
-  expect([](nlohmann::json& c) { c["Phi"] = {{1, 0.1}, {0, 0}}; }, g + "Phi': singular");
-  expect([](nlohmann::json& c) { c["Q"] = {{0, 0}, {0, 1e-7}}; }, g + "Q': the continuous intensity Q_c");
-  expect([](nlohmann::json& c) { c["Q1"] = {{1, 0}, {0, 1}}; }, g + "Q1': with the design keys the cost is the continuous");
-  expect([](nlohmann::json& c) { c["Gamma_w"] = {{1}, {0}}; }, g + "Gamma_w'");
-  expect([](nlohmann::json& c) { c.erase("Q1c"); c.erase("Q2c"); }, g + "Q1c': missing");
-  kInlineNcs.expect_refused([](nlohmann::json& j) {
-    j["plant"] = discrete_plant_of("networked_board.json");
-    j["nodes"][0]["period_us"] = 40000;
-  }, "field 'nodes[0].period_us': must be the plant's period h = 50000 us");
 }
 
 }  // namespace

@@ -1,0 +1,36 @@
+/// @file study_plant_outputs.hpp
+/// @brief What the inline- and discrete-plant tests compare: a sweep's outputs without the
+///        keys that only say where the plant came from.
+#pragma once
+
+#include <cstdint>
+#include <string>
+
+#include <nlohmann/json.hpp>
+
+#include "study_ncs_runner.hpp"
+#include "study_ncs_sweep.hpp"
+#include "support/temp_files.hpp"
+
+namespace oneshot::study::test_support {
+
+/// `j` without its "plant_source" keys (where the plant came from: the only difference).
+inline nlohmann::json without_plant_source(nlohmann::json j) {
+  if (j.is_object()) {
+    j.erase("plant_source");
+    for (auto& [k, v] : j.items()) v = without_plant_source(v);
+  } else if (j.is_array()) {
+    for (auto& v : j) v = without_plant_source(v);
+  }
+  return j;
+}
+
+/// The sweep's outputs of `s` (first seed `first`, `seeds` seeds) without plant_source.
+inline std::string outputs_of(NcsStudy s, std::uint64_t first, std::size_t seeds, const char* dir) {
+  s.first_seed = first;
+  for (NcsStudy& l : s.loops) l.first_seed = first;
+  const engine::SweepResults r = run_ncs_sweep(s, seeds, 2, engine::Shard{});
+  return without_plant_source(run_outputs(r, test::fresh_dir("oneshot_study_plant", dir), false)).dump();
+}
+
+}  // namespace oneshot::study::test_support
