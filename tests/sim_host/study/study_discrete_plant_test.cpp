@@ -14,6 +14,7 @@
 
 #include "oneshot/design/plant_description.hpp"
 #include "oneshot/design/sampled_model.hpp"
+#include "oneshot/design/zoh_inverse.hpp"
 #include "oneshot/engine/study_file.hpp"
 #include "study_check.hpp"
 #include "study_example.hpp"
@@ -38,10 +39,9 @@ nlohmann::json matrix_rows(const design::DenseMatrix& m) {
   return r;
 }
 
-/// The plant file `name` as its ZOH sampling at its period (the design step's own sample_plant:
+/// The plant file at `path` as its ZOH sampling at its period (the design step's own sample_plant:
 /// Φ, Γ, the per-step Q_d) inline as plant.discrete with the design keys.
-nlohmann::json discrete_plant_of(const char* name) {
-  const std::string path = std::string(ONESHOT_STUDY_EXAMPLES_DIR) + "/../../../lut_gen/plants/" + name;
+nlohmann::json discrete_plant_at(const std::string& path) {
   const nlohmann::json p = nlohmann::json::parse(test::read_file(path));
   const design::SampledModel s = design::sample_plant(design::load_plant_file(path));
   nlohmann::json c;
@@ -53,6 +53,11 @@ nlohmann::json discrete_plant_of(const char* name) {
   c["Q2c"] = p.at("cost").at("Q2c");
   c["measurement_covariance"] = p.at("noise").at("measurement_covariance");
   return {{"discrete", c}};
+}
+
+/// The plant file `name` of lut_gen/plants as discrete_plant_at() gives it.
+nlohmann::json discrete_plant_of(const char* name) {
+  return discrete_plant_at(std::string(ONESHOT_STUDY_EXAMPLES_DIR) + "/../../../lut_gen/plants/" + name);
 }
 
 /// Largest relative difference of the numbers under a "cost_mean" key (per approach, per scenario
@@ -112,6 +117,38 @@ TEST(StudyDiscretePlant, NcsWithItsPlantAsItsZohSamplingGivesTheSameCosts) {
   EXPECT_NEAR(e.at("B")[1][0].get<double>(), -23.8, 23.8 * 1e-13);
   EXPECT_NEAR(e.at("Q_c")[1][1].get<double>(), 4e-6, 4e-6 * 1e-12);
   EXPECT_LT(e.at("reconstruction_relative_error").get<double>(), 1e-14);
+  EXPECT_FALSE(e.contains("warning")) << e.dump();  // κ₁(Φ) ≈ 5: nothing to warn of
+}
+
+/// The board's plant with a velocity pole at A₂₂ (1/s), sampled and written as plant.discrete.
+nlohmann::json fast_pole_board(double a22) {
+  const std::string board = std::string(ONESHOT_STUDY_EXAMPLES_DIR) + "/../../../lut_gen/plants/networked_board.json";
+  nlohmann::json f = nlohmann::json::parse(test::read_file(board));
+  f["A"][1][1] = a22;
+  const std::string path = test::made_dir("oneshot_study_plant", "near_singular") + "/fast_pole_board.json";
+  std::ofstream(path) << f.dump(2);
+  return discrete_plant_at(path);
+}
+
+// (d) Φ near-singular is warned of by study check, not refused: the board's plant with a fast
+// velocity pole (A₂₂ = −300 /s: e^{−300h} = e^{−15} at h = 50 ms, κ₁(Φ) above
+// kZohInverseWarnCondition) resolves and designs, its continuous equivalent carrying the
+// condition estimate and the warning, in the JSON and the text. At A₂₂ = −400 (e^{−20}) the
+// recovered B no longer gives Γ back to its own precision (measured 8.1e−10 relative): refused
+// naming Gamma (the whole-matrix error, scaled by ‖Γ‖/‖[[Φ, Γ], [0, I]]‖, let it pass before).
+TEST(StudyDiscretePlant, ANearSingularPhiIsWarnedOfNotRefused) {
+  nlohmann::json j = kDiscreteNcs.json();
+  j["plant"] = fast_pole_board(-300.0);
+  const nlohmann::json r = resolve_study(kDiscreteNcs.parse(j));
+  const nlohmann::json& e = r.at("plant").at("continuous_equivalent");
+  ASSERT_TRUE(e.contains("warning")) << e.dump();
+  EXPECT_GT(e.at("phi_condition").get<double>(), design::kZohInverseWarnCondition);
+  EXPECT_NEAR(e.at("A")[1][1].get<double>(), -300.0, 300.0 * 1e-6);  // ill-conditioned, still close
+  const std::string text = describe_resolution(r);
+  EXPECT_NE(text.find("  warning: Phi is near-singular (condition estimate "), std::string::npos) << text;
+  std::printf("near-singular Phi: %s\n", e.at("warning").get<std::string>().c_str());
+  kDiscreteNcs.expect_refused([](nlohmann::json& k) { k["plant"] = fast_pole_board(-400.0); },
+                              "field 'plant.discrete.Gamma': the continuous plant from the logarithm samples back to Gamma");
 }
 
 // The same plant as a plant file of form discrete (with Q1c, Q2c and a board) maps like the inline one.
