@@ -4,7 +4,7 @@
 
 #include <cmath>
 
-#include "oneshot/design/sampled_model.hpp"
+#include "oneshot/design/zoh_inverse.hpp"
 #include "plant_json_reader.hpp"
 #include "plant_parts.hpp"
 
@@ -193,7 +193,7 @@ bool wants_continuous(const json& root) {
 }
 
 /// The discrete plant `p` (matrices and per-step noise read) replaced by its exact continuous
-/// equivalent (zoh_inverse); refusals name Phi, B_w or noise.process_covariance_per_period.
+/// equivalent (zoh_inverse); refusals name Phi, Gamma, B_w or noise.process_covariance_per_period.
 void to_continuous_equivalent(PlantDescription& p, const Checker& check) {
   const std::string why = " (a discrete plant with cost.Q1c/Q2c, a board or a table is read as its continuous equivalent)";
   if (p.q() != 0) check.fail("B_w", "a per-step disturbance input has no continuous equivalent here" + why);
@@ -201,7 +201,10 @@ void to_continuous_equivalent(PlantDescription& p, const Checker& check) {
   try {
     r = zoh_inverse(p.phi, p.gamma, static_cast<double>(p.period_us) * 1e-6, p.process_covariance_per_period);
   } catch (const ZohInverseError& e) {
-    check.fail(e.part() == ZohInverseError::Part::kPhi ? "Phi" : "noise.process_covariance_per_period", e.what() + why);
+    const char* field = e.part() == ZohInverseError::Part::kPhi     ? "Phi"
+                        : e.part() == ZohInverseError::Part::kGamma ? "Gamma"
+                                                                    : "noise.process_covariance_per_period";
+    check.fail(field, e.what() + why);
   } catch (const std::exception& e) {
     check.fail("Phi", e.what() + why);
   }
@@ -209,6 +212,7 @@ void to_continuous_equivalent(PlantDescription& p, const Checker& check) {
   p.from_discrete = true;
   p.d2c_relative_error = r.relative_error;
   p.d2c_noise_relative_error = r.noise_relative_error;
+  p.d2c_phi_condition = r.phi_condition;
   p.d2c_phi = std::move(p.phi);
   p.d2c_gamma = std::move(p.gamma);
   p.phi = {};

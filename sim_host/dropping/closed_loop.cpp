@@ -14,11 +14,10 @@
 #include "oneshot/engine/psd_math.hpp"
 #include "oneshot/engine/sequenced_frame.hpp"
 #include "oneshot/finite.hpp"
-#include "oneshot/kalman_correction.hpp"
 #include "oneshot/node/buffered_kalman.hpp"
 #include "oneshot/number_format.hpp"
-#include "oneshot/one_shot_predictor.hpp"
 #include "oneshot/plant_structure.hpp"
+#include "unaware_kalman.hpp"
 
 namespace oneshot::dropping {
 namespace {
@@ -46,37 +45,6 @@ double sq_err(const StateVec& a, const StateVec& b) {
   for (std::size_t i = 0; i < kN; ++i) s += (a[i] - b[i]) * (a[i] - b[i]);
   return s;
 }
-
-/// The delay-unaware baseline: a standard KF (core predict/correct) that takes the newest
-/// packet arrived in the period as y_k (predict only when none arrived).
-class UnawareKalman {
- public:
-  UnawareKalman(const node::BufferedKalmanModel<Fmt, kN, kM, kP>& m, const Cov& p0) : m_(&m), p_(p0) {}
-  Status step(const std::optional<OutputVec>& y) {
-    if (!first_) {
-      x_ = predict_state<Fmt, Structure>(m_->step, x_, u_);
-      p_ = predict_covariance<Fmt, Structure>(m_->step, p_, NoiseModel::kConstant, m_->q);
-    }
-    first_ = false;
-    corrections_ = 0;
-    if (!y) return Status::kOk;
-    corrections_ = 1;
-    Matrix<double, kN, kP> k;
-    return correct<Fmt, Structure, CovarianceUpdate::kSymmetric>(x_, p_, *y, m_->c, m_->r, k);
-  }
-  void set_applied_input(const InputVec& u) { u_ = u; }
-  const StateVec& estimate() const { return x_; }
-  const Cov& covariance() const { return p_; }
-  std::uint32_t last_corrections() const { return corrections_; }
-
- private:
-  const node::BufferedKalmanModel<Fmt, kN, kM, kP>* m_;
-  StateVec x_{};
-  Cov p_;
-  InputVec u_{};
-  bool first_ = true;
-  std::uint32_t corrections_ = 0;
-};
 
 engine::LinkConfig sensor_link(double mean_delay_periods, double loss, engine::Duration period) {
   engine::LinkConfig lc;

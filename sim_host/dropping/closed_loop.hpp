@@ -50,8 +50,8 @@ enum class ChannelKind : std::uint8_t {
 
 /// One run's settings.
 struct RunConfig {
-  EstimatorKind estimator = EstimatorKind::kBuffered;
-  ChannelKind channel = ChannelKind::kNetwork;
+  EstimatorKind estimator = EstimatorKind::kBuffered;  ///< The estimator closing the loop.
+  ChannelKind channel = ChannelKind::kNetwork;          ///< How measurements reach it.
   int t_hold = 1;                      ///< Buffer length T_hold (1 … 8).
   double mean_delay_periods = 1;       ///< D.
   double loss = 0.01;                  ///< ε.

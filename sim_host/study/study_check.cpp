@@ -13,6 +13,7 @@
 #include "ncs_model.hpp"
 #include "oneshot/design/controller_synthesis.hpp"
 #include "oneshot/design/plant_description.hpp"
+#include "oneshot/design/zoh_inverse.hpp"
 #include "study_bus_analysis.hpp"
 #include "study_cpu.hpp"
 #include "study_ncs_runner.hpp"
@@ -138,6 +139,14 @@ json plant_section(const engine::StudyFile& f, json& designs) {
                                   {"Q_c", rows(p.process_intensity)},
                                   {"reconstruction_relative_error", p.d2c_relative_error},
                                   {"noise_relative_error", p.d2c_noise_relative_error}};
+    if (!(p.d2c_phi_condition <= design::kZohInverseWarnCondition)) {  // warned, not refused: the backward check passed
+      std::ostringstream w;
+      w.precision(3);
+      w << "Phi is near-singular (condition estimate " << p.d2c_phi_condition << " above " << design::kZohInverseWarnCondition
+        << "): the recovered A is ill-conditioned (trust it to about " << p.d2c_phi_condition * 1.1e-16 << " relative)";
+      j["continuous_equivalent"]["phi_condition"] = p.d2c_phi_condition;
+      j["continuous_equivalent"]["warning"] = w.str();
+    }
   }
   designs["lqr_gain"] = rows(d.l);
   designs["closed_loop_spectral_radius"] = d.closed_loop_radius;
@@ -335,6 +344,7 @@ std::string describe_resolution(const json& r) {
       o << "  runs as its exact continuous equivalent (ZOH inverse): A = " << e.at("A").dump() << ", B = " << e.at("B").dump()
         << ", Q_c = " << e.at("Q_c").dump() << "; sampled back at h: relative error " << e.at("reconstruction_relative_error")
         << " (Phi, Gamma), " << e.at("noise_relative_error") << " (Q)\n";
+      if (e.contains("warning")) o << "  warning: " << e.at("warning").get<std::string>() << "\n";
     }
   };
   const auto approach_lines = [&o](const json& list, const char* indent) {

@@ -9,7 +9,7 @@
 
 #include "oneshot/design/dense_ops.hpp"
 #include "oneshot/design/plant_description.hpp"
-#include "oneshot/design/sampled_model.hpp"
+#include "oneshot/design/zoh_inverse.hpp"
 #include "support/run_command.hpp"
 #include "support/test_plants.hpp"
 #include "support/expect_error.hpp"

@@ -121,77 +121,74 @@ std::string inline_key(const std::string& plant_file_field) {
 constexpr std::array<const char*, 10> kDesignKeys = {"period_us", "measurement_covariance", "name",     "states", "inputs",
                                                    "outputs",   "tracked_outputs",        "actuator", "board",  "table"};
 
-/// The plant-file description of an inline continuous plant `c` at field `g` (already read into
-/// `m`): the same JSON a plant file would hold (A, B, C, period_us, names, tracked_outputs,
-/// cost {Q1c, Q2c}, noise {process_intensity = Q_c, measurement_covariance}, actuator or board,
-/// table), parsed by the plant-file parser, its errors naming the inline key.
-std::shared_ptr<const design::PlantDescription> inline_design(const json& c, const std::string& g, const ContinuousModel& m) {
-  for (const char* k : {"period_us", "measurement_covariance"}) {
-    if (!c.contains(k)) {
-      throw InputError("field '" + g + "." + k + "': missing (an inline plant with design keys needs period_us and "
-                       "measurement_covariance)");
-    }
-  }
-  if (m.bw.rows != 0) {
-    throw InputError("field '" + g + ".B_w': the design step takes no disturbance input in an inline plant (give a plant "
-                     "file with its disturbance noise)");
-  }
-  static_cast<void>(integer_in(c, g, "period_us", 1, 60'000'000));
-  const DenseMatrix r = matrix(c, g, "measurement_covariance", false);
-  psd(r, m.c.rows, g + ".measurement_covariance");
-  json f = json::object();
-  f["name"] = c.contains("name") ? c["name"] : json("inline");
-  f["form"] = "continuous";
-  for (const char* k : {"A", "B", "C", "period_us", "states", "inputs", "outputs", "tracked_outputs", "actuator", "board", "table"})
-    if (c.contains(k)) f[k] = c[k];
-  for (const char* k : {"Q1c", "Q2c"})
-    if (c.contains(k)) f["cost"][k] = c[k];
-  f["noise"] = {{"process_intensity", c["Q_c"]}, {"measurement_covariance", c["measurement_covariance"]}};
-  try {
-    return std::make_shared<const design::PlantDescription>(design::parse_plant(f.dump(), g));
-  } catch (const design::PlantError& e) {  // the design parser's field, renamed to the inline key
-    if (e.field().empty()) throw InputError("field '" + g + "': " + e.what());
-    throw InputError("field '" + g + "." + inline_key(e.field()) + "': " + e.reason());
-  }
-}
-
 /// The design keys of an inline discrete plant (its period_us is the sampling period h).
 constexpr std::array<const char*, 10> kDiscreteDesignKeys = {"measurement_covariance", "Q1c",     "Q2c",   "name",
                                                              "states",  "inputs", "outputs", "tracked_outputs",
                                                              "actuator", "board"};
 
-/// The plant-file description of an inline discrete plant with design keys: the plant file of
-/// form discrete (Phi, Gamma, C, period_us, names, cost {Q1c, Q2c}, noise {process_covariance_per_period
-/// = Q, measurement_covariance}, actuator or board), which the plant-file parser reads as its exact
-/// continuous equivalent (d2c) when it has Q1c/Q2c or a board; errors name the inline key.
-std::shared_ptr<const design::PlantDescription> inline_discrete_design(const json& c, const std::string& g,
-                                                                       const DiscreteModel& m) {
-  if (!c.contains("measurement_covariance")) {
-    throw InputError("field '" + g + ".measurement_covariance': missing (an inline discrete plant with design keys needs it)");
+/// What differs between the inline forms read for the design step.
+struct InlineForm {
+  const char* form;                       ///< The plant file's form: "continuous" or "discrete".
+  std::array<const char*, 2> required;    ///< Keys required beside the design keys (nullptr: none).
+  const char* missing_why;                ///< Why a required key is needed (the refusal's parenthesis).
+  const char* disturbance;                ///< The inline disturbance input's key (refused: B_w, Gamma_w).
+  bool refuses_discrete_cost;             ///< Q1, Q2 refused (a discrete plant's cost is then Q1c, Q2c).
+  std::array<const char*, 3> model;       ///< The model matrices copied as they are (A, B, C or Phi, Gamma, C).
+  const char* noise_key;                  ///< The inline noise key (Q_c, Q).
+  const char* noise_field;                ///< Its plant-file field under noise.
+};
+
+/// An inline continuous plant: A, B, C, Q_c as the intensity; period_us and measurement_covariance required.
+constexpr InlineForm kContinuousForm = {
+    "continuous", {"period_us", "measurement_covariance"},
+    "(an inline plant with design keys needs period_us and measurement_covariance)", "B_w", false, {"A", "B", "C"},
+    "Q_c", "process_intensity"};
+
+/// An inline discrete plant: Phi, Gamma, C, Q per step (its period_us is required anyway); the
+/// cost only as Q1c, Q2c.
+constexpr InlineForm kDiscreteForm = {
+    "discrete", {"measurement_covariance", nullptr}, "(an inline discrete plant with design keys needs it)", "Gamma_w",
+    true, {"Phi", "Gamma", "C"}, "Q", "process_covariance_per_period"};
+
+/// The plant-file description of an inline plant `c` of form `form` at field `g` with the design
+/// keys: the same JSON a plant file would hold (the model matrices, period_us, names,
+/// tracked_outputs, cost {Q1c, Q2c}, noise {the form's noise field, measurement_covariance},
+/// actuator or board, table), parsed by the plant-file parser, its errors naming the inline key. A
+/// discrete one is read as its exact continuous equivalent (d2c) when it has Q1c/Q2c or a board.
+/// `disturbance_rows` and `outputs` are the rows of the model's disturbance input and of C.
+std::shared_ptr<const design::PlantDescription> inline_plant_design(const json& c, const std::string& g,
+                                                                    const InlineForm& form, std::size_t disturbance_rows,
+                                                                    std::size_t outputs) {
+  for (const char* k : form.required) {
+    if (k != nullptr && !c.contains(k)) throw InputError("field '" + g + "." + k + "': missing " + form.missing_why);
   }
-  if (m.gamma_w.rows != 0) {
-    throw InputError("field '" + g + ".Gamma_w': the design step takes no disturbance input in an inline plant (give a "
-                     "plant file with its disturbance noise)");
+  if (disturbance_rows != 0) {
+    throw InputError("field '" + g + "." + form.disturbance + "': the design step takes no disturbance input in an inline "
+                     "plant (give a plant file with its disturbance noise)");
   }
-  for (const char* k : {"Q1", "Q2"})
-    if (c.contains(k)) {
-      throw InputError("field '" + g + "." + k + "': with the design keys the cost is the continuous plant's: give Q1c "
-                       "and Q2c (the design is then the same as for the continuous equivalent)");
-    }
+  if (form.refuses_discrete_cost) {
+    for (const char* k : {"Q1", "Q2"})
+      if (c.contains(k)) {
+        throw InputError("field '" + g + "." + k + "': with the design keys the cost is the continuous plant's: give Q1c "
+                         "and Q2c (the design is then the same as for the continuous equivalent)");
+      }
+  }
   static_cast<void>(integer_in(c, g, "period_us", 1, 60'000'000));
   const DenseMatrix r = matrix(c, g, "measurement_covariance", false);
-  psd(r, m.c.rows, g + ".measurement_covariance");
+  psd(r, outputs, g + ".measurement_covariance");
   json f = json::object();
   f["name"] = c.contains("name") ? c["name"] : json("inline");
-  f["form"] = "discrete";
-  for (const char* k : {"Phi", "Gamma", "C", "period_us", "states", "inputs", "outputs", "tracked_outputs", "actuator", "board"})
+  f["form"] = form.form;
+  for (const char* k : form.model)
     if (c.contains(k)) f[k] = c[k];
+  for (const char* k : {"period_us", "states", "inputs", "outputs", "tracked_outputs", "actuator", "board", "table"})
+    if (c.contains(k)) f[k] = c[k];  // table: continuous only (the discrete keys refuse it first)
   for (const char* k : {"Q1c", "Q2c"})
     if (c.contains(k)) f["cost"][k] = c[k];
-  f["noise"] = {{"process_covariance_per_period", c["Q"]}, {"measurement_covariance", c["measurement_covariance"]}};
+  f["noise"] = {{form.noise_field, c[form.noise_key]}, {"measurement_covariance", c["measurement_covariance"]}};
   try {
     return std::make_shared<const design::PlantDescription>(design::parse_plant(f.dump(), g));
-  } catch (const design::PlantError& e) {
+  } catch (const design::PlantError& e) {  // the design parser's field, renamed to the inline key
     if (e.field().empty()) throw InputError("field '" + g + "': " + e.what());
     throw InputError("field '" + g + "." + inline_key(e.field()) + "': " + e.reason());
   }
@@ -218,7 +215,7 @@ PlantSpec parse_plant(const json& j, const std::string& f) {
     linear_model(c, g, {"A", "B", "B_w", "C", "Q_c", "Q1c", "Q2c"}, {&m.a, &m.b, &m.bw, &m.c, &m.qc, &m.q1c, &m.q2c});
     bool designed = false;
     for (const char* k : kDesignKeys) designed = designed || c.contains(k);
-    if (designed) p.design = inline_design(c, g, m);
+    if (designed) p.design = inline_plant_design(c, g, kContinuousForm, m.bw.rows, m.c.rows);
     return p;
   }
   const std::string g = f + ".discrete";
@@ -231,7 +228,7 @@ PlantSpec parse_plant(const json& j, const std::string& f) {
   m.period = from_us(integer_in(c, g, "period_us", 1, 3'600'000'000));
   bool designed = false;
   for (const char* k : kDiscreteDesignKeys) designed = designed || c.contains(k);
-  if (designed) p.design = inline_discrete_design(c, g, m);
+  if (designed) p.design = inline_plant_design(c, g, kDiscreteForm, m.gamma_w.rows, m.c.rows);
   return p;
 }
 

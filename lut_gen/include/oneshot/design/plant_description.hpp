@@ -27,6 +27,7 @@ namespace oneshot::design {
 /// A plant description that failed validation; what() names the field.
 class PlantError : public std::runtime_error {
  public:
+  /// A refusal that names no field (an unreadable file, bad JSON …): what() is the message.
   using std::runtime_error::runtime_error;
   /// A refusal of `field` of `source`: what() is "<source>: field '<field>': <reason>".
   PlantError(const std::string& source, const std::string& field, const std::string& reason)
@@ -114,11 +115,12 @@ struct PlantDescription {
 
   /// A discrete plant (Φ, Γ, Q_d per step) read as its exact continuous equivalent, because it
   /// carries a continuous cost (cost.Q1c, Q2c), a board or a table: A, B from the principal
-  /// logarithm of [[Φ, Γ], [0, I]] over h, Q_c whose Van Loan sampling is Q_d (sampled_model.hpp
+  /// logarithm of [[Φ, Γ], [0, I]] over h, Q_c whose Van Loan sampling is Q_d (zoh_inverse.hpp
   /// zoh_inverse); the form is then continuous and phi, gamma, process_covariance_per_period empty.
   bool from_discrete = false;
   double d2c_relative_error = 0;        ///< from_discrete: ‖e^{[[A, B], [0, 0]]h} − [[Φ, Γ], [0, I]]‖₁ relative.
   double d2c_noise_relative_error = 0;  ///< from_discrete: ‖Q_d(Q_c) − Q_d‖₁ relative.
+  double d2c_phi_condition = 1;         ///< from_discrete: κ₁(Φ) (above kZohInverseWarnCondition: A ill-conditioned).
   DenseMatrix d2c_phi;                  ///< from_discrete: the Φ given.
   DenseMatrix d2c_gamma;                ///< from_discrete: the Γ given.
 
