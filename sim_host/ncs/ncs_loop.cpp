@@ -298,6 +298,7 @@ RunResult run_sampling(BasicHarness<S>& hs, Law law, Saturated saturated, bool s
   k.schedule(SimTime{hs.offset_}, EventClass::kSample, *timer_h, 0);  // at kh + φ (φ = 0 but in a run of several loops)
   RunResult r = hs.finish();
   r.saturated = saturated(ctrl->law());
+  if constexpr (kIsKalmanLaw<Law>) r.faults = ctrl->law().faults();  // corrections not exact (skipped)
   r.counters = concat(sampling_controller_counters(*ctrl), actuator_counters(*act));
   return r;
 }

@@ -147,8 +147,8 @@ std::shared_ptr<const Context> Context::load(const std::string& plant_path) {
 std::shared_ptr<const Context> Context::load_board(const std::string& plant_path) {
   std::shared_ptr<const Context> ctx = load(plant_path);
   const design::PlantDescription& p = ctx->plant();
-  if (!board_shape(p.a.rows, p.b.cols, p.c.rows)) {
-    throw std::invalid_argument(p.source + ": this ncs command runs the board's shape n = 2, m = 1, p = 2 only (study files run " +
+  if (!ctx->board()) {  // S, A, AK… and the live nodes feed y back as x: C = I (eq. 10)
+    throw std::invalid_argument(p.source + ": this ncs command runs the board's plant only: n = 2, m = 1, p = 2, C = I (study files run " +
                                 kNcsShapesText + ")");
   }
   return ctx;
@@ -230,7 +230,12 @@ typename S::Design Context::controller_design_of(double s) const {
     d.nx = padded<S::n, S::p>(design_.nx);
     d.nu = padded<S::m, S::p>(design_.nu);
     d.q_constant = padded<S::n, S::n>(design_.q_constant);
-    d.r = padded<S::p, S::p>(design_.r, 1.0);  // S = C P Cᵀ + R stays invertible
+    // S = C P Cᵀ + R stays invertible: the padded diagonal on the real R's scale (its largest
+    // diagonal entry, 1 when R is 0), so the padded entries never raise the norm the solve's
+    // singularity test takes (a pad of 1 beside R ≈ 1e-18 made every correction "singular").
+    double r_pad = 0;
+    for (std::size_t i = 0; i < design_.r.rows; ++i) r_pad = std::fmax(r_pad, design_.r(i, i));
+    d.r = padded<S::p, S::p>(design_.r, r_pad > 0 ? r_pad : 1.0);
     d.p0 = padded<S::n, S::n>(design_.p0);
     d.phi_h = padded<S::n, S::n>(design_.phi_h, 1.0);  // padded A = 0: Φ = I there
     d.gamma_h = padded<S::n, S::m>(design_.gamma_h);

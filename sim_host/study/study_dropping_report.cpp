@@ -164,15 +164,18 @@ std::string dropping_report_markdown(const DroppingStudy& s, const std::string& 
   }
   if (!plot_path.empty()) md << "![mean cost per approach, 95 % intervals](" << plot_path << ")\n\n";
   md << "### Estimator\n\nPer approach over every run: the mean squared error of the loop estimate E|x - xhat|^2 and the "
-        "filter's mean tr P, whose ratio is 1 when P is the covariance of the estimate's error (a consistent filter; above 1: "
-        "the filter trusts itself too much); gamma, the fraction of the buffered filter's anchor steps with the measurement "
+        "filter's mean tr P (each over the runs where it is finite), whose ratio is 1 when P is the covariance of the "
+        "estimate's error (a consistent filter; above 1: the filter trusts itself too much), given only when every run of "
+        "the approach is finite (both means then over the same runs); gamma, the fraction of the buffered filter's anchor steps with the measurement "
         "in its buffer. The plant's lambda_sys and the bracket of lambda_c are in the configuration above.\n\n"
      << "| approach | E|x - xhat|^2 | E tr P | ratio | gamma |\n|---|---|---|---|---|\n";
   for (const std::string& a : spec.approaches) {
     const nlohmann::json& e = outputs.at("approaches").at(a);
     const nlohmann::json& err = e.at("err_mean");
     const nlohmann::json& trp = e.at("trace_p_mean");
-    const nlohmann::json ratio = err.is_number() && trp.is_number() && trp.get<double>() > 0
+    // The ratio only when both means cover the same runs: every run finite (the cost mean is
+    // then a number; the means skip a diverged run's non-finite values, each on its own).
+    const nlohmann::json ratio = e.at("cost_mean").is_number() && err.is_number() && trp.is_number() && trp.get<double>() > 0
                                      ? nlohmann::json(err.get<double>() / trp.get<double>())
                                      : nlohmann::json(nullptr);
     md << "| " << a << " | " << drop_cell_text(err, "%.6g") << " | " << drop_cell_text(trp, "%.6g") << " | " << drop_cell_text(ratio, "%.4g")

@@ -32,7 +32,8 @@ std::string report_markdown(const std::string& file, const std::string& resoluti
      << "### Configuration\n\nAs `oneshot-sim study check` resolves it:\n\n```text\n" << resolution_text << "```\n\n"
      << simulated_time_text << "\n\n"
      << "### Cost\n\n" << ncs::table_section_markdown(outputs, pairs, plot_path)
-     << "Per scenario (mean cost of I, ratio of each approach's mean cost to I's):\n\n"
+     << "Per scenario (mean cost of " << spec.approaches[0] << ", ratio of each approach's mean cost to " << spec.approaches[0]
+     << "'s):\n\n"
      << outputs.at("markdown_per_scenario").get<std::string>() << "\n### Links\n\n"
      << "Totals over every run: sent (handed to the link), delivered (not lost), lost (dropped by the loss model), "
         "late (dropped by the receiver as stale: not newer than what it holds, or after its period; the periods without a "

@@ -18,6 +18,7 @@
 #include "ncs_loop.hpp"
 #include "oneshot/engine/sweep_statistics.hpp"
 #include "oneshot/util/statistics.hpp"
+#include "study_one_shot_discretizer.hpp"
 
 namespace oneshot::study {
 namespace {
@@ -182,6 +183,16 @@ nlohmann::json loop_sweep_config(const NcsStudy& s) {
                            {"compute_us", {s.ctx->timing().compute_min_us, s.ctx->timing().compute_max_us}},
                            {"scenarios", sc}};
   if (!on_bus.empty()) config["bus_links"] = on_bus;  // only then: the spec of files without stays as it was
+  // The one-shot discretizers when one is not "generic" (only then: generic files' specs stay as
+  // they were), so shards of files that differ in them never merge.
+  nlohmann::json disc = nlohmann::json::object();
+  bool tabled = false;
+  for (std::size_t i = 0; i < s.discretizations.size() && i < s.approaches.size(); ++i) {
+    if (!ncs::one_shot(s.approaches[i])) continue;
+    disc[ncs::name(s.approaches[i])] = name(s.discretizations[i].kind);
+    tabled = tabled || s.discretizations[i].kind != OneShotDiscretizer::kGeneric;
+  }
+  if (tabled) config["one_shot_discretizers"] = disc;
   return config;
 }
 

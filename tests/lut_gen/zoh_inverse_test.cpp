@@ -179,9 +179,10 @@ TEST(ZohInverse, RecoversATinyOrALargeGammaToItsOwnPrecision) {
       DenseMatrix phi, gamma;
       c2d(a, b, h, phi, gamma);
       const ZohInverse r = zoh_inverse(phi, gamma, h);
-      EXPECT_LT(rel(r.b, b), 3e-14) << "seed " << seed << " size " << size;
-      EXPECT_LT(r.gamma_relative_error, 3e-14) << "seed " << seed << " size " << size;
-      EXPECT_LT(r.phi_relative_error, 6e-14) << "seed " << seed << " size " << size;
+      // Measured worst: B 1.3e-15, Γ back 1.9e-15, Φ back 3.9e-15; asserted a few times that.
+      EXPECT_LT(rel(r.b, b), 6e-15) << "seed " << seed << " size " << size;
+      EXPECT_LT(r.gamma_relative_error, 8e-15) << "seed " << seed << " size " << size;
+      EXPECT_LT(r.phi_relative_error, 1.6e-14) << "seed " << seed << " size " << size;
       if (size < 1) {
         EXPECT_EQ(r.gamma_scale, 1.0);
       } else {  // halved, and at most two square roots more than Φ alone takes (unscaled: about 20)

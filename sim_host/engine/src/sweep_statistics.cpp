@@ -112,7 +112,15 @@ nlohmann::json paired_differences_json(const SweepResults& r, const SweepSummary
 void add_order_by_mean(nlohmann::json& j, const SweepResults& r, const SweepSummary& sm) {
   std::vector<std::pair<double, std::string>> order;
   for (std::size_t a = 0; a < r.spec.approaches.size(); ++a) order.emplace_back(sm.value[a].mean, r.spec.approaches[a]);
-  std::stable_sort(order.begin(), order.end());
+  // Finite means first by (mean, name), then the non-finite ones (a diverged approach: inf or
+  // NaN) by name: a NaN inside std::pair's order would break the strict weak order the sort needs.
+  std::stable_sort(order.begin(), order.end(), [](const auto& x, const auto& y) {
+    const bool fx = std::isfinite(x.first);
+    const bool fy = std::isfinite(y.first);
+    if (fx != fy) return fx;
+    if (fx && x.first != y.first) return x.first < y.first;
+    return x.second < y.second;
+  });
   std::string text;
   for (const auto& o : order) {
     j["order_by_mean_cost"].push_back(o.second);

@@ -122,8 +122,17 @@ TEST(StudyPlantShapes, APlantEmbeddedInALargerShapeRunsItsOwnRun) {
     for (const char* k : {"I", "S", "SK", "IK"}) j["approaches"].push_back({{"name", k}, {"kind", k}});
     j["scenarios"] = {j["scenarios"][0]};
   }, 2.0);
+  // The first-order plant with Q_c and R 1e-12 times smaller (R = 8e-17): the padded R's diagonal
+  // follows the real R's scale, else the pad (of 1) would raise the norm the solve's singularity
+  // test takes and every correction would be skipped as singular.
+  const NcsStudy tiny = kInlineNcs.study([](nlohmann::json& j) {
+    first_order(j);
+    nlohmann::json& c = j["plant"]["continuous"];
+    c["Q_c"] = {{4e-18}};
+    c["measurement_covariance"] = {{8e-17}};
+  }, 2.0);
   double worst = 0;
-  for (const NcsStudy* s : {&first, &board}) {
+  for (const NcsStudy* s : {&first, &board, &tiny}) {
     for (const ncs::NcsShapeOf shape : {ncs::NcsShapeOf{6, 4, 4, true}, ncs::NcsShapeOf{16, 4, 4, true}}) {
       for (ncs::Approach a : {ncs::Approach::kI, ncs::Approach::kS, ncs::Approach::kSK, ncs::Approach::kIK}) {
         if (shape.n > ncs::kMaxStateFeedbackStates && (a == ncs::Approach::kI || a == ncs::Approach::kS)) continue;
@@ -141,6 +150,7 @@ TEST(StudyPlantShapes, APlantEmbeddedInALargerShapeRunsItsOwnRun) {
             EXPECT_LE(d, 1e-13) << ncs::name(a) << " n = " << s->ctx->states() << " in " << shape.n << " noise-free " << noise_free;
             EXPECT_EQ(r1.nees_steps, r0.nees_steps);
             EXPECT_EQ(r1.commands, r0.commands);
+            EXPECT_EQ(r1.faults, r0.faults);
           }
         }
       }
