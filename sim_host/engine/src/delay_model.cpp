@@ -2,6 +2,7 @@
 /// @brief Delay models (see delay_model.hpp).
 #include "oneshot/engine/delay_model.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <limits>
@@ -63,8 +64,8 @@ Duration DelayModel::lower_bound() const {
     case Kind::kPoissonPeriods:
     case Kind::kLognormal:
       return shift;
-    case Kind::kPareto:
-      return shift + Duration{static_cast<std::int64_t>(std::floor(scale_ns))};
+    case Kind::kPareto:  // x_m past the cap: every draw is the cap (sample() clamps)
+      return std::min(shift + Duration{static_cast<std::int64_t>(std::floor(scale_ns))}, cap);
     case Kind::kTrace: {
       Duration m = trace.front();
       for (Duration d : trace) m = std::min(m, d);
@@ -103,11 +104,27 @@ double DelayModel::mean_ns() const {
     }
     case Kind::kPoissonPeriods:
       return static_cast<double>(shift.count()) + mean_periods * static_cast<double>(period.count());
-    case Kind::kLognormal:
-      return static_cast<double>(shift.count()) + median_ns * std::exp(0.5 * sigma * sigma);
-    case Kind::kPareto:
-      if (alpha <= 1) return std::numeric_limits<double>::infinity();
-      return static_cast<double>(shift.count()) + scale_ns * alpha / (alpha - 1);
+    case Kind::kLognormal: {
+      // A draw is shift + min(X, c), c = cap − shift (the clamp of sample()), X = m e^{σZ}:
+      // E min(X, c) = m e^{σ²/2} Φ((ln(c/m) − σ²)/σ) + c (1 − Φ(ln(c/m)/σ)), Φ(x) = erfc(−x/√2)/2.
+      const double c = static_cast<double>((cap - shift).count());
+      const double sh = static_cast<double>(shift.count());
+      if (!(sigma > 0)) return sh + std::fmin(median_ns, c);
+      const double l = std::log(c / median_ns);
+      const auto phi = [](double x) { return 0.5 * std::erfc(-x / std::sqrt(2.0)); };
+      return sh + median_ns * std::exp(0.5 * sigma * sigma) * phi((l - sigma * sigma) / sigma) + c * phi(-l / sigma);
+    }
+    case Kind::kPareto: {
+      // A draw is shift + min(X, c), c = cap − shift, X Pareto (x_m, α): E min(X, c) = ∫₀ᶜ P(X > t) dt
+      // = x_m (1 + ((c/x_m)^{1−α} − 1)/(1 − α)) for c > x_m (x_m (1 + ln(c/x_m)) at α = 1), c for c ≤ x_m:
+      // finite for every α, the cap being finite (the uncapped mean x_m α/(α − 1) is its limit for α > 1).
+      const double c = static_cast<double>((cap - shift).count());
+      const double sh = static_cast<double>(shift.count());
+      if (c <= scale_ns) return sh + c;
+      const double l = std::log(c / scale_ns);
+      const double e = 1 - alpha;
+      return sh + scale_ns * (1 + (e == 0 ? l : std::expm1(e * l) / e));
+    }
     case Kind::kTrace: {
       double sum = 0;
       for (Duration d : trace) sum += static_cast<double>(d.count());

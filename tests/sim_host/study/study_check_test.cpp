@@ -181,6 +181,12 @@ TEST(StudyCheck, DelayMeansAndBoundsMatchTheDraws) {
       model(R"({"model": "poisson_periods", "mean_periods": 1.5, "period_us": 10000, "offset_us": 300})"),
       model(R"({"model": "lognormal", "median_us": 3000, "sigma": 0.6, "shift_us": 500})"),
       model(R"({"model": "pareto", "scale_us": 1000, "alpha": 4.5, "shift_us": 200})"),
+      // Caps that bite: the mean is the clamped draw's (finite for a Pareto tail with α ≤ 1).
+      model(R"({"model": "lognormal", "median_us": 3000, "sigma": 1.2, "shift_us": 500, "cap_us": 8000})"),
+      model(R"({"model": "lognormal", "median_us": 3000, "sigma": 0, "shift_us": 500, "cap_us": 2000})"),
+      model(R"({"model": "pareto", "scale_us": 200, "alpha": 1.0, "shift_us": 10, "cap_us": 50000})"),
+      model(R"({"model": "pareto", "scale_us": 200, "alpha": 0.7, "cap_us": 20000})"),
+      model(R"({"model": "pareto", "scale_us": 200, "alpha": 1.3, "cap_us": 150})"),
       model(R"({"model": "trace", "file": "delays.csv"})")};
   for (const engine::DelayModel& d : models) {
     engine::RandomStream rng(3, "delay-test");

@@ -56,8 +56,8 @@ struct DelayModel {
   /// unbounded models: Poisson (no bound at all: draw() applies no cap to it), lognormal and
   /// Pareto (only their `cap` bounds the draws).
   std::optional<Duration> upper_bound() const;
-  /// Mean delay in ns of the model without its cap (exact for every model; +inf for a
-  /// Pareto tail with α ≤ 1).
+  /// Mean delay in ns of the draws (exact for every model; a heavy tail's draw clamped at its
+  /// cap, so finite for every Pareto α).
   double mean_ns() const;
   /// One-line description.
   std::string describe() const;
