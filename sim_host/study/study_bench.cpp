@@ -109,13 +109,7 @@ nlohmann::json ncs_bench(const NcsStudy& s, std::size_t seeds, unsigned threads)
 }
 
 nlohmann::json dropping_bench(const DroppingStudy& s, std::size_t seeds, unsigned threads) {
-  engine::SweepSpec spec;
-  spec.study = "study";
-  spec.experiment = "bench-dropping";
-  spec.approaches = s.approaches;
-  spec.scenarios = s.scenarios;
-  spec.first_seed = s.first_seed;
-  spec.seeds = seeds == 0 ? s.seeds : seeds;
+  engine::SweepSpec spec = dropping_sweep_spec(s, seeds, "bench-dropping");
   for (const char* m : {"cost", "events", "simulated_s", "run_s"}) spec.metrics.emplace_back(m);
   spec.config = {{"study_file", s.source}};
   const unsigned used = threads == 0 ? std::max(1U, std::thread::hardware_concurrency()) : threads;

@@ -44,14 +44,19 @@ std::string drop_md(double v, const char* format) {
 
 }  // namespace
 
-engine::SweepResults run_dropping_sweep(const DroppingStudy& s, std::size_t seeds, unsigned threads, const engine::Shard& shard) {
+engine::SweepSpec dropping_sweep_spec(const DroppingStudy& s, std::size_t seeds, const char* experiment) {
   engine::SweepSpec spec;
   spec.study = "study";
-  spec.experiment = "run-dropping";
+  spec.experiment = experiment;
   spec.approaches = s.approaches;
   spec.scenarios = s.scenarios;
   spec.first_seed = s.first_seed;
   spec.seeds = seeds == 0 ? s.seeds : seeds;
+  return spec;
+}
+
+engine::SweepResults run_dropping_sweep(const DroppingStudy& s, std::size_t seeds, unsigned threads, const engine::Shard& shard) {
+  engine::SweepSpec spec = dropping_sweep_spec(s, seeds, "run-dropping");
   for (const char* m : kDropMetrics) spec.metrics.emplace_back(m);
   nlohmann::json runs = nlohmann::json::array();
   for (std::size_t a = 0; a < s.approaches.size(); ++a) {

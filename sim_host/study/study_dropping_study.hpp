@@ -13,6 +13,7 @@
 
 #include "closed_loop.hpp"
 #include "dropping_plant.hpp"
+#include "oneshot/engine/sweep.hpp"
 
 namespace oneshot::study {
 
@@ -34,5 +35,9 @@ struct DroppingStudy {
 /// estimator, steps, the square wave, t_hold or r, the channel (bernoulli and its lambda, or the
 /// link's delay, loss and order).
 nlohmann::json dropping_run_json(const dropping::RunConfig& c);
+
+/// The sweep of `s` for `experiment` ("run-dropping", "bench-dropping"): its approaches,
+/// scenarios, first seed and `seeds` seeds (0: the file's count); metrics and config the caller's.
+engine::SweepSpec dropping_sweep_spec(const DroppingStudy& s, std::size_t seeds, const char* experiment);
 
 }  // namespace oneshot::study

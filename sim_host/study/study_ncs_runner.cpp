@@ -250,7 +250,9 @@ NcsStudy map_ncs_study(const engine::StudyFile& file) {
       if (ncs::one_shot(ap)) {
         out.discretizations.push_back(design_one_shot_discretization(
             *out.ctx, disc, f + ".params.discretizer",
-            file.plant.kind == engine::PlantSpec::Kind::kFile ? "plant.file" : "plant.continuous.table.max_bytes"));
+            file.plant.kind == engine::PlantSpec::Kind::kFile       ? "plant.file"
+            : file.plant.kind == engine::PlantSpec::Kind::kDiscrete ? "plant.discrete"
+                                                                    : "plant.continuous.table.max_bytes"));
         std::size_t slot = 0;
         while (ncs::kOneShotApproaches[slot] != ap) ++slot;
         one_shot_triples[slot] = out.discretizations.back().triple;

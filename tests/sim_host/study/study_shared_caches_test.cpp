@@ -90,6 +90,34 @@ TEST(ShapeCachePools, ARunOfAnotherShapeTakesItsCachesFromItsShapesPool) {
   EXPECT_EQ(pools.size(), 2U);
 }
 
+TEST(ShapeCachePools, TwoPlantsInOneShapesPoolKeepTheirOwnRuns) {
+  // The first-order plant embedded in (4, 1, 4) (zero padded) and the cart-pole-like plant of
+  // that shape, alternately on one pool: the pool's keys are the (padded) matrices' bytes, so
+  // neither takes the other's maps; each run is its own-cache run, bit for bit.
+  const NcsStudy cart_pole = kCachesCartPole.study([](nlohmann::json&) {}, 1.0);
+  const NcsStudy scalar = kCachesCartPole.study(scalar_plant, 1.0);
+  ncs::ShapeCachePools pools;
+  ncs::RunOptions with;
+  with.caches = &pools;
+  ncs::RunOptions padded_own;
+  padded_own.force_shape = ncs::NcsShapeOf{4, 1, 4, true};
+  ncs::RunOptions padded_with = padded_own;
+  padded_with.caches = &pools;
+  for (const std::uint64_t seed : {1U, 2U}) {
+    for (const ncs::Approach a : {ncs::Approach::kS, ncs::Approach::kSK}) {
+      const ncs::RunResult c_own = ncs::run(*cart_pole.ctx, a, cart_pole.scenarios[0], seed, {});
+      const ncs::RunResult s_own = ncs::run(*scalar.ctx, a, scalar.scenarios[0], seed, padded_own);
+      const ncs::RunResult c_shared = ncs::run(*cart_pole.ctx, a, cart_pole.scenarios[0], seed, with);
+      const ncs::RunResult s_shared = ncs::run(*scalar.ctx, a, scalar.scenarios[0], seed, padded_with);
+      EXPECT_EQ(std::memcmp(&c_own.cost, &c_shared.cost, sizeof c_own.cost), 0) << seed;
+      EXPECT_EQ(std::memcmp(&s_own.cost, &s_shared.cost, sizeof s_own.cost), 0) << seed;
+      EXPECT_NE(c_own.cost, s_own.cost);  // two plants, not one run twice
+    }
+  }
+  using CartPole = ncs::Shape<4, 1, 4>;
+  EXPECT_EQ(pools.pool<CartPole>()->size(), 4U);  // each plant's interval maps and noise terms
+}
+
 TEST(ShapeCachePools, SweepsOfEveryShapeGiveTheSameBytesWithAndWithoutThePools) {
   // 3 s: past the set-point's first switch (T_r / 2 = 2 s), so I's cost (the ratios' base) is not 0.
   const NcsStudy cart_pole = kCachesCartPole.study([](nlohmann::json&) {}, 3.0);
