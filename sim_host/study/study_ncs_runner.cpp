@@ -3,7 +3,6 @@
 #include "study_ncs_runner.hpp"
 
 #include <array>
-#include <cmath>
 #include <iterator>
 #include <map>
 #include <optional>
@@ -14,34 +13,13 @@
 #include "ncs_live.hpp"
 #include "study_cpu.hpp"
 #include "study_fields.hpp"
+#include "study_ncs_scenario_map.hpp"
 #include "study_one_shot_discretizer.hpp"
 #include "study_plant_map.hpp"
 
 namespace oneshot::study {
-namespace {
 
 using engine::InputError;
-
-/// Why approach I, the reference of every ratio, would cost exactly 0 on `sc` ("" when it does
-/// not): it starts on the set-point without delay or noise, so it costs nothing until the
-/// set-point first changes (a square wave at T_r/2), and nothing at all when it never does.
-/// Ratios to it would divide by 0.
-std::string zero_reference_cost(const ncs::Context& ctx, const ncs::Scenario& sc) {
-  const std::uint64_t k = ncs::first_setpoint_change(ctx, sc);
-  if (k == 0) {
-    return sc.setpoint_changes ? "the set-point never changes, so the reference approach I costs 0: no ratio to it"
-                               : "amplitude 0 keeps the reference approach I at cost 0: no ratio to it";
-  }
-  const double first_switch_s = static_cast<double>(k) * static_cast<double>(ctx.period_us()) * 1e-6;
-  if (!(sc.duration_s > first_switch_s)) {
-    return "the run ends (" + std::to_string(sc.duration_s) + " s) before the first set-point switch at " +
-           std::string(sc.setpoint_changes ? "" : "T_r/2 = ") + std::to_string(first_switch_s) +
-           " s, so the reference approach I costs 0: no ratio to it";
-  }
-  return "";
-}
-
-}  // namespace
 
 const NcsLeg* find_ncs_leg(const std::string& name) {
   for (const NcsLeg& g : kNcsLegs)
@@ -261,122 +239,9 @@ NcsStudy map_ncs_study(const engine::StudyFile& file) {
       }
       out.approaches.push_back(ap);
     }
-    // Scenarios: ncs Scenario fields, legs from the file with the scenario's overrides.
-    for (std::size_t i = 0; i < file.scenarios.size(); ++i) {
-      const engine::ScenarioSpec& s = file.scenarios[i];
-      const std::string f = at("scenarios", i);
-      // The set-point: the scenario's `reference`, else the file's, else the square wave of the
-      // params amplitude_volts and period_s (required then, refused with a reference).
-      const engine::ReferenceSpec* ref = s.reference ? &*s.reference : (file.reference ? &*file.reference : nullptr);
-      // The schema's checks again, on what the file gave (a file parsed without it reaches here too).
-      std::map<std::string, double> params;
-      for (const auto& [key, v] : s.params) {
-        if (s.params_given.count(key) == 0) continue;  // a schema default
-        const engine::ParamSpec* spec = nullptr;
-        for (const engine::ParamSpec& p : ncs_schema().scenario_params)
-          if (p.name == key) spec = &p;
-        if (spec == nullptr) refuse(f + ".params", "unknown parameter (amplitude_volts, period_s, noise_scale)");
-        if (!(v >= spec->min && v <= spec->max)) refuse(f + ".params." + key, "out of range");
-        params[key] = v;
-      }
-      for (const engine::ParamSpec& p : ncs_schema().scenario_params) {
-        const std::string g = f + ".params." + p.name;
-        const bool wave = p.name == "amplitude_volts" || p.name == "period_s";
-        if (wave && ref != nullptr && params.count(p.name) != 0) {
-          refuse(g, "the set-point comes from '" + ref->field + "' (a square wave there takes amplitude_volts and period_s)");
-        }
-        if (params.count(p.name) != 0) continue;
-        if (wave && ref == nullptr) refuse(g, "missing (or give the set-point as a 'reference')");
-        params[p.name] = p.fallback;
-      }
-      ncs::Scenario sc;
-      sc.name = s.name;
-      sc.amplitude_volts = params.at("amplitude_volts");
-      sc.period_s = params.at("period_s");
-      sc.noise_scale = params.at("noise_scale");
-      std::string amplitude_field = f + ".params.amplitude_volts";
-      std::string period_field = f + ".params.period_s";
-      if (ref != nullptr && ref->kind == engine::ReferenceSpec::Kind::kSquare) {  // the params' square wave, bit for bit
-        sc.amplitude_volts = ref->amplitude_volts;
-        sc.period_s = ref->period_s;
-        amplitude_field = ref->field + ".amplitude_volts";
-        period_field = ref->field + ".period_s";
-      } else if (ref != nullptr) {
-        sc.amplitude_volts = 0;
-        sc.period_s = 0;
-        amplitude_field = ref->field + (ref->kind == engine::ReferenceSpec::Kind::kFile ? ".path" : ".steps");
-        try {
-          ncs::set_steps(sc, h_us, ref->steps, ref->lines, ref->path);
-        } catch (const std::invalid_argument& e) {
-          refuse(amplitude_field, e.what());
-        }
-        sc.setpoint_description = ref->describe();
-      }
-      sc.duration_s = s.duration_s.value_or(file.duration_s);
-      sc.sod_delta = sod_delta;
-      sc.sod_time_steps = sod_time_steps;
-      if (mtm_rule) {
-        sc.sensor_mtm = true;
-        sc.mtm_sigma = mtm_rule->sigma;
-        sc.mtm_delta = mtm_rule->mtm_delta;
-        sc.mtm_k_max = mtm_rule->k_max;
-        sc.mtm_k_ref_max = mtm_rule->k_ref_max;
-      }
-      sc.controller_phase_us = phase_us;
-      for (const engine::LinkSpec& l : file.links) {
-        if (l.bus.empty()) {
-          sc.legs[l.name] = file.link_config(l.name, &s);
-          continue;
-        }
-        ncs::BusLeg b;
-        for (const engine::BusSpec& bus : file.buses) {
-          if (bus.config.name != l.bus) continue;
-          b.bus = bus.config;
-          b.background = bus.background;
-          b.offsets = bus.offsets;
-        }
-        b.id = l.id;
-        sc.bus_legs[l.name] = b;
-      }
-      // d of study ncs (every leg U[0.5, d] ms) has no meaning for the file's legs, and ncs::run
-      // takes the legs instead: 0. study run leaves ncs table's by-d keys out and reports each
-      // scenario's sc + ca delay bound (study_ncs_sweep.hpp).
-      sc.max_delay_ms = 0;
-      if (!sc.setpoint_changes) {
-        try {
-          static_cast<void>(ncs::half_wave_periods(*out.ctx, sc));
-        } catch (const std::exception&) {
-          refuse(period_field, "T_r/2 must be a whole number of periods h = " + std::to_string(h_us) + " us");
-        }
-      }
-      if (!(sc.duration_s * 1e6 >= static_cast<double>(h_us))) refuse(f + ".duration_s", "shorter than one period h");
-      if (ncs::first_setpoint_change(*out.ctx, sc) == 0) refuse(amplitude_field, zero_reference_cost(*out.ctx, sc));
-      const std::string zero = zero_reference_cost(*out.ctx, sc);
-      if (!zero.empty()) refuse(s.duration_s ? f + ".duration_s" : std::string("duration_s"), zero);
-      for (ncs::Approach a : out.approaches) {
-        const std::string g = f + " with approach " + ncs::name(a);
-        if (a == ncs::Approach::kSPlus) {
-          const double tau = out.ctx->mean_tau_io_us(sc);
-          if (!(tau < static_cast<double>(h_us))) {
-            refuse(g, "S+ designs on the mean delay tau_io = " + std::to_string(tau) + " us, which must be below h");
-          }
-          try {
-            static_cast<void>(ncs::delay_compensated_split(*out.ctx, tau));
-          } catch (const std::exception& e) {
-            refuse(g, e.what());
-          }
-        }
-        if (a == ncs::Approach::kAKl) {
-          try {
-            static_cast<void>(out.ctx->worst_chain_us(sc));
-          } catch (const std::exception& e) {
-            refuse(g, e.what());
-          }
-        }
-      }
-      sc.one_shot_triples = one_shot_triples;
-      out.scenarios.push_back(sc);
-    }
+    // Scenarios: ncs Scenario fields, legs from the file with the scenario's overrides (study_ncs_scenario_map.hpp).
+    const NcsScenarioInputs inputs{sod_delta, sod_time_steps, mtm_rule, phase_us, one_shot_triples};
+    for (std::size_t i = 0; i < file.scenarios.size(); ++i) out.scenarios.push_back(map_ncs_scenario(file, i, out, inputs));
     if (one_shot) {
       // The one-shot filter corrects the outputs one at a time (a scalar correction each):
       // exact only for a diagonal measurement covariance.
@@ -398,28 +263,6 @@ NcsStudy map_ncs_study(const engine::StudyFile& file) {
     if (what.rfind(file.source + ":", 0) == 0) throw;
     throw InputError(file.source + ": " + what);
   }
-}
-
-void cap_duration(NcsStudy& s, double max_s, const std::string& field) {
-  if (!s.loops.empty()) {  // every loop (the same scenarios), then this study's fields: the first loop's
-    std::vector<NcsStudy> loops = s.loops;
-    for (NcsStudy& l : loops) cap_duration(l, max_s, field);
-    s.scenarios = loops[0].scenarios;
-    s.loops = std::move(loops);
-    return;
-  }
-  const double h_s = static_cast<double>(s.ctx->period_us()) * 1e-6;
-  if (!(std::isfinite(max_s) && max_s >= h_s)) {
-    throw InputError("field '" + field + "': " + std::to_string(max_s) + " s is shorter than one period h = " +
-                     std::to_string(h_s) + " s");
-  }
-  std::vector<ncs::Scenario> capped = s.scenarios;  // `s` unchanged when a scenario is refused
-  for (ncs::Scenario& x : capped) {
-    x.duration_s = std::fmin(x.duration_s, max_s);
-    const std::string zero = zero_reference_cost(*s.ctx, x);
-    if (!zero.empty()) throw InputError("field '" + field + "': scenario " + x.name + ": " + zero);
-  }
-  s.scenarios = std::move(capped);
 }
 
 }  // namespace oneshot::study
