@@ -48,6 +48,15 @@ nlohmann::json bench_figures(const engine::SweepResults& r, const std::string& s
           {"events_per_cpu_s", cpu_s > 0 ? events / cpu_s : 0.0}};
 }
 
+double mean_of(const engine::SweepResults& r, std::size_t approach, const std::string& metric) {
+  const engine::SweepSpec& spec = r.spec;
+  const std::size_t m = r.metric(metric);
+  double sum = 0;
+  for (std::size_t x = 0; x < spec.scenarios.size(); ++x)
+    for (std::size_t k = 0; k < spec.seeds; ++k) sum += r.at(approach, x, k, m);
+  return sum / static_cast<double>(spec.scenarios.size() * spec.seeds);
+}
+
 std::string bench_line(const std::string& file, const nlohmann::json& j) {
   char line[320];  // the figures (the file's name goes around them: any length)
   std::snprintf(line, sizeof line,
@@ -94,16 +103,9 @@ nlohmann::json ncs_bench(const NcsStudy& s, std::size_t seeds, unsigned threads)
   nlohmann::json j = bench_figures(r, s.source, used, wall, cpu);
   for (std::size_t a = 0; a < spec.approaches.size(); ++a) {
     // The mean cost over the approach's runs: the loop's, or per loop of a file with several.
-    const auto cost_mean = [&](const std::string& metric) {
-      const std::size_t m = r.metric(metric);
-      double sum = 0;
-      for (std::size_t x = 0; x < spec.scenarios.size(); ++x)
-        for (std::size_t k = 0; k < spec.seeds; ++k) sum += r.at(a, x, k, m);
-      return sum / static_cast<double>(spec.scenarios.size() * spec.seeds);
-    };
     nlohmann::json& per = j["per_approach"][spec.approaches[a]];
-    if (s.loops.empty()) per["cost_mean"] = cost_mean("cost");
-    for (const NcsStudy& l : s.loops) per["loops"][l.loop]["cost_mean"] = cost_mean(l.loop + "/cost");
+    if (s.loops.empty()) per["cost_mean"] = mean_of(r, a, "cost");
+    for (const NcsStudy& l : s.loops) per["loops"][l.loop]["cost_mean"] = mean_of(r, a, l.loop + "/cost");
   }
   return j;
 }
@@ -129,12 +131,8 @@ nlohmann::json dropping_bench(const DroppingStudy& s, std::size_t seeds, unsigne
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   const double cpu = static_cast<double>(std::clock() - cpu0) / CLOCKS_PER_SEC;
   nlohmann::json j = bench_figures(r, s.source, used, wall, cpu);
-  const std::size_t cost = r.metric("cost");
   for (std::size_t a = 0; a < spec.approaches.size(); ++a) {
-    double sum = 0;
-    for (std::size_t x = 0; x < spec.scenarios.size(); ++x)
-      for (std::size_t k = 0; k < spec.seeds; ++k) sum += r.at(a, x, k, cost);
-    j["per_approach"][spec.approaches[a]]["cost_mean"] = dropping::num(sum / static_cast<double>(spec.scenarios.size() * spec.seeds));
+    j["per_approach"][spec.approaches[a]]["cost_mean"] = dropping::num(mean_of(r, a, "cost"));
   }
   return j;
 }

@@ -22,6 +22,11 @@ namespace oneshot::study {
 nlohmann::json bench_figures(const engine::SweepResults& r, const std::string& source, unsigned threads, double wall_s,
                              double cpu_s);
 
+/// The mean of metric `metric` (one of r.spec.metrics) over approach `approach`'s runs of `r`,
+/// every scenario x seed: (1 / (S K)) sum_x sum_k r.at(approach, x, k, metric), summed scenario
+/// by scenario, seed by seed.
+double mean_of(const engine::SweepResults& r, std::size_t approach, const std::string& metric);
+
 struct NcsStudy;
 struct DroppingStudy;
 
