@@ -15,17 +15,21 @@ namespace oneshot::study {
 
 using engine::InputError;
 
-std::string zero_reference_cost(const ncs::Context& ctx, const ncs::Scenario& sc) {
+std::string zero_reference_cost(const ncs::Context& ctx, const ncs::Scenario& sc, ncs::Approach leading) {
+  // IK (no delay, Kalman) runs the plant's process noise Q_c · noise_scale: it costs more than 0 while that is not 0.
+  if (leading != ncs::Approach::kI && sc.noise_scale != 0) return "";
+  const std::string who = std::string("the reference approach ") + ncs::name(leading);
+  const std::string noiseless = leading == ncs::Approach::kI ? "" : " (noise_scale 0)";
   const std::uint64_t k = ncs::first_setpoint_change(ctx, sc);
   if (k == 0) {
-    return sc.setpoint_changes ? "the set-point never changes, so the reference approach I costs 0: no ratio to it"
-                               : "amplitude 0 keeps the reference approach I at cost 0: no ratio to it";
+    return sc.setpoint_changes ? "the set-point never changes, so " + who + noiseless + " costs 0: no ratio to it"
+                               : "amplitude 0 keeps " + who + noiseless + " at cost 0: no ratio to it";
   }
   const double first_switch_s = static_cast<double>(k) * static_cast<double>(ctx.period_us()) * 1e-6;
   if (!(sc.duration_s > first_switch_s)) {
     return "the run ends (" + std::to_string(sc.duration_s) + " s) before the first set-point switch at " +
-           std::string(sc.setpoint_changes ? "" : "T_r/2 = ") + std::to_string(first_switch_s) +
-           " s, so the reference approach I costs 0: no ratio to it";
+           std::string(sc.setpoint_changes ? "" : "T_r/2 = ") + std::to_string(first_switch_s) + " s, so " + who + noiseless +
+           " costs 0: no ratio to it";
   }
   return "";
 }
@@ -119,8 +123,9 @@ ncs::Scenario map_ncs_scenario(const engine::StudyFile& file, std::size_t i, con
     }
   }
   if (!(sc.duration_s * 1e6 >= static_cast<double>(h_us))) refuse(f + ".duration_s", "shorter than one period h");
-  if (ncs::first_setpoint_change(*study.ctx, sc) == 0) refuse(amplitude_field, zero_reference_cost(*study.ctx, sc));
-  const std::string zero = zero_reference_cost(*study.ctx, sc);
+  const ncs::Approach leading = study.approaches.empty() ? ncs::Approach::kI : study.approaches[0];  // the ratios' reference
+  const std::string zero = zero_reference_cost(*study.ctx, sc, leading);
+  if (!zero.empty() && ncs::first_setpoint_change(*study.ctx, sc) == 0) refuse(amplitude_field, zero);
   if (!zero.empty()) refuse(s.duration_s ? f + ".duration_s" : std::string("duration_s"), zero);
   for (ncs::Approach a : study.approaches) {
     const std::string g = f + " with approach " + ncs::name(a);
@@ -164,7 +169,7 @@ void cap_duration(NcsStudy& s, double max_s, const std::string& field) {
   std::vector<ncs::Scenario> capped = s.scenarios;  // `s` unchanged when a scenario is refused
   for (ncs::Scenario& x : capped) {
     x.duration_s = std::fmin(x.duration_s, max_s);
-    const std::string zero = zero_reference_cost(*s.ctx, x);
+    const std::string zero = zero_reference_cost(*s.ctx, x, s.approaches.empty() ? ncs::Approach::kI : s.approaches[0]);
     if (!zero.empty()) throw InputError("field '" + field + "': scenario " + x.name + ": " + zero);
   }
   s.scenarios = std::move(capped);

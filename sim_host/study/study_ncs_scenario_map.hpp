@@ -1,8 +1,8 @@
 /// @file study_ncs_scenario_map.hpp
 /// @brief A scenario of a study file with "study": "ncs" mapped onto an ncs Scenario (its
 ///        set-point, noise, legs, the sensor's trigger and the controller's phase), refused
-///        naming the field where the loop cannot run it, and where the reference approach I would
-///        cost exactly 0 on it.
+///        naming the field where the loop cannot run it, and where the approach that leads the
+///        ratios (I, or IK for a plant of n > 6) would cost exactly 0 on it.
 #pragma once
 
 #include <array>
@@ -30,11 +30,14 @@ struct NcsScenarioInputs {
   std::array<std::shared_ptr<const ncs::OneShotTriple>, ncs::kOneShotApproaches.size()> one_shot_triples{};
 };
 
-/// Why approach I, the reference of every ratio, would cost exactly 0 on `sc` ("" when it does
-/// not): it starts on the set-point without delay or noise, so it costs nothing until the
-/// set-point first changes (a square wave at T_r/2), and nothing at all when it never does.
-/// Ratios to it would divide by 0.
-std::string zero_reference_cost(const ncs::Context& ctx, const ncs::Scenario& sc);
+/// Why the approach `leading` (the first, the reference of every ratio: I, or IK for a plant of
+/// n > 6) would cost exactly 0 on `sc` ("" when it does not); ratios to it would divide by 0. A
+/// loop without delay that starts on the set-point costs nothing until the set-point first
+/// changes (a square wave at T_r/2), and nothing at all when it never does, unless noise moves
+/// it: I runs without noise (at cost 0 whenever the set-point does not change within the run);
+/// IK runs the plant's process noise Q_c · noise_scale (at cost 0 then only with noise_scale 0:
+/// with noise, amplitude 0 is a regulation study, the loop holding 0 against the noise).
+std::string zero_reference_cost(const ncs::Context& ctx, const ncs::Scenario& sc, ncs::Approach leading);
 
 /// Scenario `i` of `file` on the loop of `study` (its ctx and approaches mapped) with `in`;
 /// engine::InputError naming the field (without the file's name) for a parameter out of range
