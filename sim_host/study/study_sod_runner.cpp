@@ -142,8 +142,8 @@ nlohmann::json sod_run_outputs(const engine::SweepResults& r, const std::string&
   }
   engine::add_order_by_mean(j, r, sm);
   if (!sm.paired.empty()) j["paired_differences"] = engine::paired_differences_json(r, sm);
-  md << "\n| scenario | xi |";
-  for (std::size_t a = 0; a < na; ++a) md << " " << spec.approaches[a] << " e1 | e2 | NEES | packets |";
+  md << "\n| scenario | xi |";  // per approach: e1, e2, NEES, packets of both nodes
+  for (std::size_t a = 0; a < na; ++a) md << " " << spec.approaches[a] << " e1 | e2 | NEES | packets 1+2 |";
   md << "\n|---|---|";
   for (std::size_t a = 0; a < na; ++a) md << "---|---|---|---|";
   md << "\n";
