@@ -81,7 +81,7 @@ nlohmann::json write_sod_cost_plot(const engine::SweepResults& r, const std::str
 
 /// One traced run per approach of `selected` (first scenario, first seed, the sweep's designs):
 /// OUT/trace_<i>_<A>.csv (k, t_s, then per node i: x_i, xhat_i, y_i, z_i (the value the filter
-/// used, empty: none), sent_i (node::SendCause: 0 none, 1 delta, 2 time, 3 periodic), arrived_i)
+/// used, empty: none), sent_i (node::SendCause: 0 none, 1 first, 2 periodic, 3 delta, 4 time), arrived_i)
 /// and with `plots` its png. Returns per approach its files, e1 + e2 of the run and the step.
 nlohmann::json write_sod_traces(const SodStudy& s, const SodDesigns& d, const std::vector<std::size_t>& selected,
                                 const std::string& out_dir, bool plots) {
