@@ -158,8 +158,11 @@ void check_params(const std::map<std::string, double>& params, const std::vector
     }
     const auto it = params.find(s.name);
     require(it != params.end(), what + ": parameter " + s.name + " missing after defaults");
-    require(it->second >= s.min && it->second <= s.max, what + "." + s.name + ": out of range");
-    if (s.integer) require(it->second == std::floor(it->second), what + "." + s.name + ": not an integer");
+    // An absent optional parameter reads its fallback, which a schema may put outside the range
+    // as the mark "not given" (the dropping and sod schemas: 0 below every range).
+    const bool absent_mark = !s.required && it->second == s.fallback;
+    require(absent_mark || (it->second >= s.min && it->second <= s.max), what + "." + s.name + ": out of range");
+    if (s.integer && !absent_mark) require(it->second == std::floor(it->second), what + "." + s.name + ": not an integer");
   }
   for (const auto& [name, v] : params) {
     bool known = false;
