@@ -237,6 +237,7 @@ RunResult simulate_run(const SodModel& model, const RunConfig& cfg, std::uint64_
   });
   kernel.schedule(engine::SimTime{0}, engine::EventClass::kSample, sample_handler, 0);
   kernel.run_until(end);
+  res.events = static_cast<double>(kernel.events_run());
 
   for (std::size_t i = 0; i < kNodes; ++i)
     if (faults[i]) res.injected += faults[i]->counters();

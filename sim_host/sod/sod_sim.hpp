@@ -71,6 +71,7 @@ struct RunResult {
   double refused_non_finite = 0;  ///< Frames the receiver refused: y not finite (faults only).
   double refused_sequence = 0;    ///< Frames the receiver refused: k not the current sample (faults only).
   engine::FaultCounters injected; ///< Faults injected on both links.
+  double events = 0;              ///< Kernel events run (queue pops: plant steps, samples, deliveries, estimator steps).
 };
 
 /// The link names a fault spec of the study may name.

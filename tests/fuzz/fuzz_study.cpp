@@ -21,8 +21,14 @@
 /// naming a field (engine::InputError "field '…'") or gives only finite numbers (null for an
 /// unbounded delay or response time); the ncs mapping (also on a third parse with the ncs
 /// schema) refuses naming a field or yields one scenario per file scenario with the file's
-/// legs. A plant file "networked_board.json" (study ncs's) sits in the harness's folder, and
-/// inputs are parsed as if they were a file there.
+/// legs. A fourth parse with the sod schema reaches the sod mapping (sim_host/study/
+/// study_sod_map.cpp; its δt design, which runs simulations, is not called): `study check`'s
+/// resolution of a sod file and the mapping either refuse naming a field or give finite figures
+/// and a study of two sensors with distinct links, finite thresholds δy ≥ 0, per scenario ξ in
+/// [0, 1] and at least one step, one approach per file approach with its sender and filter. A
+/// plant file "networked_board.json" (study ncs's; n = 2, m = 1, p = 2 with diagonal R: one the
+/// sod mapping takes) sits in the harness's folder, and inputs are parsed as if they were a file
+/// there.
 #include <Eigen/Dense>
 #include <cmath>
 #include <cstdint>
@@ -42,6 +48,8 @@
 #include "oneshot/engine/study_file.hpp"
 #include "study_check.hpp"
 #include "study_ncs_runner.hpp"
+#include "study_sod_runner.hpp"
+#include "study_sod_study.hpp"
 
 namespace e = oneshot::engine;
 using oneshot::fuzz::require;
@@ -150,8 +158,11 @@ void check_params(const std::map<std::string, double>& params, const std::vector
     }
     const auto it = params.find(s.name);
     require(it != params.end(), what + ": parameter " + s.name + " missing after defaults");
-    require(it->second >= s.min && it->second <= s.max, what + "." + s.name + ": out of range");
-    if (s.integer) require(it->second == std::floor(it->second), what + "." + s.name + ": not an integer");
+    // An absent optional parameter reads its fallback, which a schema may put outside the range
+    // as the mark "not given" (the dropping and sod schemas: 0 below every range).
+    const bool absent_mark = !s.required && it->second == s.fallback;
+    require(absent_mark || (it->second >= s.min && it->second <= s.max), what + "." + s.name + ": out of range");
+    if (s.integer && !absent_mark) require(it->second == std::floor(it->second), what + "." + s.name + ": not an integer");
   }
   for (const auto& [name, v] : params) {
     bool known = false;
@@ -251,6 +262,27 @@ void check_study_check(const e::StudyFile& s) {
   }
 }
 
+/// A file parsed with the sod schema: `study check`'s resolution and the sod mapping.
+void check_sod(const e::StudyFile& s) {
+  try {
+    require_finite_json(oneshot::study::resolve_sod_study(s), "resolution", "sod study check");
+  } catch (const e::InputError& x) {
+    require_named(x, "sod study check");
+  }
+  try {
+    const std::shared_ptr<const oneshot::study::SodStudy> m = oneshot::study::map_sod_study(s);
+    require(m->approaches.size() == s.approaches.size() && m->scenarios.size() == s.scenarios.size(), "sod mapping: sizes");
+    require(m->sensors[0] != m->sensors[1] && m->links[0] != m->links[1] && !m->links[0].empty() && !m->links[1].empty(),
+            "sod mapping: two sensors, one link each");
+    for (double d : m->delta_y) require(std::isfinite(d) && d >= 0, "sod mapping: delta_y");
+    for (const oneshot::study::SodScenario& x : m->scenarios)
+      require(x.loss >= 0 && x.loss <= 1 && x.steps >= 1 && std::isfinite(x.amplitude), "sod mapping: scenario");
+    for (const oneshot::study::SodApproach& a : m->approaches) require(a.every >= 1 && a.mu > 1, "sod mapping: approach");
+  } catch (const e::InputError& x) {
+    require_named(x, "sod mapping");
+  }
+}
+
 }  // namespace
 
 extern "C" int LLVMFuzzerInitialize(int*, char***) {
@@ -266,7 +298,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
       {{"gain", 0, 10, false, false, 1}, {"horizon", 1, 100, true, false, 10}},
       {{"amplitude", 0, 5, false, true, 0}, {"steps", 0, 1000, true, false, 0}}};
   const std::string source = g_base_dir + "/fuzz.json";  // plant files resolve in the harness's folder
-  for (const e::StudySchema* sc : {static_cast<const e::StudySchema*>(nullptr), &schema, &oneshot::study::ncs_schema()}) {
+  for (const e::StudySchema* sc : {static_cast<const e::StudySchema*>(nullptr), &schema, &oneshot::study::ncs_schema(),
+                                   &oneshot::study::sod_schema()}) {
     e::StudyFile s;
     try {
       s = e::parse_study(text, source, sc, g_base_dir);
@@ -275,6 +308,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     }
     check_study(s, sc);
     if (sc != &schema) check_study_check(s);
+    if (sc == &oneshot::study::sod_schema()) check_sod(s);
   }
   return 0;
 }
