@@ -27,6 +27,7 @@
 #include "study_file_report.hpp"
 #include "study_ncs_runner.hpp"
 #include "study_ncs_sweep.hpp"
+#include "study_oneshot_study.hpp"
 
 namespace oneshot::sim {
 namespace {
@@ -37,6 +38,7 @@ struct Checked {
   nlohmann::json resolution;             ///< resolve_study(), plus "runnable" (and "refusal").
   std::optional<study::NcsStudy> ncs;    ///< Set when the file runs on the ncs loop.
   std::shared_ptr<const study::DroppingStudy> dropping;  ///< Set when it runs on the dropping loop.
+  std::shared_ptr<const study::OneShotFileStudy> oneshot;  ///< Set when it runs on the one-shot board.
   std::string refusal;                   ///< "field '<f>': <reason>" when it does not run.
 };
 
@@ -47,9 +49,12 @@ Checked check_file(const std::string& path) {
   const engine::StudyFile generic = engine::load_study(path, nullptr);
   Checked c;
   c.resolution = study::resolve_study(generic);
+  if (!c.resolution.contains("links")) c.resolution["links"] = nlohmann::json::array();  // a file without links (oneshot)
   try {
     if (generic.study == "dropping") {
       c.dropping = study::map_dropping_study(engine::load_study(path, &study::dropping_schema()));
+    } else if (generic.study == "oneshot") {
+      c.oneshot = study::map_oneshot_study(engine::load_study(path, &study::oneshot_schema()));
     } else {
       c.ncs = generic.study != "ncs" ? study::map_ncs_study(generic)  // refuses naming 'study'
                                      : study::map_ncs_study(engine::load_study(path, &study::ncs_schema()));
@@ -59,7 +64,7 @@ Checked check_file(const std::string& path) {
     const std::string prefix = generic.source + ": ";
     if (c.refusal.rfind(prefix, 0) == 0) c.refusal.erase(0, prefix.size());
   }
-  c.resolution["runnable"] = c.ncs.has_value() || c.dropping != nullptr;
+  c.resolution["runnable"] = c.ncs.has_value() || c.dropping != nullptr || c.oneshot != nullptr;
   if (c.ncs) {
     study::add_ncs_designs(c.resolution, *c.ncs);
     study::attach_bus_bounds(*c.ncs, c.resolution);
@@ -67,6 +72,9 @@ Checked check_file(const std::string& path) {
   } else if (c.dropping) {
     study::add_dropping_design(c.resolution, *c.dropping);
     c.resolution["runs_with"] = "dropping";
+  } else if (c.oneshot) {
+    study::add_oneshot_design(c.resolution, *c.oneshot);
+    c.resolution["runs_with"] = "oneshot";
   } else {
     c.resolution["refusal"] = c.refusal;
   }
@@ -110,7 +118,7 @@ struct BenchCli {
 
 /// The file's ncs loop, its scenarios cut at `max_duration_s` when the option was given.
 study::NcsStudy runnable(const Checked& k, const CLI::Option* max_duration, double max_duration_s) {
-  if (k.dropping)  // the commands route a dropping file before (run_dropping, report_dropping, dropping_bench)
+  if (k.dropping || k.oneshot)  // the commands route a dropping or oneshot file before (run_dropping, report_dropping, dropping_bench)
     throw std::logic_error("a dropping file on the ncs loop");
   if (!k.ncs) throw engine::InputError(k.resolution.at("source").get<std::string>() + ": " + k.refusal);  // one line, nothing written
   study::NcsStudy s = *k.ncs;
@@ -213,9 +221,10 @@ void add_study_commands(CLI::App* group) {
       if (c->json != "-") {
         std::cout << study::describe_resolution(k.resolution);
         if (k.dropping) std::cout << study::describe_dropping(k.resolution);
-        if (k.ncs || k.dropping) std::cout << "runs with: oneshot-sim study run " << c->file << "\n";
+        if (k.oneshot) std::cout << study::describe_oneshot(k.resolution);
+        if (k.ncs || k.dropping || k.oneshot) std::cout << "runs with: oneshot-sim study run " << c->file << "\n";
       }
-      if (!k.ncs && !k.dropping) {  // the resolution is out; the refusal is the last line, and the exit is non-zero
+      if (!k.ncs && !k.dropping && !k.oneshot) {  // the resolution is out; the refusal is the last line, and the exit is non-zero
         std::cout.flush();
         std::cerr << "cannot run: " << k.refusal << "\n";
         throw CLI::RuntimeError(1);
@@ -224,7 +233,7 @@ void add_study_commands(CLI::App* group) {
   }
   {
     auto c = std::make_shared<RunCli>();
-    CLI::App* cmd = group->add_subcommand("run", "Run a study file's approaches x scenarios x seeds (files with \"study\": \"ncs\" or \"dropping\")");
+    CLI::App* cmd = group->add_subcommand("run", "Run a study file's approaches x scenarios x seeds (files with \"study\": \"ncs\", \"dropping\" or \"oneshot\")");
     cmd->add_option("file", c->file, "study file (oneshot-study/1)")->required();
     cmd->add_option("--seeds", c->seeds, "seeds per scenario (default: the file's seeds.count)")->check(CLI::Range(2, 10000000));
     cmd->add_option("--threads", c->threads, "worker threads (0: every core)")->capture_default_str();
@@ -241,6 +250,12 @@ void add_study_commands(CLI::App* group) {
       const Checked k = check_file(c->file);
       if (k.dropping) {
         run_dropping(*k.dropping, *c, max_duration);
+        return;
+      }
+      if (k.oneshot) {
+        if (c->analytic) throw engine::InputError("field '--analytic': a oneshot file runs the emulated board (`oneshot table1 --analytic`: the linear board)");
+        if (max_duration->count() > 0) throw engine::InputError("field '--max-duration': a oneshot file's runs take its duration_s");
+        study::oneshot_run_command(*k.oneshot, c->seeds, c->threads, c->shard, c->out, c->json, !c->no_plots);
         return;
       }
       const study::NcsStudy s = runnable(k, max_duration, c->max_duration_s);
@@ -279,6 +294,18 @@ void add_study_commands(CLI::App* group) {
       const Checked k = check_file(c->file);
       if (k.dropping) {
         report_dropping(k, *c, max_duration, trace);
+        return;
+      }
+      if (k.oneshot) {
+        if (max_duration->count() > 0) throw engine::InputError("field '--max-duration': a oneshot file's runs take its duration_s");
+        if (trace->count() > 0) throw engine::InputError("field '--trace': no traces of a oneshot file (`oneshot-sim oneshot run` traces a run)");
+        nlohmann::json resolution = k.resolution;  // the grid that runs: --seeds overrides the file's count
+        if (c->seeds != 0) {
+          resolution["seeds"]["count"] = c->seeds;
+          resolution["grid"]["runs"] = k.oneshot->approaches.size() * k.oneshot->scenarios.size() * c->seeds;
+        }
+        study::oneshot_report_command(*k.oneshot, c->file, study::describe_resolution(resolution) + study::describe_oneshot(resolution),
+                                      c->seeds, c->threads, c->out, !c->no_plots);
         return;
       }
       const study::NcsStudy s = runnable(k, max_duration, c->max_duration_s);
@@ -341,6 +368,13 @@ void add_study_commands(CLI::App* group) {
     cmd->add_option("--json", c->json, "write the figures as JSON to PATH, or '-' for standard output");
     cmd->callback([c, max_duration]() {
       const Checked k = check_file(c->file);
+      if (k.oneshot) {
+        if (max_duration->count() > 0) throw engine::InputError("field '--max-duration': a oneshot file's runs take its duration_s");
+        const nlohmann::json j = study::oneshot_bench(*k.oneshot, c->seeds, c->threads);
+        if (!c->json.empty()) util::write_json(c->json, j);
+        if (c->json != "-") std::cout << study::bench_line(c->file, j);
+        return;
+      }
       if (k.dropping && max_duration->count() > 0)
         throw engine::InputError("field '--max-duration': a dropping file's runs take its duration_s");
       const nlohmann::json j = k.dropping ? study::dropping_bench(*k.dropping, c->seeds, c->threads)
@@ -355,7 +389,8 @@ void add_study_commands(CLI::App* group) {
 
 StudyDescriptor study_files_study() {
   return {"study", "Study files (oneshot-study/1): check what a file resolves to, run it, report it (docs/study-files.md)",
-          add_study_commands, {{"run", study::run_outputs}, {"run-dropping", study::dropping_run_outputs}}, std::nullopt};
+          add_study_commands, {{"run", study::run_outputs}, {"run-dropping", study::dropping_run_outputs},
+                                              {"run-oneshot", study::oneshot_run_outputs}}, std::nullopt};
 }
 
 }  // namespace oneshot::sim
