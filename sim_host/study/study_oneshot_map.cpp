@@ -247,7 +247,8 @@ void add_oneshot_design(nlohmann::json& r, const OneShotFileStudy& s) {
   for (std::size_t x = 0; x < s.scenarios.size(); ++x) {
     const sim::Scenario& c = s.scenarios[x];
     nlohmann::json e = {{"name", c.name}, {"duration_s", c.duration_s}, {"amplitude_volts", c.amplitude_volts},
-                        {"change_period_s", c.change_period_s}, {"jitter", c.jitter.describe()}};
+                        {"change_period_s", c.change_period_s},
+                        {"jitter", s.cpu ? "CPU " + s.cpu->name + " schedule (per seed)" : c.jitter.describe()}};
     if (c.jitter.kind == sim::JitterModel::Kind::kUniform) {
       e["release_us"] = {c.jitter.release_min_us, c.jitter.release_max_us};
       e["exec_us"] = {c.jitter.exec_min_us, c.jitter.exec_max_us};
@@ -267,7 +268,8 @@ std::string describe_oneshot(const nlohmann::json& r) {
   std::ostringstream o;
   o << "one-shot board: plant " << d.at("plant").at("name").get<std::string>() << " (h = " << d.at("plant").at("period_us")
     << " us), node " << d.at("node").get<std::string>() << " samples, computes and actuates";
-  if (d.contains("design")) o << ", L = " << d.at("design").value("L", nlohmann::json()).dump();
+  if (d.contains("design"))
+    o << ", L = " << d.at("design").value("L", nlohmann::json()).dump() << ", K = " << d.at("design").value("kalman_gain", nlohmann::json()).dump();
   o << "\n";
   for (const nlohmann::json& a : d.at("approaches"))
     o << "  approach " << a.at("name").get<std::string>() << " (" << a.at("kind").get<std::string>() << ": "
