@@ -10,7 +10,9 @@
 
 #include <nlohmann/json.hpp>
 
+#include "oneshot/design/controller_synthesis.hpp"
 #include "oneshot/design/design_report.hpp"
+#include "oneshot/design/plant_description.hpp"
 #include "oneshot/engine/cpu_analysis.hpp"
 #include "oneshot/engine/study_file.hpp"
 #include "study_fields.hpp"
@@ -34,20 +36,28 @@ std::string word(const engine::ApproachSpec& a, const char* key, const char* fal
   return it == a.words.end() ? fallback : it->second;
 }
 
-/// The run options of approach `i` (kind A–E, its words; table1's defaults otherwise).
-sim::RunOptions approach_options(const engine::ApproachSpec& a, std::size_t i, const sim::SimContext& ctx) {
+/// The run options of approach `i` (kind A–E, its words; table1's defaults otherwise) and their
+/// settings as JSON (the words by their names: simulation.cpp's to_string(), which the mapping
+/// does not link so that the fuzz harness reaches it).
+sim::RunOptions approach_options(const engine::ApproachSpec& a, std::size_t i, const design::DesignResult& d, nlohmann::json& settings) {
   sim::RunOptions o;
-  try {
-    o.approach = sim::parse_approach(a.kind);
-  } catch (const std::invalid_argument&) {
-    refuse(at("approaches", i) + ".kind", "'" + a.kind + "' (A, B, C, D, E: Table I's approaches)");
-  }
-  if (!sim::approach_available(ctx, o.approach))
-    refuse(at("approaches", i) + ".kind", "'" + a.kind + "': the plant has no deadbeat observer (" + ctx.design().deadbeat_unavailable_reason + ")");
-  o.format = *sim::number_format_named(word(a, "number_format", "float"));
-  o.discretizer = *sim::discretizer_named(word(a, "discretizer", "table"));
-  o.noise = word(a, "noise_model", "exact") == "constant" ? oneshot::NoiseModel::kConstant : oneshot::NoiseModel::kExact;
-  o.board.update = word(a, "pwm_update", "immediate") == "period" ? sim::PwmUpdate::kNextPeriod : sim::PwmUpdate::kImmediate;
+  bool known = false;
+  for (sim::Approach x : sim::kAllApproaches)
+    if (a.kind.size() == 1 && a.kind[0] == sim::info(x).letter) {
+      o.approach = x;
+      known = true;
+    }
+  if (!known) refuse(at("approaches", i) + ".kind", "'" + a.kind + "' (A, B, C, D, E: Table I's approaches)");
+  if (o.approach == sim::Approach::kE && !d.deadbeat)
+    refuse(at("approaches", i) + ".kind", "'" + a.kind + "': the plant has no deadbeat observer (" + d.deadbeat_unavailable_reason + ")");
+  const std::string format = word(a, "number_format", "float"), disc = word(a, "discretizer", "table");
+  const std::string noise = word(a, "noise_model", "exact"), pwm = word(a, "pwm_update", "immediate");
+  o.format = format == "double" ? sim::NumberFormat::kDouble : sim::NumberFormat::kFloat;
+  o.discretizer = disc == "generic" ? sim::DiscretizerKind::kGeneric : disc == "nearest" ? sim::DiscretizerKind::kNearest : sim::DiscretizerKind::kTable;
+  o.noise = noise == "constant" ? oneshot::NoiseModel::kConstant : oneshot::NoiseModel::kExact;
+  o.board.update = pwm == "period" ? sim::PwmUpdate::kNextPeriod : sim::PwmUpdate::kImmediate;
+  settings = {{"kind", a.kind}, {"description", sim::info(o.approach).description}, {"jitter", sim::info(o.approach).jitter},
+              {"number_format", format}, {"discretizer", disc}, {"noise_model", noise}, {"pwm_update", pwm}};
   return o;
 }
 
@@ -101,7 +111,7 @@ void map_cpu(const engine::StudyFile& file, const engine::NodeSpec& n, std::int6
 sim::Scenario map_scenario(const engine::StudyFile& file, std::size_t i, const OneShotFileStudy& out) {
   const engine::ScenarioSpec& x = file.scenarios[i];
   const std::string fs = at("scenarios", i);
-  const design::PlantDescription& plant = out.ctx->plant();
+  const design::PlantDescription& plant = out.plant;
   const std::int64_t h = plant.period_us;
   if (x.reference)
     refuse(fs + ".reference", "the board's set-point is a random step every change period: give params.amplitude_volts and params.change_period_s");
@@ -148,7 +158,7 @@ sim::Scenario map_scenario(const engine::StudyFile& file, std::size_t i, const O
   return s;
 }
 
-std::shared_ptr<const OneShotFileStudy> map_oneshot(const engine::StudyFile& file) {
+std::shared_ptr<OneShotFileStudy> map_oneshot(const engine::StudyFile& file) {
   if (file.study != "oneshot") refuse("study", "'" + file.study + "' is not 'oneshot'");
   if (!file.loops.empty()) refuse("loops", "the one-shot study runs one board per file");
   if (!file.links.empty()) refuse("links", "the one-shot board has no links: one MCU samples, computes and actuates");
@@ -156,24 +166,29 @@ std::shared_ptr<const OneShotFileStudy> map_oneshot(const engine::StudyFile& fil
   if (file.reference) refuse("reference", "the board's set-point is a random step every change period: give scenarios[].params.amplitude_volts and change_period_s");
   auto out = std::make_shared<OneShotFileStudy>();
   out->source = file.source;
-  try {
+  if (file.plant.kind == engine::PlantSpec::Kind::kDiscrete || (file.plant.kind == engine::PlantSpec::Kind::kContinuous && !file.plant.design))
+    refuse(file.plant.kind == engine::PlantSpec::Kind::kDiscrete ? "plant.discrete" : "plant.continuous",
+           "the one-shot board runs a continuous plant with its board (PWM, ADC) and design keys: give plant.file "
+           "(e.g. lut_gen/plants/reference_board.json)");
+  out->plant_field = file.plant.kind == engine::PlantSpec::Kind::kFile ? "plant.file" : "plant.continuous";
+  try {  // what SimContext::from_plant() requires (map_oneshot_study() then builds it)
     if (file.plant.kind == engine::PlantSpec::Kind::kFile) {
       out->plant_path = plant_file_path(file);
-      out->ctx = sim::SimContext::load(out->plant_path);
-    } else if (file.plant.kind == engine::PlantSpec::Kind::kContinuous && file.plant.design) {
-      out->plant_path = "(inline continuous plant)";
-      out->ctx = sim::SimContext::from_plant(*file.plant.design);
+      out->plant = design::load_plant_file(out->plant_path);
     } else {
-      refuse(file.plant.kind == engine::PlantSpec::Kind::kDiscrete ? "plant.discrete" : "plant.continuous",
-             "the one-shot board runs a continuous plant with its board (PWM, ADC) and design keys: give plant.file "
-             "(e.g. lut_gen/plants/reference_board.json)");
+      out->plant_path = "(inline continuous plant)";
+      out->plant = *file.plant.design;
     }
+    design::require_continuous_board_and_table(out->plant, "the one-shot harness");
+    out->design = design::synthesize(out->plant);
   } catch (const InputError&) {
     throw;
   } catch (const std::exception& e) {
-    refuse(file.plant.kind == engine::PlantSpec::Kind::kFile ? "plant.file" : "plant.continuous", e.what());
+    refuse(out->plant_field, e.what());
   }
-  const std::int64_t h = out->ctx->plant().period_us;
+  if (!out->design.tracking)
+    refuse(out->plant_field, "the harness needs set-point feed-forward (as many outputs as inputs and a unique equilibrium)");
+  const std::int64_t h = out->plant.period_us;
   const engine::NodeSpec& n = check_board_node(file, h);
   out->node = n.name;
   map_cpu(file, n, h, *out);
@@ -182,7 +197,10 @@ std::shared_ptr<const OneShotFileStudy> map_oneshot(const engine::StudyFile& fil
   for (std::size_t i = 0; i < file.approaches.size(); ++i) {
     out->approaches.push_back(file.approaches[i].name);
     out->kinds.push_back(file.approaches[i].kind);
-    out->options.push_back(approach_options(file.approaches[i], i, *out->ctx));
+    nlohmann::json settings;
+    out->options.push_back(approach_options(file.approaches[i], i, out->design, settings));
+    settings["name"] = file.approaches[i].name;
+    out->settings.push_back(settings);
   }
   for (std::size_t i = 0; i < file.scenarios.size(); ++i) out->scenarios.push_back(map_scenario(file, i, *out));
   return out;
@@ -207,7 +225,7 @@ const engine::StudySchema& oneshot_schema() {
   return schema;
 }
 
-std::shared_ptr<const OneShotFileStudy> map_oneshot_study(const engine::StudyFile& file) {
+std::shared_ptr<OneShotFileStudy> map_oneshot_file(const engine::StudyFile& file) {
   try {
     return map_oneshot(file);
   } catch (const InputError& e) {
@@ -218,22 +236,15 @@ std::shared_ptr<const OneShotFileStudy> map_oneshot_study(const engine::StudyFil
 }
 
 void add_oneshot_design(nlohmann::json& r, const OneShotFileStudy& s) {
-  const design::PlantDescription& p = s.ctx->plant();
+  const design::PlantDescription& p = s.plant;
   const std::int64_t h = p.period_us;
   nlohmann::json d;
   d["plant"] = {{"name", p.name}, {"file", s.plant_path}, {"period_us", h}};
-  const nlohmann::json dj = design::design_json(p, s.ctx->design());
+  const nlohmann::json dj = design::design_json(p, s.design);
   for (const char* k : {"L", "kalman_gain"})
     if (dj.contains(k)) d["design"][k] = dj.at(k);
   d["node"] = s.node;
-  for (std::size_t a = 0; a < s.approaches.size(); ++a) {
-    const sim::RunOptions& o = s.options[a];
-    d["approaches"].push_back({{"name", s.approaches[a]}, {"kind", s.kinds[a]}, {"description", sim::info(o.approach).description},
-                               {"jitter", sim::info(o.approach).jitter}, {"number_format", sim::to_string(o.format)},
-                               {"discretizer", sim::to_string(o.discretizer)},
-                               {"noise_model", o.noise == oneshot::NoiseModel::kExact ? "exact" : "constant"},
-                               {"pwm_update", o.board.update == sim::PwmUpdate::kNextPeriod ? "period" : "immediate"}});
-  }
+  d["approaches"] = s.settings;
   if (s.cpu) {
     const engine::cpu::Analysis a = engine::cpu::analyze(*s.cpu);
     const engine::cpu::TaskBound& b = a.tasks.at(s.job_task);

@@ -18,6 +18,7 @@
 #include "oneshot/design/design_report.hpp"
 #include "oneshot/engine/cpu.hpp"
 #include "oneshot/engine/random_stream.hpp"
+#include "oneshot/engine/study_file.hpp"
 #include "oneshot/engine/sweep.hpp"
 #include "oneshot/engine/sweep_statistics.hpp"
 #include "oneshot/util/output_files.hpp"
@@ -48,7 +49,7 @@ std::string hex64(std::uint64_t v) {
 /// The job's timings in the CPU's schedule of `seed` over `duration_s` + 2 h: per job k,
 /// release = sample − k·h and exec = actuation − sample, rounded to whole µs.
 std::vector<sim::JobTiming> cpu_job_trace(const OneShotFileStudy& s, std::uint64_t seed, double duration_s) {
-  const std::int64_t h_us = s.ctx->plant().period_us;
+  const std::int64_t h_us = s.plant.period_us;
   engine::Kernel k(seed);
   engine::cpu::Cpu cpu(k, *s.cpu);
   std::vector<sim::JobTiming> jobs;
@@ -69,6 +70,16 @@ std::vector<sim::JobTiming> cpu_job_trace(const OneShotFileStudy& s, std::uint64
 
 }  // namespace
 
+std::shared_ptr<const OneShotFileStudy> map_oneshot_study(const engine::StudyFile& file) {
+  const std::shared_ptr<OneShotFileStudy> s = map_oneshot_file(file);
+  try {
+    s->ctx = sim::SimContext::from_plant(s->plant);
+  } catch (const std::exception& e) {  // map_oneshot_file() checked what it requires
+    throw engine::InputError(file.source + ": field '" + s->plant_field + "': " + e.what());
+  }
+  return s;
+}
+
 sim::Scenario oneshot_run_scenario(const OneShotFileStudy& s, std::size_t x, std::uint64_t seed) {
   sim::Scenario c = s.scenarios.at(x);
   if (s.cpu) c.jitter.trace = cpu_job_trace(s, seed, c.duration_s);
@@ -86,8 +97,8 @@ engine::SweepSpec oneshot_sweep_spec(const OneShotFileStudy& s, std::size_t seed
   nlohmann::json design;
   add_oneshot_design(design, s);
   nlohmann::json& d = design.at("oneshot");
-  const nlohmann::json plant_digest = hex64(engine::stream_id(design::design_json(s.ctx->plant(), s.ctx->design()).dump()));
-  spec.config = {{"study_file", s.source}, {"plant", s.ctx->plant().name}, {"plant_digest", plant_digest},
+  const nlohmann::json plant_digest = hex64(engine::stream_id(design::design_json(s.plant, s.design).dump()));
+  spec.config = {{"study_file", s.source}, {"plant", s.plant.name}, {"plant_digest", plant_digest},
                  {"node", s.node}, {"approaches", d.at("approaches")}, {"scenarios", d.at("scenarios")}};
   if (d.contains("cpu")) spec.config["cpu"] = d.at("cpu");
   return spec;

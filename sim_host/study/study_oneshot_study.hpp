@@ -31,11 +31,17 @@ namespace oneshot::study {
 struct OneShotFileStudy {
   std::string source;                                ///< The study file.
   std::string plant_path;                            ///< Its plant file (resolved).
-  std::shared_ptr<const sim::SimContext> ctx;        ///< Plant, design and tables (SimContext::load(plant_path)).
+  std::string plant_field;                           ///< Where the file gives it: "plant.file" or "plant.continuous".
+  design::PlantDescription plant;                    ///< The plant.
+  design::DesignResult design;                       ///< Its design (design::synthesize()).
+  /// Plant, design and tables of the simulator (SimContext::from_plant(plant); null from
+  /// map_oneshot_file()).
+  std::shared_ptr<const sim::SimContext> ctx;
   std::string node;                                  ///< The board node's name.
   std::vector<std::string> approaches;               ///< Names, in the file's order.
   std::vector<std::string> kinds;                    ///< Their kinds (the letters A–E).
   std::vector<sim::RunOptions> options;              ///< Per approach: the run's options.
+  std::vector<nlohmann::json> settings;              ///< Per approach: name, kind, description, jitter and option words.
   std::vector<sim::Scenario> scenarios;              ///< Per scenario: set-point, duration, jitter model.
   /// Set when the node's job runs on a CPU (`nodes[0].cpu`): the file's CPU with the job added as
   /// the periodic task `node` (period h, arrival k·h); its schedule gives every scenario's timing.
@@ -55,6 +61,11 @@ const engine::StudySchema& oneshot_schema();
 /// "<source>: field '<f>': <reason>" for what the loop does not run (another plant form, nodes
 /// other than one timer node at the plant's period, links, buses, a reference signal, a job that
 /// may not finish within its period, ...).
+/// Without the simulator's context (`ctx` null; study_oneshot_map.cpp links the design, the
+/// engine and the scenario code only: the study fuzz harness reaches it).
+std::shared_ptr<OneShotFileStudy> map_oneshot_file(const engine::StudyFile& file);
+
+/// map_oneshot_file() with the simulator's context of its plant (SimContext::from_plant()).
 std::shared_ptr<const OneShotFileStudy> map_oneshot_study(const engine::StudyFile& file);
 
 /// Adds "oneshot" to the resolution `r`: the plant and its design (K, Kalman gain, ...), per
