@@ -104,6 +104,11 @@ void map_cpu(const engine::StudyFile& file, const engine::NodeSpec& n, std::int6
                                (b.bounded ? std::to_string(static_cast<double>(b.wcrt.count()) * 1e-3) + " us" : "unbounded") +
                                ", not below the period " + std::to_string(period_us) +
                                " us: the job of period k must prepare u before the timer applies it at (k+1) h");
+  // Every job completes (its timing is the run's): none aborted at a deadline before its end.
+  if (job.overrun == engine::cpu::OverrunPolicy::kAbort && b.wcrt > job.deadline)
+    refuse("nodes[0].job.deadline_us", "the job may be aborted at it (overrun abort, worst-case response " +
+                                           std::to_string(static_cast<double>(b.wcrt.count()) * 1e-3) +
+                                           " us): the board's job must complete to prepare u");
   out.cpu = std::move(set);
 }
 

@@ -260,6 +260,8 @@ TEST(StudyOneShotFile, RefusalsNameTheField) {
   const std::vector<Case> cpu_cases = {
       {"nodes[0].job", [](nlohmann::json& j) { j["nodes"][0]["job"] = {{"wcet_us", 49000}, {"bcet_us", 200}, {"priority", 3}}; }},
       {"scenarios[0].params.release_max_us", [](nlohmann::json& j) { j["scenarios"][0]["params"]["release_max_us"] = 1000; }},
+      {"nodes[0].job.deadline_us",
+       [](nlohmann::json& j) { j["nodes"][0]["job"] = {{"wcet_us", 600}, {"bcet_us", 200}, {"priority", 3}, {"deadline_us", 1000}, {"overrun", "abort"}}; }},
       {"cpus", [](nlohmann::json& j) {
          j["nodes"][0].erase("cpu");
          j["nodes"][0].erase("job");
