@@ -75,8 +75,10 @@ TEST(StudyOneShotFile, ExampleGivesTheCostsOfTable1) {
   nlohmann::json scenario_file;
   scenario_file["scenarios"] = sc;
   util::write_text(dir + "/scenarios.json", scenario_file.dump());
+  test::CommandOptions to_file;  // `--json -`: the JSON alone on standard output
+  to_file.stdout_path = dir + "/study.json";
   const test::CommandResult a = test::run_command({ONESHOT_SIM_PATH, "study", "run", kOneShotExample, "--seeds", "3", "--threads", "2",
-                                                   "--out", dir + "/study", "--json", dir + "/study.json"});
+                                                   "--out", dir + "/study", "--json", "-"}, to_file);
   ASSERT_EQ(a.exit_code, 0) << a.output;
   const test::CommandResult b = test::run_command({ONESHOT_SIM_PATH, "oneshot", "table1", "--plant", std::string(ONESHOT_STUDY_EXAMPLES_DIR) +
                                                    "/../../../lut_gen/plants/reference_board.json", "--scenarios", dir + "/scenarios.json",
