@@ -28,6 +28,7 @@
 #include "study_ncs_runner.hpp"
 #include "study_ncs_sweep.hpp"
 #include "study_sod_runner.hpp"
+#include "study_oneshot_study.hpp"
 
 namespace oneshot::sim {
 namespace {
@@ -39,6 +40,7 @@ struct Checked {
   std::optional<study::NcsStudy> ncs;    ///< Set when the file runs on the ncs loop.
   std::shared_ptr<const study::DroppingStudy> dropping;  ///< Set when it runs on the dropping loop.
   std::shared_ptr<const study::SodStudy> sod;  ///< Set when it runs on the sod study's run.
+  std::shared_ptr<const study::OneShotFileStudy> oneshot;  ///< Set when it runs on the one-shot board.
   std::string refusal;                   ///< "field '<f>': <reason>" when it does not run.
 };
 
@@ -49,11 +51,14 @@ Checked check_file(const std::string& path) {
   const engine::StudyFile generic = engine::load_study(path, nullptr);
   Checked c;
   c.resolution = generic.study == "sod" ? study::resolve_sod_study(generic) : study::resolve_study(generic);
+  if (!c.resolution.contains("links")) c.resolution["links"] = nlohmann::json::array();  // a file without links (oneshot)
   try {
     if (generic.study == "dropping") {
       c.dropping = study::map_dropping_study(engine::load_study(path, &study::dropping_schema()));
     } else if (generic.study == "sod") {
       c.sod = study::map_sod_study(engine::load_study(path, &study::sod_schema()));
+    } else if (generic.study == "oneshot") {
+      c.oneshot = study::map_oneshot_study(engine::load_study(path, &study::oneshot_schema()));
     } else {
       c.ncs = generic.study != "ncs" ? study::map_ncs_study(generic)  // refuses naming 'study'
                                      : study::map_ncs_study(engine::load_study(path, &study::ncs_schema()));
@@ -63,7 +68,7 @@ Checked check_file(const std::string& path) {
     const std::string prefix = generic.source + ": ";
     if (c.refusal.rfind(prefix, 0) == 0) c.refusal.erase(0, prefix.size());
   }
-  c.resolution["runnable"] = c.ncs.has_value() || c.dropping != nullptr || c.sod != nullptr;
+  c.resolution["runnable"] = c.ncs.has_value() || c.dropping != nullptr || c.sod != nullptr || c.oneshot != nullptr;
   if (c.ncs) {
     study::add_ncs_designs(c.resolution, *c.ncs);
     study::attach_bus_bounds(*c.ncs, c.resolution);
@@ -74,6 +79,9 @@ Checked check_file(const std::string& path) {
   } else if (c.sod) {
     study::add_sod_design(c.resolution, *c.sod);
     c.resolution["runs_with"] = "sod";
+  } else if (c.oneshot) {
+    study::add_oneshot_design(c.resolution, *c.oneshot);
+    c.resolution["runs_with"] = "oneshot";
   } else {
     c.resolution["refusal"] = c.refusal;
   }
@@ -117,7 +125,7 @@ struct BenchCli {
 
 /// The file's ncs loop, its scenarios cut at `max_duration_s` when the option was given.
 study::NcsStudy runnable(const Checked& k, const CLI::Option* max_duration, double max_duration_s) {
-  if (k.dropping)  // the commands route a dropping file before (run_dropping, report_dropping, dropping_bench)
+  if (k.dropping || k.oneshot)  // the commands route a dropping or oneshot file before (run_dropping, report_dropping, dropping_bench)
     throw std::logic_error("a dropping file on the ncs loop");
   if (!k.ncs) throw engine::InputError(k.resolution.at("source").get<std::string>() + ": " + k.refusal);  // one line, nothing written
   study::NcsStudy s = *k.ncs;
@@ -221,9 +229,10 @@ void add_study_commands(CLI::App* group) {
         std::cout << study::describe_resolution(k.resolution);
         if (k.dropping) std::cout << study::describe_dropping(k.resolution);
         if (k.sod) std::cout << study::describe_sod(k.resolution);
-        if (k.ncs || k.dropping || k.sod) std::cout << "runs with: oneshot-sim study run " << c->file << "\n";
+        if (k.oneshot) std::cout << study::describe_oneshot(k.resolution);
+        if (k.ncs || k.dropping || k.sod || k.oneshot) std::cout << "runs with: oneshot-sim study run " << c->file << "\n";
       }
-      if (!k.ncs && !k.dropping && !k.sod) {  // the resolution is out; the refusal is the last line, and the exit is non-zero
+      if (!k.ncs && !k.dropping && !k.sod && !k.oneshot) {  // the resolution is out; the refusal is the last line, and the exit is non-zero
         std::cout.flush();
         std::cerr << "cannot run: " << k.refusal << "\n";
         throw CLI::RuntimeError(1);
@@ -232,7 +241,7 @@ void add_study_commands(CLI::App* group) {
   }
   {
     auto c = std::make_shared<RunCli>();
-    CLI::App* cmd = group->add_subcommand("run", "Run a study file's approaches x scenarios x seeds (files with \"study\": \"ncs\" or \"dropping\")");
+    CLI::App* cmd = group->add_subcommand("run", "Run a study file's approaches x scenarios x seeds (files with \"study\": \"ncs\", \"dropping\" or \"oneshot\")");
     cmd->add_option("file", c->file, "study file (oneshot-study/1)")->required();
     cmd->add_option("--seeds", c->seeds, "seeds per scenario (default: the file's seeds.count)")->check(CLI::Range(2, 10000000));
     cmd->add_option("--threads", c->threads, "worker threads (0: every core)")->capture_default_str();
@@ -253,6 +262,12 @@ void add_study_commands(CLI::App* group) {
       }
       if (k.sod) {
         study::run_sod_file(*k.sod, c->seeds, c->threads, c->shard, c->out, c->json, c->analytic, max_duration->count() > 0);
+        return;
+      }
+      if (k.oneshot) {
+        if (c->analytic) throw engine::InputError("field '--analytic': a oneshot file runs the emulated board (`oneshot table1 --analytic`: the linear board)");
+        if (max_duration->count() > 0) throw engine::InputError("field '--max-duration': a oneshot file's runs take its duration_s");
+        study::oneshot_run_command(*k.oneshot, c->seeds, c->threads, c->shard, c->out, c->json, !c->no_plots);
         return;
       }
       const study::NcsStudy s = runnable(k, max_duration, c->max_duration_s);
@@ -296,6 +311,18 @@ void add_study_commands(CLI::App* group) {
       if (k.sod) {
         study::report_sod_file(*k.sod, c->file, k.resolution, c->out, c->seeds, c->threads, !c->no_plots, max_duration->count() > 0,
                                trace->count() > 0 ? &c->trace : nullptr);
+        return;
+      }
+      if (k.oneshot) {
+        if (max_duration->count() > 0) throw engine::InputError("field '--max-duration': a oneshot file's runs take its duration_s");
+        if (trace->count() > 0) throw engine::InputError("field '--trace': no traces of a oneshot file (`oneshot-sim oneshot run` traces a run)");
+        nlohmann::json resolution = k.resolution;  // the grid that runs: --seeds overrides the file's count
+        if (c->seeds != 0) {
+          resolution["seeds"]["count"] = c->seeds;
+          resolution["grid"]["runs"] = k.oneshot->approaches.size() * k.oneshot->scenarios.size() * c->seeds;
+        }
+        study::oneshot_report_command(*k.oneshot, c->file, study::describe_resolution(resolution) + study::describe_oneshot(resolution),
+                                      c->seeds, c->threads, c->out, !c->no_plots);
         return;
       }
       const study::NcsStudy s = runnable(k, max_duration, c->max_duration_s);
@@ -365,6 +392,13 @@ void add_study_commands(CLI::App* group) {
         if (c->json != "-") std::cout << study::bench_line(c->file, j);
         return;
       }
+      if (k.oneshot) {
+        if (max_duration->count() > 0) throw engine::InputError("field '--max-duration': a oneshot file's runs take its duration_s");
+        const nlohmann::json j = study::oneshot_bench(*k.oneshot, c->seeds, c->threads);
+        if (!c->json.empty()) util::write_json(c->json, j);
+        if (c->json != "-") std::cout << study::bench_line(c->file, j);
+        return;
+      }
       if (k.dropping && max_duration->count() > 0)
         throw engine::InputError("field '--max-duration': a dropping file's runs take its duration_s");
       const nlohmann::json j = k.dropping ? study::dropping_bench(*k.dropping, c->seeds, c->threads)
@@ -380,7 +414,7 @@ void add_study_commands(CLI::App* group) {
 StudyDescriptor study_files_study() {
   return {"study", "Study files (oneshot-study/1): check what a file resolves to, run it, report it (docs/study-files.md)",
           add_study_commands, {{"run", study::run_outputs}, {"run-dropping", study::dropping_run_outputs},
-                                {"run-sod", study::sod_run_outputs}}, std::nullopt};
+                                {"run-sod", study::sod_run_outputs}, {"run-oneshot", study::oneshot_run_outputs}}, std::nullopt};
 }
 
 }  // namespace oneshot::sim

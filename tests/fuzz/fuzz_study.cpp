@@ -29,6 +29,10 @@
 /// plant file "networked_board.json" (study ncs's; n = 2, m = 1, p = 2 with diagonal R: one the
 /// sod mapping takes) sits in the harness's folder, and inputs are parsed as if they were a file
 /// there.
+/// Parsed with the oneshot schema, the one-shot board's mapping (study_oneshot_map.cpp, without
+/// the simulator) refuses naming a field or yields one scenario per file scenario whose job always
+/// finishes before the period (release + exec < h), set-points inside the ADC range, one run option
+/// per approach, a design summary of finite numbers, and with a CPU the job among its tasks.
 #include <Eigen/Dense>
 #include <cmath>
 #include <cstdint>
@@ -37,6 +41,7 @@
 #include <fstream>
 #include <optional>
 #include <map>
+#include <memory>
 #include <set>
 #include <string>
 
@@ -50,6 +55,7 @@
 #include "study_ncs_runner.hpp"
 #include "study_sod_runner.hpp"
 #include "study_sod_study.hpp"
+#include "study_oneshot_study.hpp"
 
 namespace e = oneshot::engine;
 using oneshot::fuzz::require;
@@ -283,6 +289,25 @@ void check_sod(const e::StudyFile& s) {
   }
 }
 
+void check_oneshot_mapping(const e::StudyFile& s) {
+  try {
+    const std::shared_ptr<oneshot::study::OneShotFileStudy> o = oneshot::study::map_oneshot_file(s);
+    require(o->scenarios.size() == s.scenarios.size() && o->options.size() == s.approaches.size(), "oneshot mapping: sizes");
+    for (const oneshot::sim::Scenario& x : o->scenarios) {
+      require(x.jitter.max_busy_us() < o->plant.period_us, "oneshot mapping: the job past its period");
+      require(x.duration_s * 1e6 >= static_cast<double>(o->plant.period_us), "oneshot mapping: shorter than a period");
+      require(x.amplitude_volts < o->plant.board.adc_max_volts[0] && -x.amplitude_volts > o->plant.board.adc_min_volts[0],
+              "oneshot mapping: set-point outside the ADC range");
+    }
+    require(!o->cpu || o->job_task < o->cpu->tasks.size(), "oneshot mapping: the job on its CPU");
+    nlohmann::json r;
+    oneshot::study::add_oneshot_design(r, *o);
+    require_finite_json(r, "oneshot design", "oneshot mapping");
+  } catch (const e::InputError& x) {
+    require_named(x, "oneshot mapping");
+  }
+}
+
 }  // namespace
 
 extern "C" int LLVMFuzzerInitialize(int*, char***) {
@@ -309,6 +334,11 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     check_study(s, sc);
     if (sc != &schema) check_study_check(s);
     if (sc == &oneshot::study::sod_schema()) check_sod(s);
+  }
+  try {  // the one-shot board's mapping, on the file parsed with its schema
+    check_oneshot_mapping(e::parse_study(text, source, &oneshot::study::oneshot_schema(), g_base_dir));
+  } catch (const e::InputError&) {
+    // refused by the parser with a message: fine
   }
   return 0;
 }

@@ -19,6 +19,7 @@
 #include "study_dropping_runner.hpp"
 #include "study_ncs_runner.hpp"
 #include "study_sod_runner.hpp"
+#include "study_oneshot_study.hpp"
 #include "support/run_command.hpp"
 #include "support/temp_files.hpp"
 
@@ -275,6 +276,13 @@ TEST(StudyCheck, EveryShippedExampleResolvesAndMaps) {
       const engine::StudyFile f = engine::parse_study(text.str(), entry.path().string(), &sod_schema(), ONESHOT_STUDY_EXAMPLES_DIR);
       expect_finite(resolve_sod_study(f), name);
       EXPECT_NO_THROW(static_cast<void>(map_sod_study(f))) << name;
+      ++files;
+      continue;
+    }
+    if (nlohmann::json::parse(text.str()).at("study") == "oneshot") {  // the one-shot board (study_oneshot_file_test.cpp)
+      const engine::StudyFile f = engine::parse_study(text.str(), entry.path().string(), &oneshot_schema(), ONESHOT_STUDY_EXAMPLES_DIR);
+      expect_finite(resolve_study(f), name);
+      EXPECT_NO_THROW(static_cast<void>(map_oneshot_study(f))) << name;
       ++files;
       continue;
     }
