@@ -27,6 +27,7 @@
 #include "study_file_report.hpp"
 #include "study_ncs_runner.hpp"
 #include "study_ncs_sweep.hpp"
+#include "study_petc_study.hpp"
 
 namespace oneshot::sim {
 namespace {
@@ -37,6 +38,7 @@ struct Checked {
   nlohmann::json resolution;             ///< resolve_study(), plus "runnable" (and "refusal").
   std::optional<study::NcsStudy> ncs;    ///< Set when the file runs on the ncs loop.
   std::shared_ptr<const study::DroppingStudy> dropping;  ///< Set when it runs on the dropping loop.
+  std::shared_ptr<const study::PetcStudy> petc;  ///< Set when it runs on the petc loop.
   std::string refusal;                   ///< "field '<f>': <reason>" when it does not run.
 };
 
@@ -50,6 +52,8 @@ Checked check_file(const std::string& path) {
   try {
     if (generic.study == "dropping") {
       c.dropping = study::map_dropping_study(engine::load_study(path, &study::dropping_schema()));
+    } else if (generic.study == "petc") {
+      c.petc = study::map_petc_study(engine::load_study(path, &study::petc_schema()));
     } else {
       c.ncs = generic.study != "ncs" ? study::map_ncs_study(generic)  // refuses naming 'study'
                                      : study::map_ncs_study(engine::load_study(path, &study::ncs_schema()));
@@ -59,7 +63,7 @@ Checked check_file(const std::string& path) {
     const std::string prefix = generic.source + ": ";
     if (c.refusal.rfind(prefix, 0) == 0) c.refusal.erase(0, prefix.size());
   }
-  c.resolution["runnable"] = c.ncs.has_value() || c.dropping != nullptr;
+  c.resolution["runnable"] = c.ncs.has_value() || c.dropping != nullptr || c.petc != nullptr;
   if (c.ncs) {
     study::add_ncs_designs(c.resolution, *c.ncs);
     study::attach_bus_bounds(*c.ncs, c.resolution);
@@ -67,6 +71,9 @@ Checked check_file(const std::string& path) {
   } else if (c.dropping) {
     study::add_dropping_design(c.resolution, *c.dropping);
     c.resolution["runs_with"] = "dropping";
+  } else if (c.petc) {
+    study::add_petc_design(c.resolution, *c.petc);
+    c.resolution["runs_with"] = "petc";
   } else {
     c.resolution["refusal"] = c.refusal;
   }
@@ -213,9 +220,10 @@ void add_study_commands(CLI::App* group) {
       if (c->json != "-") {
         std::cout << study::describe_resolution(k.resolution);
         if (k.dropping) std::cout << study::describe_dropping(k.resolution);
-        if (k.ncs || k.dropping) std::cout << "runs with: oneshot-sim study run " << c->file << "\n";
+        if (k.petc) std::cout << study::describe_petc(k.resolution);
+        if (k.ncs || k.dropping || k.petc) std::cout << "runs with: oneshot-sim study run " << c->file << "\n";
       }
-      if (!k.ncs && !k.dropping) {  // the resolution is out; the refusal is the last line, and the exit is non-zero
+      if (!k.ncs && !k.dropping && !k.petc) {  // the resolution is out; the refusal is the last line, and the exit is non-zero
         std::cout.flush();
         std::cerr << "cannot run: " << k.refusal << "\n";
         throw CLI::RuntimeError(1);
@@ -241,6 +249,11 @@ void add_study_commands(CLI::App* group) {
       const Checked k = check_file(c->file);
       if (k.dropping) {
         run_dropping(*k.dropping, *c, max_duration);
+        return;
+      }
+      if (k.petc) {
+        study::petc_run_command(*k.petc, {c->file, c->seeds, c->threads, c->shard, c->out, c->json, c->no_plots, c->analytic,
+                                          max_duration->count() > 0, false});
         return;
       }
       const study::NcsStudy s = runnable(k, max_duration, c->max_duration_s);
@@ -279,6 +292,11 @@ void add_study_commands(CLI::App* group) {
       const Checked k = check_file(c->file);
       if (k.dropping) {
         report_dropping(k, *c, max_duration, trace);
+        return;
+      }
+      if (k.petc) {
+        study::petc_report_command(*k.petc, k.resolution, {c->file, c->seeds, c->threads, "0/1", c->out, "", c->no_plots, false,
+                                                           max_duration->count() > 0, trace->count() > 0});
         return;
       }
       const study::NcsStudy s = runnable(k, max_duration, c->max_duration_s);
@@ -341,6 +359,13 @@ void add_study_commands(CLI::App* group) {
     cmd->add_option("--json", c->json, "write the figures as JSON to PATH, or '-' for standard output");
     cmd->callback([c, max_duration]() {
       const Checked k = check_file(c->file);
+      if (k.petc) {
+        if (max_duration->count() > 0) throw engine::InputError("field '--max-duration': a petc file's runs take its duration_s");
+        const nlohmann::json j = study::petc_bench(*k.petc, c->seeds, c->threads);
+        if (!c->json.empty()) util::write_json(c->json, j);
+        if (c->json != "-") std::cout << study::bench_line(c->file, j);
+        return;
+      }
       if (k.dropping && max_duration->count() > 0)
         throw engine::InputError("field '--max-duration': a dropping file's runs take its duration_s");
       const nlohmann::json j = k.dropping ? study::dropping_bench(*k.dropping, c->seeds, c->threads)
@@ -355,7 +380,8 @@ void add_study_commands(CLI::App* group) {
 
 StudyDescriptor study_files_study() {
   return {"study", "Study files (oneshot-study/1): check what a file resolves to, run it, report it (docs/study-files.md)",
-          add_study_commands, {{"run", study::run_outputs}, {"run-dropping", study::dropping_run_outputs}}, std::nullopt};
+          add_study_commands, {{"run", study::run_outputs}, {"run-dropping", study::dropping_run_outputs},
+                              {"run-petc", study::petc_run_outputs}}, std::nullopt};
 }
 
 }  // namespace oneshot::sim
