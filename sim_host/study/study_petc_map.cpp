@@ -320,10 +320,13 @@ std::string describe_petc(const nlohmann::json& r) {
     o << "  scenario " << x.at("name").get<std::string>() << ": K = " << c.at("steps") << " periods of "
       << g.at("plant").at("period_us") << " us, r = " << c.at("reference") << ", sigma_w " << c.at("sigma_w") << ", sigma_v "
       << c.at("sigma_v") << ", H = " << c.at("horizon") << ", TTS ISE " << c.at("ise") << "\n";
-    o << "    MRCI m = " << m.at("ratio") << ": " << m.at("slow_modes").size() << " slow + fast part, CS = " << m.at("cs");
+    o << "    MRCI m = " << m.at("ratio") << ": " << m.at("slow_modes").size() << " slow modes + the fast part, CS = " << m.at("cs");
     for (const nlohmann::json& sm : m.at("slow_modes"))
       o << "; slow pole " << sm.at("pole") << " -> " << sm.at("slow_pole") << " (phase " << sm.at("phase") << ")";
-    o << "\n    DOB: Q cutoff " << g.at("dob").at("cutoff_hz") << " Hz, rho = " << g.at("dob").at("delay") << "; noise accumulation "
+    o << "; fast part " << m.at("fast_part").at("numerator").dump() << " / " << m.at("fast_part").at("denominator").dump()
+      << " (powers of z, highest first)";
+    o << "\n    DOB: Q cutoff " << g.at("dob").at("cutoff_hz") << " Hz, rho = " << g.at("dob").at("delay") << ", gamma (d->d-dhat) "
+      << g.at("dob").at("gamma_d_to_error") << "; noise accumulation "
       << c.at("noise_accumulation").get<std::string>() << ", sample at update " << c.at("sample_at_update") << "\n";
   }
   for (const nlohmann::json& a : d.value("approaches", nlohmann::json::array())) {

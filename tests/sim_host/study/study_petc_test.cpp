@@ -113,8 +113,33 @@ TEST(StudyPetc, NoiseFreeRunsAreSeedIndependentAndTtsIsItsDeterministicResponse)
   EXPECT_EQ(r.at(0, 0, 0, r.metric("U_a")), 1.0);
   EXPECT_NEAR(r.at(0, 0, 0, r.metric("cost")), 0.9, 1e-15);
   EXPECT_EQ(r.at(0, 0, 0, r.metric("ISE")), std::sqrt(ise2));
-  // The noise-free scenario's cases 4 and 5 equal their noise-free selves: case 4 becomes case 3.
+  // The noise-free scenario's case 4 is case 3 (the same settings once the noise is off).
   for (std::size_t m = 0; m < r.spec.metrics.size(); ++m) EXPECT_EQ(r.at(3, 0, 0, m), r.at(2, 0, 0, m)) << r.spec.metrics[m];
+}
+
+TEST(StudyPetc, ScenarioOverridesReachTheDesign) {
+  nlohmann::json j = petc_example_json();
+  // A step of 2 without noise: the TTS loop is linear from rest, so r - y doubles and its ISE
+  // with it (measured 0 relative difference: doubling is exact in binary; 1e-14 allowed).
+  j["scenarios"].push_back({{"name", "step2"}, {"params", {{"noise", 0}, {"sigma_w", 1e-4}, {"sigma_v", 2e-4}}},
+                            {"reference", {{"kind", "steps"}, {"steps", {{0, 2}}}}}});
+  j["scenarios"].push_back({{"name", "short"}, {"duration_s", 0.002}, {"params", {{"ratio", 1}, {"dob_cutoff_hz", 500}}}});
+  const std::shared_ptr<const PetcStudy> s = petc_map_text(j);
+  ASSERT_EQ(s->setups.size(), 3U);
+  EXPECT_NEAR(s->setups[1].ise, 2 * s->setups[0].ise, 1e-14 * s->setups[0].ise);
+  EXPECT_EQ(s->setups[1].opt.reference, 2.0);
+  EXPECT_NEAR(std::sqrt(s->setups[1].plant.augmented.w), 1e-4, 1e-18);
+  EXPECT_NEAR(std::sqrt(s->setups[1].plant.augmented.v), 2e-4, 1e-18);
+  EXPECT_EQ(s->setups[2].opt.steps, 100U);
+  EXPECT_EQ(s->setups[2].mrci.ratio, 1U);
+  EXPECT_EQ(s->setups[2].dob.cutoff_hz, 500.0);
+  for (std::size_t a = 0; a < s->approaches.size(); ++a) {
+    EXPECT_FALSE(s->runs[a][1].noise);
+    EXPECT_EQ(s->runs[a][2].noise, s->runs[a][0].noise);
+  }
+  const engine::SweepResults r = run_petc_sweep(*s, 2, 2, engine::Shard{});
+  EXPECT_EQ(r.at(0, 1, 0, r.metric("ISEP")), 0.0);  // TTS on its own y^TTS at r = 2
+  EXPECT_EQ(r.at(0, 2, 0, r.metric("sensor_packets")), 100.0);
 }
 
 TEST(StudyPetc, CheckGivesTheDesignReportAndBenchRun) {
