@@ -18,6 +18,7 @@
 #include "study_check.hpp"
 #include "study_dropping_runner.hpp"
 #include "study_ncs_runner.hpp"
+#include "study_petc_study.hpp"
 #include "support/run_command.hpp"
 #include "support/temp_files.hpp"
 
@@ -267,6 +268,13 @@ TEST(StudyCheck, EveryShippedExampleResolvesAndMaps) {
       const engine::StudyFile f = engine::parse_study(text.str(), entry.path().string(), &dropping_schema(), ONESHOT_STUDY_EXAMPLES_DIR);
       expect_finite(resolve_study(f), name);
       EXPECT_NO_THROW(static_cast<void>(map_dropping_study(f))) << name;
+      ++files;
+      continue;
+    }
+    if (nlohmann::json::parse(text.str()).at("study") == "petc") {  // the petc loop (study_petc_test.cpp)
+      const engine::StudyFile f = engine::parse_study(text.str(), entry.path().string(), &petc_schema(), ONESHOT_STUDY_EXAMPLES_DIR);
+      expect_finite(resolve_study(f), name);
+      EXPECT_NO_THROW(static_cast<void>(map_petc_study(f))) << name;
       ++files;
       continue;
     }
