@@ -253,7 +253,7 @@ void add_study_commands(CLI::App* group) {
       }
       if (k.petc) {
         study::petc_run_command(*k.petc, {c->file, c->seeds, c->threads, c->shard, c->out, c->json, c->no_plots, c->analytic,
-                                          max_duration->count() > 0, false});
+                                          max_duration->count() > 0, false, ""});
         return;
       }
       const study::NcsStudy s = runnable(k, max_duration, c->max_duration_s);
@@ -296,7 +296,7 @@ void add_study_commands(CLI::App* group) {
       }
       if (k.petc) {
         study::petc_report_command(*k.petc, k.resolution, {c->file, c->seeds, c->threads, "0/1", c->out, "", c->no_plots, false,
-                                                           max_duration->count() > 0, trace->count() > 0});
+                                                           max_duration->count() > 0, trace->count() > 0, c->trace});
         return;
       }
       const study::NcsStudy s = runnable(k, max_duration, c->max_duration_s);

@@ -22,7 +22,63 @@ std::string petc_cell_text(const nlohmann::json& v, const char* format) {
   return b;
 }
 
+/// The file stem of approach `a` (index from 0) named `name`: trace_<a+1>_<name with every
+/// character outside [A-Za-z0-9._-] as '_'> (names come from the file: never a path).
+std::string petc_trace_stem(std::size_t a, const std::string& name) {
+  std::string out = "trace_" + std::to_string(a + 1) + "_";
+  for (char c : name) {
+    const bool ok = (c >= 'A' && c <= 'Z') || (c >= 'a' && c <= 'z') || (c >= '0' && c <= '9') || c == '.' || c == '_' || c == '-';
+    out += ok ? c : '_';
+  }
+  return out;
+}
+
+/// The gnuplot script of one traced run (see write_petc_traces()).
+std::string petc_trace_plot(const std::string& stem, const std::string& title) {
+  const std::string csv = util::gnuplot_quote(stem + ".csv");
+  std::ostringstream g;
+  g << util::gnuplot_png_terminal(1100, 950, 10) << "set output " << util::gnuplot_quote(stem + ".png") << "\n"
+    << "set datafile separator ','\nset grid\nset key outside right\nset lmargin 12\nset rmargin 24\n"
+    << "set multiplot layout 3,1 title " << util::gnuplot_quote(title) << "\n"
+    << "set ylabel 'output'\nplot " << csv << " using 2:4 skip 1 with lines lw 1.2 lc rgb '#000000' title 'y', '' using "
+       "2:($9 > 0 ? $5 : 1/0) skip 1 with points pt 7 ps 0.35 lc rgb '#8888cc' title 'y sent', '' using 2:3 skip 1 with lines "
+       "dt 2 lc rgb 'gray' title 'r'\n"
+    << "set ylabel 'u'\nplot " << csv << " using 2:6 skip 1 with steps lc rgb '#000000' title 'u applied', '' using 2:($10 > 0 ? "
+       "$6 : 1/0) skip 1 with points pt 7 ps 0.35 lc rgb '#c44e52' title 'packet sent'\n"
+    << "set xlabel 't (s)'\nset ylabel 'disturbance'\nplot " << csv << " using 2:7 skip 1 with lines lc rgb '#4c72b0' title "
+       "'d', '' using 2:8 skip 1 with lines lc rgb '#c44e52' title 'd hat'\nunset multiplot\n";
+  return g.str();
+}
+
 }  // namespace
+
+nlohmann::json write_petc_traces(const PetcStudy& s, const std::vector<std::size_t>& selected, const std::string& out_dir,
+                                 bool plots) {
+  nlohmann::json j = nlohmann::json::object();
+  if (s.scenarios.empty()) return j;
+  const sim::petc::PetcSetup& st = s.setups[0];
+  const double period_s = static_cast<double>(st.plant.file.period_us) * 1e-6;
+  for (std::size_t a : selected) {
+    sim::petc::RunTrace t;
+    const std::vector<double> v = sim::petc::run_case(st, s.runs[a][0], s.first_seed, &t);
+    std::vector<std::vector<double>> rows;
+    for (std::size_t k = 0; k < t.y_true.size() && k < t.u.size() && k < t.d.size(); ++k)
+      rows.push_back({static_cast<double>(k), static_cast<double>(k) * period_s, st.opt.reference, t.y_true[k], t.y_meas[k], t.u[k],
+                      t.d[k], t.d_hat[k], static_cast<double>(t.sensor_sent[k]), static_cast<double>(t.actuator_sent[k])});
+    const std::string stem = petc_trace_stem(a, s.approaches[a]);
+    util::write_csv(util::path_in(out_dir, stem + ".csv"),
+                    {"k", "t_s", "r", "y", "y_meas", "u", "d", "d_hat", "sensor_sent", "actuator_sent"}, rows);
+    nlohmann::json e = {{"scenario", s.scenarios[0]}, {"seed", s.first_seed}, {"cost", v[4]}, {"files", {stem + ".csv"}}};
+    if (plots) {
+      const std::string title = s.approaches[a] + " (" + s.kinds[a] + ") on " + s.scenarios[0] + ", seed " +
+                                std::to_string(s.first_seed) + ": output and samples, input and packets, d and d hat";
+      util::run_gnuplot(out_dir, stem + ".gp", petc_trace_plot(stem, title));
+      e["files"].push_back(stem + ".png");
+    }
+    j[s.approaches[a]] = e;
+  }
+  return j;
+}
 
 nlohmann::json write_petc_cost_plot(const engine::SweepResults& r, const std::string& out_dir, bool plots) {
   const engine::SweepSummary sm = engine::summarize_metric(r, r.metric("cost"), 0);
@@ -54,7 +110,8 @@ nlohmann::json write_petc_cost_plot(const engine::SweepResults& r, const std::st
 }
 
 std::string petc_report_markdown(const PetcStudy& s, const std::string& file, const std::string& resolution_text,
-                                 const engine::SweepResults& r, const nlohmann::json& j, const std::string& plot_path) {
+                                 const engine::SweepResults& r, const nlohmann::json& j, const std::string& plot_path,
+                                 const nlohmann::json& traces, bool plots) {
   const engine::SweepSpec& spec = r.spec;
   std::ostringstream md;
   md << "# Study file " << file << " (study petc)\n\n"
@@ -91,7 +148,27 @@ std::string petc_report_markdown(const PetcStudy& s, const std::string& file, co
     for (const auto& [link, c] : j.at("links").at(a).items())
       md << "| " << a << " | " << link << " | " << petc_cell_text(c.at("sent"), "%.0f") << " | "
          << petc_cell_text(c.at("delivered"), "%.0f") << " |\n";
-  md << "\nNo traces: `oneshot-sim petc traces` draws d, d_hat and N of the built-in cases.\n";
+  if (!traces.empty()) {
+    md << "\n## Traces\n\nOne run per approach on the first scenario and the first seed (the sweep's run: same seed, same "
+          "draws; the trace only records). "
+       << (plots ? "Each plot: the output y, the samples the sensor sends and r; the applied input u and the instants the "
+                   "controller sends a packet; the disturbance d and its estimate d hat (0 without an estimator)."
+                 : "CSV files only (--no-plots).")
+       << "\n\n";
+    const std::size_t cost = r.metric("cost");
+    for (std::size_t a = 0; a < spec.approaches.size(); ++a) {
+      const std::string& an = spec.approaches[a];
+      if (!traces.contains(an)) continue;
+      const nlohmann::json& e = traces.at(an);
+      char line[160];
+      std::snprintf(line, sizeof line, "(the sweep's run: %.6g)", r.at(a, 0, 0, cost));
+      md << "- " << an << " on " << e.at("scenario").get<std::string>() << ": GPI " << petc_cell_text(e.at("cost"), "%.6g") << " "
+         << line << "; files:";
+      for (const auto& f : e.at("files")) md << " `" << f.get<std::string>() << "`";
+      md << "\n";
+      if (plots) md << "\n![" << an << "](" << e.at("files").back().get<std::string>() << ")\n\n";
+    }
+  }
   return md.str();
 }
 

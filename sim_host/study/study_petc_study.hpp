@@ -84,11 +84,23 @@ nlohmann::json petc_bench(const PetcStudy& s, std::size_t seeds, unsigned thread
 /// GPI) and, with `plots`, OUT_DIR/table.png (bars with 95 % intervals). Returns the files.
 nlohmann::json write_petc_cost_plot(const engine::SweepResults& r, const std::string& out_dir, bool plots);
 
+/// One traced run per approach of `selected` on the first scenario and the first seed: the
+/// sweep's run (sim::petc::run_case with a RunTrace, which only records).
+/// OUT_DIR/trace_<i>_<A>.csv (k, t_s, r, y, y_meas, u, d, d_hat, sensor_sent, actuator_sent
+/// every period) and, with `plots`, trace_<i>_<A>.png (output, samples and r with the sensor's
+/// sends; u with the controller's sends; d and d̂). `<i>` the approach's index from 1, `<A>`
+/// its name with every character outside [A-Za-z0-9._-] as '_'. Returns per approach its
+/// files, scenario, seed and the run's cost (GPI).
+nlohmann::json write_petc_traces(const PetcStudy& s, const std::vector<std::size_t>& selected, const std::string& out_dir,
+                                 bool plots);
+
 /// The report of a complete sweep: the file and grid, `resolution_text`, the table of
 /// petc_run_outputs() (`outputs`), per approach the petc table's columns, order, paired
-/// differences, links, the plot `plot_path` (empty: none).
+/// differences, links, the plot `plot_path` (empty: none), the traces `traces`
+/// (write_petc_traces(), with same_cost_as_sweep).
 std::string petc_report_markdown(const PetcStudy& s, const std::string& file, const std::string& resolution_text,
-                                 const engine::SweepResults& r, const nlohmann::json& outputs, const std::string& plot_path);
+                                 const engine::SweepResults& r, const nlohmann::json& outputs, const std::string& plot_path,
+                                 const nlohmann::json& traces, bool plots);
 
 /// What the `study` commands hand a petc file (study_cli.cpp's options).
 struct PetcCommand {
@@ -101,16 +113,18 @@ struct PetcCommand {
   bool no_plots = false;         ///< --no-plots.
   bool analytic = false;         ///< --analytic given (refused).
   bool max_duration = false;     ///< --max-duration given (refused).
-  bool trace = false;            ///< --trace given (refused: report).
+  bool trace = false;            ///< --trace given (report).
+  std::string trace_names;       ///< --trace's approaches, comma-separated (report; empty: the default selection).
 };
 
 /// `study run` of a petc file: the sweep (or shard), the summary printed and written as an ncs
 /// file's; --analytic and --max-duration refused naming the option before anything is written.
 void petc_run_command(const PetcStudy& s, const PetcCommand& c);
 
-/// `study report` of a petc file: the sweep, OUT/runs.csv, table_summary.csv, table.png,
-/// report.md, report.json; `resolution` is study check's (the report prints it with the seed
-/// count and runs that ran). --max-duration and --trace refused before anything is written.
+/// `study report` of a petc file: the sweep, OUT/runs.csv, table_summary.csv, table.png, the
+/// traces, report.md, report.json; `resolution` is study check's (the report prints it with the
+/// seed count and runs that ran). --max-duration and a bad --trace refused before anything is
+/// written.
 void petc_report_command(const PetcStudy& s, const nlohmann::json& resolution, const PetcCommand& c);
 
 }  // namespace oneshot::study

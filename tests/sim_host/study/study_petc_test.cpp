@@ -5,6 +5,7 @@
 ///        response, check's design, report, bench, and the refusals naming the field.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <functional>
@@ -158,8 +159,9 @@ TEST(StudyPetc, CheckGivesTheDesignReportAndBenchRun) {
   EXPECT_EQ(d.at("approaches")[4].at("per_scenario")[0].at("sigma_s").get<double>(), 1e-7);
   EXPECT_EQ(d.at("approaches")[3].at("per_scenario")[0].at("sigma_c").get<double>(), 1.32e-2);  // the node's trigger
 
-  // report (no plots) holds study run's table verbatim.
-  const test::CommandResult rep = petc_sim({"study", "report", kPetcExample, dir + "/report", "--seeds", "2", "--no-plots"});
+  // report (no plots) holds study run's table verbatim; the traced runs are the sweep's.
+  const test::CommandResult rep =
+      petc_sim({"study", "report", kPetcExample, dir + "/report", "--seeds", "2", "--no-plots", "--trace", "5,6'"});
   ASSERT_EQ(rep.exit_code, 0) << rep.output;
   const test::CommandResult run = petc_sim({"study", "run", kPetcExample, "--seeds", "2", "--out", dir + "/run", "--json", dir + "/run.json"});
   ASSERT_EQ(run.exit_code, 0) << run.output;
@@ -168,6 +170,11 @@ TEST(StudyPetc, CheckGivesTheDesignReportAndBenchRun) {
   EXPECT_EQ(rj.at("approaches"), uj.at("approaches"));
   EXPECT_NE(test::read_file(dir + "/report/report.md").find(uj.at("markdown").get<std::string>()), std::string::npos);
   EXPECT_TRUE(std::filesystem::exists(dir + "/report/table_summary.csv"));
+  ASSERT_EQ(rj.at("traces").size(), 2U);
+  for (const auto& [name, t] : rj.at("traces").items()) EXPECT_TRUE(t.at("same_cost_as_sweep").get<bool>()) << name;
+  const std::string csv = test::read_file(dir + "/report/trace_7_6_.csv");  // "6'" as a file name
+  EXPECT_EQ(static_cast<std::size_t>(std::count(csv.begin(), csv.end(), '\n')), 465U);  // the header + one row per period
+  EXPECT_FALSE(std::filesystem::exists(dir + "/report/trace_1_1.csv"));
 
   // bench: the same runs (per approach the same mean GPI), at least one event per period.
   const nlohmann::json b = petc_bench(*petc_map_text(petc_example_json()), 2, 2);
@@ -260,11 +267,12 @@ TEST(StudyPetc, CommandsRefuseBeforeWritingAnything) {
       {"study", "bench", bad},
       {"study", "run", kPetcExample, "--out", dir + "/no", "--analytic"},
       {"study", "run", kPetcExample, "--out", dir + "/no", "--max-duration", "1"},
-      {"study", "report", kPetcExample, dir + "/no", "--trace", "1"},
+      {"study", "report", kPetcExample, dir + "/no", "--trace", "7"},
+      {"study", "report", kPetcExample, dir + "/no", "--trace", "1,1"},
       {"study", "report", kPetcExample, dir + "/no", "--max-duration", "1"},
   };
   const std::vector<std::string> fields = {"approaches[0].kind", "approaches[0].kind", "approaches[0].kind", "--analytic",
-                                           "--max-duration",     "--trace",            "--max-duration"};
+                                           "--max-duration",     "--trace",            "--trace",            "--max-duration"};
   for (std::size_t i = 0; i < argvs.size(); ++i) {
     const test::CommandResult r = petc_sim(argvs[i]);
     EXPECT_NE(r.exit_code, 0) << argvs[i][1];
