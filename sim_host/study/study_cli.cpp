@@ -360,10 +360,8 @@ void add_study_commands(CLI::App* group) {
     cmd->callback([c, max_duration]() {
       const Checked k = check_file(c->file);
       if (k.petc) {
-        if (max_duration->count() > 0) throw engine::InputError("field '--max-duration': a petc file's runs take its duration_s");
-        const nlohmann::json j = study::petc_bench(*k.petc, c->seeds, c->threads);
-        if (!c->json.empty()) util::write_json(c->json, j);
-        if (c->json != "-") std::cout << study::bench_line(c->file, j);
+        study::petc_bench_command(*k.petc, {c->file, c->seeds, c->threads, "0/1", "", c->json, false, false,
+                                            max_duration->count() > 0, false, ""});
         return;
       }
       if (k.dropping && max_duration->count() > 0)

@@ -1,5 +1,5 @@
 /// @file study_petc_commands.cpp
-/// @brief `study run` and `study report` of a "study": "petc" file (see study_petc_study.hpp).
+/// @brief `study run`, `study report` and `study bench` of a "study": "petc" file (see study_petc_study.hpp).
 #include <chrono>
 #include <filesystem>
 #include <iostream>
@@ -7,6 +7,7 @@
 #include "oneshot/engine/json_fields.hpp"
 #include "oneshot/engine/sweep.hpp"
 #include "oneshot/util/output_files.hpp"
+#include "study_bench.hpp"
 #include "study_check.hpp"
 #include "study_file_report.hpp"
 #include "study_petc_study.hpp"
@@ -54,6 +55,13 @@ void petc_report_command(const PetcStudy& s, const nlohmann::json& resolution, c
   util::write_text((std::filesystem::path(c.out) / "report.md").string(), md);
   util::write_json((std::filesystem::path(c.out) / "report.json").string(), j);
   std::cout << "study report: " << r.spec.runs() << " runs, written to " << (std::filesystem::path(c.out) / "report.md").string() << "\n";
+}
+
+void petc_bench_command(const PetcStudy& s, const PetcCommand& c) {
+  if (c.max_duration) throw engine::InputError("field '--max-duration': a petc file's runs take its duration_s");
+  const nlohmann::json j = petc_bench(s, c.seeds, c.threads);
+  if (!c.json.empty()) util::write_json(c.json, j);
+  if (c.json != "-") std::cout << bench_line(c.file, j);
 }
 
 }  // namespace oneshot::study

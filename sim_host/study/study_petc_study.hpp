@@ -127,4 +127,8 @@ void petc_run_command(const PetcStudy& s, const PetcCommand& c);
 /// written.
 void petc_report_command(const PetcStudy& s, const nlohmann::json& resolution, const PetcCommand& c);
 
+/// `study bench` of a petc file: petc_bench() printed (bench_line) and written to --json;
+/// --max-duration refused naming it.
+void petc_bench_command(const PetcStudy& s, const PetcCommand& c);
+
 }  // namespace oneshot::study
