@@ -226,6 +226,7 @@ std::vector<double> simulate(const PetcSetup& s, const CaseSpec& c, std::uint64_
     double e2 = 0;
     for (double y : y_true) e2 += (s.opt.reference - y) * (s.opt.reference - y);
     fr->tracking_error = std::sqrt(e2);
+    fr->events = kernel.events_run();
     sim::RunFaultCounts& n = fr->counts;
     n = sim::RunFaultCounts{};
     if (faulted) {

@@ -97,6 +97,7 @@ struct FaultRun {
   engine::FaultSpec spec;       ///< Faults (empty: the clean run, bit for bit).
   sim::RunFaultCounts counts;   ///< Out: injected, refused by cause, stale, estimator resets (ratio_to_clean unset).
   double tracking_error = 0;    ///< Out: √Σ_k (r − y_k)² of the true output (also for a clean run).
+  std::uint64_t events = 0;     ///< Out: the kernel's events of the run (queue pops; also for a clean run).
 };
 
 /// Designs everything; std::invalid_argument naming what does not fit the compiled sizes.

@@ -8,12 +8,14 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <map>
 #include <iostream>
 #include <memory>
 #include <optional>
 #include <sstream>
 #include <stdexcept>
 #include <string>
+#include <utility>
 
 #include "oneshot/engine/study_file.hpp"
 #include "oneshot/sim/study_descriptor.hpp"
@@ -21,26 +23,20 @@
 #include "ncs_loop.hpp"
 #include "study_bench.hpp"
 #include "study_check.hpp"
-#include "study_dropping_report.hpp"
-#include "study_dropping_runner.hpp"
-#include "study_dropping_study.hpp"
 #include "study_file_report.hpp"
+#include "study_file_runner.hpp"
 #include "study_ncs_runner.hpp"
 #include "study_ncs_sweep.hpp"
-#include "study_sod_runner.hpp"
-#include "study_oneshot_study.hpp"
 
 namespace oneshot::sim {
 namespace {
 
-/// A study file resolved into everything `study check` can compute and, when the ncs loop
-/// can run it, mapped onto that loop.
+/// A study file resolved into everything `study check` can compute and, when it can run, mapped
+/// onto the ncs loop or onto its study's runner (study_file_runner.hpp).
 struct Checked {
-  nlohmann::json resolution;             ///< resolve_study(), plus "runnable" (and "refusal").
+  nlohmann::json resolution;             ///< resolve_file_study(), plus "runnable" (and "refusal").
   std::optional<study::NcsStudy> ncs;    ///< Set when the file runs on the ncs loop.
-  std::shared_ptr<const study::DroppingStudy> dropping;  ///< Set when it runs on the dropping loop.
-  std::shared_ptr<const study::SodStudy> sod;  ///< Set when it runs on the sod study's run.
-  std::shared_ptr<const study::OneShotFileStudy> oneshot;  ///< Set when it runs on the one-shot board.
+  std::shared_ptr<const study::FileStudyRunner> other;  ///< Set when it runs on another study's runner.
   std::string refusal;                   ///< "field '<f>': <reason>" when it does not run.
 };
 
@@ -50,16 +46,10 @@ struct Checked {
 Checked check_file(const std::string& path) {
   const engine::StudyFile generic = engine::load_study(path, nullptr);
   Checked c;
-  c.resolution = generic.study == "sod" ? study::resolve_sod_study(generic) : study::resolve_study(generic);
-  if (!c.resolution.contains("links")) c.resolution["links"] = nlohmann::json::array();  // a file without links (oneshot)
+  c.resolution = study::resolve_file_study(generic);
   try {
-    if (generic.study == "dropping") {
-      c.dropping = study::map_dropping_study(engine::load_study(path, &study::dropping_schema()));
-    } else if (generic.study == "sod") {
-      c.sod = study::map_sod_study(engine::load_study(path, &study::sod_schema()));
-    } else if (generic.study == "oneshot") {
-      c.oneshot = study::map_oneshot_study(engine::load_study(path, &study::oneshot_schema()));
-    } else {
+    c.other = study::map_file_study(generic, path);
+    if (!c.other) {
       c.ncs = generic.study != "ncs" ? study::map_ncs_study(generic)  // refuses naming 'study'
                                      : study::map_ncs_study(engine::load_study(path, &study::ncs_schema()));
     }
@@ -68,24 +58,28 @@ Checked check_file(const std::string& path) {
     const std::string prefix = generic.source + ": ";
     if (c.refusal.rfind(prefix, 0) == 0) c.refusal.erase(0, prefix.size());
   }
-  c.resolution["runnable"] = c.ncs.has_value() || c.dropping != nullptr || c.sod != nullptr || c.oneshot != nullptr;
+  c.resolution["runnable"] = c.ncs.has_value() || c.other != nullptr;
   if (c.ncs) {
     study::add_ncs_designs(c.resolution, *c.ncs);
     study::attach_bus_bounds(*c.ncs, c.resolution);
     c.resolution["runs_with"] = "ncs";
-  } else if (c.dropping) {
-    study::add_dropping_design(c.resolution, *c.dropping);
-    c.resolution["runs_with"] = "dropping";
-  } else if (c.sod) {
-    study::add_sod_design(c.resolution, *c.sod);
-    c.resolution["runs_with"] = "sod";
-  } else if (c.oneshot) {
-    study::add_oneshot_design(c.resolution, *c.oneshot);
-    c.resolution["runs_with"] = "oneshot";
+  } else if (c.other) {
+    c.other->add_design(c.resolution);
+    c.resolution["runs_with"] = c.other->study();
   } else {
     c.resolution["refusal"] = c.refusal;
   }
   return c;
+}
+
+/// The options of a command as the study runners take them.
+study::FileCommand file_command(const std::string& file, std::size_t seeds, unsigned threads, const std::string& out) {
+  study::FileCommand f;
+  f.file = file;
+  f.seeds = seeds;
+  f.threads = threads;
+  f.out = out;
+  return f;
 }
 
 struct CheckCli {
@@ -125,8 +119,8 @@ struct BenchCli {
 
 /// The file's ncs loop, its scenarios cut at `max_duration_s` when the option was given.
 study::NcsStudy runnable(const Checked& k, const CLI::Option* max_duration, double max_duration_s) {
-  if (k.dropping || k.oneshot)  // the commands route a dropping or oneshot file before (run_dropping, report_dropping, dropping_bench)
-    throw std::logic_error("a dropping file on the ncs loop");
+  if (k.other)  // the commands route a file of another study to its runner before
+    throw std::logic_error("a " + std::string(k.other->study()) + " file on the ncs loop");
   if (!k.ncs) throw engine::InputError(k.resolution.at("source").get<std::string>() + ": " + k.refusal);  // one line, nothing written
   study::NcsStudy s = *k.ncs;
   if (max_duration->count() > 0) study::cap_duration(s, max_duration_s, "--max-duration");
@@ -160,58 +154,6 @@ std::string simulated_time_text(const study::NcsStudy& s, const CLI::Option* max
   return t.str();
 }
 
-/// `study run` of a dropping file: its sweep (or shard), the summary, the same outputs as an ncs file's.
-void run_dropping(const study::DroppingStudy& s, const RunCli& c, const CLI::Option* max_duration) {
-  if (c.analytic) throw engine::InputError("field '--analytic': no exact cost for the dropping loop (its filters run on what arrives)");
-  if (max_duration->count() > 0) throw engine::InputError("field '--max-duration': a dropping file's runs take its duration_s");
-  const engine::Shard part = engine::parse_shard(c.shard);
-  util::make_directory(c.out);
-  const auto start = std::chrono::steady_clock::now();
-  const engine::SweepResults r = study::run_dropping_sweep(s, c.seeds, c.threads, part);
-  const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  nlohmann::json j;
-  if (!part.whole()) {
-    j = engine::write_shard_file(r, c.out, "run", part);
-  } else {
-    j = study::dropping_run_outputs(r, c.out, !c.no_plots);
-    if (c.json != "-") std::cout << j.at("markdown").get<std::string>() << "order: " << j.at("order_text").get<std::string>() << "\n";
-  }
-  if (!c.json.empty()) util::write_json(c.json, j);
-  if (c.json != "-") std::cout << "study run: " << r.spec.runs() << " runs, wall time " << wall << " s, written to " << c.out << "\n";
-}
-
-/// `study report` of a dropping file: its sweep, the summary, the cost plot, the traced runs and
-/// OUT/report.md, OUT/report.json (refusals of the options before anything is written).
-void report_dropping(const Checked& k, const ReportCli& c, const CLI::Option* max_duration, const CLI::Option* trace) {
-  const study::DroppingStudy& s = *k.dropping;
-  if (max_duration->count() > 0) throw engine::InputError("field '--max-duration': a dropping file's runs take its duration_s");
-  if (trace->count() > 0 && c.trace.empty()) throw engine::InputError("field '--trace': an empty approach name");
-  const std::vector<std::size_t> traced = study::trace_selection(s.approaches, s.source, c.trace);
-  util::make_directory(c.out);
-  const engine::SweepResults r = study::run_dropping_sweep(s, c.seeds, c.threads, engine::Shard{});
-  nlohmann::json j = study::dropping_run_outputs(r, c.out, false);
-  for (const auto& f : study::write_dropping_cost_plot(r, c.out, !c.no_plots)) j["files"].push_back(f);
-  nlohmann::json traces = study::write_dropping_traces(s, traced, c.out, !c.no_plots);
-  for (std::size_t a : traced) {  // the traced run is the sweep's: the same cost, bit for bit
-    const std::string& an = r.spec.approaches[a];
-    if (!traces.contains(an)) continue;
-    const nlohmann::json cost = traces[an].at("cost");  // null: not finite (a diverged loop), as the sweep's must be
-    const double swept = r.at(a, 0, 0, r.metric("cost"));
-    const bool same = cost.is_null() ? !std::isfinite(swept) : cost.get<double>() == swept;
-    traces[an]["same_cost_as_sweep"] = same;
-  }
-  j["traces"] = traces;
-  nlohmann::json resolution = k.resolution;  // the grid that ran: --seeds overrides the file's count
-  resolution["seeds"]["count"] = r.spec.seeds;
-  resolution["grid"]["runs"] = r.spec.runs();
-  const std::string md = study::dropping_report_markdown(
-      s, c.file, study::describe_resolution(resolution) + study::describe_dropping(resolution), r, j, c.no_plots ? "" : "table.png",
-      traces, !c.no_plots);
-  util::write_text((std::filesystem::path(c.out) / "report.md").string(), md);
-  util::write_json((std::filesystem::path(c.out) / "report.json").string(), j);
-  std::cout << "study report: " << r.spec.runs() << " runs, written to " << (std::filesystem::path(c.out) / "report.md").string() << "\n";
-}
-
 constexpr const char* kMaxDurationHelp = "cap every scenario's simulated seconds (at least one period h; default: the file's)";
 
 void add_study_commands(CLI::App* group) {
@@ -227,12 +169,10 @@ void add_study_commands(CLI::App* group) {
       if (!c->json.empty()) util::write_json(c->json, k.resolution);
       if (c->json != "-") {
         std::cout << study::describe_resolution(k.resolution);
-        if (k.dropping) std::cout << study::describe_dropping(k.resolution);
-        if (k.sod) std::cout << study::describe_sod(k.resolution);
-        if (k.oneshot) std::cout << study::describe_oneshot(k.resolution);
-        if (k.ncs || k.dropping || k.sod || k.oneshot) std::cout << "runs with: oneshot-sim study run " << c->file << "\n";
+        if (k.other) std::cout << k.other->describe(k.resolution);
+        if (k.ncs || k.other) std::cout << "runs with: oneshot-sim study run " << c->file << "\n";
       }
-      if (!k.ncs && !k.dropping && !k.sod && !k.oneshot) {  // the resolution is out; the refusal is the last line, and the exit is non-zero
+      if (!k.ncs && !k.other) {  // the resolution is out; the refusal is the last line, and the exit is non-zero
         std::cout.flush();
         std::cerr << "cannot run: " << k.refusal << "\n";
         throw CLI::RuntimeError(1);
@@ -241,7 +181,7 @@ void add_study_commands(CLI::App* group) {
   }
   {
     auto c = std::make_shared<RunCli>();
-    CLI::App* cmd = group->add_subcommand("run", "Run a study file's approaches x scenarios x seeds (files with \"study\": \"ncs\", \"dropping\" or \"oneshot\")");
+    CLI::App* cmd = group->add_subcommand("run", "Run a study file's approaches x scenarios x seeds (files with \"study\": \"ncs\", \"dropping\", \"sod\", \"oneshot\" or \"petc\")");
     cmd->add_option("file", c->file, "study file (oneshot-study/1)")->required();
     cmd->add_option("--seeds", c->seeds, "seeds per scenario (default: the file's seeds.count)")->check(CLI::Range(2, 10000000));
     cmd->add_option("--threads", c->threads, "worker threads (0: every core)")->capture_default_str();
@@ -256,18 +196,14 @@ void add_study_commands(CLI::App* group) {
                   "loop: analytic_refused with the reason)");
     cmd->callback([c, max_duration]() {
       const Checked k = check_file(c->file);
-      if (k.dropping) {
-        run_dropping(*k.dropping, *c, max_duration);
-        return;
-      }
-      if (k.sod) {
-        study::run_sod_file(*k.sod, c->seeds, c->threads, c->shard, c->out, c->json, c->analytic, max_duration->count() > 0);
-        return;
-      }
-      if (k.oneshot) {
-        if (c->analytic) throw engine::InputError("field '--analytic': a oneshot file runs the emulated board (`oneshot table1 --analytic`: the linear board)");
-        if (max_duration->count() > 0) throw engine::InputError("field '--max-duration': a oneshot file's runs take its duration_s");
-        study::oneshot_run_command(*k.oneshot, c->seeds, c->threads, c->shard, c->out, c->json, !c->no_plots);
+      if (k.other) {
+        study::FileCommand f = file_command(c->file, c->seeds, c->threads, c->out);
+        f.shard = c->shard;
+        f.json = c->json;
+        f.no_plots = c->no_plots;
+        f.analytic = c->analytic;
+        f.max_duration = max_duration->count() > 0;
+        k.other->run(f);
         return;
       }
       const study::NcsStudy s = runnable(k, max_duration, c->max_duration_s);
@@ -304,25 +240,13 @@ void add_study_commands(CLI::App* group) {
         "CSV of states, estimates, input and messages, and a plot each");
     cmd->callback([c, max_duration, trace]() {
       const Checked k = check_file(c->file);
-      if (k.dropping) {
-        report_dropping(k, *c, max_duration, trace);
-        return;
-      }
-      if (k.sod) {
-        study::report_sod_file(*k.sod, c->file, k.resolution, c->out, c->seeds, c->threads, !c->no_plots, max_duration->count() > 0,
-                               trace->count() > 0 ? &c->trace : nullptr);
-        return;
-      }
-      if (k.oneshot) {
-        if (max_duration->count() > 0) throw engine::InputError("field '--max-duration': a oneshot file's runs take its duration_s");
-        if (trace->count() > 0) throw engine::InputError("field '--trace': no traces of a oneshot file (`oneshot-sim oneshot run` traces a run)");
-        nlohmann::json resolution = k.resolution;  // the grid that runs: --seeds overrides the file's count
-        if (c->seeds != 0) {
-          resolution["seeds"]["count"] = c->seeds;
-          resolution["grid"]["runs"] = k.oneshot->approaches.size() * k.oneshot->scenarios.size() * c->seeds;
-        }
-        study::oneshot_report_command(*k.oneshot, c->file, study::describe_resolution(resolution) + study::describe_oneshot(resolution),
-                                      c->seeds, c->threads, c->out, !c->no_plots);
+      if (k.other) {
+        study::FileCommand f = file_command(c->file, c->seeds, c->threads, c->out);
+        f.no_plots = c->no_plots;
+        f.max_duration = max_duration->count() > 0;
+        f.trace = trace->count() > 0;
+        f.trace_names = c->trace;
+        k.other->report(k.resolution, f);
         return;
       }
       const study::NcsStudy s = runnable(k, max_duration, c->max_duration_s);
@@ -385,24 +309,9 @@ void add_study_commands(CLI::App* group) {
     cmd->add_option("--json", c->json, "write the figures as JSON to PATH, or '-' for standard output");
     cmd->callback([c, max_duration]() {
       const Checked k = check_file(c->file);
-      if (k.sod) {
-        if (max_duration->count() > 0) throw engine::InputError("field '--max-duration': a sod file's runs take its duration_s");
-        const nlohmann::json j = study::sod_bench(*k.sod, c->seeds, c->threads);
-        if (!c->json.empty()) util::write_json(c->json, j);
-        if (c->json != "-") std::cout << study::bench_line(c->file, j);
-        return;
-      }
-      if (k.oneshot) {
-        if (max_duration->count() > 0) throw engine::InputError("field '--max-duration': a oneshot file's runs take its duration_s");
-        const nlohmann::json j = study::oneshot_bench(*k.oneshot, c->seeds, c->threads);
-        if (!c->json.empty()) util::write_json(c->json, j);
-        if (c->json != "-") std::cout << study::bench_line(c->file, j);
-        return;
-      }
-      if (k.dropping && max_duration->count() > 0)
-        throw engine::InputError("field '--max-duration': a dropping file's runs take its duration_s");
-      const nlohmann::json j = k.dropping ? study::dropping_bench(*k.dropping, c->seeds, c->threads)
-                                          : study::ncs_bench(runnable(k, max_duration, c->max_duration_s), c->seeds, c->threads);
+      study::FileCommand f = file_command(c->file, c->seeds, c->threads, "");
+      f.max_duration = max_duration->count() > 0;
+      const nlohmann::json j = k.other ? k.other->bench(f) : study::ncs_bench(runnable(k, max_duration, c->max_duration_s), c->seeds, c->threads);
       if (!c->json.empty()) util::write_json(c->json, j);
       if (c->json != "-") std::cout << study::bench_line(c->file, j);
     });
@@ -412,9 +321,10 @@ void add_study_commands(CLI::App* group) {
 }  // namespace
 
 StudyDescriptor study_files_study() {
+  std::map<std::string, SweepSummarizer> finishers = {{"run", study::run_outputs}};
+  for (const auto& [experiment, finish] : study::file_study_finishers()) finishers.emplace(experiment, finish);
   return {"study", "Study files (oneshot-study/1): check what a file resolves to, run it, report it (docs/study-files.md)",
-          add_study_commands, {{"run", study::run_outputs}, {"run-dropping", study::dropping_run_outputs},
-                                {"run-sod", study::sod_run_outputs}, {"run-oneshot", study::oneshot_run_outputs}}, std::nullopt};
+          add_study_commands, std::move(finishers), std::nullopt};
 }
 
 }  // namespace oneshot::sim

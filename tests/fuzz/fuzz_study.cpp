@@ -33,6 +33,12 @@
 /// the simulator) refuses naming a field or yields one scenario per file scenario whose job always
 /// finishes before the period (release + exec < h), set-points inside the ADC range, one run option
 /// per approach, a design summary of finite numbers, and with a CPU the job among its tasks.
+///
+/// The petc mapping (a fourth parse with the petc schema, study_petc_map.cpp; the petc plant
+/// "hdd_numre.json" beside the other): it refuses naming a field or yields one design per
+/// scenario (a TTS response of K finite outputs and a finite, positive ISE) and one case per
+/// approach and scenario with finite thresholds ≥ 0; files of more than 5000 periods
+/// (0.1 s) per scenario are not mapped (the design runs the TTS loop over K).
 #include <Eigen/Dense>
 #include <cmath>
 #include <cstdint>
@@ -56,6 +62,7 @@
 #include "study_sod_runner.hpp"
 #include "study_sod_study.hpp"
 #include "study_oneshot_study.hpp"
+#include "study_petc_study.hpp"
 
 namespace e = oneshot::engine;
 using oneshot::fuzz::require;
@@ -308,10 +315,34 @@ void check_oneshot_mapping(const e::StudyFile& s) {
   }
 }
 
+/// The petc mapping: a refusal naming a field, or the designs and cases (see the file's brief).
+void check_petc_mapping(const e::StudyFile& s) {
+  double longest = s.duration_s;
+  for (const e::ScenarioSpec& x : s.scenarios)
+    if (x.duration_s) longest = std::fmax(longest, *x.duration_s);
+  if (longest > 0.1) return;  // bounded: K ≤ 5000 periods of the petc plant's 20 us
+  try {
+    const std::shared_ptr<const oneshot::study::PetcStudy> p = oneshot::study::map_petc_study(s);
+    require(p->setups.size() == s.scenarios.size() && p->runs.size() == s.approaches.size(), "petc mapping: sizes");
+    for (const auto& st : p->setups) {
+      require(st.y_tts.size() == st.opt.steps && std::isfinite(st.ise) && st.ise > 0, "petc mapping: TTS response");
+      for (double y : st.y_tts) require(std::isfinite(y), "petc mapping: a non-finite TTS output");
+    }
+    for (const auto& per : p->runs) {
+      require(per.size() == s.scenarios.size(), "petc mapping: one case per scenario");
+      for (const auto& c : per)
+        for (double t : {c.sigma_s, c.delta_s, c.sigma_c, c.delta_c}) require(std::isfinite(t) && t >= 0, "petc mapping: threshold");
+    }
+  } catch (const e::InputError& x) {
+    require_named(x, "petc mapping");
+  }
+}
+
 }  // namespace
 
 extern "C" int LLVMFuzzerInitialize(int*, char***) {
   g_base_dir = oneshot::fuzz::study_folder(ONESHOT_NCS_PLANT_FILE);
+  std::filesystem::copy_file(ONESHOT_PETC_PLANT_FILE, g_base_dir + "/hdd_numre.json", std::filesystem::copy_options::overwrite_existing);
   return 0;
 }
 
@@ -324,12 +355,18 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
       {{"amplitude", 0, 5, false, true, 0}, {"steps", 0, 1000, true, false, 0}}};
   const std::string source = g_base_dir + "/fuzz.json";  // plant files resolve in the harness's folder
   for (const e::StudySchema* sc : {static_cast<const e::StudySchema*>(nullptr), &schema, &oneshot::study::ncs_schema(),
-                                   &oneshot::study::sod_schema()}) {
+                                   &oneshot::study::sod_schema(),
+                                   &oneshot::study::petc_schema()}) {
     e::StudyFile s;
     try {
       s = e::parse_study(text, source, sc, g_base_dir);
     } catch (const e::InputError&) {
       continue;  // refused with a message: fine
+    }
+    if (sc == &oneshot::study::petc_schema()) {  // its absent approach params read a sentinel below their range
+      check_study(s, nullptr);
+      check_petc_mapping(s);
+      continue;
     }
     check_study(s, sc);
     if (sc != &schema) check_study_check(s);

@@ -61,7 +61,7 @@ TEST(StudyDescriptors, MergeFindsEverySummarizerAndNamesTheKnownOnes) {
     EXPECT_STREQ(e.what(),
                  "no study experiment 'oneshot noise' can merge sweeps (known: dropping arrival, dropping closed-loop, "
                  "dropping hold, ncs table, oneshot kernel, oneshot table1, petc gpi, petc table, sod table, study run, "
-                 "study run-dropping, study run-oneshot)");
+                 "study run-dropping, study run-oneshot, study run-petc, study run-sod)");
   }
 }
 

@@ -20,6 +20,7 @@
 #include "study_ncs_runner.hpp"
 #include "study_sod_runner.hpp"
 #include "study_oneshot_study.hpp"
+#include "study_petc_study.hpp"
 #include "support/run_command.hpp"
 #include "support/temp_files.hpp"
 
@@ -283,6 +284,13 @@ TEST(StudyCheck, EveryShippedExampleResolvesAndMaps) {
       const engine::StudyFile f = engine::parse_study(text.str(), entry.path().string(), &oneshot_schema(), ONESHOT_STUDY_EXAMPLES_DIR);
       expect_finite(resolve_study(f), name);
       EXPECT_NO_THROW(static_cast<void>(map_oneshot_study(f))) << name;
+      ++files;
+      continue;
+    }
+    if (nlohmann::json::parse(text.str()).at("study") == "petc") {  // the petc loop (study_petc_test.cpp)
+      const engine::StudyFile f = engine::parse_study(text.str(), entry.path().string(), &petc_schema(), ONESHOT_STUDY_EXAMPLES_DIR);
+      expect_finite(resolve_study(f), name);
+      EXPECT_NO_THROW(static_cast<void>(map_petc_study(f))) << name;
       ++files;
       continue;
     }

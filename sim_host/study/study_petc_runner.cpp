@@ -1,0 +1,197 @@
+/// @file study_petc_runner.cpp
+/// @brief A "study": "petc" file's sweep, its summary and its bench (see study_petc_study.hpp).
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <ctime>
+#include <sstream>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "oneshot/engine/sweep.hpp"
+#include "oneshot/engine/sweep_statistics.hpp"
+#include "oneshot/util/output_files.hpp"
+#include "oneshot/util/statistics.hpp"
+#include "petc_experiments.hpp"
+#include "study_bench.hpp"
+#include "study_petc_study.hpp"
+
+namespace oneshot::study {
+namespace {
+
+namespace pt = sim::petc;
+
+/// A finite number, or null.
+nlohmann::json petc_num(double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr); }
+
+/// `v` in `format` for a table, "—" when not finite.
+std::string petc_md(double v, const char* format) {
+  if (!std::isfinite(v)) return "—";
+  char b[48];
+  std::snprintf(b, sizeof b, format, v);
+  return b;
+}
+
+/// The sweep's configuration: what a shard must agree on (the file, the plant, per scenario the
+/// design's options and digest, per approach its cases).
+nlohmann::json petc_config(const PetcStudy& s) {
+  nlohmann::json runs = nlohmann::json::array();
+  for (std::size_t a = 0; a < s.approaches.size(); ++a) {
+    nlohmann::json per = nlohmann::json::array();
+    for (const pt::CaseSpec& c : s.runs[a]) per.push_back(petc_case_json(c));
+    runs.push_back({{"name", s.approaches[a]}, {"kind", s.kinds[a]}, {"per_scenario", per}});
+  }
+  nlohmann::json setups = nlohmann::json::array();
+  for (const pt::PetcSetup& x : s.setups) setups.push_back(pt::setup_config(x));
+  return {{"study_file", s.source}, {"plant", s.setups.empty() ? std::string() : s.setups[0].plant.file.name},
+          {"links", {{"sc", s.sc}, {"ca", s.ca}}}, {"setups", setups}, {"approaches", runs}};
+}
+
+}  // namespace
+
+engine::SweepSpec petc_sweep_spec(const PetcStudy& s, std::size_t seeds, const char* experiment) {
+  engine::SweepSpec spec;
+  spec.study = "study";
+  spec.experiment = experiment;
+  spec.approaches = s.approaches;
+  spec.scenarios = s.scenarios;
+  spec.first_seed = s.first_seed;
+  spec.seeds = seeds == 0 ? s.seeds : seeds;
+  return spec;
+}
+
+engine::SweepResults run_petc_sweep(const PetcStudy& s, std::size_t seeds, unsigned threads, const engine::Shard& shard) {
+  engine::SweepSpec spec = petc_sweep_spec(s, seeds, "run-petc");
+  spec.metrics = {"cost"};
+  for (const std::string& m : pt::metric_names()) spec.metrics.push_back(m);
+  spec.config = petc_config(s);
+  const std::size_t gpi = 4;  // metric_names()[4] is "GPI"
+  return engine::run_sweep(
+      spec, shard, threads,
+      [&s](std::size_t a, std::size_t x, std::uint64_t seed) {
+        std::vector<double> v = pt::run_case(s.setups[x], s.runs[a][x], seed);
+        v.insert(v.begin(), v[gpi]);  // cost = GPI
+        return v;
+      },
+      "study run (petc)");
+}
+
+nlohmann::json petc_run_outputs(const engine::SweepResults& r, const std::string& out_dir, bool plots) {
+  static_cast<void>(plots);  // no plot: the table and the runs' CSV (study report draws the cost plot)
+  util::make_directory(out_dir);
+  const engine::SweepSpec& spec = r.spec;
+  const std::size_t na = spec.approaches.size(), ns = spec.scenarios.size();
+  const engine::SweepSummary sm = engine::summarize_metric(r, r.metric("cost"), 0);
+  std::vector<engine::SweepSummary> all;
+  for (std::size_t m = 1; m < spec.metrics.size(); ++m) all.push_back(engine::summarize_metric(r, m, 0));
+  const std::string ref = spec.approaches[0];
+  nlohmann::json j;
+  j["study"] = "petc";
+  j["experiment"] = "study run";
+  j["cost_metric"] = "GPI = 0.45 U_c + 0.45 U_a + 0.1 N_E";
+  j["study_file"] = spec.config.at("study_file");
+  j["plant"] = spec.config.at("plant");
+  j["first_seed"] = spec.first_seed;
+  j["seeds"] = spec.seeds;
+  j["runs"] = spec.runs();
+  j["settings"] = spec.config.at("approaches");
+  j["setups"] = spec.config.at("setups");
+  std::ostringstream md;
+  md << "| approach | kind | mean GPI | 95 % CI | ratio to " << ref << " (95 % CI) | U_c | U_a | C_c | N_E | rms(d - d_hat) |\n"
+     << "|---|---|---|---|---|---|---|---|---|---|\n";
+  const std::string sc = spec.config.at("links").at("sc").get<std::string>();
+  const std::string ca = spec.config.at("links").at("ca").get<std::string>();
+  const std::size_t m_s = r.metric("sensor_packets"), m_a = r.metric("actuator_packets");
+  const auto metric_mean = [&](const char* name) -> const std::vector<util::Summary>& { return all[r.metric(name) - 1].value; };
+  for (std::size_t a = 0; a < na; ++a) {
+    const std::string& nm = spec.approaches[a];
+    double sent_s = 0, sent_a = 0;
+    for (std::size_t x = 0; x < ns; ++x)
+      for (std::size_t k = 0; k < spec.seeds; ++k) {
+        sent_s += r.at(a, x, k, m_s);
+        sent_a += r.at(a, x, k, m_a);
+      }
+    j["links"][nm][sc] = {{"sent", sent_s}, {"delivered", sent_s}, {"lost", 0}, {"late", 0}, {"refused", 0}};
+    j["links"][nm][ca] = {{"sent", sent_a}, {"delivered", sent_a}, {"lost", 0}, {"late", 0}, {"refused", 0}};
+    nlohmann::json metrics = nlohmann::json::object();
+    for (std::size_t m = 1; m < spec.metrics.size(); ++m) metrics[spec.metrics[m]] = util::mean_ci_json(all[m - 1].value[a]);
+    const std::string kind = spec.config.at("approaches")[a].at("kind").get<std::string>();
+    j["approaches"][nm] = {{"kind", kind},
+                           {"cost_mean", petc_num(sm.value[a].mean)},
+                           {"cost_ci95", petc_num(sm.value[a].ci95)},
+                           {"ratio_to_" + ref, petc_num(sm.ratio_of_means[a])},
+                           {"ratio_mean", petc_num(sm.ratio[a].mean)},
+                           {"ratio_ci95", petc_num(sm.ratio[a].ci95)},
+                           {"metrics", metrics}};
+    const auto cell = [&](const char* name) {
+      const util::Summary& v = metric_mean(name)[a];
+      return petc_md(v.mean, "%.4g") + " ± " + petc_md(v.ci95, "%.2g");
+    };
+    md << "| " << nm << " | " << kind << " | " << petc_md(sm.value[a].mean, "%.6g") << " | ± " << petc_md(sm.value[a].ci95, "%.3g")
+       << " | " << petc_md(sm.ratio_of_means[a], "%.4f") << " ± " << petc_md(sm.ratio[a].ci95, "%.4f") << " | " << cell("U_c")
+       << " | " << cell("U_a") << " | " << cell("C_c") << " | " << cell("N_E") << " | " << cell("d_error_rms") << " |\n";
+  }
+  engine::add_order_by_mean(j, r, sm);
+  if (!sm.paired.empty()) j["paired_differences"] = engine::paired_differences_json(r, sm);
+  md << "\n| scenario |";
+  for (std::size_t a = 0; a < na; ++a) md << " " << spec.approaches[a] << " |";
+  md << "\n|---|";
+  for (std::size_t a = 0; a < na; ++a) md << "---|";
+  md << "\n";
+  for (std::size_t x = 0; x < ns; ++x) {
+    nlohmann::json e = {{"name", spec.scenarios[x]}};
+    md << "| " << spec.scenarios[x] << " |";
+    for (std::size_t a = 0; a < na; ++a) {
+      const std::string& nm = spec.approaches[a];
+      e["cost_mean"][nm] = petc_num(sm.per_scenario[a][x].mean);
+      e["cost_ci95"][nm] = petc_num(sm.per_scenario[a][x].ci95);
+      e["ratio_to_" + ref][nm] = petc_num(sm.per_scenario_ratio[a][x].mean);
+      e["ratio_to_" + ref + "_ci95"][nm] = petc_num(sm.per_scenario_ratio[a][x].ci95);
+      md << " " << petc_md(sm.per_scenario[a][x].mean, "%.6g") << " |";
+    }
+    md << "\n";
+    j["per_scenario"].push_back(e);
+  }
+  j["markdown"] = md.str();
+  engine::write_runs_csv(r, util::path_in(out_dir, "runs.csv"), util::NonFinite::kMissing);
+  j["files"] = {"runs.csv"};
+  return j;
+}
+
+nlohmann::json petc_bench(const PetcStudy& s, std::size_t seeds, unsigned threads) {
+  engine::SweepSpec spec = petc_sweep_spec(s, seeds, "bench-petc");
+  for (const char* m : {"cost", "events", "simulated_s", "run_s"}) spec.metrics.emplace_back(m);
+  spec.config = {{"study_file", s.source}};
+  const unsigned used = threads == 0 ? std::max(1U, std::thread::hardware_concurrency()) : threads;
+  const std::clock_t cpu0 = std::clock();
+  const auto start = std::chrono::steady_clock::now();
+  const engine::SweepResults r = engine::run_sweep(
+      spec, engine::Shard{}, used,
+      [&s](std::size_t a, std::size_t x, std::uint64_t seed) {
+        const auto t0 = std::chrono::steady_clock::now();
+        pt::FaultRun clean;  // an empty spec: the clean run, bit for bit; it counts the kernel's events
+        const std::vector<double> v = pt::run_case(s.setups[x], s.runs[a][x], seed, nullptr, &clean);
+        const double run_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+        const pt::PetcSetup& st = s.setups[x];
+        const double simulated = static_cast<double>(st.opt.steps) * static_cast<double>(st.plant.file.period_us) * 1e-6;
+        return std::vector<double>{v[4], static_cast<double>(clean.events), simulated, run_s};
+      },
+      "study bench (petc)");
+  const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  const double cpu = static_cast<double>(std::clock() - cpu0) / CLOCKS_PER_SEC;
+  nlohmann::json j = bench_figures(r, s.source, used, wall, cpu);
+  const std::size_t cost = r.metric("cost");
+  for (std::size_t a = 0; a < spec.approaches.size(); ++a) {
+    double sum = 0;
+    for (std::size_t x = 0; x < spec.scenarios.size(); ++x)
+      for (std::size_t k = 0; k < spec.seeds; ++k) sum += r.at(a, x, k, cost);
+    j["per_approach"][spec.approaches[a]]["cost_mean"] = petc_num(sum / static_cast<double>(spec.scenarios.size() * spec.seeds));
+  }
+  return j;
+}
+
+}  // namespace oneshot::study
