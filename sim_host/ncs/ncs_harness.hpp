@@ -96,8 +96,8 @@ class BasicHarness {
     }
     r_chol_ = engine::psd_cholesky<S::p>(design_.r);
     for (std::size_t j = 0; j < S::m; ++j) {  // the actuator's range (live::actuator_range() on the board)
-      u_min_[j] = j < m_ ? ctx.design().u_min[j] : -1.0;  // a padded input: [−1, 1] holds its 0
-      u_max_[j] = j < m_ ? ctx.design().u_max[j] : 1.0;
+      u_min_[j] = design_.actuator.u_min[j];  // the design's (a padded input's −1: ncs_shape_design.cpp)
+      u_max_[j] = j < m_ ? ctx.design().u_max[j] : 1.0;  // a padded input: [−1, 1] holds its 0
     }
     const StateVec x0 = ref_.state(0);
     plant_.set_state(x0);
