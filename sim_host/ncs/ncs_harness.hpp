@@ -1,7 +1,8 @@
 /// @file ncs_harness.hpp
-/// @brief What every loop of study `ncs` shares (private to ncs_loop.cpp and
-///        ncs_one_shot_loop.cpp): the Harness (kernel, plant, network, set-point, noise and
-///        timing streams, the controller's CPU) and the loops' type aliases and addresses.
+/// @brief What every loop of study `ncs` shares (private to ncs_loop.cpp, ncs_sync_loop.cpp
+///        and ncs_one_shot_loop.cpp): the Harness (kernel, plant, network, set-point, noise and
+///        timing streams, the controller's CPU); the loops' aliases, addresses and World in
+///        ncs_world.hpp, a NEES term in ncs_nees.hpp, a CPU's run figures in ncs_cpu_stats.hpp.
 #pragma once
 
 #include <algorithm>
@@ -17,8 +18,11 @@
 #include "ncs_analytic.hpp"
 #include "ncs_cache_pools.hpp"
 #include "ncs_cpu.hpp"
+#include "ncs_cpu_stats.hpp"
 #include "ncs_live_nodes.hpp"
 #include "ncs_loop.hpp"
+#include "ncs_nees.hpp"
+#include "ncs_world.hpp"
 #include "oneshot/engine/can_traffic.hpp"
 #include "oneshot/engine/continuous_plant.hpp"
 #include "oneshot/engine/cpu.hpp"
@@ -31,34 +35,6 @@
 #include "oneshot/plant_structure.hpp"
 
 namespace oneshot::ncs::loop {
-
-using Board = host::HostNetwork;
-using Structure = DenseStructure<kN, kM, kP>;
-using Ref = SetpointReference;
-using Plant = engine::ContinuousPlant<kN, kM, kP, 1>;
-using engine::Duration;
-using engine::EventClass;
-using engine::HandlerId;
-using engine::SimTime;
-using InputVec = Vector<double, kM>;
-using OutputVec = Vector<double, kP>;
-
-// The live run's addresses (ncs_live.hpp): the frame checks of ncs_live_nodes.hpp name them.
-constexpr std::uint8_t kSensor = kLiveSensor;
-constexpr std::uint8_t kController = kLiveController;
-constexpr std::uint8_t kActuator = kLiveActuator;
-
-/// The engine of a run: kernel, network and the CAN buses with their background traffic;
-/// one per run, shared by the loops of a run of several (run_loops()).
-struct World {
-  /// The engine seeded with `seed`.
-  explicit World(std::uint64_t seed) : kernel(seed), net(kernel) {}
-  engine::Kernel kernel;   ///< Events.
-  engine::Network net;     ///< Nodes, links, buses.
-  std::vector<std::pair<std::string, engine::CanBus*>> buses;   ///< Buses by name (built on first use).
-  std::vector<std::unique_ptr<engine::CanTraffic>> traffic;     ///< Their background streams.
-  SimTime end{0};  ///< The run's end: the latest loop's (the kernel and the background traffic run to it).
-};
 
 /// What every loop shares: kernel, plant, network, set-point, noise and timing streams, for
 /// a plant of shape S (ncs_model.hpp; the analytic tracker on the board's shape only).
@@ -120,8 +96,8 @@ class BasicHarness {
     }
     r_chol_ = engine::psd_cholesky<S::p>(design_.r);
     for (std::size_t j = 0; j < S::m; ++j) {  // the actuator's range (live::actuator_range() on the board)
-      u_min_[j] = j < m_ ? ctx.design().u_min[j] : -1.0;  // a padded input: [−1, 1] holds its 0
-      u_max_[j] = j < m_ ? ctx.design().u_max[j] : 1.0;
+      u_min_[j] = design_.actuator.u_min[j];  // the design's (a padded input's −1: ncs_shape_design.cpp)
+      u_max_[j] = j < m_ ? ctx.design().u_max[j] : 1.0;  // a padded input: [−1, 1] holds its 0
     }
     const StateVec x0 = ref_.state(0);
     plant_.set_state(x0);
@@ -330,40 +306,10 @@ class BasicHarness {
   /// Over the plant's real n states only (a padded state's P is 0).
   void add_nees(const StateVec& x, const StateVec& xh, const Matrix<double, S::n, S::n>& p) {
     double q = 0;
-    if (!nees_term(x, xh, p, q)) return;
+    if (!nees_term<S::n>(x, xh, p, n_, q)) return;
     if (!std::isfinite(q)) return;
     nees_sum_ += q;
     ++nees_n_;
-  }
-
-  /// q = e_kᵀ P⁻¹ e_k on the real n states; false when P is not positive there.
-  bool nees_term(const StateVec& x, const StateVec& xh, const Matrix<double, S::n, S::n>& p, double& q) const {
-    if constexpr (S::n >= 2) {
-      if (n_ == 2) {  // the closed form (the board's figures as before, to the bit)
-        const double e0 = x[0] - xh[0];
-        const double e1 = x[1] - xh[1];
-        const double det = p(0, 0) * p(1, 1) - p(0, 1) * p(1, 0);
-        if (!(det > 0)) return false;
-        // eᵀ P⁻¹ e with P⁻¹ = [[p11, −p01], [−p10, p00]] / det
-        q = (e0 * e0 * p(1, 1) - e0 * e1 * (p(0, 1) + p(1, 0)) + e1 * e1 * p(0, 0)) / det;
-        return true;
-      }
-    }
-    // eᵀ P⁻¹ e = |L⁻¹ e|², P = L Lᵀ (a Cholesky solve), nothing unless P > 0 on the real states
-    Matrix<double, S::n, S::n> sym;
-    for (std::size_t i = 0; i < S::n; ++i)
-      for (std::size_t j = 0; j < S::n; ++j) sym(i, j) = 0.5 * (p(i, j) + p(j, i));
-    const Matrix<double, S::n, S::n> l = engine::psd_cholesky<S::n>(sym);
-    StateVec z;
-    q = 0;
-    for (std::size_t i = 0; i < S::n && i < n_; ++i) {
-      if (!(l(i, i) > 0)) return false;
-      double v = x[i] - xh[i];
-      for (std::size_t j = 0; j < i; ++j) v -= l(i, j) * z[j];
-      z[i] = v / l(i, i);
-      q += z[i] * z[i];
-    }
-    return true;
   }
 
   /// Node `address` restarts: whatever its interface held is lost.
@@ -406,23 +352,6 @@ class BasicHarness {
       result_.setpoint.push_back(Point{t, {s.r[0], s.u[0]}});
     }
     return std::move(result_);
-  }
-
-  /// Job `task`'s statistics on `cpu` into `c`.
-  static void cpu_stats(const engine::cpu::Cpu& cpu, std::size_t task, CpuRunStats& c) {
-    const engine::cpu::CpuTaskStats& st = cpu.stats()[task];
-    c.present = true;
-    c.jobs = st.finished;
-    c.response_min = st.response_min;
-    c.response_max = st.response_max;
-    c.response_sum_us = st.response_sum_s * 1e6;
-    c.deadline_misses = st.deadline_misses;
-    c.sample_min = st.sample_min;
-    c.sample_max = st.sample_max;
-    for (std::size_t e = 0; e < cpu.stats().size(); ++e) {
-      c.busy += cpu.stats()[e].busy;
-      if (e != task) c.other_misses += cpu.stats()[e].deadline_misses;
-    }
   }
 
   const Context& ctx_;
@@ -473,5 +402,8 @@ using Harness = BasicHarness<BoardShape>;
 
 /// The one-shot loop OS, OSp or OSK `a` on `hs` (ncs_one_shot_loop.cpp).
 RunResult run_one_shot(Harness& hs, Approach a);
+
+/// The actuation-synchronized loop A, AK, AKx or AKl `a` on `hs` (ncs_sync_loop.cpp).
+RunResult run_synchronized(Harness& hs, Approach a);
 
 }  // namespace oneshot::ncs::loop

@@ -66,7 +66,7 @@ typename S::Design Context::controller_design_of(double s) const {
     if (design_.deadbeat_gain.rows == plant_.a.rows && design_.deadbeat_gain.cols == plant_.c.rows) {
       d.deadbeat_gain = padded<S::n, S::p>(design_.deadbeat_gain);
     }
-    d.actuator.u_min = padded<S::m>(design_.u_min, -1.0);
+    d.actuator.u_min = padded<S::m>(design_.u_min, -1.0);  // a padded input in [−1, 1] (u_max: BasicHarness) holds its 0
     d.actuator.volts_per_step = padded<S::m>(design_.volts_per_step, 1.0);
     d.actuator.steps_per_volt = padded<S::m>(design_.steps_per_volt, 1.0);
     d.actuator.steps = design_.actuator_steps;
