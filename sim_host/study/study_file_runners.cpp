@@ -29,12 +29,6 @@ void refuse_max_duration(const FileCommand& c, const char* study) {
     throw engine::InputError(std::string("field '--max-duration': a ") + study + " file's runs take its duration_s");
 }
 
-/// Prints and writes a bench's figures as `study bench` does.
-void print_bench(const FileCommand& c, const nlohmann::json& j) {
-  if (!c.json.empty()) util::write_json(c.json, j);
-  if (c.json != "-") std::cout << bench_line(c.file, j);
-}
-
 class DroppingRunner final : public FileStudyRunner {
  public:
   explicit DroppingRunner(std::shared_ptr<const DroppingStudy> s) : s_(std::move(s)) {}
