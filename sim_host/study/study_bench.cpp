@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstddef>
 #include <cstdint>
 #include <cstdio>
@@ -110,31 +111,44 @@ nlohmann::json ncs_bench(const NcsStudy& s, std::size_t seeds, unsigned threads)
   return j;
 }
 
-nlohmann::json dropping_bench(const DroppingStudy& s, std::size_t seeds, unsigned threads) {
-  engine::SweepSpec spec = dropping_sweep_spec(s, seeds, "bench-dropping");
+nlohmann::json timed_bench(engine::SweepSpec spec, unsigned threads, const std::string& source, const BenchRunFn& run,
+                           const char* label) {
+  spec.metrics.clear();
   for (const char* m : {"cost", "events", "simulated_s", "run_s"}) spec.metrics.emplace_back(m);
-  spec.config = {{"study_file", s.source}};
   const unsigned used = threads == 0 ? std::max(1U, std::thread::hardware_concurrency()) : threads;
-  const double period_s = static_cast<double>(s.plant.plant.period_us) * 1e-6;
   const std::clock_t cpu0 = std::clock();
   const auto start = std::chrono::steady_clock::now();
   const engine::SweepResults r = engine::run_sweep(
       spec, engine::Shard{}, used,
-      [&s, period_s](std::size_t a, std::size_t x, std::uint64_t seed) {
+      [&run](std::size_t a, std::size_t x, std::uint64_t seed) {
         const auto t0 = std::chrono::steady_clock::now();
-        const dropping::RunConfig& c = s.runs[a][x];
-        const dropping::RunMetrics m = dropping::run_closed_loop(s.plant, c, seed);
+        const BenchRun m = run(a, x, seed);
         const double run_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-        return std::vector<double>{m.cost, m.events, static_cast<double>(c.steps) * period_s, run_s};
+        return std::vector<double>{m.cost, m.events, m.simulated_s, run_s};
       },
-      "study bench (dropping)");
+      label);
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   const double cpu = static_cast<double>(std::clock() - cpu0) / CLOCKS_PER_SEC;
-  nlohmann::json j = bench_figures(r, s.source, used, wall, cpu);
+  nlohmann::json j = bench_figures(r, source, used, wall, cpu);
   for (std::size_t a = 0; a < spec.approaches.size(); ++a) {
-    j["per_approach"][spec.approaches[a]]["cost_mean"] = dropping::num(mean_of(r, a, "cost"));
+    const double mean = mean_of(r, a, "cost");
+    j["per_approach"][spec.approaches[a]]["cost_mean"] = std::isfinite(mean) ? nlohmann::json(mean) : nlohmann::json(nullptr);
   }
   return j;
+}
+
+nlohmann::json dropping_bench(const DroppingStudy& s, std::size_t seeds, unsigned threads) {
+  engine::SweepSpec spec = dropping_sweep_spec(s, seeds, "bench-dropping");
+  spec.config = {{"study_file", s.source}};
+  const double period_s = static_cast<double>(s.plant.plant.period_us) * 1e-6;
+  return timed_bench(
+      spec, threads, s.source,
+      [&s, period_s](std::size_t a, std::size_t x, std::uint64_t seed) {
+        const dropping::RunConfig& c = s.runs[a][x];
+        const dropping::RunMetrics m = dropping::run_closed_loop(s.plant, c, seed);
+        return BenchRun{m.cost, m.events, static_cast<double>(c.steps) * period_s};
+      },
+      "study bench (dropping)");
 }
 
 }  // namespace oneshot::study

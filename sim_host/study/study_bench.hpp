@@ -5,6 +5,8 @@
 #pragma once
 
 #include <cstddef>
+#include <cstdint>
+#include <functional>
 #include <string>
 
 #include <nlohmann/json.hpp>
@@ -26,6 +28,24 @@ nlohmann::json bench_figures(const engine::SweepResults& r, const std::string& s
 /// every scenario x seed: (1 / (S K)) sum_x sum_k r.at(approach, x, k, metric), summed scenario
 /// by scenario, seed by seed.
 double mean_of(const engine::SweepResults& r, std::size_t approach, const std::string& metric);
+
+/// What one run of a timed sweep gives: its cost, its kernel events, its simulated seconds.
+struct BenchRun {
+  double cost = 0;         ///< The run's cost (the study's `cost` metric).
+  double events = 0;       ///< Its kernel events (queue pops).
+  double simulated_s = 0;  ///< Its simulated seconds.
+};
+
+/// One run of a timed sweep: approach `a`, scenario `x`, seed `seed`.
+using BenchRunFn = std::function<BenchRun(std::size_t a, std::size_t x, std::uint64_t seed)>;
+
+/// `study bench` of a study file other than ncs: the sweep `spec` (its metrics set here to cost,
+/// events, simulated_s, run_s) run with `run` on `threads` threads (0: every core) and timed
+/// (wall and process CPU time; each run's own time on its thread); bench_figures() plus per
+/// approach the mean cost over its runs (`cost_mean`, null when not finite). `label` names the
+/// sweep in its errors.
+nlohmann::json timed_bench(engine::SweepSpec spec, unsigned threads, const std::string& source, const BenchRunFn& run,
+                           const char* label);
 
 struct NcsStudy;
 struct DroppingStudy;

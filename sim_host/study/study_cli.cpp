@@ -4,7 +4,6 @@
 ///        wall time of the sweep): study files (`oneshot-study/1`, docs/study-files.md) from the
 ///        command line; `merge` finishes the shards of `study run`.
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -196,38 +195,27 @@ void add_study_commands(CLI::App* group) {
                   "loop: analytic_refused with the reason)");
     cmd->callback([c, max_duration]() {
       const Checked k = check_file(c->file);
+      study::FileCommand f = file_command(c->file, c->seeds, c->threads, c->out);
+      f.shard = c->shard;
+      f.json = c->json;
+      f.no_plots = c->no_plots;
+      f.analytic = c->analytic;
+      f.max_duration = max_duration->count() > 0;
       if (k.other) {
-        study::FileCommand f = file_command(c->file, c->seeds, c->threads, c->out);
-        f.shard = c->shard;
-        f.json = c->json;
-        f.no_plots = c->no_plots;
-        f.analytic = c->analytic;
-        f.max_duration = max_duration->count() > 0;
         k.other->run(f);
         return;
       }
       const study::NcsStudy s = runnable(k, max_duration, c->max_duration_s);
-      const engine::Shard part = engine::parse_shard(c->shard);
-      util::make_directory(c->out);
-      const auto start = std::chrono::steady_clock::now();
-      const engine::SweepResults r = study::run_ncs_sweep(s, c->seeds, c->threads, part, c->analytic);
-      const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-      nlohmann::json j;
-      if (!part.whole()) {
-        j = engine::write_shard_file(r, c->out, "run", part);
-      } else {
-        j = study::run_outputs(r, c->out, !c->no_plots);
-        if (c->json != "-") std::cout << j.at("markdown").get<std::string>() << "order: " << j.at("order_text").get<std::string>() << "\n";
-      }
-      if (!c->json.empty()) util::write_json(c->json, j);
-      if (c->json != "-") std::cout << "study run: " << r.spec.runs() << " runs, wall time " << wall << " s, written to " << c->out << "\n";
+      study::run_file_sweep(
+          f, [&](const engine::Shard& part) { return study::run_ncs_sweep(s, c->seeds, c->threads, part, c->analytic); },
+          study::run_outputs);
     });
   }
   {
     auto c = std::make_shared<ReportCli>();
     CLI::App* cmd = group->add_subcommand(
         "report", "Run a study file as `study run` does and write OUTDIR/report.md: the resolved configuration, costs with "
-                  "95 % intervals, ratios to I (a dropping file: to its first approach), paired differences, per-link counters, the cost plot; OUTDIR/report.json");
+                  "95 % intervals, ratios to I (an ncs file; another study's file: to its first approach), paired differences, per-link counters, the cost plot; OUTDIR/report.json");
     cmd->add_option("file", c->file, "study file (oneshot-study/1)")->required();
     cmd->add_option("outdir", c->out, "output directory")->required();
     cmd->add_option("--seeds", c->seeds, "seeds per scenario (default: the file's seeds.count)")->check(CLI::Range(2, 10000000));
@@ -279,10 +267,7 @@ void add_study_commands(CLI::App* group) {
         return;
       }
       nlohmann::json traces = study::write_traces(s, traced, c->out, !c->no_plots);
-      for (std::size_t a : traced) {  // the traced run is the sweep's: the same cost, bit for bit
-        const std::string an = r.spec.approaches[a];
-        if (traces.contains(an)) traces[an]["same_cost_as_sweep"] = traces[an].at("cost").get<double>() == r.at(a, 0, 0, r.metric("cost"));
-      }
+      study::mark_same_cost_as_sweep(traces, r, traced);
       j["traces"] = traces;
       nlohmann::json resolution = k.resolution;  // the grid that ran: --seeds overrides the file's count
       resolution["seeds"]["count"] = r.spec.seeds;

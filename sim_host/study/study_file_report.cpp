@@ -235,4 +235,15 @@ std::string traces_markdown(const nlohmann::json& traces, const engine::SweepRes
   return md.str();
 }
 
+void mark_same_cost_as_sweep(nlohmann::json& traces, const engine::SweepResults& r, const std::vector<std::size_t>& traced) {
+  const std::size_t cost = r.metric("cost");
+  for (std::size_t a : traced) {  // the traced run is the sweep's: the same cost, bit for bit
+    const std::string& an = r.spec.approaches[a];
+    if (!traces.contains(an)) continue;
+    const nlohmann::json& traced_cost = traces[an].at("cost");
+    const double swept = r.at(a, 0, 0, cost);
+    traces[an]["same_cost_as_sweep"] = traced_cost.is_null() ? !std::isfinite(swept) : traced_cost.get<double>() == swept;
+  }
+}
+
 }  // namespace oneshot::study

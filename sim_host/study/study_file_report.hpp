@@ -28,6 +28,11 @@ std::vector<std::size_t> trace_selection(const NcsStudy& s, const std::string& n
 std::vector<std::size_t> trace_selection(const std::vector<std::string>& approaches, const std::string& source,
                                          const std::string& names);
 
+/// Marks each traced approach of `traced` that has an entry in `traces` with
+/// `same_cost_as_sweep`: its trace's "cost" (null when not finite) equal to the sweep's run of the
+/// first scenario and the first seed, bit for bit (a null cost matches a non-finite run).
+void mark_same_cost_as_sweep(nlohmann::json& traces, const engine::SweepResults& r, const std::vector<std::size_t>& traced);
+
 /// One traced run per approach of `selected` on the first scenario and the first seed, the
 /// same run as the sweep's (same seed and streams; the trace and the message log only
 /// observe): OUT_DIR/trace_<A>_states.csv (t_s, x1, x2, r1, u: the plant's true states, the

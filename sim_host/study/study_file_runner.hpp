@@ -5,6 +5,7 @@
 #pragma once
 
 #include <cstddef>
+#include <functional>
 #include <memory>
 #include <string>
 #include <utility>
@@ -52,6 +53,16 @@ class FileStudyRunner {
   virtual nlohmann::json bench(const FileCommand& c) const = 0;
 };
 
+/// The summary of a complete sweep, its files written to `out_dir` (plots with `plots`): a
+/// study's `*_run_outputs` (with "markdown" and "order_text").
+using SweepOutputs = nlohmann::json (*)(const engine::SweepResults& r, const std::string& out_dir, bool plots);
+
+/// `study run`'s common part, after the study's refusals of the options: the sweep `sweep` of
+/// the part `c.shard` timed, then OUT/run.shard-i-of-N.json for a part, else `outputs`' summary
+/// (printed unless `--json -`); the JSON written to `--json`; the closing line printed.
+void run_file_sweep(const FileCommand& c, const std::function<engine::SweepResults(const engine::Shard&)>& sweep,
+                    SweepOutputs outputs);
+
 /// `study check`'s resolution of `generic` (its study's own where it has one: sod's takes the
 /// plant's shape only), with `links` always present.
 nlohmann::json resolve_file_study(const engine::StudyFile& generic);
@@ -61,7 +72,6 @@ nlohmann::json resolve_file_study(const engine::StudyFile& generic);
 std::unique_ptr<const FileStudyRunner> map_file_study(const engine::StudyFile& generic, const std::string& path);
 
 /// The merge finishers of those studies' `study run` sweeps ("run-dropping", …).
-std::vector<std::pair<std::string, nlohmann::json (*)(const engine::SweepResults&, const std::string&, bool)>>
-file_study_finishers();
+std::vector<std::pair<std::string, SweepOutputs>> file_study_finishers();
 
 }  // namespace oneshot::study

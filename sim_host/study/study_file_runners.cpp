@@ -29,6 +29,13 @@ void refuse_max_duration(const FileCommand& c, const char* study) {
     throw engine::InputError(std::string("field '--max-duration': a ") + study + " file's runs take its duration_s");
 }
 
+/// Refuses what `study run` of these studies does not take: --analytic (`no_analytic`: why) and
+/// --max-duration.
+void refuse_run_options(const FileCommand& c, const char* study, const char* no_analytic) {
+  if (c.analytic) throw engine::InputError(std::string("field '--analytic': ") + no_analytic);
+  refuse_max_duration(c, study);
+}
+
 class DroppingRunner final : public FileStudyRunner {
  public:
   explicit DroppingRunner(std::shared_ptr<const DroppingStudy> s) : s_(std::move(s)) {}
@@ -36,24 +43,9 @@ class DroppingRunner final : public FileStudyRunner {
   void add_design(nlohmann::json& r) const override { add_dropping_design(r, *s_); }
   std::string describe(const nlohmann::json& r) const override { return describe_dropping(r); }
 
-  /// The sweep (or shard), the summary, the same outputs as an ncs file's.
   void run(const FileCommand& c) const override {
-    if (c.analytic) throw engine::InputError("field '--analytic': no exact cost for the dropping loop (its filters run on what arrives)");
-    refuse_max_duration(c, "dropping");
-    const engine::Shard part = engine::parse_shard(c.shard);
-    util::make_directory(c.out);
-    const auto start = std::chrono::steady_clock::now();
-    const engine::SweepResults r = run_dropping_sweep(*s_, c.seeds, c.threads, part);
-    const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    nlohmann::json j;
-    if (!part.whole()) {
-      j = engine::write_shard_file(r, c.out, "run", part);
-    } else {
-      j = dropping_run_outputs(r, c.out, !c.no_plots);
-      if (c.json != "-") std::cout << j.at("markdown").get<std::string>() << "order: " << j.at("order_text").get<std::string>() << "\n";
-    }
-    if (!c.json.empty()) util::write_json(c.json, j);
-    if (c.json != "-") std::cout << "study run: " << r.spec.runs() << " runs, wall time " << wall << " s, written to " << c.out << "\n";
+    refuse_run_options(c, "dropping", "no exact cost for the dropping loop (its filters run on what arrives)");
+    run_file_sweep(c, [&](const engine::Shard& part) { return run_dropping_sweep(*s_, c.seeds, c.threads, part); }, dropping_run_outputs);
   }
 
   /// The sweep, the summary, the cost plot, the traced runs, OUT/report.md and OUT/report.json.
@@ -67,13 +59,7 @@ class DroppingRunner final : public FileStudyRunner {
     nlohmann::json j = dropping_run_outputs(r, c.out, false);
     for (const auto& f : write_dropping_cost_plot(r, c.out, !c.no_plots)) j["files"].push_back(f);
     nlohmann::json traces = write_dropping_traces(s, traced, c.out, !c.no_plots);
-    for (std::size_t a : traced) {  // the traced run is the sweep's: the same cost, bit for bit
-      const std::string& an = r.spec.approaches[a];
-      if (!traces.contains(an)) continue;
-      const nlohmann::json cost = traces[an].at("cost");  // null: not finite (a diverged loop), as the sweep's must be
-      const double swept = r.at(a, 0, 0, r.metric("cost"));
-      traces[an]["same_cost_as_sweep"] = cost.is_null() ? !std::isfinite(swept) : cost.get<double>() == swept;
-    }
+    mark_same_cost_as_sweep(traces, r, traced);
     j["traces"] = traces;
     nlohmann::json resolution = check;  // the grid that ran: --seeds overrides the file's count
     resolution["seeds"]["count"] = r.spec.seeds;
@@ -101,7 +87,8 @@ class SodRunner final : public FileStudyRunner {
   void add_design(nlohmann::json& r) const override { add_sod_design(r, *s_); }
   std::string describe(const nlohmann::json& r) const override { return describe_sod(r); }
   void run(const FileCommand& c) const override {
-    run_sod_file(*s_, c.seeds, c.threads, c.shard, c.out, c.json, c.analytic, c.max_duration);
+    refuse_run_options(c, "sod", "no exact cost for the sod study (its estimator runs on what arrives)");
+    run_file_sweep(c, [&](const engine::Shard& part) { return run_sod_sweep(*s_, c.seeds, c.threads, part); }, sod_run_outputs);
   }
   void report(const nlohmann::json& check, const FileCommand& c) const override {
     report_sod_file(*s_, c.file, check, c.out, c.seeds, c.threads, !c.no_plots, c.max_duration, c.trace ? &c.trace_names : nullptr);
@@ -122,9 +109,8 @@ class OneShotRunner final : public FileStudyRunner {
   void add_design(nlohmann::json& r) const override { add_oneshot_design(r, *s_); }
   std::string describe(const nlohmann::json& r) const override { return describe_oneshot(r); }
   void run(const FileCommand& c) const override {
-    if (c.analytic) throw engine::InputError("field '--analytic': a oneshot file runs the emulated board (`oneshot table1 --analytic`: the linear board)");
-    refuse_max_duration(c, "oneshot");
-    oneshot_run_command(*s_, c.seeds, c.threads, c.shard, c.out, c.json, !c.no_plots);
+    refuse_run_options(c, "oneshot", "a oneshot file runs the emulated board (`oneshot table1 --analytic`: the linear board)");
+    run_file_sweep(c, [&](const engine::Shard& part) { return run_oneshot_sweep(*s_, c.seeds, c.threads, part); }, oneshot_run_outputs);
   }
   void report(const nlohmann::json& check, const FileCommand& c) const override {
     refuse_max_duration(c, "oneshot");
@@ -152,7 +138,10 @@ class PetcRunner final : public FileStudyRunner {
   const char* study() const override { return "petc"; }
   void add_design(nlohmann::json& r) const override { add_petc_design(r, *s_); }
   std::string describe(const nlohmann::json& r) const override { return describe_petc(r); }
-  void run(const FileCommand& c) const override { petc_run_command(*s_, c); }
+  void run(const FileCommand& c) const override {
+    refuse_run_options(c, "petc", "no exact cost for the petc loop (its triggers run on what is measured)");
+    run_file_sweep(c, [&](const engine::Shard& part) { return run_petc_sweep(*s_, c.seeds, c.threads, part); }, petc_run_outputs);
+  }
   void report(const nlohmann::json& check, const FileCommand& c) const override { petc_report_command(*s_, check, c); }
   nlohmann::json bench(const FileCommand& c) const override {
     refuse_max_duration(c, "petc");
@@ -164,6 +153,24 @@ class PetcRunner final : public FileStudyRunner {
 };
 
 }  // namespace
+
+void run_file_sweep(const FileCommand& c, const std::function<engine::SweepResults(const engine::Shard&)>& sweep,
+                    SweepOutputs outputs) {
+  const engine::Shard part = engine::parse_shard(c.shard);
+  util::make_directory(c.out);
+  const auto start = std::chrono::steady_clock::now();
+  const engine::SweepResults r = sweep(part);
+  const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  nlohmann::json j;
+  if (!part.whole()) {
+    j = engine::write_shard_file(r, c.out, "run", part);
+  } else {
+    j = outputs(r, c.out, !c.no_plots);
+    if (c.json != "-") std::cout << j.at("markdown").get<std::string>() << "order: " << j.at("order_text").get<std::string>() << "\n";
+  }
+  if (!c.json.empty()) util::write_json(c.json, j);
+  if (c.json != "-") std::cout << "study run: " << r.spec.runs() << " runs, wall time " << wall << " s, written to " << c.out << "\n";
+}
 
 nlohmann::json resolve_file_study(const engine::StudyFile& generic) {
   nlohmann::json r = generic.study == "sod" ? resolve_sod_study(generic) : resolve_study(generic);
@@ -179,8 +186,7 @@ std::unique_ptr<const FileStudyRunner> map_file_study(const engine::StudyFile& g
   return nullptr;
 }
 
-std::vector<std::pair<std::string, nlohmann::json (*)(const engine::SweepResults&, const std::string&, bool)>>
-file_study_finishers() {
+std::vector<std::pair<std::string, SweepOutputs>> file_study_finishers() {
   return {{"run-dropping", dropping_run_outputs}, {"run-sod", sod_run_outputs}, {"run-oneshot", oneshot_run_outputs},
           {"run-petc", petc_run_outputs}};
 }

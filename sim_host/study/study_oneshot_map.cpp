@@ -290,7 +290,7 @@ std::string describe_oneshot(const nlohmann::json& r) {
   for (const nlohmann::json& a : d.at("approaches"))
     o << "  approach " << a.at("name").get<std::string>() << " (" << a.at("kind").get<std::string>() << ": "
       << a.at("description").get<std::string>() << "), " << a.at("number_format").get<std::string>() << ", "
-      << a.at("discretizer").get<std::string>() << ", noise " << a.at("noise_model").get<std::string>() << "\n";
+      << a.at("discretizer").get<std::string>() << ", noise " << a.at("noise_model").get<std::string>() << ", pwm " << a.at("pwm_update").get<std::string>() << "\n";
   if (d.contains("cpu")) {
     const nlohmann::json& c = d.at("cpu");
     o << "  job on CPU " << c.at("name").get<std::string>() << " (U = " << c.at("utilization") << ", priority "

@@ -47,8 +47,8 @@ std::string hex64(std::uint64_t v) {
 }
 
 /// The job's timings in the CPU's schedule of `seed` over `duration_s` + 2 h: per job k,
-/// release = sample − k·h and exec = actuation − sample, rounded to whole µs.
-std::vector<sim::JobTiming> cpu_job_trace(const OneShotFileStudy& s, std::uint64_t seed, double duration_s) {
+/// release = sample − k·h rounded to whole µs, exec = (actuation − k·h rounded) − release.
+std::vector<sim::JobTiming> cpu_job_trace(const OneShotFileStudy& s, std::uint64_t seed, double duration_s, std::uint64_t* events) {
   const std::int64_t h_us = s.plant.period_us;
   engine::Kernel k(seed);
   engine::cpu::Cpu cpu(k, *s.cpu);
@@ -56,7 +56,8 @@ std::vector<sim::JobTiming> cpu_job_trace(const OneShotFileStudy& s, std::uint64
   cpu.on_job([&](const engine::cpu::CpuJob& j) {
     if (j.entity != s.job_task) return;
     const auto rel = static_cast<std::int32_t>(std::llround(static_cast<double>((j.sample - j.arrival).count()) * 1e-3));
-    const auto ex = static_cast<std::int32_t>(std::llround(static_cast<double>((j.actuate - j.sample).count()) * 1e-3));
+    // exec from the rounded response, so that release + exec is the response rounded (at most the analysed WCRT < h)
+    const auto ex = static_cast<std::int32_t>(std::llround(static_cast<double>((j.actuate - j.arrival).count()) * 1e-3) - rel);
     if (j.aborted || rel + ex >= h_us) throw std::logic_error("study oneshot: the job past its period (the analysis bounds it below)");
     if (jobs.size() != j.index) throw std::logic_error("study oneshot: jobs out of order");
     jobs.push_back(sim::JobTiming{rel, ex});
@@ -65,6 +66,7 @@ std::vector<sim::JobTiming> cpu_job_trace(const OneShotFileStudy& s, std::uint64
   cpu.start(end);
   k.run_until(end + engine::from_us(h_us));
   if (jobs.empty()) throw std::logic_error("study oneshot: no job in the schedule");
+  if (events != nullptr) *events = k.events_run();
   return jobs;
 }
 
@@ -80,9 +82,10 @@ std::shared_ptr<const OneShotFileStudy> map_oneshot_study(const engine::StudyFil
   return s;
 }
 
-sim::Scenario oneshot_run_scenario(const OneShotFileStudy& s, std::size_t x, std::uint64_t seed) {
+sim::Scenario oneshot_run_scenario(const OneShotFileStudy& s, std::size_t x, std::uint64_t seed, std::uint64_t* cpu_events) {
   sim::Scenario c = s.scenarios.at(x);
-  if (s.cpu) c.jitter.trace = cpu_job_trace(s, seed, c.duration_s);
+  if (cpu_events != nullptr) *cpu_events = 0;
+  if (s.cpu) c.jitter.trace = cpu_job_trace(s, seed, c.duration_s, cpu_events);
   return c;
 }
 
@@ -195,50 +198,16 @@ nlohmann::json oneshot_run_outputs(const engine::SweepResults& r, const std::str
   return j;
 }
 
-void oneshot_run_command(const OneShotFileStudy& s, std::size_t seeds, unsigned threads, const std::string& shard,
-                         const std::string& out, const std::string& json, bool plots) {
-  const engine::Shard part = engine::parse_shard(shard);
-  util::make_directory(out);
-  const auto start = std::chrono::steady_clock::now();
-  const engine::SweepResults r = run_oneshot_sweep(s, seeds, threads, part);
-  const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  nlohmann::json j;
-  if (!part.whole()) {
-    j = engine::write_shard_file(r, out, "run", part);
-  } else {
-    j = oneshot_run_outputs(r, out, plots);
-    if (json != "-") std::cout << j.at("markdown").get<std::string>() << "order: " << j.at("order_text").get<std::string>() << "\n";
-  }
-  if (!json.empty()) util::write_json(json, j);
-  if (json != "-") std::cout << "study run: " << r.spec.runs() << " runs, wall time " << wall << " s, written to " << out << "\n";
-}
-
 nlohmann::json oneshot_bench(const OneShotFileStudy& s, std::size_t seeds, unsigned threads) {
-  engine::SweepSpec spec = oneshot_sweep_spec(s, seeds, "bench-oneshot");
-  for (const char* m : {"cost", "events", "simulated_s", "run_s"}) spec.metrics.emplace_back(m);
-  const unsigned used = threads == 0 ? std::max(1U, std::thread::hardware_concurrency()) : threads;
-  const std::clock_t cpu0 = std::clock();
-  const auto start = std::chrono::steady_clock::now();
-  const engine::SweepResults r = engine::run_sweep(
-      spec, engine::Shard{}, used,
+  return timed_bench(
+      oneshot_sweep_spec(s, seeds, "bench-oneshot"), threads, s.source,
       [&s](std::size_t a, std::size_t x, std::uint64_t seed) {
-        const auto t0 = std::chrono::steady_clock::now();
-        const sim::RunResult m = sim::simulate(*s.ctx, oneshot_run_scenario(s, x, seed), seed, s.options[a]);
-        const double run_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-        return std::vector<double>{m.cost.total(), static_cast<double>(m.events), m.duration_s, run_s};
+        std::uint64_t cpu_events = 0;  // the CPU schedule's own events (a job on a CPU), simulated for the run
+        const sim::Scenario c = oneshot_run_scenario(s, x, seed, &cpu_events);
+        const sim::RunResult m = sim::simulate(*s.ctx, c, seed, s.options[a]);
+        return BenchRun{m.cost.total(), static_cast<double>(m.events + cpu_events), m.duration_s};
       },
       "study bench (oneshot)");
-  const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  const double cpu = static_cast<double>(std::clock() - cpu0) / CLOCKS_PER_SEC;
-  nlohmann::json j = bench_figures(r, s.source, used, wall, cpu);
-  const std::size_t cost = r.metric("cost");
-  for (std::size_t a = 0; a < spec.approaches.size(); ++a) {
-    double sum = 0;
-    for (std::size_t x = 0; x < spec.scenarios.size(); ++x)
-      for (std::size_t k = 0; k < spec.seeds; ++k) sum += r.at(a, x, k, cost);
-    j["per_approach"][spec.approaches[a]]["cost_mean"] = os_num(sum / static_cast<double>(spec.scenarios.size() * spec.seeds));
-  }
-  return j;
 }
 
 }  // namespace oneshot::study

@@ -78,8 +78,9 @@ std::string describe_oneshot(const nlohmann::json& r);
 
 /// Scenario `x` of `s` as run with `seed`: the file's scenario, or with a CPU its timing the
 /// trace of the job in the CPU's schedule for that seed (release = sample − k·h, exec = actuation
-/// − sample, in whole µs).
-sim::Scenario oneshot_run_scenario(const OneShotFileStudy& s, std::size_t x, std::uint64_t seed);
+/// − sample, in whole µs); `cpu_events` (optional) set to the events of that schedule's
+/// simulation (0 without a CPU).
+sim::Scenario oneshot_run_scenario(const OneShotFileStudy& s, std::size_t x, std::uint64_t seed, std::uint64_t* cpu_events = nullptr);
 
 /// The sweep of `s` for `experiment` ("run-oneshot", "bench-oneshot"): its approaches,
 /// scenarios, first seed and `seeds` seeds (0: the file's count), its configuration (what a
@@ -97,11 +98,6 @@ engine::SweepResults run_oneshot_sweep(const OneShotFileStudy& s, std::size_t se
 /// saturated_runs, overruns, faults; order; paired_differences; per_scenario; markdown; runs.csv
 /// in `out_dir`.
 nlohmann::json oneshot_run_outputs(const engine::SweepResults& r, const std::string& out_dir, bool plots);
-
-/// `study run` of a oneshot file: its sweep (or shard: OUT/run.shard-i-of-N.json), the summary,
-/// `json` ("-": standard output, empty: none), the table on standard output otherwise.
-void oneshot_run_command(const OneShotFileStudy& s, std::size_t seeds, unsigned threads, const std::string& shard,
-                         const std::string& out, const std::string& json, bool plots);
 
 /// `study report` of a oneshot file: its sweep, the summary, the cost plot (table_summary.csv,
 /// table.png), OUT/report.md (`resolution_text`: what `study check` prints) and OUT/report.json.

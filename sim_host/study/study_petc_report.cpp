@@ -68,7 +68,7 @@ nlohmann::json write_petc_traces(const PetcStudy& s, const std::vector<std::size
     const std::string stem = petc_trace_stem(a, s.approaches[a]);
     util::write_csv(util::path_in(out_dir, stem + ".csv"),
                     {"k", "t_s", "r", "y", "y_meas", "u", "d", "d_hat", "sensor_sent", "actuator_sent"}, rows);
-    nlohmann::json e = {{"scenario", s.scenarios[0]}, {"seed", s.first_seed}, {"cost", v[4]}, {"files", {stem + ".csv"}}};
+    nlohmann::json e = {{"scenario", s.scenarios[0]}, {"seed", s.first_seed}, {"cost", std::isfinite(v[petc_gpi_index()]) ? nlohmann::json(v[petc_gpi_index()]) : nlohmann::json(nullptr)}, {"files", {stem + ".csv"}}};
     if (plots) {
       const std::string title = s.approaches[a] + " (" + s.kinds[a] + ") on " + s.scenarios[0] + ", seed " +
                                 std::to_string(s.first_seed) + ": output and samples, input and packets, d and d hat";

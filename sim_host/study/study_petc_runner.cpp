@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <ctime>
 #include <sstream>
+#include <stdexcept>
 #include <string>
 #include <thread>
 #include <vector>
@@ -64,15 +65,25 @@ engine::SweepSpec petc_sweep_spec(const PetcStudy& s, std::size_t seeds, const c
   return spec;
 }
 
+std::size_t petc_gpi_index() {
+  static const std::size_t index = [] {
+    const std::vector<std::string>& names = pt::metric_names();
+    const auto it = std::find(names.begin(), names.end(), "GPI");
+    if (it == names.end()) throw std::logic_error("petc: no metric GPI");
+    return static_cast<std::size_t>(it - names.begin());
+  }();
+  return index;
+}
+
 engine::SweepResults run_petc_sweep(const PetcStudy& s, std::size_t seeds, unsigned threads, const engine::Shard& shard) {
   engine::SweepSpec spec = petc_sweep_spec(s, seeds, "run-petc");
   spec.metrics = {"cost"};
   for (const std::string& m : pt::metric_names()) spec.metrics.push_back(m);
   spec.config = petc_config(s);
-  const std::size_t gpi = 4;  // metric_names()[4] is "GPI"
+  const std::size_t gpi = petc_gpi_index();
   return engine::run_sweep(
       spec, shard, threads,
-      [&s](std::size_t a, std::size_t x, std::uint64_t seed) {
+      [&s, gpi](std::size_t a, std::size_t x, std::uint64_t seed) {
         std::vector<double> v = pt::run_case(s.setups[x], s.runs[a][x], seed);
         v.insert(v.begin(), v[gpi]);  // cost = GPI
         return v;
@@ -164,34 +175,17 @@ nlohmann::json petc_run_outputs(const engine::SweepResults& r, const std::string
 
 nlohmann::json petc_bench(const PetcStudy& s, std::size_t seeds, unsigned threads) {
   engine::SweepSpec spec = petc_sweep_spec(s, seeds, "bench-petc");
-  for (const char* m : {"cost", "events", "simulated_s", "run_s"}) spec.metrics.emplace_back(m);
   spec.config = {{"study_file", s.source}};
-  const unsigned used = threads == 0 ? std::max(1U, std::thread::hardware_concurrency()) : threads;
-  const std::clock_t cpu0 = std::clock();
-  const auto start = std::chrono::steady_clock::now();
-  const engine::SweepResults r = engine::run_sweep(
-      spec, engine::Shard{}, used,
+  return timed_bench(
+      spec, threads, s.source,
       [&s](std::size_t a, std::size_t x, std::uint64_t seed) {
-        const auto t0 = std::chrono::steady_clock::now();
         pt::FaultRun clean;  // an empty spec: the clean run, bit for bit; it counts the kernel's events
         const std::vector<double> v = pt::run_case(s.setups[x], s.runs[a][x], seed, nullptr, &clean);
-        const double run_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
         const pt::PetcSetup& st = s.setups[x];
         const double simulated = static_cast<double>(st.opt.steps) * static_cast<double>(st.plant.file.period_us) * 1e-6;
-        return std::vector<double>{v[4], static_cast<double>(clean.events), simulated, run_s};
+        return BenchRun{v[petc_gpi_index()], static_cast<double>(clean.events), simulated};
       },
       "study bench (petc)");
-  const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  const double cpu = static_cast<double>(std::clock() - cpu0) / CLOCKS_PER_SEC;
-  nlohmann::json j = bench_figures(r, s.source, used, wall, cpu);
-  const std::size_t cost = r.metric("cost");
-  for (std::size_t a = 0; a < spec.approaches.size(); ++a) {
-    double sum = 0;
-    for (std::size_t x = 0; x < spec.scenarios.size(); ++x)
-      for (std::size_t k = 0; k < spec.seeds; ++k) sum += r.at(a, x, k, cost);
-    j["per_approach"][spec.approaches[a]]["cost_mean"] = petc_num(sum / static_cast<double>(spec.scenarios.size() * spec.seeds));
-  }
-  return j;
 }
 
 }  // namespace oneshot::study

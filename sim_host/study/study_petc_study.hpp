@@ -60,6 +60,9 @@ void add_petc_design(nlohmann::json& r, const PetcStudy& s);
 /// The resolution's "petc" section as text.
 std::string describe_petc(const nlohmann::json& r);
 
+/// The index of "GPI" (the cost of a petc file's runs) in sim::petc::metric_names().
+std::size_t petc_gpi_index();
+
 /// The sweep spec of `s` for `experiment` ("run-petc", "bench-petc"): approaches, scenarios,
 /// first seed, `seeds` seeds (0: the file's count); metrics and config the caller's.
 engine::SweepSpec petc_sweep_spec(const PetcStudy& s, std::size_t seeds, const char* experiment);
@@ -106,17 +109,10 @@ std::string petc_report_markdown(const PetcStudy& s, const std::string& file, co
 /// What the `study` commands hand a petc file (study_cli.cpp's options).
 using PetcCommand = FileCommand;
 
-/// `study run` of a petc file: the sweep (or shard), the summary printed and written as an ncs
-/// file's; --analytic and --max-duration refused naming the option before anything is written.
-void petc_run_command(const PetcStudy& s, const PetcCommand& c);
-
 /// `study report` of a petc file: the sweep, OUT/runs.csv, table_summary.csv, table.png, the
 /// traces, report.md, report.json; `resolution` is study check's (the report prints it with the
 /// seed count and runs that ran). --max-duration and a bad --trace refused before anything is
 /// written.
 void petc_report_command(const PetcStudy& s, const nlohmann::json& resolution, const PetcCommand& c);
-
-/// --max-duration refused naming it.
-void petc_bench_command(const PetcStudy& s, const PetcCommand& c);
 
 }  // namespace oneshot::study

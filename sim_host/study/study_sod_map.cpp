@@ -159,6 +159,14 @@ std::shared_ptr<const SodStudy> map_sod(const engine::StudyFile& file) {
     }
     out->approaches.push_back(p);
   }
+  bool msod = false;
+  for (const SodApproach& p : out->approaches) msod = msod || p.sender == sod::SenderKind::kModifiedSod;
+  if (out->n_t_given && !msod) {  // only msod's sender takes the time rule: it would be ignored
+    for (std::size_t i = 0; i < file.nodes.size(); ++i)
+      if (file.nodes[i].role == "sensor")
+        refuse(at("nodes", i) + ".trigger.time_steps", "no approach is msod (the time rule n_t is msod's; sod-held, sod-kf and "
+                                                       "periodic send without it)");
+  }
   for (std::size_t s = 0; s < file.scenarios.size(); ++s) {
     const engine::ScenarioSpec& x = file.scenarios[s];
     const std::string fs = at("scenarios", s);

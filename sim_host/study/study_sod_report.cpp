@@ -104,7 +104,7 @@ nlohmann::json write_sod_traces(const SodStudy& s, const SodDesigns& d, const st
     util::write_csv(util::path_in(out_dir, stem + ".csv"),
                     {"k", "t_s", "x1", "xhat1", "y1", "z1", "sent1", "arrived1", "x2", "xhat2", "y2", "z2", "sent2", "arrived2"}, rows,
                     util::NonFinite::kMissing);
-    nlohmann::json e = {{"scenario", s.scenarios[0].name}, {"seed", s.first_seed}, {"cost", m.e[0] + m.e[1]}, {"every_steps", step},
+    nlohmann::json e = {{"scenario", s.scenarios[0].name}, {"seed", s.first_seed}, {"cost", std::isfinite(m.e[0] + m.e[1]) ? nlohmann::json(m.e[0] + m.e[1]) : nlohmann::json(nullptr)}, {"every_steps", step},
                         {"files", {stem + ".csv"}}};
     if (plots) {
       const std::string csv = util::gnuplot_quote(stem + ".csv");
@@ -200,10 +200,7 @@ void report_sod_file(const SodStudy& s, const std::string& file, nlohmann::json 
   for (const auto& f : write_sod_cost_plot(r, out, plots)) j["files"].push_back(f);
   const SodDesigns d = sod_designs(s, r.spec.seeds, threads);
   nlohmann::json traces = write_sod_traces(s, d, traced, out, plots);
-  for (std::size_t a : traced) {  // the traced run is the sweep's: the same cost, bit for bit
-    const std::string& an = r.spec.approaches[a];
-    if (traces.contains(an)) traces[an]["same_cost_as_sweep"] = traces[an].at("cost").get<double>() == r.at(a, 0, 0, r.metric("cost"));
-  }
+  mark_same_cost_as_sweep(traces, r, traced);
   j["traces"] = traces;
   resolution["seeds"]["count"] = r.spec.seeds;  // the grid that ran: --seeds overrides the file's count
   resolution["grid"]["runs"] = r.spec.runs();
@@ -218,35 +215,18 @@ void report_sod_file(const SodStudy& s, const std::string& file, nlohmann::json 
 
 nlohmann::json sod_bench(const SodStudy& s, std::size_t seeds, unsigned threads) {
   engine::SweepSpec spec = sod_sweep_spec(s, seeds, "bench-sod");
-  for (const char* m : {"cost", "events", "simulated_s", "run_s"}) spec.metrics.emplace_back(m);
   spec.config = {{"study_file", s.source}};
   const unsigned used = threads == 0 ? std::max(1U, std::thread::hardware_concurrency()) : threads;
   const SodDesigns d = sod_designs(s, spec.seeds, used);  // before the clock: the design is not the sweep
   const double period_s = s.model.period_s();
-  const std::clock_t cpu0 = std::clock();
-  const auto start = std::chrono::steady_clock::now();
-  const engine::SweepResults r = engine::run_sweep(
-      spec, engine::Shard{}, used,
+  return timed_bench(
+      spec, used, s.source,
       [&s, &d, period_s](std::size_t a, std::size_t x, std::uint64_t seed) {
-        const auto t0 = std::chrono::steady_clock::now();
         const sod::RunConfig c = sod_run_config(s, d, a, x);
         const sod::RunResult m = sod::simulate_run(s.model, c, seed);
-        const double run_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-        return std::vector<double>{m.e[0] + m.e[1], m.events, static_cast<double>(c.steps) * period_s, run_s};
+        return BenchRun{m.e[0] + m.e[1], m.events, static_cast<double>(c.steps) * period_s};
       },
       "study bench (sod)");
-  const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  const double cpu = static_cast<double>(std::clock() - cpu0) / CLOCKS_PER_SEC;
-  nlohmann::json j = bench_figures(r, s.source, used, wall, cpu);
-  const std::size_t cost = r.metric("cost");
-  for (std::size_t a = 0; a < spec.approaches.size(); ++a) {
-    double sum = 0;
-    for (std::size_t x = 0; x < spec.scenarios.size(); ++x)
-      for (std::size_t k = 0; k < spec.seeds; ++k) sum += r.at(a, x, k, cost);
-    const double mean = sum / static_cast<double>(spec.scenarios.size() * spec.seeds);
-    j["per_approach"][spec.approaches[a]]["cost_mean"] = std::isfinite(mean) ? nlohmann::json(mean) : nlohmann::json(nullptr);
-  }
-  return j;
 }
 
 }  // namespace oneshot::study

@@ -178,24 +178,4 @@ nlohmann::json sod_run_outputs(const engine::SweepResults& r, const std::string&
   return j;
 }
 
-void run_sod_file(const SodStudy& s, std::size_t seeds, unsigned threads, const std::string& shard, const std::string& out,
-                  const std::string& json_path, bool analytic, bool max_duration) {
-  if (analytic) throw engine::InputError("field '--analytic': no exact cost for the sod study (its estimator runs on what arrives)");
-  if (max_duration) throw engine::InputError("field '--max-duration': a sod file's runs take its duration_s");
-  const engine::Shard part = engine::parse_shard(shard);
-  util::make_directory(out);
-  const auto start = std::chrono::steady_clock::now();
-  const engine::SweepResults r = run_sod_sweep(s, seeds, threads, part);
-  const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  nlohmann::json j;
-  if (!part.whole()) {
-    j = engine::write_shard_file(r, out, "run", part);
-  } else {
-    j = sod_run_outputs(r, out, true);
-    if (json_path != "-") std::cout << j.at("markdown").get<std::string>() << "order: " << j.at("order_text").get<std::string>() << "\n";
-  }
-  if (!json_path.empty()) util::write_json(json_path, j);
-  if (json_path != "-") std::cout << "study run: " << r.spec.runs() << " runs, wall time " << wall << " s, written to " << out << "\n";
-}
-
 }  // namespace oneshot::study

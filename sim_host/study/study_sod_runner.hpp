@@ -61,12 +61,6 @@ engine::SweepResults run_sod_sweep(const SodStudy& s, std::size_t seeds, unsigne
 /// markdown; files runs.csv in `out_dir`.
 nlohmann::json sod_run_outputs(const engine::SweepResults& r, const std::string& out_dir, bool plots);
 
-/// `study run` of a sod file: refuses --analytic and --max-duration (given: true) naming them,
-/// then the sweep (or shard `shard` written to `out`), the summary printed (not with json_path "-"),
-/// written to `json_path` when not empty.
-void run_sod_file(const SodStudy& s, std::size_t seeds, unsigned threads, const std::string& shard, const std::string& out,
-                  const std::string& json_path, bool analytic, bool max_duration);
-
 /// `study report` of a sod file: refuses --max-duration (given: true) and an empty or unknown
 /// --trace name (`trace`: its text, null when not given), then the sweep, the summary, the cost
 /// plot (`plots`), one traced run per selected approach (first scenario, first seed: the

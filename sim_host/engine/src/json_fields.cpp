@@ -3,6 +3,8 @@
 #include "oneshot/engine/json_fields.hpp"
 
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
 #include <set>
 #include <sstream>
 #include <vector>
@@ -68,6 +70,15 @@ const nlohmann::json& member(const nlohmann::json& j, const std::string& where, 
   return *it;
 }
 
+std::string shortest_number(double v) {
+  char b[32];
+  for (int digits = 6; digits <= 17; ++digits) {
+    std::snprintf(b, sizeof b, "%.*g", digits, v);
+    if (std::strtod(b, nullptr) == v) break;
+  }
+  return b;
+}
+
 double number_in(const nlohmann::json& j, const std::string& where, const char* key, double lo, double hi, bool optional,
                  double fallback) {
   const auto it = j.find(key);
@@ -77,7 +88,7 @@ double number_in(const nlohmann::json& j, const std::string& where, const char* 
   }
   if (!it->is_number() || !std::isfinite(it->get<double>()) || it->get<double>() < lo || it->get<double>() > hi) {
     std::ostringstream o;
-    o << "field '" << where << "." << key << "': must be a number in [" << lo << ", " << hi << "]";
+    o << "field '" << where << "." << key << "': must be a number in [" << shortest_number(lo) << ", " << shortest_number(hi) << "]";
     throw InputError(o.str());
   }
   return it->get<double>();

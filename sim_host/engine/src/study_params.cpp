@@ -65,7 +65,7 @@ std::map<std::string, double> parse_params(const json& j, const std::string& f, 
           throw InputError("field '" + g + "': must be one of " + list + " (a string)");
         }
         std::ostringstream range;
-        range << "[" << s->min << ", " << s->max << "]";
+        range << "[" << shortest_number(s->min) << ", " << shortest_number(s->max) << "]";
         if (v < s->min || v > s->max) throw InputError("field '" + g + "': must be in " + range.str());
         if (s->integer && std::floor(v) != v) throw InputError("field '" + g + "': must be a whole number");
       }

@@ -97,5 +97,27 @@ TEST(ExactSegmentCompact, FullPlantIsDense) {
   EXPECT_TRUE(same_bytes(cache.get(1234000), cache.dense_segment(1234000)));
 }
 
+// A state with no dynamics (zero row and column of A, no input) but a cost weight, and one with a
+// cross weight only: both stay coupled (the cost integral G grows with them), so the compact map
+// is the dense one. Measured: 0 differ.
+TEST(ExactSegmentCompact, AStateWithCostButNoDynamicsStaysCoupled) {
+  RandomStream rng(3, "exact segment cost only");
+  Matrix<double, 4, 2> b;
+  Matrix<double, 4, 4> a;
+  Matrix<double, 4, 4> q;
+  a(0, 1) = 1;
+  a(1, 0) = -50;  // |A| ~ 50: several squarings at 20 ms
+  a(1, 1) = -2;
+  b(1, 0) = 1;
+  q(0, 0) = 1;
+  q(1, 1) = 0.1;
+  q(2, 2) = 3;     // state 2: no dynamics, a weight
+  q(0, 3) = 0.5;   // state 3: no dynamics, a cross weight only
+  q(3, 0) = 0.5;
+  ExactSegmentCache<4, 2> cache(a, b, q);
+  EXPECT_EQ(cache.coupled(), 5u);  // states 0..3 and input 0; input 1 (and the absent disturbance) padded
+  EXPECT_EQ(differing(cache, rng, 500), 0);
+}
+
 }  // namespace
 }  // namespace oneshot::engine

@@ -162,8 +162,24 @@ TEST(StudySod, RefusalsNameTheField) {
          j["plant"] = {{"continuous", {{"A", {{0, 1}, {-0.2, -0.2}}}, {"B", {{0}, {6}}}, {"C", {{1, 0}, {0, 1}}}, {"Q_c", {{0.01, 0}, {0, 0.01}}}}}};
        }},
       {"study", [](nlohmann::json& j) { j["study"] = "dropping"; }},
+      {"nodes[0].trigger.time_steps",  // a time rule no approach runs (only msod's sender takes it)
+       [](nlohmann::json& j) {
+         j["nodes"][0]["trigger"]["time_steps"] = 50;
+         j["nodes"][1]["trigger"]["time_steps"] = 50;
+         j["approaches"].erase(2);
+       }},
   };
   ASSERT_NO_THROW(static_cast<void>(sod_map_text(sod_example_json())));
+  {  // a range bound is printed as itself: mu must exceed 1, so its lower bound is not "1"
+    nlohmann::json j = sod_example_json();
+    j["approaches"][2]["params"]["mu"] = 1;
+    try {
+      static_cast<void>(sod_map_text(j));
+      ADD_FAILURE() << "mu = 1 accepted";
+    } catch (const engine::InputError& e) {
+      EXPECT_NE(std::string(e.what()).find("[1.000001, 1e+06]"), std::string::npos) << e.what();
+    }
+  }
   for (const Case& c : cases) {
     nlohmann::json j = sod_example_json();
     c.edit(j);

@@ -2,6 +2,7 @@
 /// @brief Sample mean and two-sided 95 % confidence interval (Student t).
 #pragma once
 
+#include <cmath>
 #include <cstddef>
 #include <vector>
 
@@ -23,7 +24,11 @@ double student_t975(std::size_t dof);
 /// Summary of `samples`.
 Summary summarize(const std::vector<double>& samples);
 
-/// {"mean": s.mean, "ci95": s.ci95}: how the study outputs give a mean with its interval.
-inline nlohmann::json mean_ci_json(const Summary& s) { return {{"mean", s.mean}, {"ci95", s.ci95}}; }
+/// {"mean": s.mean, "ci95": s.ci95}: how the study outputs give a mean with its interval (null
+/// where not finite: a diverged run is shown, never hidden, and the JSON stays valid).
+inline nlohmann::json mean_ci_json(const Summary& s) {
+  const auto num = [](double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr); };
+  return {{"mean", num(s.mean)}, {"ci95", num(s.ci95)}};
+}
 
 }  // namespace oneshot::util

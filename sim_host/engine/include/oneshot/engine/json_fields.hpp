@@ -27,6 +27,10 @@ void require_keys(const nlohmann::json& j, const std::string& where, std::initia
 /// Required member `key` of object `j` (InputError "where.key: missing").
 const nlohmann::json& member(const nlohmann::json& j, const std::string& where, const char* key);
 
+/// `v` in the fewest significant digits (%g style, 6 to 17) that read back as `v`: how refusals
+/// print a range's bounds (1.000001 as itself, not as 1).
+std::string shortest_number(double v);
+
 /// Number `key` in [lo, hi] (finite); `fallback` when absent and `optional`.
 double number_in(const nlohmann::json& j, const std::string& where, const char* key, double lo, double hi,
                  bool optional = false, double fallback = 0);
