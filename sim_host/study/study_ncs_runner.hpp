@@ -101,14 +101,16 @@ engine::StudyFile loop_view(const engine::StudyFile& file, std::size_t i);
 
 /// Maps a file parsed with ncs_schema() onto the ncs loop; engine::InputError naming the
 /// file and the field for anything the loop cannot run, and for a scenario on which the
-/// reference approach I would cost 0 (a set-point that never changes, or a run that ends
-/// before its first change): every ratio to I would divide by 0.
+/// reference approach would cost 0 (I, or IK without noise, when the set-point never changes or
+/// the run ends before its first change): every ratio to it would divide by 0. With IK leading
+/// (plants of n > 6) and noise, such a scenario runs (a regulation study).
 NcsStudy map_ncs_study(const engine::StudyFile& file);
 
 /// Caps the simulated time of every scenario of `s` at `max_s` seconds (`study run
 /// --max-duration`, the fuzz harness); longer runs are cut there, shorter ones stay.
 /// engine::InputError naming `field` when `max_s` is not finite, below one period h, or
-/// before a scenario's first set-point switch (T_r/2: the reference approach I would cost 0).
+/// before a scenario's first set-point switch when the reference approach would then cost 0
+/// (I; IK without noise).
 /// `s` is unchanged when refused.
 void cap_duration(NcsStudy& s, double max_s, const std::string& field);
 
