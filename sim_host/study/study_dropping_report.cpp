@@ -14,31 +14,13 @@
 #include "study_dropping_runner.hpp"
 #include "study_dropping_study.hpp"
 #include "study_format.hpp"
+#include "study_text.hpp"
 
 namespace oneshot::study {
 namespace {
 
 /// Traces longer than this many steps keep every ⌈steps / this⌉-th step.
 constexpr std::size_t kMaxDropTraceRows = 5000;
-
-/// `v` in `format`, "—" when null or not finite (a diverged loop).
-std::string drop_cell_text(const nlohmann::json& v, const char* format) {
-  if (!v.is_number() || !std::isfinite(v.get<double>())) return "—";
-  char b[48];
-  std::snprintf(b, sizeof b, format, v.get<double>());
-  return b;
-}
-
-/// The file stem of approach `a` (index from 0) named `name`: trace_<a+1>_<name with every
-/// character outside [A-Za-z0-9._-] as '_'> (names come from the file: never a path).
-std::string drop_trace_stem(std::size_t a, const std::string& name) {
-  std::string out = "trace_" + std::to_string(a + 1) + "_";
-  for (char c : name) {
-    const bool ok = (c >= 'A' && c <= 'Z') || (c >= 'a' && c <= 'z') || (c >= '0' && c <= '9') || c == '.' || c == '_' || c == '-';
-    out += ok ? c : '_';
-  }
-  return out;
-}
 
 /// The gnuplot script of one traced run (see write_dropping_traces()).
 std::string drop_trace_plot(const std::string& stem, const std::string& title) {
@@ -112,7 +94,7 @@ nlohmann::json write_dropping_traces(const DroppingStudy& s, const std::vector<s
       rows.push_back({static_cast<double>(k), static_cast<double>(k) * period_s, t.r[k], t.y[k], t.cx[k], t.cxhat[k], t.u[k],
                       t.trace_p[k], t.err[k]});
     }
-    const std::string stem = drop_trace_stem(a, s.approaches[a]);
+    const std::string stem = trace_stem(a, s.approaches[a]);
     util::write_csv(util::path_in(out_dir, stem + ".csv"), {"k", "t_s", "r", "y", "cx", "cxhat", "u", "trace_p", "err"}, rows,
                     util::NonFinite::kMissing);
     nlohmann::json e = {{"scenario", s.scenarios[0]}, {"seed", s.first_seed}, {"cost", dropping::num(m.cost)}, {"every_steps", step},
@@ -158,7 +140,7 @@ std::string dropping_report_markdown(const DroppingStudy& s, const std::string& 
       for (std::size_t b = a + 1; b < spec.approaches.size(); ++b) {
         const std::string key = spec.approaches[a] + "-" + spec.approaches[b];
         const nlohmann::json& p = outputs.at("paired_differences").at(key);
-        md << "| " << key << " | " << drop_cell_text(p.at("mean"), "%.6g") << " | ± " << drop_cell_text(p.at("ci95"), "%.3g") << " |\n";
+        md << "| " << key << " | " << md_cell(p.at("mean"), "%.6g") << " | ± " << md_cell(p.at("ci95"), "%.3g") << " |\n";
       }
     md << "\n";
   }
@@ -178,8 +160,8 @@ std::string dropping_report_markdown(const DroppingStudy& s, const std::string& 
     const nlohmann::json ratio = e.at("cost_mean").is_number() && err.is_number() && trp.is_number() && trp.get<double>() > 0
                                      ? nlohmann::json(err.get<double>() / trp.get<double>())
                                      : nlohmann::json(nullptr);
-    md << "| " << a << " | " << drop_cell_text(err, "%.6g") << " | " << drop_cell_text(trp, "%.6g") << " | " << drop_cell_text(ratio, "%.4g")
-       << " | " << drop_cell_text(e.at("gamma_mean"), "%.4f") << " |\n";
+    md << "| " << a << " | " << md_cell(err, "%.6g") << " | " << md_cell(trp, "%.6g") << " | " << md_cell(ratio, "%.4g")
+       << " | " << md_cell(e.at("gamma_mean"), "%.4f") << " |\n";
   }
   const std::string link = spec.config.at("link").get<std::string>();
   md << "\n### Links\n\nTotals over every run of the link `" << link
@@ -212,7 +194,7 @@ std::string dropping_report_markdown(const DroppingStudy& s, const std::string& 
       const nlohmann::json& e = traces.at(an);
       char line[160];
       std::snprintf(line, sizeof line, "(the sweep's run: %.6g)", r.at(a, 0, 0, cost));
-      md << "- " << an << " on " << e.at("scenario").get<std::string>() << ": cost " << drop_cell_text(e.at("cost"), "%.6g") << " "
+      md << "- " << an << " on " << e.at("scenario").get<std::string>() << ": cost " << md_cell(e.at("cost"), "%.6g") << " "
          << line << "; files:";
       for (const auto& f : e.at("files")) md << " `" << f.get<std::string>() << "`";
       md << "\n";

@@ -16,6 +16,7 @@
 #include "oneshot/util/output_files.hpp"
 #include "study_dropping_study.hpp"
 #include "study_format.hpp"
+#include "study_text.hpp"
 #include "sweep_parts.hpp"
 
 namespace oneshot::study {
@@ -32,14 +33,6 @@ double drop_mean(const std::vector<double>& v) {
       ++n;
     }
   return n == 0 ? std::nan("") : s / static_cast<double>(n);
-}
-
-/// `v` in `format` for a table, "—" when not finite (a diverged loop).
-std::string drop_md(double v, const char* format) {
-  if (!std::isfinite(v)) return "—";
-  char b[48];
-  std::snprintf(b, sizeof b, format, v);
-  return b;
 }
 
 }  // namespace
@@ -144,9 +137,9 @@ nlohmann::json dropping_run_outputs(const engine::SweepResults& r, const std::st
                            {"trace_p_mean", dropping::num(drop_mean(trp))},
                            {"gamma_mean", dropping::num(drop_mean(gam))},
                            {"failed_runs", failed}};
-    md << "| " << nm << " | " << kind << " | " << drop_md(sm.value[a].mean, "%.6g") << " | ± " << drop_md(sm.value[a].ci95, "%.3g") << " | "
-       << drop_md(sm.ratio_of_means[a], "%.4f") << " ± " << drop_md(sm.ratio[a].ci95, "%.4f") << " | " << drop_md(drop_mean(err), "%.6g")
-       << " | " << drop_md(drop_mean(trp), "%.6g") << " | " << drop_md(drop_mean(gam), "%.4f") << " | " << failed << " |\n";
+    md << "| " << nm << " | " << kind << " | " << md_cell(sm.value[a].mean, "%.6g") << " | ± " << md_cell(sm.value[a].ci95, "%.3g") << " | "
+       << md_cell(sm.ratio_of_means[a], "%.4f") << " ± " << md_cell(sm.ratio[a].ci95, "%.4f") << " | " << md_cell(drop_mean(err), "%.6g")
+       << " | " << md_cell(drop_mean(trp), "%.6g") << " | " << md_cell(drop_mean(gam), "%.4f") << " | " << failed << " |\n";
   }
   engine::add_order_by_mean(j, r, sm);
   if (!sm.paired.empty()) j["paired_differences"] = engine::paired_differences_json(r, sm);
@@ -164,7 +157,7 @@ nlohmann::json dropping_run_outputs(const engine::SweepResults& r, const std::st
       e["cost_ci95"][nm] = dropping::num(sm.per_scenario[a][x].ci95);
       e["ratio_to_" + ref][nm] = dropping::num(sm.per_scenario_ratio[a][x].mean);
       e["ratio_to_" + ref + "_ci95"][nm] = dropping::num(sm.per_scenario_ratio[a][x].ci95);
-      md << " " << drop_md(sm.per_scenario[a][x].mean, "%.6g") << " |";
+      md << " " << md_cell(sm.per_scenario[a][x].mean, "%.6g") << " |";
     }
     md << "\n";
     j["per_scenario"].push_back(e);

@@ -24,21 +24,12 @@
 #include "oneshot/util/output_files.hpp"
 #include "study_bench.hpp"
 #include "study_oneshot_study.hpp"
+#include "study_text.hpp"
 
 namespace oneshot::study {
 namespace {
 
 const char* const kOneShotMetrics[] = {"cost", "saturated", "overruns", "faults", "jobs"};
-
-/// `v` in `format` for a table, "—" when not finite.
-std::string os_md(double v, const char* format) {
-  if (!std::isfinite(v)) return "—";
-  char b[48];
-  std::snprintf(b, sizeof b, format, v);
-  return b;
-}
-
-nlohmann::json os_num(double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr); }
 
 std::string hex64(std::uint64_t v) {
   char b[20];
@@ -155,18 +146,18 @@ nlohmann::json oneshot_run_outputs(const engine::SweepResults& r, const std::str
     const std::string kind = set.at("kind").get<std::string>(), description = set.at("description").get<std::string>();
     j["approaches"][nm] = {{"kind", kind},
                            {"description", description},
-                           {"cost_mean", os_num(sm.value[a].mean)},
-                           {"cost_ci95", os_num(sm.value[a].ci95)},
-                           {"ratio_to_" + ref, os_num(sm.ratio_of_means[a])},
-                           {"ratio_mean", os_num(sm.ratio[a].mean)},
-                           {"ratio_ci95", os_num(sm.ratio[a].ci95)},
-                           {"ratio_scenario_weighted", os_num(sm.ratio_weighted[a].mean)},
-                           {"ratio_scenario_weighted_ci95", os_num(sm.ratio_weighted[a].ci95)},
+                           {"cost_mean", finite_or_null(sm.value[a].mean)},
+                           {"cost_ci95", finite_or_null(sm.value[a].ci95)},
+                           {"ratio_to_" + ref, finite_or_null(sm.ratio_of_means[a])},
+                           {"ratio_mean", finite_or_null(sm.ratio[a].mean)},
+                           {"ratio_ci95", finite_or_null(sm.ratio[a].ci95)},
+                           {"ratio_scenario_weighted", finite_or_null(sm.ratio_weighted[a].mean)},
+                           {"ratio_scenario_weighted_ci95", finite_or_null(sm.ratio_weighted[a].ci95)},
                            {"saturated_runs", saturated},
                            {"overruns", overruns},
                            {"faults", faults}};
-    md << "| " << nm << " | " << kind << " | " << description << " | " << os_md(sm.value[a].mean, "%.6g") << " | ± "
-       << os_md(sm.value[a].ci95, "%.3g") << " | " << os_md(sm.ratio_of_means[a], "%.4f") << " ± " << os_md(sm.ratio[a].ci95, "%.4f")
+    md << "| " << nm << " | " << kind << " | " << description << " | " << md_cell(sm.value[a].mean, "%.6g") << " | ± "
+       << md_cell(sm.value[a].ci95, "%.3g") << " | " << md_cell(sm.ratio_of_means[a], "%.4f") << " ± " << md_cell(sm.ratio[a].ci95, "%.4f")
        << " | " << saturated << " | " << overruns << " |\n";
   }
   engine::add_order_by_mean(j, r, sm);
@@ -183,11 +174,11 @@ nlohmann::json oneshot_run_outputs(const engine::SweepResults& r, const std::str
     md << "| " << spec.scenarios[x] << " | " << sc.at("jitter").get<std::string>() << " |";
     for (std::size_t a = 0; a < na; ++a) {
       const std::string& nm = spec.approaches[a];
-      e["cost_mean"][nm] = os_num(sm.per_scenario[a][x].mean);
-      e["cost_ci95"][nm] = os_num(sm.per_scenario[a][x].ci95);
-      e["ratio_to_" + ref][nm] = os_num(sm.per_scenario_ratio[a][x].mean);
-      e["ratio_to_" + ref + "_ci95"][nm] = os_num(sm.per_scenario_ratio[a][x].ci95);
-      md << " " << os_md(sm.per_scenario[a][x].mean, "%.6g") << " |";
+      e["cost_mean"][nm] = finite_or_null(sm.per_scenario[a][x].mean);
+      e["cost_ci95"][nm] = finite_or_null(sm.per_scenario[a][x].ci95);
+      e["ratio_to_" + ref][nm] = finite_or_null(sm.per_scenario_ratio[a][x].mean);
+      e["ratio_to_" + ref + "_ci95"][nm] = finite_or_null(sm.per_scenario_ratio[a][x].ci95);
+      md << " " << md_cell(sm.per_scenario[a][x].mean, "%.6g") << " |";
     }
     md << "\n";
     j["per_scenario"].push_back(e);

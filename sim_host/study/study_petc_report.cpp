@@ -10,28 +10,10 @@
 #include "oneshot/util/number_text.hpp"
 #include "oneshot/util/output_files.hpp"
 #include "study_petc_study.hpp"
+#include "study_text.hpp"
 
 namespace oneshot::study {
 namespace {
-
-/// `v` in `format`, "—" when null or not finite.
-std::string petc_cell_text(const nlohmann::json& v, const char* format) {
-  if (!v.is_number() || !std::isfinite(v.get<double>())) return "—";
-  char b[48];
-  std::snprintf(b, sizeof b, format, v.get<double>());
-  return b;
-}
-
-/// The file stem of approach `a` (index from 0) named `name`: trace_<a+1>_<name with every
-/// character outside [A-Za-z0-9._-] as '_'> (names come from the file: never a path).
-std::string petc_trace_stem(std::size_t a, const std::string& name) {
-  std::string out = "trace_" + std::to_string(a + 1) + "_";
-  for (char c : name) {
-    const bool ok = (c >= 'A' && c <= 'Z') || (c >= 'a' && c <= 'z') || (c >= '0' && c <= '9') || c == '.' || c == '_' || c == '-';
-    out += ok ? c : '_';
-  }
-  return out;
-}
 
 /// The gnuplot script of one traced run (see write_petc_traces()).
 std::string petc_trace_plot(const std::string& stem, const std::string& title) {
@@ -65,10 +47,10 @@ nlohmann::json write_petc_traces(const PetcStudy& s, const std::vector<std::size
     for (std::size_t k = 0; k < t.y_true.size() && k < t.u.size() && k < t.d.size(); ++k)
       rows.push_back({static_cast<double>(k), static_cast<double>(k) * period_s, st.opt.reference, t.y_true[k], t.y_meas[k], t.u[k],
                       t.d[k], t.d_hat[k], static_cast<double>(t.sensor_sent[k]), static_cast<double>(t.actuator_sent[k])});
-    const std::string stem = petc_trace_stem(a, s.approaches[a]);
+    const std::string stem = trace_stem(a, s.approaches[a]);
     util::write_csv(util::path_in(out_dir, stem + ".csv"),
                     {"k", "t_s", "r", "y", "y_meas", "u", "d", "d_hat", "sensor_sent", "actuator_sent"}, rows);
-    nlohmann::json e = {{"scenario", s.scenarios[0]}, {"seed", s.first_seed}, {"cost", std::isfinite(v[petc_gpi_index()]) ? nlohmann::json(v[petc_gpi_index()]) : nlohmann::json(nullptr)}, {"files", {stem + ".csv"}}};
+    nlohmann::json e = {{"scenario", s.scenarios[0]}, {"seed", s.first_seed}, {"cost", finite_or_null(v[petc_gpi_index()])}, {"files", {stem + ".csv"}}};
     if (plots) {
       const std::string title = s.approaches[a] + " (" + s.kinds[a] + ") on " + s.scenarios[0] + ", seed " +
                                 std::to_string(s.first_seed) + ": output and samples, input and packets, d and d hat";
@@ -130,7 +112,7 @@ std::string petc_report_markdown(const PetcStudy& s, const std::string& file, co
   if (j.contains("paired_differences")) {
     md << "Paired differences of the GPI (A - B per seed, mean and 95 % interval):\n\n| pair | mean | 95 % CI |\n|---|---|---|\n";
     for (const auto& [pair, p] : j.at("paired_differences").items())
-      md << "| " << pair << " | " << petc_cell_text(p.at("mean"), "%.6g") << " | ± " << petc_cell_text(p.at("ci95"), "%.3g") << " |\n";
+      md << "| " << pair << " | " << md_cell(p.at("mean"), "%.6g") << " | ± " << md_cell(p.at("ci95"), "%.3g") << " |\n";
     md << "\n";
   }
   if (!plot_path.empty()) md << "![GPI](" << plot_path << ")\n\n";
@@ -138,7 +120,7 @@ std::string petc_report_markdown(const PetcStudy& s, const std::string& file, co
         "run | max per arrival | ISEP | rms d |\n|---|---|---|---|---|---|---|---|\n";
   for (const std::string& a : spec.approaches) {
     const nlohmann::json& m = j.at("approaches").at(a).at("metrics");
-    const auto mean = [&](const char* k, const char* f = "%.4g") { return petc_cell_text(m.at(k).at("mean"), f); };
+    const auto mean = [&](const char* k, const char* f = "%.4g") { return md_cell(m.at(k).at("mean"), f); };
     md << "| " << a << " | " << mean("longest_silence_sensor") << " / " << mean("longest_silence_actuator") << " | "
        << mean("sensor_safety_fires") << " / " << mean("controller_safety_fires") << " | " << mean("N_max") << " | " << mean("macs")
        << " | " << mean("macs_max_arrival") << " | " << mean("ISEP") << " | " << mean("d_rms") << " |\n";
@@ -146,8 +128,8 @@ std::string petc_report_markdown(const PetcStudy& s, const std::string& file, co
   md << "\n## Links\n\nZero delay, no loss: every frame sent is delivered.\n\n| approach | link | sent | delivered |\n|---|---|---|---|\n";
   for (const std::string& a : spec.approaches)
     for (const auto& [link, c] : j.at("links").at(a).items())
-      md << "| " << a << " | " << link << " | " << petc_cell_text(c.at("sent"), "%.0f") << " | "
-         << petc_cell_text(c.at("delivered"), "%.0f") << " |\n";
+      md << "| " << a << " | " << link << " | " << md_cell(c.at("sent"), "%.0f") << " | "
+         << md_cell(c.at("delivered"), "%.0f") << " |\n";
   if (!traces.empty()) {
     md << "\n## Traces\n\nOne run per approach on the first scenario and the first seed (the sweep's run: same seed, same "
           "draws; the trace only records). "
@@ -162,7 +144,7 @@ std::string petc_report_markdown(const PetcStudy& s, const std::string& file, co
       const nlohmann::json& e = traces.at(an);
       char line[160];
       std::snprintf(line, sizeof line, "(the sweep's run: %.6g)", r.at(a, 0, 0, cost));
-      md << "- " << an << " on " << e.at("scenario").get<std::string>() << ": GPI " << petc_cell_text(e.at("cost"), "%.6g") << " "
+      md << "- " << an << " on " << e.at("scenario").get<std::string>() << ": GPI " << md_cell(e.at("cost"), "%.6g") << " "
          << line << "; files:";
       for (const auto& f : e.at("files")) md << " `" << f.get<std::string>() << "`";
       md << "\n";

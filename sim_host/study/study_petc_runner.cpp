@@ -20,22 +20,12 @@
 #include "petc_experiments.hpp"
 #include "study_bench.hpp"
 #include "study_petc_study.hpp"
+#include "study_text.hpp"
 
 namespace oneshot::study {
 namespace {
 
 namespace pt = sim::petc;
-
-/// A finite number, or null.
-nlohmann::json petc_num(double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr); }
-
-/// `v` in `format` for a table, "—" when not finite.
-std::string petc_md(double v, const char* format) {
-  if (!std::isfinite(v)) return "—";
-  char b[48];
-  std::snprintf(b, sizeof b, format, v);
-  return b;
-}
 
 /// The sweep's configuration: what a shard must agree on (the file, the plant, per scenario the
 /// design's options and digest, per approach its cases).
@@ -132,18 +122,18 @@ nlohmann::json petc_run_outputs(const engine::SweepResults& r, const std::string
     for (std::size_t m = 1; m < spec.metrics.size(); ++m) metrics[spec.metrics[m]] = util::mean_ci_json(all[m - 1].value[a]);
     const std::string kind = spec.config.at("approaches")[a].at("kind").get<std::string>();
     j["approaches"][nm] = {{"kind", kind},
-                           {"cost_mean", petc_num(sm.value[a].mean)},
-                           {"cost_ci95", petc_num(sm.value[a].ci95)},
-                           {"ratio_to_" + ref, petc_num(sm.ratio_of_means[a])},
-                           {"ratio_mean", petc_num(sm.ratio[a].mean)},
-                           {"ratio_ci95", petc_num(sm.ratio[a].ci95)},
+                           {"cost_mean", finite_or_null(sm.value[a].mean)},
+                           {"cost_ci95", finite_or_null(sm.value[a].ci95)},
+                           {"ratio_to_" + ref, finite_or_null(sm.ratio_of_means[a])},
+                           {"ratio_mean", finite_or_null(sm.ratio[a].mean)},
+                           {"ratio_ci95", finite_or_null(sm.ratio[a].ci95)},
                            {"metrics", metrics}};
     const auto cell = [&](const char* name) {
       const util::Summary& v = metric_mean(name)[a];
-      return petc_md(v.mean, "%.4g") + " ± " + petc_md(v.ci95, "%.2g");
+      return md_cell(v.mean, "%.4g") + " ± " + md_cell(v.ci95, "%.2g");
     };
-    md << "| " << nm << " | " << kind << " | " << petc_md(sm.value[a].mean, "%.6g") << " | ± " << petc_md(sm.value[a].ci95, "%.3g")
-       << " | " << petc_md(sm.ratio_of_means[a], "%.4f") << " ± " << petc_md(sm.ratio[a].ci95, "%.4f") << " | " << cell("U_c")
+    md << "| " << nm << " | " << kind << " | " << md_cell(sm.value[a].mean, "%.6g") << " | ± " << md_cell(sm.value[a].ci95, "%.3g")
+       << " | " << md_cell(sm.ratio_of_means[a], "%.4f") << " ± " << md_cell(sm.ratio[a].ci95, "%.4f") << " | " << cell("U_c")
        << " | " << cell("U_a") << " | " << cell("C_c") << " | " << cell("N_E") << " | " << cell("d_error_rms") << " |\n";
   }
   engine::add_order_by_mean(j, r, sm);
@@ -158,11 +148,11 @@ nlohmann::json petc_run_outputs(const engine::SweepResults& r, const std::string
     md << "| " << spec.scenarios[x] << " |";
     for (std::size_t a = 0; a < na; ++a) {
       const std::string& nm = spec.approaches[a];
-      e["cost_mean"][nm] = petc_num(sm.per_scenario[a][x].mean);
-      e["cost_ci95"][nm] = petc_num(sm.per_scenario[a][x].ci95);
-      e["ratio_to_" + ref][nm] = petc_num(sm.per_scenario_ratio[a][x].mean);
-      e["ratio_to_" + ref + "_ci95"][nm] = petc_num(sm.per_scenario_ratio[a][x].ci95);
-      md << " " << petc_md(sm.per_scenario[a][x].mean, "%.6g") << " |";
+      e["cost_mean"][nm] = finite_or_null(sm.per_scenario[a][x].mean);
+      e["cost_ci95"][nm] = finite_or_null(sm.per_scenario[a][x].ci95);
+      e["ratio_to_" + ref][nm] = finite_or_null(sm.per_scenario_ratio[a][x].mean);
+      e["ratio_to_" + ref + "_ci95"][nm] = finite_or_null(sm.per_scenario_ratio[a][x].ci95);
+      md << " " << md_cell(sm.per_scenario[a][x].mean, "%.6g") << " |";
     }
     md << "\n";
     j["per_scenario"].push_back(e);

@@ -22,30 +22,13 @@
 #include "study_file_report.hpp"
 #include "study_sod_runner.hpp"
 #include "study_sod_study.hpp"
+#include "study_text.hpp"
 
 namespace oneshot::study {
 namespace {
 
 /// Traces longer than this many steps keep every ⌈steps / this⌉-th step.
 constexpr std::size_t kMaxSodTraceRows = 5000;
-
-/// A JSON number in `format`, "—" when null or not finite.
-std::string sod_cell_text(const nlohmann::json& v, const char* format) {
-  if (!v.is_number() || !std::isfinite(v.get<double>())) return "—";
-  char b[48];
-  std::snprintf(b, sizeof b, format, v.get<double>());
-  return b;
-}
-
-/// trace_<a+1>_<name with every character outside [A-Za-z0-9._-] as '_'> (never a path).
-std::string sod_trace_stem(std::size_t a, const std::string& name) {
-  std::string out = "trace_" + std::to_string(a + 1) + "_";
-  for (char c : name) {
-    const bool ok = (c >= 'A' && c <= 'Z') || (c >= 'a' && c <= 'z') || (c >= '0' && c <= '9') || c == '.' || c == '_' || c == '-';
-    out += ok ? c : '_';
-  }
-  return out;
-}
 
 /// OUT/table_summary.csv and, with `plots`, table.png: one bar per approach at its mean cost
 /// e1 + e2 (over seeds of the scenario mean) with its 95 % interval. Returns the files.
@@ -100,11 +83,11 @@ nlohmann::json write_sod_traces(const SodStudy& s, const SodDesigns& d, const st
                                static_cast<double>(t.arrived[i][k])});
       rows.push_back(row);
     }
-    const std::string stem = sod_trace_stem(a, s.approaches[a].name);
+    const std::string stem = trace_stem(a, s.approaches[a].name);
     util::write_csv(util::path_in(out_dir, stem + ".csv"),
                     {"k", "t_s", "x1", "xhat1", "y1", "z1", "sent1", "arrived1", "x2", "xhat2", "y2", "z2", "sent2", "arrived2"}, rows,
                     util::NonFinite::kMissing);
-    nlohmann::json e = {{"scenario", s.scenarios[0].name}, {"seed", s.first_seed}, {"cost", std::isfinite(m.e[0] + m.e[1]) ? nlohmann::json(m.e[0] + m.e[1]) : nlohmann::json(nullptr)}, {"every_steps", step},
+    nlohmann::json e = {{"scenario", s.scenarios[0].name}, {"seed", s.first_seed}, {"cost", finite_or_null(m.e[0] + m.e[1])}, {"every_steps", step},
                         {"files", {stem + ".csv"}}};
     if (plots) {
       const std::string csv = util::gnuplot_quote(stem + ".csv");
@@ -153,7 +136,7 @@ std::string sod_report_markdown(const SodStudy& s, const std::string& file, cons
       for (std::size_t b = a + 1; b < spec.approaches.size(); ++b) {
         const std::string key = spec.approaches[a] + "-" + spec.approaches[b];
         const nlohmann::json& p = outputs.at("paired_differences").at(key);
-        md << "| " << key << " | " << sod_cell_text(p.at("mean"), "%.6g") << " | ± " << sod_cell_text(p.at("ci95"), "%.3g") << " |\n";
+        md << "| " << key << " | " << md_cell(p.at("mean"), "%.6g") << " | ± " << md_cell(p.at("ci95"), "%.3g") << " |\n";
       }
     md << "\n";
   }
@@ -164,7 +147,7 @@ std::string sod_report_markdown(const SodStudy& s, const std::string& file, cons
   for (const std::string& a : spec.approaches)
     for (const auto& [link, e] : outputs.at("links").at(a).items()) {
       md << "| " << a << " | " << link << " |";
-      for (const char* c : {"sent", "delivered", "lost", "time_rule_sent", "detected"}) md << " " << sod_cell_text(e.at(c), "%.0f") << " |";
+      for (const char* c : {"sent", "delivered", "lost", "time_rule_sent", "detected"}) md << " " << md_cell(e.at(c), "%.0f") << " |";
       md << "\n";
     }
   if (!traces.empty()) {
@@ -175,8 +158,8 @@ std::string sod_report_markdown(const SodStudy& s, const std::string& file, cons
       const std::string& an = spec.approaches[a];
       if (!traces.contains(an)) continue;
       const nlohmann::json& e = traces.at(an);
-      md << "- " << an << " on " << e.at("scenario").get<std::string>() << ": e1 + e2 " << sod_cell_text(e.at("cost"), "%.6g")
-         << " (the sweep's run: " << sod_cell_text(r.at(a, 0, 0, r.metric("cost")), "%.6g") << "); files:";
+      md << "- " << an << " on " << e.at("scenario").get<std::string>() << ": e1 + e2 " << md_cell(e.at("cost"), "%.6g")
+         << " (the sweep's run: " << md_cell(r.at(a, 0, 0, r.metric("cost")), "%.6g") << "); files:";
       for (const auto& f : e.at("files")) md << " `" << f.get<std::string>() << "`";
       md << "\n";
       if (plots) md << "\n![" << an << "](" << e.at("files").back().get<std::string>() << ")\n\n";

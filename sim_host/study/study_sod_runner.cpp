@@ -19,23 +19,13 @@
 #include "oneshot/util/output_files.hpp"
 #include "oneshot/util/statistics.hpp"
 #include "study_sod_study.hpp"
+#include "study_text.hpp"
 
 namespace oneshot::study {
 namespace {
 
 const char* const kSodMetrics[] = {"cost",  "e1",          "e2",          "e1_tail", "e2_tail", "nees",      "sends1",
                                    "sends2", "time_sends1", "time_sends2", "lost1",   "lost2",   "detected1", "detected2"};
-
-/// A number for JSON (non-finite → null).
-nlohmann::json sod_num(double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr); }
-
-/// `v` in `format` for a table, "—" when not finite.
-std::string sod_md(double v, const char* format) {
-  if (!std::isfinite(v)) return "—";
-  char b[48];
-  std::snprintf(b, sizeof b, format, v);
-  return b;
-}
 
 /// Metric `m` of approach `a` in scenario `x`, one value per seed.
 std::vector<double> sod_cell(const engine::SweepResults& r, std::size_t a, std::size_t x, std::size_t m) {
@@ -127,18 +117,18 @@ nlohmann::json sod_run_outputs(const engine::SweepResults& r, const std::string&
     const double e1 = over_scenarios(a, "e1"), e2 = over_scenarios(a, "e2"), nees = over_scenarios(a, "nees");
     const double p1 = over_scenarios(a, "sends1"), p2 = over_scenarios(a, "sends2");
     j["approaches"][nm] = {{"kind", kind},
-                           {"cost_mean", sod_num(sm.value[a].mean)},
-                           {"cost_ci95", sod_num(sm.value[a].ci95)},
-                           {"ratio_to_" + ref, sod_num(sm.ratio_of_means[a])},
-                           {"ratio_mean", sod_num(sm.ratio[a].mean)},
-                           {"ratio_ci95", sod_num(sm.ratio[a].ci95)},
-                           {"e1_mean", sod_num(e1)},
-                           {"e2_mean", sod_num(e2)},
-                           {"nees_mean", sod_num(nees)},
-                           {"packets_mean", {sod_num(p1), sod_num(p2)}}};
-    md << "| " << nm << " | " << kind << " | " << sod_md(sm.value[a].mean, "%.6g") << " | ± " << sod_md(sm.value[a].ci95, "%.3g") << " | "
-       << sod_md(sm.ratio_of_means[a], "%.4f") << " ± " << sod_md(sm.ratio[a].ci95, "%.4f") << " | " << sod_md(e1, "%.4g") << " | "
-       << sod_md(e2, "%.4g") << " | " << sod_md(nees, "%.4g") << " | " << sod_md(p1, "%.5g") << " | " << sod_md(p2, "%.5g") << " |\n";
+                           {"cost_mean", finite_or_null(sm.value[a].mean)},
+                           {"cost_ci95", finite_or_null(sm.value[a].ci95)},
+                           {"ratio_to_" + ref, finite_or_null(sm.ratio_of_means[a])},
+                           {"ratio_mean", finite_or_null(sm.ratio[a].mean)},
+                           {"ratio_ci95", finite_or_null(sm.ratio[a].ci95)},
+                           {"e1_mean", finite_or_null(e1)},
+                           {"e2_mean", finite_or_null(e2)},
+                           {"nees_mean", finite_or_null(nees)},
+                           {"packets_mean", {finite_or_null(p1), finite_or_null(p2)}}};
+    md << "| " << nm << " | " << kind << " | " << md_cell(sm.value[a].mean, "%.6g") << " | ± " << md_cell(sm.value[a].ci95, "%.3g") << " | "
+       << md_cell(sm.ratio_of_means[a], "%.4f") << " ± " << md_cell(sm.ratio[a].ci95, "%.4f") << " | " << md_cell(e1, "%.4g") << " | "
+       << md_cell(e2, "%.4g") << " | " << md_cell(nees, "%.4g") << " | " << md_cell(p1, "%.5g") << " | " << md_cell(p2, "%.5g") << " |\n";
   }
   engine::add_order_by_mean(j, r, sm);
   if (!sm.paired.empty()) j["paired_differences"] = engine::paired_differences_json(r, sm);
@@ -153,10 +143,10 @@ nlohmann::json sod_run_outputs(const engine::SweepResults& r, const std::string&
     md << "| " << spec.scenarios[x] << " | " << xi << " |";
     for (std::size_t a = 0; a < na; ++a) {
       const std::string& nm = spec.approaches[a];
-      e["cost_mean"][nm] = sod_num(sm.per_scenario[a][x].mean);
-      e["cost_ci95"][nm] = sod_num(sm.per_scenario[a][x].ci95);
-      e["ratio_to_" + ref][nm] = sod_num(sm.per_scenario_ratio[a][x].mean);
-      e["ratio_to_" + ref + "_ci95"][nm] = sod_num(sm.per_scenario_ratio[a][x].ci95);
+      e["cost_mean"][nm] = finite_or_null(sm.per_scenario[a][x].mean);
+      e["cost_ci95"][nm] = finite_or_null(sm.per_scenario[a][x].ci95);
+      e["ratio_to_" + ref][nm] = finite_or_null(sm.per_scenario_ratio[a][x].mean);
+      e["ratio_to_" + ref + "_ci95"][nm] = finite_or_null(sm.per_scenario_ratio[a][x].ci95);
       for (const char* m : {"e1", "e2", "e1_tail", "e2_tail", "nees"}) e[m][nm] = util::mean_ci_json(stat(a, x, m));
       for (int i = 1; i <= 2; ++i) {
         const std::string n = std::to_string(i);
@@ -165,9 +155,9 @@ nlohmann::json sod_run_outputs(const engine::SweepResults& r, const std::string&
         e["losses"][nm].push_back(util::mean_ci_json(stat(a, x, "lost" + n)));
         e["detected_losses"][nm].push_back(util::mean_ci_json(stat(a, x, "detected" + n)));
       }
-      md << " " << sod_md(stat(a, x, "e1").mean, "%.4g") << " | " << sod_md(stat(a, x, "e2").mean, "%.4g") << " | "
-         << sod_md(stat(a, x, "nees").mean, "%.4g") << " | "
-         << sod_md(stat(a, x, "sends1").mean + stat(a, x, "sends2").mean, "%.5g") << " |";
+      md << " " << md_cell(stat(a, x, "e1").mean, "%.4g") << " | " << md_cell(stat(a, x, "e2").mean, "%.4g") << " | "
+         << md_cell(stat(a, x, "nees").mean, "%.4g") << " | "
+         << md_cell(stat(a, x, "sends1").mean + stat(a, x, "sends2").mean, "%.5g") << " |";
     }
     md << "\n";
     j["per_scenario"].push_back(e);

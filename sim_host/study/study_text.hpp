@@ -1,0 +1,42 @@
+/// @file study_text.hpp
+/// @brief The number and name formatting that the study files' summaries and reports share
+///        (study_dropping_*, study_sod_*, study_petc_*, study_oneshot_*).
+#pragma once
+
+#include <cmath>
+#include <cstddef>
+#include <cstdio>
+#include <string>
+
+#include <nlohmann/json.hpp>
+
+namespace oneshot::study {
+
+/// A number for JSON: null when not finite (a diverged run is shown, and the JSON stays valid).
+inline nlohmann::json finite_or_null(double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr); }
+
+/// `v` in printf `format` for a markdown table, "—" when not finite (a diverged loop).
+inline std::string md_cell(double v, const char* format) {
+  if (!std::isfinite(v)) return "—";
+  char b[48];
+  std::snprintf(b, sizeof b, format, v);
+  return b;
+}
+
+/// A JSON number in printf `format`, "—" when null or not finite.
+inline std::string md_cell(const nlohmann::json& v, const char* format) {
+  return v.is_number() ? md_cell(v.get<double>(), format) : std::string("—");
+}
+
+/// The file stem of approach `a` (index from 0) named `name`: trace_<a+1>_<name with every
+/// character outside [A-Za-z0-9._-] as '_'> (names come from the file: never a path).
+inline std::string trace_stem(std::size_t a, const std::string& name) {
+  std::string out = "trace_" + std::to_string(a + 1) + "_";
+  for (char c : name) {
+    const bool ok = (c >= 'A' && c <= 'Z') || (c >= 'a' && c <= 'z') || (c >= '0' && c <= '9') || c == '.' || c == '_' || c == '-';
+    out += ok ? c : '_';
+  }
+  return out;
+}
+
+}  // namespace oneshot::study
