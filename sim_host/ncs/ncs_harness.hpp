@@ -72,12 +72,23 @@ class BasicHarness {
         ref_(reference_of<S>(ctx, sc)),
         noisy_(noisy(a, opt)),
         h_(engine::from_us(ctx.period_us())),
-        offset_(engine::from_us(on != nullptr ? on->clock_offset_us : 0)),
+        offset_(engine::from_us(on != nullptr ? on->clock_offset_us : loop_phase_us(a, sc))),
         end_(offset_ + engine::from_seconds(sc.duration_s, "ncs scenario duration")) {
     if (offset_ < Duration{0} || offset_ >= h_) {
       throw std::invalid_argument("ncs: a loop's clock offset is in [0, h) (" + std::to_string(offset_.count() / 1000) + " us)");
     }
     if (own_world_ || end_ > world_.end) world_.end = end_;
+    // The timer node's φ is the loop's phase (in [0, h): above); the others' |φ| < h.
+    for (const std::int64_t phi : {sc.sensor_clock_us, sc.controller_clock_us, sc.actuator_clock_us}) {
+      if (phi != 0 && (on != nullptr || one_shot(a) || engine::from_us(phi < 0 ? -phi : phi) >= h_)) {
+        throw std::invalid_argument("ncs: a node's clock offset is within (-h, h) in a loop run alone, not one-shot (" +
+                                    std::to_string(phi) + " us)");
+      }
+    }
+    on_bus_ = on != nullptr;
+    if (opt.analytic && (sc.sensor_clock_us != 0 || sc.controller_clock_us != 0 || sc.actuator_clock_us != 0)) {
+      throw std::invalid_argument("ncs: the analytic tracker runs the nodes on one clock (no clock offsets)");
+    }
     if (on != nullptr) {
       sensor_at_ = on->sensor;
       controller_at_ = on->controller;
@@ -151,6 +162,10 @@ class BasicHarness {
       kernel_.schedule(mark, EventClass::kRecord, at_mark);
     }
   }
+
+  /// Node `role`'s clock offset for the engine (its clock reads t + offset = t − φ: Scenario::sensor_clock_us);
+  /// 0 in a run of several loops (their clocks are the loop's phase alone).
+  Duration clock_offset_of(std::int64_t phi_us) const { return on_bus_ ? Duration{0} : -engine::from_us(phi_us); }
 
   /// Whether a run of `a` under `opt` draws process and measurement noise.
   static bool noisy(Approach a, const RunOptions& opt) { return !opt.noise_free && !opt.analytic && a != Approach::kI; }
@@ -376,6 +391,7 @@ class BasicHarness {
   Duration h_;
   Duration offset_;  ///< The loop's clock offset φ (LoopOnBus::clock_offset_us): its timer at kh + φ.
   SimTime end_;      ///< The loop's end: φ + the scenario's duration.
+  bool on_bus_ = false;  ///< One loop of several on one engine (LoopOnBus).
   Matrix<double, S::p, S::p> r_chol_{};  ///< Lower Cholesky factor of R (the measurement noise).
   InputVec u_min_;
   InputVec u_max_;

@@ -97,10 +97,12 @@ RunResult run_sampling(BasicHarness<S>& hs, Law law, Saturated saturated, bool s
       }
     }
   });
-  net.add_node(sensor_at, "sensor", Duration{0}, nullptr);
-  net.add_node(controller_at, "controller", Duration{0},
+  // Each node's clock reads t − φ of its own offset (Scenario::sensor_clock_us; the sensor's is
+  // the loop's phase): only the sensor's stamps read one, which the laws do not use.
+  net.add_node(sensor_at, "sensor", hs.clock_offset_of(hs.sc_.sensor_clock_us), nullptr);
+  net.add_node(controller_at, "controller", hs.clock_offset_of(hs.sc_.controller_clock_us),
                [&]() { hs.start_computation(compute_h); });
-  net.add_node(actuator_at, "actuator", Duration{0}, [&]() {
+  net.add_node(actuator_at, "actuator", hs.clock_offset_of(hs.sc_.actuator_clock_us), [&]() {
     act->on_receive();
     InputVec u;
     if (act->take_output(u)) hs.apply(u);
@@ -279,6 +281,20 @@ auto on_shape(const Context& ctx, Fn&& fn, NcsShapeOf force = {}) -> decltype(fn
 }
 
 }  // namespace
+
+std::int64_t loop_phase_us(Approach a, const Scenario& s) {
+  if (one_shot(a)) return 0;
+  return actuation_synchronized(a) ? s.actuator_clock_us : s.sensor_clock_us;
+}
+
+Scenario at_phase_zero(Scenario s, Approach a) {
+  const std::int64_t phi = loop_phase_us(a, s);
+  if (one_shot(a) || phi == 0) return s;
+  s.sensor_clock_us -= phi;  // the timer node's to 0, the others by as much
+  s.controller_clock_us -= phi;
+  s.actuator_clock_us -= phi;
+  return s;
+}
 
 RunResult run_approach(const Context& ctx, Approach a, const Scenario& sc, std::uint64_t seed, const RunOptions& options) {
   return on_shape(ctx, [&](auto shape) {

@@ -209,7 +209,30 @@ struct Scenario {
   std::shared_ptr<const std::vector<std::pair<std::uint64_t, double>>> setpoint_changes;
   double setpoint_r0 = 0;            ///< r_0 of the stepped set-point (before its first change).
   std::string setpoint_description;  ///< The stepped set-point in one line (the sweep's configuration).
+  /// The nodes' clock offsets φ (whole µs, 0 ≤ φ < h; a study file's `nodes[i].clock_offset_us`):
+  /// a node's clock reads t − φ, so its timer at local kh fires at true kh + φ and its stamps
+  /// lag true time by φ. The loop's timer node gives the loop's phase (the sensor's for I, S,
+  /// SK, S+, IK; the actuator's for A, AK, AKx, AKl): the loop, its plant and set-point, shift
+  /// by it (LoopOnBus::clock_offset_us). The other nodes' offsets against it are clock
+  /// disagreements: the synchronized loops' sensor reads the actuator's t_k on its own clock
+  /// (τ_k biased by φ_s − φ_a); the controller's clock enters only through differences; the
+  /// sampling loops' controller and actuator read none. The one-shot loops take none (0).
+  std::int64_t sensor_clock_us = 0;
+  std::int64_t controller_clock_us = 0;  ///< The controller's φ_c (sensor_clock_us).
+  std::int64_t actuator_clock_us = 0;    ///< The actuator's φ_a (sensor_clock_us).
 };
+
+/// True when a node of `s` runs a clock offset (Scenario::sensor_clock_us).
+inline bool has_clock_offsets(const Scenario& s) {
+  return s.sensor_clock_us != 0 || s.controller_clock_us != 0 || s.actuator_clock_us != 0;
+}
+/// The loop's phase φ of approach `a` on `s` run alone: its timer node's clock offset (the
+/// actuator's for A, AK, AKx, AKl; the sensor's for I, S, SK, S+, IK; 0 for the one-shot loops).
+std::int64_t loop_phase_us(Approach a, const Scenario& s);
+/// `s` with every node's clock offset less the loop's phase of `a` (loop_phase_us()): the same
+/// loop at phase 0, the same cost to the bit (the timer node's clock then reads t, the others
+/// t − (φ_i − φ), possibly negative); what a trace runs (the trace is on the run's time).
+Scenario at_phase_zero(Scenario s, Approach a);
 
 /// Puts the steps (t_s, value) (times strictly increasing, the set-point 0 before the first)
 /// on the kh grid of `sc`: each step from the first period k with kh ≥ t_s (to the ns), r_0

@@ -73,7 +73,9 @@ RunResult run_synchronized(Harness& hs, Estimator est, std::int32_t late_us) {
                            hs.ref_.input(ctrl->last_k()), ctrl->last_command());
     }
   });
-  net.add_node(kSensor, "sensor", Duration{0}, [&]() {
+  // Each node's clock reads t − φ of its own offset (Scenario::sensor_clock_us): the actuator's
+  // is the loop's phase (its timer below at kh + φ_a), the sensor reads t_k on its own clock.
+  net.add_node(kSensor, "sensor", hs.clock_offset_of(hs.sc_.sensor_clock_us), [&]() {
     const McuInstant now = net.node_clock(kSensor);
     McuInstant at;
     if (!sensor->on_receive(now, at)) return;
@@ -86,9 +88,9 @@ RunResult run_synchronized(Harness& hs, Estimator est, std::int32_t late_us) {
       k.schedule_in(engine::from_us(wait_us), EventClass::kSample, sample_h);
     }
   });
-  net.add_node(kController, "controller", Duration{0},
+  net.add_node(kController, "controller", hs.clock_offset_of(hs.sc_.controller_clock_us),
                [&]() { hs.start_computation(compute_h); });
-  net.add_node(kActuator, "actuator", Duration{0}, [&]() { act->on_receive(); });
+  net.add_node(kActuator, "actuator", hs.clock_offset_of(hs.sc_.actuator_clock_us), [&]() { act->on_receive(); });
   hs.route_leg(kActuator, kSensor, "as");
   hs.route_leg(kSensor, kController, "sc");
   hs.route_leg(kController, kActuator, "ca");
@@ -135,7 +137,7 @@ RunResult run_synchronized(Harness& hs, Estimator est, std::int32_t late_us) {
     const SimTime t_next = k.now() + hs.h_;
     if (t_next < hs.end_) k.schedule(t_next, EventClass::kActuation, *timer_h, n + 1);
   });
-  k.schedule(SimTime{0}, EventClass::kActuation, *timer_h, 0);
+  k.schedule(SimTime{hs.offset_}, EventClass::kActuation, *timer_h, 0);  // at kh + φ_a (the loop's phase)
   RunResult r = hs.finish();
   r.late = act->statistics().late;
   r.saturated = ctrl->statistics().saturated;

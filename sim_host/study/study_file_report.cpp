@@ -148,7 +148,8 @@ nlohmann::json write_traces(const NcsStudy& s, const std::vector<std::size_t>& s
     const ncs::Approach ap = s.approaches[a];
     const std::string an = ncs::name(ap);
     const std::string stem = file_stem(an);
-    const ncs::RunResult r = ncs::run(*s.ctx, ap, sc, s.first_seed, ro);
+    // With clock offsets the loop at phase 0: its own time, the same cost to the bit (ncs::at_phase_zero()).
+    const ncs::RunResult r = ncs::run(*s.ctx, ap, ncs::at_phase_zero(sc, ap), s.first_seed, ro);
     std::vector<std::vector<double>> rows;
     rows.reserve(r.truth.size());
     for (std::size_t i = 0; i < r.truth.size() && i < r.setpoint.size(); ++i) {

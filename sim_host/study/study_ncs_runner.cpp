@@ -70,6 +70,7 @@ NcsStudy map_ncs_study(const engine::StudyFile& file) {
     std::uint32_t sod_time_steps = 0;
     std::optional<engine::TriggerSpec> mtm_rule;  // the sensor's MTM trigger (sod_field names it)
     std::int64_t phase_us = 0;
+    std::map<std::string, std::int64_t> clocks_us;  // role → its clock offset φ (µs), when not 0
     for (std::size_t i = 0; i < file.nodes.size(); ++i) {
       const engine::NodeSpec& n = file.nodes[i];
       const std::string f = at("nodes", i);
@@ -79,7 +80,18 @@ NcsStudy map_ncs_study(const engine::StudyFile& file) {
       }
       const bool timed_controller = one_shot && n.role == "controller";
       if (n.clock_offset.count() != 0 && !timed_controller) {
-        refuse(f + ".clock_offset_us", "study ncs runs its nodes on one clock (0 only; the one-shot controller's gives its phase)");
+        // The node's clock reads t − φ: its timer at kh + φ, its stamps φ behind (ncs::Scenario::sensor_clock_us).
+        if (one_shot) {
+          refuse(f + ".clock_offset_us", "a file with one-shot approaches runs its sensor and actuator on one clock (0 only; the "
+                                         "one-shot controller's gives its phase)");
+        }
+        if (!file.cpus.empty()) refuse(f + ".clock_offset_us", "clock offsets run without cpus (0 only in a file with cpus)");
+        const std::int64_t phi = n.clock_offset.count() / 1000;
+        if (!(phi >= 0 && phi < h_us) || phi * 1000 != n.clock_offset.count()) {
+          refuse(f + ".clock_offset_us", "the " + n.role + "'s clock reads t - clock_offset_us (its timer at kh + it): 0 <= it < h = " +
+                                             std::to_string(h_us) + " us (whole us)");
+        }
+        clocks_us[n.role] = phi;
       }
       const bool sod = n.trigger && n.trigger->rule == engine::TriggerSpec::Rule::kSendOnDelta && n.role == "sensor";
       const bool mtm = n.trigger && n.trigger->rule == engine::TriggerSpec::Rule::kMtm && n.role == "sensor";
@@ -241,7 +253,13 @@ NcsStudy map_ncs_study(const engine::StudyFile& file) {
     }
     // Scenarios: ncs Scenario fields, legs from the file with the scenario's overrides (study_ncs_scenario_map.hpp).
     const NcsScenarioInputs inputs{sod_delta, sod_time_steps, mtm_rule, phase_us, one_shot_triples};
-    for (std::size_t i = 0; i < file.scenarios.size(); ++i) out.scenarios.push_back(map_ncs_scenario(file, i, out, inputs));
+    for (std::size_t i = 0; i < file.scenarios.size(); ++i) {
+      out.scenarios.push_back(map_ncs_scenario(file, i, out, inputs));
+      ncs::Scenario& sc = out.scenarios.back();  // every scenario runs the nodes' clocks (only when not 0: the rest as it was)
+      for (const auto& [role, phi] : clocks_us) {
+        (role == "sensor" ? sc.sensor_clock_us : role == "controller" ? sc.controller_clock_us : sc.actuator_clock_us) = phi;
+      }
+    }
     if (one_shot) {
       // The one-shot filter corrects the outputs one at a time (a scalar correction each):
       // exact only for a diagonal measurement covariance.

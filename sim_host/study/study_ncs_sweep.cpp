@@ -174,6 +174,10 @@ nlohmann::json loop_sweep_config(const NcsStudy& s) {
                   {"legs", legs}});
     if (!x.bus_legs.empty()) sc.back()["bus_legs"] = bus_legs;
     if (x.setpoint_changes) sc.back()["reference"] = setpoint_json(x);  // only then: square-wave files' specs stay as they were
+    if (ncs::has_clock_offsets(x)) {  // likewise: files without clock offsets keep their spec
+      sc.back()["clock_offsets_us"] = {{"sensor", x.sensor_clock_us}, {"controller", x.controller_clock_us},
+                                       {"actuator", x.actuator_clock_us}};
+    }
   }
   nlohmann::json config = {{"study_file", s.source},
                            {"plant", s.ctx->plant().name},
@@ -231,6 +235,9 @@ engine::SweepResults run_ncs_sweep(const NcsStudy& s, std::size_t seeds, unsigne
   if (analytic && !board) {
     throw engine::InputError("field '--analytic': the analytic tracker is 2-state: it runs the board's plant (n = 2, m = 1, p = 2, C = I) only, not n = " +
                              std::to_string(plant.a.rows));
+  }
+  if (analytic && !s.scenarios.empty() && ncs::has_clock_offsets(s.scenarios[0])) {
+    throw engine::InputError("field '--analytic': the analytic tracker runs the nodes on one clock (nodes[].clock_offset_us 0)");
   }
   const bool sensor_on_cpu = !s.scenarios.empty() && s.scenarios[0].sensor_cpu != nullptr;
   if (analytic && sensor_on_cpu) {
