@@ -266,7 +266,7 @@ void expect_refused(const std::function<void(nlohmann::json&)>& edit, const std:
 }
 
 TEST(StudyFiles, WhatTheLoopCannotRunIsRefusedNamingTheField) {
-  expect_refused([](nlohmann::json& j) { j["nodes"][1]["clock_offset_us"] = 100; }, "field 'nodes[1].clock_offset_us'");
+  expect_refused([](nlohmann::json& j) { j["nodes"][1]["clock_offset_us"] = 50000; }, "field 'nodes[1].clock_offset_us'");  // = h
   expect_refused([](nlohmann::json& j) { j["nodes"][0]["address"] = 7; }, "field 'nodes[0].address'");
   expect_refused([](nlohmann::json& j) { j["nodes"][0]["period_us"] = 40000; }, "field 'nodes[0].period_us'");
   expect_refused([](nlohmann::json& j) { j["nodes"][1]["mode"] = "timer"; j["nodes"][1]["period_us"] = 50000; },
