@@ -18,6 +18,9 @@
 /// "actuator" restart at the spec's instants: a restarted node is rebuilt as at power-on
 /// (its interface emptied; the actuator's period index starts again from 0 at its next
 /// timer, the plant keeping the last applied input until a new command is applied).
+/// With clock offsets (Scenario::sensor_clock_us) each node's clock reads t − φ of its own: the
+/// timer node's φ shifts the loop (t_k = kh + φ_a, samples at kh + φ_s), the others' against it
+/// are what its nodes read on their clocks.
 #pragma once
 
 #include <array>

@@ -13,8 +13,10 @@
 /// approaches and S+ are refused then, as is the leg as on a bus. The set-point is the
 /// scenario's or the file's `reference` (square, steps, file), else the params' square wave; the
 /// one-shot loops' sensor may run send-on-delta or MTM, the one-shot controller's timer takes a
-/// phase, and in a file with several loops (`loops[]`) a loop's sensor phase (its
-/// `clock_offset_us`) is mapped. Everything else the schema accepts (other clock offsets, other
+/// phase, in a file with several loops (`loops[]`) a loop's sensor phase (its
+/// `clock_offset_us`) is mapped, and in a file of one loop without one-shot approaches or CPUs
+/// every node's `clock_offset_us` φ, 0 ≤ φ < h (ncs::Scenario::sensor_clock_us: its clock reads
+/// t − φ). Everything else the schema accepts (other clock offsets, other
 /// trigger rules, other addresses, other plant shapes, discrete plants) is refused with the field
 /// and the reason. The plant's mapping (plant file or inline plant) is study_plant_map.hpp's.
 #pragma once
