@@ -209,7 +209,8 @@ struct Scenario {
   std::shared_ptr<const std::vector<std::pair<std::uint64_t, double>>> setpoint_changes;
   double setpoint_r0 = 0;            ///< r_0 of the stepped set-point (before its first change).
   std::string setpoint_description;  ///< The stepped set-point in one line (the sweep's configuration).
-  /// The nodes' clock offsets φ (whole µs, 0 ≤ φ < h; a study file's `nodes[i].clock_offset_us`):
+  /// The nodes' clock offsets φ (whole µs; a study file's `nodes[i].clock_offset_us`, 0 ≤ φ < h;
+  /// a run takes the timer node's in [0, h), the others' in (−h, h): at_phase_zero()):
   /// a node's clock reads t − φ, so its timer at local kh fires at true kh + φ and its stamps
   /// lag true time by φ. The loop's timer node gives the loop's phase (the sensor's for I, S,
   /// SK, S+, IK; the actuator's for A, AK, AKx, AKl): the loop, its plant and set-point, shift
