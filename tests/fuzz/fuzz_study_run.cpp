@@ -13,7 +13,8 @@
 /// The other studies refuse --max-duration; their runs are bounded by editing the mapped
 /// study: at most kMaxRuns approaches (the file's first), their first scenarios up to kMaxRuns
 /// runs (at least one), one seed, and each scenario's length cut: dropping and sod at
-/// kMaxSteps steps (the mapped runs' `steps`; sod's δt design runs at the same steps), oneshot
+/// kMaxSteps steps (the mapped runs' `steps`; sod's δt design runs at the same steps; a sod
+/// input needing more than kMaxSodDesigns δt designs after the cut is skipped), oneshot
 /// at min(0.3 s, 20 h), at least h (the scenarios' duration_s; a CPU's schedule spans the
 /// same). A petc file's mapping designs over the whole horizon K (its TTS response), so petc
 /// inputs longer than kMaxPetcSeconds (50 periods of the petc plant's 20 us) or of a mapped
@@ -21,7 +22,7 @@
 ///
 /// Oracles: no crash; bad input refused by the parser (engine::InputError), what a loop
 /// cannot run refused by the mapping or the cap with engine::InputError naming the field
-/// ("field '…'"); a run gives finite metrics (cost, counters; with --analytic, chosen by the
+/// ("field '…'"; so must a sweep's refusal: sod's failed δt design); a run gives finite metrics (cost, counters; with --analytic, chosen by the
 /// input's length, the exact expected cost too), except the non-finite ones a study
 /// documents (dropping: a diverging loop's cost, err, trace_p; gamma but the buffered filter's), its link counters add up (ncs: delivered + lost =
 /// sent, late + refused ≤ delivered; dropping and sod: lost ≤ sent ≤ steps + 1) and the
