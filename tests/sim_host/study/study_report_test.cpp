@@ -19,8 +19,12 @@
 
 #include "ncs_loop.hpp"
 #include "oneshot/engine/study_file.hpp"
+#include "study_dropping_runner.hpp"
 #include "study_ncs_runner.hpp"
 #include "study_ncs_sweep.hpp"
+#include "study_oneshot_study.hpp"
+#include "study_petc_study.hpp"
+#include "study_sod_runner.hpp"
 #include "support/run_command.hpp"
 #include "support/temp_files.hpp"
 
@@ -203,21 +207,44 @@ TEST(StudyReport, MaxDurationCutsEveryScenario) {
 
 TEST(StudyReport, FuzzRunCorpusFilesRunWithinTheHarnessBound) {
   // The seeds of tests/fuzz/fuzz_study_run.cpp run, not refused: parsed in a folder that holds
-  // what the harness's holds, cut at the harness's 0.3 s (its run limit and oracles are the
-  // harness's own; here: every figure finite).
+  // what the harness's holds, ncs files cut at the harness's 0.3 s, the other studies' seeds
+  // (within the harness's cuts but oneshot's 1 s) run whole on one seed (the run limits and
+  // oracles are the harness's own; here: every figure finite).
   const std::string dir = test::made_dir("oneshot_study_report", "fuzz_corpus");
-  std::filesystem::copy_file(std::string(ONESHOT_STUDY_EXAMPLES_DIR) + "/../../../lut_gen/plants/networked_board.json",
-                             dir + "/networked_board.json");
+  for (const char* plant : {"networked_board.json", "sinopoli_dropping.json", "send_on_delta_oscillator.json", "hdd_numre.json",
+                            "reference_board.json"})
+    std::filesystem::copy_file(std::string(ONESHOT_STUDY_EXAMPLES_DIR) + "/../../../lut_gen/plants/" + plant, dir + "/" + plant);
   std::ofstream(dir + "/delays.csv") << "delay_us\n500\n# a comment\n1500\n\n250\n";
   std::size_t files = 0;
+  std::map<std::string, std::size_t> other;  // files per study other than ncs
   for (const auto& f : std::filesystem::directory_iterator(std::string(ONESHOT_STUDY_FUZZ_CORPUS) + "/../study_run")) {
     ++files;
-    NcsStudy s = map_ncs_study(engine::parse_study(test::read_file(f.path().string()), dir + "/fuzz.json", &ncs_schema(), dir));
+    const std::string text = test::read_file(f.path().string());
+    const std::string study = engine::parse_study(text, dir + "/fuzz.json", nullptr, dir).study;
+    if (study != "ncs") {
+      ++other[study];
+      const auto parse = [&](const engine::StudySchema& schema) { return engine::parse_study(text, dir + "/fuzz.json", &schema, dir); };
+      engine::SweepResults r;
+      if (study == "dropping") r = run_dropping_sweep(*map_dropping_study(parse(dropping_schema())), 1, 1, engine::Shard{});
+      if (study == "sod") r = run_sod_sweep(*map_sod_study(parse(sod_schema())), 1, 1, engine::Shard{});
+      if (study == "petc") r = run_petc_sweep(*map_petc_study(parse(petc_schema())), 1, 1, engine::Shard{});
+      if (study == "oneshot") r = run_oneshot_sweep(*map_oneshot_study(parse(oneshot_schema())), 1, 1, engine::Shard{});
+      EXPECT_TRUE(r.complete() && r.spec.runs() > 0) << f.path();
+      for (std::size_t a = 0; a < r.spec.approaches.size(); ++a)
+        for (std::size_t x = 0; x < r.spec.scenarios.size(); ++x)
+          for (std::size_t m = 0; m < r.spec.metrics.size(); ++m)  // dropping's gamma: the buffered filter's only (NaN otherwise)
+            if (study != "dropping" || r.spec.metrics[m] != "gamma") {
+              EXPECT_TRUE(std::isfinite(r.at(a, x, 0, m))) << f.path() << " " << r.spec.metrics[m];
+            }
+      continue;
+    }
+    NcsStudy s = map_ncs_study(engine::parse_study(text, dir + "/fuzz.json", &ncs_schema(), dir));
     cap_duration(s, 0.3, "--max-duration");
     const engine::SweepResults r = run_ncs_sweep(s, 1, 1, engine::Shard{});
     for (double v : r.values) EXPECT_TRUE(std::isfinite(v)) << f.path();
   }
   EXPECT_GE(files, 3U);
+  for (const char* study : {"dropping", "sod", "petc", "oneshot"}) EXPECT_GE(other[study], 1U) << study;
 }
 
 /// The rows of a CSV file (header included), split at commas (an empty field stays empty).
