@@ -58,8 +58,9 @@ class FileStudyRunner {
 using SweepOutputs = nlohmann::json (*)(const engine::SweepResults& r, const std::string& out_dir, bool plots);
 
 /// `study run`'s common part, after the study's refusals of the options: the sweep `sweep` of
-/// the part `c.shard` timed, then OUT/run.shard-i-of-N.json for a part, else `outputs`' summary
-/// (printed unless `--json -`); the JSON written to `--json`; the closing line printed.
+/// the part `c.shard` timed, then (the output folder made only now: a refusal from the sweep writes
+/// nothing) OUT/run.shard-i-of-N.json for a part, else `outputs`' summary (printed unless `--json -`);
+/// the JSON written to `--json`; the closing line printed.
 void run_file_sweep(const FileCommand& c, const std::function<engine::SweepResults(const engine::Shard&)>& sweep,
                     SweepOutputs outputs);
 

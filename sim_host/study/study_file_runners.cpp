@@ -157,10 +157,10 @@ class PetcRunner final : public FileStudyRunner {
 void run_file_sweep(const FileCommand& c, const std::function<engine::SweepResults(const engine::Shard&)>& sweep,
                     SweepOutputs outputs) {
   const engine::Shard part = engine::parse_shard(c.shard);
-  util::make_directory(c.out);
   const auto start = std::chrono::steady_clock::now();
-  const engine::SweepResults r = sweep(part);
+  const engine::SweepResults r = sweep(part);  // a refusal from inside the sweep (sod's δt design) leaves nothing written
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  util::make_directory(c.out);
   nlohmann::json j;
   if (!part.whole()) {
     j = engine::write_shard_file(r, c.out, "run", part);
