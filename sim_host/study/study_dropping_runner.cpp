@@ -153,10 +153,7 @@ nlohmann::json dropping_run_outputs(const engine::SweepResults& r, const std::st
     md << "| " << spec.scenarios[x] << " |";
     for (std::size_t a = 0; a < na; ++a) {
       const std::string& nm = spec.approaches[a];
-      e["cost_mean"][nm] = dropping::num(sm.per_scenario[a][x].mean);
-      e["cost_ci95"][nm] = dropping::num(sm.per_scenario[a][x].ci95);
-      e["ratio_to_" + ref][nm] = dropping::num(sm.per_scenario_ratio[a][x].mean);
-      e["ratio_to_" + ref + "_ci95"][nm] = dropping::num(sm.per_scenario_ratio[a][x].ci95);
+      add_scenario_cost(e, sm, nm, ref, a, x);
       md << " " << md_cell(sm.per_scenario[a][x].mean, "%.6g") << " |";
     }
     md << "\n";

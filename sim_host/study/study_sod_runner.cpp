@@ -143,10 +143,7 @@ nlohmann::json sod_run_outputs(const engine::SweepResults& r, const std::string&
     md << "| " << spec.scenarios[x] << " | " << xi << " |";
     for (std::size_t a = 0; a < na; ++a) {
       const std::string& nm = spec.approaches[a];
-      e["cost_mean"][nm] = finite_or_null(sm.per_scenario[a][x].mean);
-      e["cost_ci95"][nm] = finite_or_null(sm.per_scenario[a][x].ci95);
-      e["ratio_to_" + ref][nm] = finite_or_null(sm.per_scenario_ratio[a][x].mean);
-      e["ratio_to_" + ref + "_ci95"][nm] = finite_or_null(sm.per_scenario_ratio[a][x].ci95);
+      add_scenario_cost(e, sm, nm, ref, a, x);
       for (const char* m : {"e1", "e2", "e1_tail", "e2_tail", "nees"}) e[m][nm] = util::mean_ci_json(stat(a, x, m));
       for (int i = 1; i <= 2; ++i) {
         const std::string n = std::to_string(i);

@@ -1,6 +1,6 @@
 /// @file study_text.hpp
-/// @brief The number and name formatting that the study files' summaries and reports share
-///        (study_dropping_*, study_sod_*, study_petc_*, study_oneshot_*).
+/// @brief The number and name formatting and the per-scenario cost entries that the study files'
+///        summaries and reports share (study_dropping_*, study_sod_*, study_petc_*, study_oneshot_*).
 #pragma once
 
 #include <cmath>
@@ -9,6 +9,8 @@
 #include <string>
 
 #include <nlohmann/json.hpp>
+
+#include "oneshot/engine/sweep_statistics.hpp"
 
 namespace oneshot::study {
 
@@ -37,6 +39,17 @@ inline std::string trace_stem(std::size_t a, const std::string& name) {
     out += ok ? c : '_';
   }
   return out;
+}
+
+/// Approach `a`'s figures in scenario `x` of the summary `sm` into the per-scenario entry `e`
+/// under its `name`: cost_mean, cost_ci95 (over seeds), ratio_to_<ref> and its _ci95 (the mean of
+/// the per-seed ratios to the first approach `ref`); null where not finite.
+inline void add_scenario_cost(nlohmann::json& e, const engine::SweepSummary& sm, const std::string& name, const std::string& ref,
+                              std::size_t a, std::size_t x) {
+  e["cost_mean"][name] = finite_or_null(sm.per_scenario[a][x].mean);
+  e["cost_ci95"][name] = finite_or_null(sm.per_scenario[a][x].ci95);
+  e["ratio_to_" + ref][name] = finite_or_null(sm.per_scenario_ratio[a][x].mean);
+  e["ratio_to_" + ref + "_ci95"][name] = finite_or_null(sm.per_scenario_ratio[a][x].ci95);
 }
 
 }  // namespace oneshot::study
