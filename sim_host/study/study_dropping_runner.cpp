@@ -143,22 +143,7 @@ nlohmann::json dropping_run_outputs(const engine::SweepResults& r, const std::st
   }
   engine::add_order_by_mean(j, r, sm);
   if (!sm.paired.empty()) j["paired_differences"] = engine::paired_differences_json(r, sm);
-  md << "\n| scenario |";
-  for (std::size_t a = 0; a < na; ++a) md << " " << spec.approaches[a] << " |";
-  md << "\n|---|";
-  for (std::size_t a = 0; a < na; ++a) md << "---|";
-  md << "\n";
-  for (std::size_t x = 0; x < ns; ++x) {
-    nlohmann::json e = {{"name", spec.scenarios[x]}};
-    md << "| " << spec.scenarios[x] << " |";
-    for (std::size_t a = 0; a < na; ++a) {
-      const std::string& nm = spec.approaches[a];
-      add_scenario_cost(e, sm, nm, ref, a, x);
-      md << " " << md_cell(sm.per_scenario[a][x].mean, "%.6g") << " |";
-    }
-    md << "\n";
-    j["per_scenario"].push_back(e);
-  }
+  add_per_scenario_costs(j, md, r, sm);
   j["markdown"] = md.str();
   engine::write_runs_csv(r, util::path_in(out_dir, "runs.csv"), util::NonFinite::kMissing);
   j["files"] = {"runs.csv"};

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstddef>
 #include <cstdio>
+#include <sstream>
 #include <string>
 
 #include <nlohmann/json.hpp>
@@ -50,6 +51,29 @@ inline void add_scenario_cost(nlohmann::json& e, const engine::SweepSummary& sm,
   e["cost_ci95"][name] = finite_or_null(sm.per_scenario[a][x].ci95);
   e["ratio_to_" + ref][name] = finite_or_null(sm.per_scenario_ratio[a][x].mean);
   e["ratio_to_" + ref + "_ci95"][name] = finite_or_null(sm.per_scenario_ratio[a][x].ci95);
+}
+
+/// The per-scenario costs of a study file's sweep `r` summarized in `sm`: j["per_scenario"], one
+/// entry per scenario ({"name"} and add_scenario_cost() of every approach, the reference the first
+/// approach), and the markdown table scenario × approach of the mean costs onto `md`.
+inline void add_per_scenario_costs(nlohmann::json& j, std::ostringstream& md, const engine::SweepResults& r,
+                                   const engine::SweepSummary& sm) {
+  const engine::SweepSpec& spec = r.spec;
+  md << "\n| scenario |";
+  for (const std::string& a : spec.approaches) md << " " << a << " |";
+  md << "\n|---|";
+  for (std::size_t a = 0; a < spec.approaches.size(); ++a) md << "---|";
+  md << "\n";
+  for (std::size_t x = 0; x < spec.scenarios.size(); ++x) {
+    nlohmann::json e = {{"name", spec.scenarios[x]}};
+    md << "| " << spec.scenarios[x] << " |";
+    for (std::size_t a = 0; a < spec.approaches.size(); ++a) {
+      add_scenario_cost(e, sm, spec.approaches[a], spec.approaches[0], a, x);
+      md << " " << md_cell(sm.per_scenario[a][x].mean, "%.6g") << " |";
+    }
+    md << "\n";
+    j["per_scenario"].push_back(e);
+  }
 }
 
 }  // namespace oneshot::study
